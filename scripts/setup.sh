@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Installs every Debian package the project needs. Idempotent: packages that
+# are already installed are skipped, and `apt-get update` runs at most once per
+# invocation (only if something is missing). Works as root on Debian 12; uses
+# sudo otherwise.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config git
+  libeigen3-dev                     # core: linear algebra
+  nlohmann-json3-dev libcli11-dev   # scenes, command line
+  libgtest-dev libgmock-dev googletest libbenchmark-dev  # tests, benchmarks
+  libdeal.ii-dev                    # reference_fem (brings Trilinos, p4est, MPI)
+  libsundials-dev                   # integrators
+  libcgal-dev                       # meshing
+  libvtk9-dev                       # VTK output
+  libnlopt-cxx-dev libnlopt-dev libgsl-dev   # calibration
+  openmpi-bin libopenmpi-dev        # MPI runs of the FEM
+  python3 python3-matplotlib python3-numpy   # plots in results/
+  xvfb                              # offscreen rendering in CI
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#PACKAGES[@]} packages already installed"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "setup: installing ${#missing[@]} missing packages: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "setup: done"
