@@ -1,0 +1,169 @@
+// force_mesh.hpp: the mass-spring force mesh of one layer surface (seed paper
+// Sec. 2.2, Fig. 1-2, Eq. 5).
+//
+// Geometry. A hexagonal ring lattice (hex_lattice.hpp) of w rings and spacing
+// L is laid out in the tangent plane of the contact point and every node is
+// placed on the layer surface with ContactSurface::project, which also gives
+// the node's outward unit normal n_i. Node 0 is the contact node (ring 1).
+//
+// Mechanics (our reading of Fig. 2; the paper gives only Eq. 5):
+//   * every node i moves along its own normal with the scalar deflection
+//     z_i (m, the paper's Delta Z, positive INTO the tissue), so its position
+//     is  x_i = x_i^0 - z_i n_i;
+//   * every node carries a virtual spring of stiffness K (N/m) along the
+//     normal, anchored at the rest position: force -K z_i;
+//   * every surface spring (neighbours i, j) acts as a membrane spring of
+//     transverse stiffness k_s (N/m, ForceMeshParams::surface_stiffness_N_per_m)
+//     between the deflections: force on i is -k_s (z_i - z_j);
+//   * node mass m = density * layer thickness * sqrt(3)/2 L^2 (the tissue
+//     column under one hexagon cell), node damping c (N s/m) on z_i';
+//   * the outer ring is free (no anchor other than its virtual springs);
+//   * the contact node's deflection z_0 is prescribed by the needle.
+// So for the free nodes f:  m z_f'' + c z_f' + K_ff z_f = b z_0, with
+// K_ff = K I + k_s (graph Laplacian restricted to f) and b_i = k_s for the
+// neighbours of the contact node. The deflection of the rings comes out of
+// this system, not from a fall-off curve.
+//
+// Forces. The surface force on the needle is the elastic reaction at the
+// contact node, F = K z_0 + k_s sum_{j ~ 0} (z_0 - z_j) (N, positive when it
+// resists insertion; the contact node's own inertia and damping are carried
+// by the needle and not included). At equilibrium it equals Eq. (5):
+// F = K dZ_1 + K sum_{j=2..w} 6 (j-1) dZ_j with dZ_j the mean deflection of
+// ring j (global force balance: the Laplacian terms sum to zero).
+//
+// Breakthrough. Ring j counts as deformed when its mean deflection exceeds
+// ForceMeshParams::deformed_threshold_m. deformed_rings() is the largest j
+// whose ring (and all rings inside it) is deformed; when it reaches w the
+// layer breaks (Table 1 post-puncture).
+//
+// Time integration (one fixed step dt per advance(), the haptic step):
+//   QuasiStatic: equilibrium every step, z = u z_0 with the unit-deflection
+//       influence vector u precomputed at construction (O(N) per step).
+//   Explicit:    symplectic Euler (v += dt a; z += dt v) with the damping
+//       evaluated explicitly. Stable for omega dt < 2 (sqrt(1+zeta^2) - zeta),
+//       i.e. dt < dt_crit, the root of omega_max^2 dt^2 + (c/m) dt = 4 (and
+//       dt < 2 m / c). omega_max^2 <= max_i (K + 2 k_s deg_i) / m is the
+//       Gershgorin bound on the eigenvalues of M^-1 K_ff, so dt_crit is safe.
+//       When dt > safety * dt_crit the step is split into substeps (the
+//       contact deflection is interpolated linearly across them); if more
+//       than max_explicit_substeps would be needed the step is done with the
+//       implicit integrator instead.
+//   Implicit:    backward Euler; the sparse LDLT of (M/dt^2 + C/dt + K_ff) is
+//       factorised once at construction (contact node eliminated as a
+//       prescribed value); each step is two triangular solves on
+//       preallocated storage (no allocation).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "puncture/contact_surface.hpp"
+#include "puncture/hex_lattice.hpp"
+#include "puncture/scene.hpp"
+
+namespace puncture {
+
+enum class MeshIntegrator { QuasiStatic, Explicit, Implicit };
+
+/// "quasi_static", "explicit" or "implicit" (RealtimeSettings::integrator);
+/// throws std::invalid_argument naming realtime.integrator otherwise.
+MeshIntegrator parse_mesh_integrator(const std::string& name);
+const char* to_string(MeshIntegrator integrator);
+
+/// Numerical knobs of the force-mesh time integration.
+struct MeshIntegrationSettings {
+  MeshIntegrator integrator = MeshIntegrator::Implicit;
+  double time_step_s = 1e-3;          ///< fixed step of advance() (the haptic step)
+  double explicit_safety = 0.9;       ///< explicit substep <= safety * dt_crit
+  int max_explicit_substeps = 64;     ///< beyond this the explicit step falls back to implicit
+};
+
+class ForceMesh {
+ public:
+  /// contact: the contact point and outward normal on `surface` (m).
+  /// layer_thickness_m, density_kg_per_m3: give the node mass.
+  /// Throws std::invalid_argument on non-positive parameters or a projection
+  /// that returns non-finite positions.
+  ForceMesh(const ContactSurface& surface, const SurfacePoint& contact, const ForceMeshParams& params,
+            double layer_thickness_m, double density_kg_per_m3, const MeshIntegrationSettings& settings);
+
+  /// Advances one step dt with the contact-node deflection prescribed
+  /// (m, into the tissue; negative values are clamped to 0). No allocation.
+  /// Throws std::runtime_error if the state becomes non-finite.
+  void advance(double contact_deflection_m);
+  /// Back to the undeformed state at rest.
+  void reset();
+
+  // --- forces (N, positive resisting insertion) ---
+  double contact_reaction_N() const;  ///< elastic reaction at the contact node
+  double eq5_force_N() const;         ///< K dZ_1 + K sum_j 6 (j-1) dZ_j (Eq. 5)
+  /// Reaction per unit contact deflection at equilibrium, N/m.
+  double static_stiffness_N_per_m() const { return static_stiffness_N_per_m_; }
+
+  // --- deformation ---
+  int rings() const { return params_.rings_w; }
+  int node_count() const { return lattice_.node_count(); }
+  double ring_mean_deflection_m(int ring) const { return ring_mean_m_[ring - 1]; }  ///< ring in 1..w
+  int deformed_rings() const;
+  bool broken() const { return deformed_rings() >= params_.rings_w; }
+  const Eigen::VectorXd& deflections_m() const { return z_; }       ///< size N, [0] = contact node
+  const Eigen::VectorXd& velocities_m_per_s() const { return v_; }  ///< size N, [0] = contact node rate
+  /// Equilibrium deflection of every node per metre of contact deflection (u_0 = 1).
+  const Eigen::VectorXd& unit_influence() const { return influence_; }
+
+  // --- geometry (3 x N, m) ---
+  const Eigen::Matrix3Xd& rest_positions() const { return rest_; }
+  const Eigen::Matrix3Xd& normals() const { return normals_; }
+  const Eigen::Matrix3Xd& positions() const { return positions_; }
+  const HexLattice& lattice() const { return lattice_; }
+  const std::vector<int>& node_rings() const { return lattice_.ring; }
+
+  // --- energy (J) ---
+  double kinetic_energy_J() const;
+  double virtual_spring_energy_J() const;
+  double surface_spring_energy_J() const;
+  double energy_J() const { return kinetic_energy_J() + virtual_spring_energy_J() + surface_spring_energy_J(); }
+
+  // --- integration facts ---
+  double node_mass_kg() const { return mass_kg_; }
+  double time_step_s() const { return settings_.time_step_s; }
+  /// Gershgorin-safe critical step of the explicit integrator (s).
+  double critical_time_step_s() const { return dt_crit_s_; }
+  /// Upper bound on omega_max^2 (rad^2/s^2) used for dt_crit.
+  double omega_max_squared_bound() const { return omega_max_sq_; }
+  int explicit_substeps() const { return substeps_; }
+  /// True when the explicit integrator does every step implicitly (too many substeps).
+  bool explicit_falls_back_to_implicit() const { return explicit_fallback_; }
+  const ForceMeshParams& params() const { return params_; }
+
+ private:
+  void explicit_substep(double dt, double z0);
+  void implicit_step(double z0);
+  void update_derived();
+
+  ForceMeshParams params_;
+  MeshIntegrationSettings settings_;
+  HexLattice lattice_;
+  double mass_kg_ = 0.0;
+  double static_stiffness_N_per_m_ = 0.0;
+  double dt_crit_s_ = 0.0;
+  double omega_max_sq_ = 0.0;
+  int substeps_ = 1;
+  bool explicit_fallback_ = false;
+  bool use_implicit_ = false;
+
+  Eigen::Matrix3Xd rest_, normals_, positions_;
+  Eigen::VectorXd z_, v_, influence_, rhs_, work_;
+  Eigen::VectorXd ring_mean_m_;
+  Eigen::VectorXd ring_size_;
+
+  // LDLT factors of the implicit system over the free nodes (index f = node - 1):
+  // P A P^T = L D L^T, L unit lower, stored column-wise (CSC, strictly lower part).
+  std::vector<int> l_col_start_, l_row_;
+  std::vector<double> l_val_;
+  Eigen::VectorXd d_inv_;
+  std::vector<int> perm_;  ///< (P b)[perm_[k]] = b[k]
+};
+
+}  // namespace puncture

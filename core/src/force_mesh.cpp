@@ -1,0 +1,297 @@
+#include "puncture/force_mesh.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace puncture {
+
+MeshIntegrator parse_mesh_integrator(const std::string& name) {
+  if (name == "quasi_static") return MeshIntegrator::QuasiStatic;
+  if (name == "explicit") return MeshIntegrator::Explicit;
+  if (name == "implicit") return MeshIntegrator::Implicit;
+  throw std::invalid_argument("realtime.integrator must be \"quasi_static\", \"explicit\" or \"implicit\" (got \"" +
+                              name + "\")");
+}
+
+const char* to_string(MeshIntegrator integrator) {
+  switch (integrator) {
+    case MeshIntegrator::QuasiStatic: return "quasi_static";
+    case MeshIntegrator::Explicit: return "explicit";
+    case MeshIntegrator::Implicit: return "implicit";
+  }
+  return "unknown";
+}
+
+namespace {
+
+void require_positive(double value, const char* what) {
+  if (!(value > 0.0) || !std::isfinite(value))
+    throw std::invalid_argument(std::string("force mesh: ") + what + " must be positive and finite (got " +
+                                std::to_string(value) + ")");
+}
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+// K_ff + shift * I over the free nodes (node i -> row i - 1).
+SparseMatrix free_stiffness(const HexLattice& lat, double K, double ks, double diagonal_shift) {
+  const int nf = lat.node_count() - 1;
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(static_cast<std::size_t>(nf) * 7);
+  for (int i = 1; i <= nf; ++i) {
+    t.emplace_back(i - 1, i - 1, K + ks * lat.neighbour_count(i) + diagonal_shift);
+    for (int k = lat.neighbour_offsets[i]; k < lat.neighbour_offsets[i + 1]; ++k) {
+      const int j = lat.neighbours[k];
+      if (j != 0) t.emplace_back(i - 1, j - 1, -ks);
+    }
+  }
+  SparseMatrix A(nf, nf);
+  A.setFromTriplets(t.begin(), t.end());
+  return A;
+}
+
+}  // namespace
+
+ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact, const ForceMeshParams& params,
+                     double layer_thickness_m, double density_kg_per_m3, const MeshIntegrationSettings& settings)
+    : params_(params), settings_(settings), lattice_(make_hex_lattice(params.rings_w)) {
+  require_positive(params.virtual_stiffness_N_per_m, "virtual_stiffness_N_per_m (K)");
+  require_positive(params.spacing_L_m, "spacing_L_m (L)");
+  require_positive(params.deformed_threshold_m, "deformed_threshold_m");
+  require_positive(layer_thickness_m, "layer thickness");
+  require_positive(density_kg_per_m3, "density");
+  require_positive(settings.time_step_s, "time step");
+  if (!(params.surface_stiffness_N_per_m >= 0.0) || !std::isfinite(params.surface_stiffness_N_per_m))
+    throw std::invalid_argument("force mesh: surface_stiffness_N_per_m must be >= 0 and finite");
+  if (!(params.node_damping_N_s_per_m >= 0.0) || !std::isfinite(params.node_damping_N_s_per_m))
+    throw std::invalid_argument("force mesh: node_damping_N_s_per_m must be >= 0 and finite");
+  if (!(settings.explicit_safety > 0.0 && settings.explicit_safety <= 1.0))
+    throw std::invalid_argument("force mesh: explicit_safety must be in (0, 1]");
+  if (settings.max_explicit_substeps < 1) throw std::invalid_argument("force mesh: max_explicit_substeps must be >= 1");
+
+  const int n = lattice_.node_count();
+  const int nf = n - 1;
+  const double K = params.virtual_stiffness_N_per_m;
+  const double ks = params.surface_stiffness_N_per_m;
+  const double c = params.node_damping_N_s_per_m;
+  const double L = params.spacing_L_m;
+  mass_kg_ = density_kg_per_m3 * layer_thickness_m * 0.5 * std::sqrt(3.0) * L * L;
+
+  // --- geometry: tangent plane of the contact point, nodes projected on the surface ---
+  Eigen::Vector3d nrm = contact.normal;
+  if (!(nrm.norm() > 0.0) || !nrm.allFinite()) throw std::invalid_argument("force mesh: contact normal is not a direction");
+  nrm.normalize();
+  const Eigen::Vector3d helper = std::abs(nrm.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d e1 = (helper - helper.dot(nrm) * nrm).normalized();
+  const Eigen::Vector3d e2 = nrm.cross(e1);
+  rest_.resize(3, n);
+  normals_.resize(3, n);
+  rest_.col(0) = contact.position;
+  normals_.col(0) = nrm;
+  for (int i = 1; i < n; ++i) {
+    const Eigen::Vector2d p = lattice_.planar_position(i, L);
+    const SurfacePoint sp = surface.project(contact.position + p.x() * e1 + p.y() * e2);
+    if (!sp.position.allFinite() || !sp.normal.allFinite() || !(sp.normal.norm() > 0.0))
+      throw std::invalid_argument("force mesh: projecting node " + std::to_string(i) +
+                                  " onto the layer surface gave a non-finite point");
+    rest_.col(i) = sp.position;
+    normals_.col(i) = sp.normal.normalized();
+  }
+  positions_ = rest_;
+
+  z_.setZero(n);
+  v_.setZero(n);
+  rhs_.setZero(nf);
+  work_.setZero(nf);
+  ring_mean_m_.setZero(params.rings_w);
+  ring_size_.setZero(params.rings_w);
+  for (int i = 0; i < n; ++i) ring_size_[lattice_.ring[i] - 1] += 1.0;
+
+  // --- unit-deflection influence vector: K_ff u_f = b ---
+  influence_.setZero(n);
+  influence_[0] = 1.0;
+  if (nf > 0) {
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(nf);
+    for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
+      b[lattice_.neighbours[k] - 1] = ks;
+    Eigen::SimplicialLDLT<SparseMatrix> static_solver(free_stiffness(lattice_, K, ks, 0.0));
+    if (static_solver.info() != Eigen::Success)
+      throw std::runtime_error("force mesh: static stiffness matrix could not be factorised");
+    influence_.tail(nf) = static_solver.solve(b);
+  }
+  static_stiffness_N_per_m_ = K;
+  for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
+    static_stiffness_N_per_m_ += ks * (1.0 - influence_[lattice_.neighbours[k]]);
+
+  // --- explicit stability: Gershgorin bound on omega_max^2 ---
+  int max_degree = 0;
+  for (int i = 1; i < n; ++i) max_degree = std::max(max_degree, lattice_.neighbour_count(i));
+  omega_max_sq_ = (K + 2.0 * ks * max_degree) / mass_kg_;
+  const double cm = c / mass_kg_;
+  dt_crit_s_ = (-cm + std::sqrt(cm * cm + 16.0 * omega_max_sq_)) / (2.0 * omega_max_sq_);
+  if (c > 0.0) dt_crit_s_ = std::min(dt_crit_s_, 2.0 / cm);
+  const double dt = settings.time_step_s;
+  const double substeps_needed = std::ceil(dt / (settings.explicit_safety * dt_crit_s_));
+  substeps_ = static_cast<int>(std::min<double>(std::max(1.0, substeps_needed), settings.max_explicit_substeps + 1.0));
+  explicit_fallback_ = substeps_needed > settings.max_explicit_substeps;
+
+  use_implicit_ = settings.integrator == MeshIntegrator::Implicit ||
+                  (settings.integrator == MeshIntegrator::Explicit && explicit_fallback_);
+  if (use_implicit_ && nf > 0) {
+    const double shift = mass_kg_ / (dt * dt) + c / dt;
+    Eigen::SimplicialLDLT<SparseMatrix> ldlt(free_stiffness(lattice_, K, ks, shift));
+    if (ldlt.info() != Eigen::Success)
+      throw std::runtime_error("force mesh: implicit system matrix could not be factorised");
+    // Copy the factors into plain arrays so that a step is allocation-free.
+    SparseMatrix Lm = ldlt.matrixL();
+    Lm.makeCompressed();
+    l_col_start_.assign(Lm.outerIndexPtr(), Lm.outerIndexPtr() + nf + 1);
+    l_row_.assign(Lm.innerIndexPtr(), Lm.innerIndexPtr() + Lm.nonZeros());
+    l_val_.assign(Lm.valuePtr(), Lm.valuePtr() + Lm.nonZeros());
+    d_inv_ = ldlt.vectorD().cwiseInverse();
+    perm_.resize(nf);
+    for (int k = 0; k < nf; ++k) perm_[k] = ldlt.permutationP().indices()[k];
+  }
+}
+
+void ForceMesh::reset() {
+  z_.setZero();
+  v_.setZero();
+  update_derived();
+}
+
+void ForceMesh::explicit_substep(double dt, double z0) {
+  const double K = params_.virtual_stiffness_N_per_m;
+  const double ks = params_.surface_stiffness_N_per_m;
+  const double c = params_.node_damping_N_s_per_m;
+  const int n = lattice_.node_count();
+  z_[0] = z0;
+  // Symplectic Euler: all accelerations from the old deflections, then v, then z.
+  for (int i = 1; i < n; ++i) {
+    double f = -K * z_[i] - c * v_[i];
+    for (int k = lattice_.neighbour_offsets[i]; k < lattice_.neighbour_offsets[i + 1]; ++k)
+      f -= ks * (z_[i] - z_[lattice_.neighbours[k]]);
+    work_[i - 1] = f / mass_kg_;
+  }
+  for (int i = 1; i < n; ++i) {
+    v_[i] += dt * work_[i - 1];
+    z_[i] += dt * v_[i];
+  }
+}
+
+void ForceMesh::implicit_step(double z0) {
+  const int n = lattice_.node_count();
+  const int nf = n - 1;
+  const double dt = settings_.time_step_s;
+  const double m_dt2 = mass_kg_ / (dt * dt);
+  const double c_dt = params_.node_damping_N_s_per_m / dt;
+  const double ks = params_.surface_stiffness_N_per_m;
+  // rhs = M/dt^2 (z + dt v) + C/dt z + b z0
+  for (int i = 1; i < n; ++i) rhs_[i - 1] = m_dt2 * (z_[i] + dt * v_[i]) + c_dt * z_[i];
+  for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
+    rhs_[lattice_.neighbours[k] - 1] += ks * z0;
+  // Solve P^T L D L^T P x = rhs.
+  for (int k = 0; k < nf; ++k) work_[perm_[k]] = rhs_[k];
+  for (int j = 0; j < nf; ++j) {
+    const double yj = work_[j];
+    for (int p = l_col_start_[j]; p < l_col_start_[j + 1]; ++p)
+      if (l_row_[p] > j) work_[l_row_[p]] -= l_val_[p] * yj;
+  }
+  for (int j = 0; j < nf; ++j) work_[j] *= d_inv_[j];
+  for (int j = nf - 1; j >= 0; --j) {
+    double s = work_[j];
+    for (int p = l_col_start_[j]; p < l_col_start_[j + 1]; ++p)
+      if (l_row_[p] > j) s -= l_val_[p] * work_[l_row_[p]];
+    work_[j] = s;
+  }
+  for (int k = 0; k < nf; ++k) {
+    const double z_new = work_[perm_[k]];
+    v_[k + 1] = (z_new - z_[k + 1]) / dt;
+    z_[k + 1] = z_new;
+  }
+  z_[0] = z0;
+}
+
+void ForceMesh::advance(double contact_deflection_m) {
+  const double z0 = std::max(0.0, contact_deflection_m);
+  if (!std::isfinite(z0)) throw std::runtime_error("force mesh: non-finite contact deflection");
+  const double dt = settings_.time_step_s;
+  const double z0_old = z_[0];
+  switch (settings_.integrator) {
+    case MeshIntegrator::QuasiStatic:
+      z_ = influence_ * z0;
+      break;
+    case MeshIntegrator::Explicit:
+      if (!use_implicit_) {
+        const double h = dt / substeps_;
+        for (int s = 1; s <= substeps_; ++s) explicit_substep(h, z0_old + (z0 - z0_old) * s / substeps_);
+        break;
+      }
+      implicit_step(z0);
+      break;
+    case MeshIntegrator::Implicit:
+      implicit_step(z0);
+      break;
+  }
+  z_[0] = z0;
+  v_[0] = (z0 - z0_old) / dt;
+  // Quasi-static: the free nodes are at equilibrium and carry no kinetic energy.
+  if (settings_.integrator == MeshIntegrator::QuasiStatic) v_.tail(v_.size() - 1).setZero();
+  update_derived();
+  if (!std::isfinite(ring_mean_m_.sum()) || !std::isfinite(v_.sum()))
+    throw std::runtime_error("force mesh: deflections became non-finite (integrator " +
+                             std::string(to_string(settings_.integrator)) + ")");
+}
+
+void ForceMesh::update_derived() {
+  const int n = lattice_.node_count();
+  ring_mean_m_.setZero();
+  for (int i = 0; i < n; ++i) {
+    ring_mean_m_[lattice_.ring[i] - 1] += z_[i];
+    positions_.col(i) = rest_.col(i) - z_[i] * normals_.col(i);
+  }
+  ring_mean_m_.array() /= ring_size_.array();
+}
+
+double ForceMesh::contact_reaction_N() const {
+  double f = params_.virtual_stiffness_N_per_m * z_[0];
+  for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
+    f += params_.surface_stiffness_N_per_m * (z_[0] - z_[lattice_.neighbours[k]]);
+  return f;
+}
+
+double ForceMesh::eq5_force_N() const {
+  double f = ring_mean_m_[0];
+  for (int j = 2; j <= params_.rings_w; ++j) f += 6.0 * (j - 1) * ring_mean_m_[j - 1];
+  return params_.virtual_stiffness_N_per_m * f;
+}
+
+int ForceMesh::deformed_rings() const {
+  int j = 0;
+  while (j < params_.rings_w && ring_mean_m_[j] > params_.deformed_threshold_m) ++j;
+  return j;
+}
+
+double ForceMesh::kinetic_energy_J() const {
+  // Free nodes only: the contact node moves with the needle.
+  return 0.5 * mass_kg_ * v_.tail(v_.size() - 1).squaredNorm();
+}
+
+double ForceMesh::virtual_spring_energy_J() const { return 0.5 * params_.virtual_stiffness_N_per_m * z_.squaredNorm(); }
+
+double ForceMesh::surface_spring_energy_J() const {
+  double e = 0.0;
+  const int n = lattice_.node_count();
+  for (int i = 0; i < n; ++i)
+    for (int k = lattice_.neighbour_offsets[i]; k < lattice_.neighbour_offsets[i + 1]; ++k) {
+      const int j = lattice_.neighbours[k];
+      if (j > i) e += (z_[i] - z_[j]) * (z_[i] - z_[j]);
+    }
+  return 0.5 * params_.surface_stiffness_N_per_m * e;
+}
+
+}  // namespace puncture
