@@ -1,0 +1,53 @@
+#include <puncture/io/pvd.hpp>
+
+#include <puncture/io/output_session.hpp>
+
+#include <charconv>
+#include <cmath>
+#include <stdexcept>
+
+namespace puncture::io {
+
+namespace {
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+}  // namespace
+
+std::string pvd_document(const std::vector<PvdEntry>& entries) {
+  std::string out =
+      "<?xml version=\"1.0\"?>\n"
+      "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      "  <Collection>\n";
+  char buffer[64];
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const PvdEntry& e = entries[i];
+    const std::string where = "write_pvd: entry " + std::to_string(i);
+    if (!std::isfinite(e.time_s)) throw std::invalid_argument(where + ": time_s is not finite");
+    if (e.part < 0) throw std::invalid_argument(where + ": part must be >= 0");
+    if (e.file.empty()) throw std::invalid_argument(where + ": empty file name");
+    const auto res = std::to_chars(buffer, buffer + sizeof(buffer), e.time_s);
+    out += "    <DataSet timestep=\"" + std::string(buffer, res.ptr) + "\" group=\"\" part=\"" +
+           std::to_string(e.part) + "\" file=\"" + xml_escape(e.file) + "\"/>\n";
+  }
+  out += "  </Collection>\n</VTKFile>\n";
+  return out;
+}
+
+void write_pvd(OutputSession& session, const std::string& relative_name,
+               const std::vector<PvdEntry>& entries) {
+  session.write_text(relative_name, pvd_document(entries));
+}
+
+}  // namespace puncture::io
