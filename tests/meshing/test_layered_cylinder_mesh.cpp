@@ -4,6 +4,7 @@
 // computed here independently of measure_quality.
 #include <puncture/meshing/layered_cylinder_mesh.hpp>
 #include <puncture/meshing/hex_mesh_quality.hpp>
+#include <puncture/scene_io.hpp>
 
 #include <gtest/gtest.h>
 
@@ -12,9 +13,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <iterator>
 #include <map>
 #include <set>
 #include <stdexcept>
+#include <tuple>
 
 namespace {
 
@@ -221,10 +225,6 @@ TEST(LayeredCylinderMesh, VerticesUniqueAndInteriorFacesSharedByTwoCells) {
   const HexMesh mesh = build_layered_cylinder_mesh(scene, opt);
   const double R = 0.5 * scene.sample.diameter_m, H = scene.total_thickness_m();
   // No two vertices closer than a tiny fraction of the needle radius.
-  std::vector<Eigen::Vector3d> sorted = mesh.vertices;
-  std::sort(sorted.begin(), sorted.end(), [](const auto& p, const auto& q) {
-    return std::tie(p.z(), p.x(), p.y()) < std::tie(q.z(), q.x(), q.y());
-  });
   std::set<std::tuple<long, long, long>> keys;
   const double tol = 1e-6 * scene.needle.radius_m;
   for (const auto& v : mesh.vertices)
@@ -345,6 +345,74 @@ TEST(LayeredCylinderMesh, InvalidInputNamesTheField) {
   bad = ok;
   bad.thickness_grading = 0.0;
   EXPECT_NE(message_of(s, bad).find("options.thickness_grading"), std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(LayeredCylinderMesh, MeshesTheShippedDefaultSceneFile) {
+  const puncture::Scene scene =
+      puncture::load_scene(std::filesystem::path(PUNCTURE_SOURCE_DIR) / "scenes" / "default.json");
+  const HexMesh mesh = build_layered_cylinder_mesh(scene, SlabMeshOptions{});
+  const auto q = puncture::meshing::measure_quality(mesh);
+  ASSERT_EQ(q.cells_per_material.size(), scene.layers.size());
+  double total = 0.0;
+  for (std::size_t c = 0; c < mesh.cells.size(); ++c) total += hex_volume(mesh, c);
+  const double expected = polygon_area(16, 0.5 * scene.sample.diameter_m) * scene.total_thickness_m();
+  EXPECT_NEAR(total, expected, 1e-12 * expected);
+  EXPECT_GT(q.min_scaled_jacobian, 0.7);
+}
+
+TEST(LayeredCylinderMesh, ScaledJacobianStaysAboveSeventyPercentForAllSectorCounts) {
+  // The header promises >= 0.7 for every sector count (worst case: sectors = 4,
+  // a single central cell whose corners are 90 + 45 degrees).
+  for (int sectors = 4; sectors <= 48; sectors += 4) {
+    SlabMeshOptions opt;
+    opt.sectors = sectors;
+    const auto q = puncture::meshing::measure_quality(build_layered_cylinder_mesh(default_scene(), opt));
+    EXPECT_GE(q.min_scaled_jacobian, std::sqrt(0.5) - 1e-12) << "sectors " << sectors;
+  }
+}
+
+TEST(LayeredCylinderMesh, ThickLayersStartNearTheSkinElementHeight) {
+  // The needle meets every layer's top surface: the first element below each
+  // interface is within the grading factor of the skin element height.
+  const Scene scene = default_scene();
+  SlabMeshOptions opt;
+  const HexMesh mesh = build_layered_cylinder_mesh(scene, opt);
+  std::set<double> planes;
+  for (const auto& v : mesh.vertices) planes.insert(v.z());
+  const double h_skin = scene.layers[0].thickness_m / opt.elements_through_skin;
+  for (std::size_t l = 1; l < scene.layers.size(); ++l) {
+    const double top = -scene.layer_top_depth_m(l);
+    auto it = planes.find(top);
+    ASSERT_NE(it, planes.end()) << "interface " << l << " is not a node plane";
+    ASSERT_NE(it, planes.begin());
+    const double first_height = top - *std::prev(it);
+    EXPECT_GT(first_height, h_skin / opt.thickness_grading) << "layer " << l;
+    EXPECT_LT(first_height, h_skin * opt.thickness_grading) << "layer " << l;
+  }
+}
+
+TEST(LayeredCylinderMesh, ThinLayersAndANarrowSampleStayValid) {
+  // Four layers, one thinner than the skin elements; sample radius only 1.5
+  // needle radii (one annulus).
+  Scene s = default_scene();
+  puncture::Layer thin;
+  thin.thickness_m = 0.05e-3;
+  s.layers.insert(s.layers.begin() + 1, thin);
+  s.sample.diameter_m = 3.0 * s.needle.radius_m;
+  const HexMesh mesh = build_layered_cylinder_mesh(s, SlabMeshOptions{});
+  const auto q = puncture::meshing::measure_quality(mesh);
+  ASSERT_EQ(q.cells_per_material.size(), 4u);
+  EXPECT_GT(q.cells_per_material[1], 0u);
+  EXPECT_GT(q.min_scaled_jacobian, 0.7);
+  double layer_volume = 0.0;
+  for (std::size_t c = 0; c < mesh.cells.size(); ++c)
+    if (mesh.material_id[c] == 1) layer_volume += hex_volume(mesh, c);
+  const double expected = polygon_area(16, 0.5 * s.sample.diameter_m) * thin.thickness_m;
+  EXPECT_NEAR(layer_volume, expected, 1e-12 * expected);
 }
 
 }  // namespace
