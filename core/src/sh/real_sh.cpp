@@ -1,6 +1,7 @@
 // real_sh.cpp: fully normalised recurrence for the real SH basis; see real_sh.hpp.
 #include "puncture/sh/real_sh.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -37,7 +38,7 @@ RealSHBasis::RealSHBasis(int degree) : degree_(degree) {
 
 template <bool kWithGradient>
 void RealSHBasis::evaluate_impl(const Eigen::Vector3d& u_in, double* values,
-                                double* gradient) const {
+                                double* gradient, int max_order) const {
   const double norm = u_in.norm();
   if (!(norm > 0.0) || !std::isfinite(norm)) {
     throw std::invalid_argument("RealSHBasis::evaluate: direction must be finite and non-zero");
@@ -62,7 +63,8 @@ void RealSHBasis::evaluate_impl(const Eigen::Vector3d& u_in, double* values,
     }
   };
 
-  for (int m = 0; m <= L; ++m) {
+  const int m_end = std::min(L, max_order);
+  for (int m = 0; m <= m_end; ++m) {
     if (m > 0) {
       q_mm *= diag_[m];
       c_prev = c;
@@ -103,12 +105,21 @@ void RealSHBasis::evaluate_impl(const Eigen::Vector3d& u_in, double* values,
 }
 
 void RealSHBasis::evaluate(const Eigen::Vector3d& u, double* values) const {
-  evaluate_impl<false>(u, values, nullptr);
+  evaluate_impl<false>(u, values, nullptr, degree_);
+}
+
+void RealSHBasis::evaluate(const Eigen::Vector3d& u, double* values, int max_order) const {
+  evaluate_impl<false>(u, values, nullptr, max_order);
+}
+
+void RealSHBasis::evaluate_with_gradient(const Eigen::Vector3d& u, double* values,
+                                         double* tangential_gradient, int max_order) const {
+  evaluate_impl<true>(u, values, tangential_gradient, max_order);
 }
 
 void RealSHBasis::evaluate_with_gradient(const Eigen::Vector3d& u, double* values,
                                          double* tangential_gradient) const {
-  evaluate_impl<true>(u, values, tangential_gradient);
+  evaluate_impl<true>(u, values, tangential_gradient, degree_);
 }
 
 double real_sh(int l, int m, double theta, double phi) {

@@ -1,6 +1,7 @@
 // sh_surface.cpp: radial (Eq. 4) and parametric (Eq. 3) SH surfaces; see sh_surface.hpp.
 #include "puncture/sh/sh_surface.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -32,6 +33,14 @@ bool normal_from_jacobian(const Eigen::Vector3d& u, const Eigen::Matrix3d& jacob
   return true;
 }
 
+int highest_order(const Eigen::MatrixXd& coefficients, int degree) {
+  int order = 0;
+  for (int l = 0; l <= degree; ++l)
+    for (int m = -l; m <= l; ++m)
+      if (std::abs(m) > order && !coefficients.row(sh_index(l, m)).isZero(0.0)) order = std::abs(m);
+  return order;
+}
+
 namespace {
 Eigen::Vector3d unit(const Eigen::Vector3d& u) {
   const double n = u.norm();
@@ -49,6 +58,7 @@ RadialSHSurface::RadialSHSurface(int degree, Eigen::VectorXd coefficients)
                                 " coefficients for degree " + std::to_string(degree) + ", got " +
                                 std::to_string(coefficients_.size()));
   }
+  max_order_ = highest_order(coefficients_, degree);
 }
 
 RadialSHSurface RadialSHSurface::fit(int degree, const Eigen::MatrixX3d& directions,
@@ -61,8 +71,12 @@ RadialSHSurface RadialSHSurface::fit(int degree, const Eigen::MatrixX3d& directi
 }
 
 double RadialSHSurface::radius(const Eigen::Vector3d& u, SHWorkspace& ws) const {
-  basis_.evaluate(u, ws.values.data());
-  return coefficients_.dot(ws.values);
+  basis_.evaluate(u, ws.values.data(), max_order_);
+  double r = 0.0;
+  for (int l = 0; l <= degree(); ++l)
+    for (int m = -std::min(l, max_order_); m <= std::min(l, max_order_); ++m)
+      r += coefficients_(sh_index(l, m)) * ws.values(sh_index(l, m));
+  return r;
 }
 
 Eigen::Vector3d RadialSHSurface::position(const Eigen::Vector3d& u, SHWorkspace& ws) const {
@@ -71,13 +85,19 @@ Eigen::Vector3d RadialSHSurface::position(const Eigen::Vector3d& u, SHWorkspace&
 
 SurfacePoint RadialSHSurface::evaluate(const Eigen::Vector3d& u_in, SHWorkspace& ws) const {
   const Eigen::Vector3d u = unit(u_in);
-  basis_.evaluate_with_gradient(u, ws.values.data(), ws.gradient.data());
-  const double r = coefficients_.dot(ws.values);
+  basis_.evaluate_with_gradient(u, ws.values.data(), ws.gradient.data(), max_order_);
+  double r = 0.0;
+  Eigen::Vector3d grad_r = Eigen::Vector3d::Zero();
+  for (int l = 0; l <= degree(); ++l)
+    for (int m = -std::min(l, max_order_); m <= std::min(l, max_order_); ++m) {
+      const int k = sh_index(l, m);
+      r += coefficients_(k) * ws.values(k);
+      grad_r += coefficients_(k) * ws.gradient.col(k);
+    }
   if (!(r > 0.0)) {
     throw std::domain_error("RadialSHSurface::evaluate: radius " + std::to_string(r) +
                             " <= 0; the expansion is not a star-shaped surface here");
   }
-  const Eigen::Vector3d grad_r = ws.gradient * coefficients_;
   SurfacePoint p;
   p.position = r * u;
   p.normal = (r * u - grad_r).normalized();
@@ -103,6 +123,7 @@ ParametricSHSurface::ParametricSHSurface(int degree, Eigen::MatrixX3d coefficien
                                 " coefficient rows for degree " + std::to_string(degree) + ", got " +
                                 std::to_string(coefficients_.rows()));
   }
+  max_order_ = highest_order(coefficients_, degree);
 }
 
 ParametricSHSurface ParametricSHSurface::fit(int degree, const Eigen::MatrixX3d& directions,
@@ -115,17 +136,36 @@ ParametricSHSurface ParametricSHSurface::fit(int degree, const Eigen::MatrixX3d&
 }
 
 Eigen::Vector3d ParametricSHSurface::position(const Eigen::Vector3d& u, SHWorkspace& ws) const {
-  basis_.evaluate(u, ws.values.data());
-  return coefficients_.transpose() * ws.values;
+  basis_.evaluate(u, ws.values.data(), max_order_);
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  for (int l = 0; l <= degree(); ++l)
+    for (int m = -std::min(l, max_order_); m <= std::min(l, max_order_); ++m) {
+      const int k = sh_index(l, m);
+      x += ws.values(k) * coefficients_.row(k).transpose();
+    }
+  return x;
 }
 
 void ParametricSHSurface::position_and_jacobian(const Eigen::Vector3d& u, SHWorkspace& ws,
                                                 Eigen::Vector3d& position,
                                                 Eigen::Matrix3d& jacobian) const {
-  basis_.evaluate_with_gradient(u, ws.values.data(), ws.gradient.data());
-  position.noalias() = coefficients_.transpose() * ws.values;
-  // J(a, b) = sum_k C(k, a) grad_b Y_k
-  jacobian.noalias() = coefficients_.transpose() * ws.gradient.transpose();
+  basis_.evaluate_with_gradient(u, ws.values.data(), ws.gradient.data(), max_order_);
+  // X = sum_k C_k Y_k and J(a, b) = sum_k C(k, a) grad_b Y_k over the present
+  // orders, as fixed-size loops (Eigen's dynamic GEMM path costs ~10 us here).
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d j = Eigen::Matrix3d::Zero();
+  const double* y = ws.values.data();
+  const double* g = ws.gradient.data();
+  for (int l = 0; l <= degree(); ++l)
+    for (int m = -std::min(l, max_order_); m <= std::min(l, max_order_); ++m) {
+      const int k = sh_index(l, m);
+      const Eigen::Vector3d c = coefficients_.row(k).transpose();
+      const Eigen::Vector3d grad(g[3 * k], g[3 * k + 1], g[3 * k + 2]);
+      x += y[k] * c;
+      j += c * grad.transpose();
+    }
+  position = x;
+  jacobian = j;
 }
 
 void ParametricSHSurface::tangent_derivatives(const Eigen::Vector3d& u, const Eigen::Vector3d& t1,

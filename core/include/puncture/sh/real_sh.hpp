@@ -58,9 +58,17 @@ class RealSHBasis {
   void evaluate_with_gradient(const Eigen::Vector3d& u, double* values,
                               double* tangential_gradient) const;
 
+  /// Order-limited variants: only terms with |m| <= max_order are written
+  /// (the others are left untouched). For expansions known to contain low
+  /// orders only (e.g. axisymmetric surfaces), at a fraction of the cost.
+  void evaluate(const Eigen::Vector3d& u, double* values, int max_order) const;
+  void evaluate_with_gradient(const Eigen::Vector3d& u, double* values,
+                              double* tangential_gradient, int max_order) const;
+
  private:
   template <bool kWithGradient>
-  void evaluate_impl(const Eigen::Vector3d& u, double* values, double* gradient) const;
+  void evaluate_impl(const Eigen::Vector3d& u, double* values, double* gradient,
+                     int max_order) const;
 
   int degree_;
   std::vector<double> a_;     ///< a_lm = sqrt((4l^2 - 1) / (l^2 - m^2)), at sh_index(l, m), m >= 0

@@ -19,6 +19,9 @@
 
 namespace puncture {
 
+/// Largest |m| among the non-zero coefficient rows (0 for an all-zero set).
+int highest_order(const Eigen::MatrixXd& coefficients, int degree);
+
 /// Scratch space for one evaluation: basis values and tangential gradients.
 struct SHWorkspace {
   explicit SHWorkspace(int count) : values(count), gradient(3, count) {}
@@ -41,6 +44,8 @@ class RadialSHSurface {
   int degree() const { return basis_.degree(); }
   const RealSHBasis& basis() const { return basis_; }
   const Eigen::VectorXd& coefficients() const { return coefficients_; }
+  /// Largest |m| with a non-zero coefficient; evaluation runs over |m| <= this only.
+  int max_order() const { return max_order_; }
   SHWorkspace make_workspace() const { return SHWorkspace(basis_.count()); }
 
   double radius(const Eigen::Vector3d& u, SHWorkspace& ws) const;
@@ -55,6 +60,7 @@ class RadialSHSurface {
  private:
   RealSHBasis basis_;
   Eigen::VectorXd coefficients_;
+  int max_order_ = 0;
 };
 
 class ParametricSHSurface {
@@ -68,6 +74,9 @@ class ParametricSHSurface {
   int degree() const { return basis_.degree(); }
   const RealSHBasis& basis() const { return basis_; }
   const Eigen::MatrixX3d& coefficients() const { return coefficients_; }
+  /// Largest |m| with a non-zero coefficient row; evaluation runs over |m| <= this
+  /// only (exactly zero rows cost nothing, e.g. for axisymmetric surfaces).
+  int max_order() const { return max_order_; }
   SHWorkspace make_workspace() const { return SHWorkspace(basis_.count()); }
 
   Eigen::Vector3d position(const Eigen::Vector3d& u, SHWorkspace& ws) const;
@@ -92,6 +101,7 @@ class ParametricSHSurface {
  private:
   RealSHBasis basis_;
   Eigen::MatrixX3d coefficients_;
+  int max_order_ = 0;
 };
 
 /// Unit normal from a Jacobian J at u (as ParametricSHSurface::evaluate);
