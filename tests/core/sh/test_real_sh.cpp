@@ -190,6 +190,25 @@ TEST(RealSH, TangentialGradientMatchesFiniteDifferencesIncludingPoles) {
   for (int k = 0; k < 3 * n; ++k) EXPECT_NEAR(g[k], gp[k], 1e-6);
 }
 
+TEST(RealSH, OrderLimitedEvaluationWritesOnlyLowOrders) {
+  const RealSHBasis basis(12);
+  const int n = basis.count();
+  std::vector<double> full(n), grad_full(3 * n), part(n, 7.0), grad_part(3 * n, 7.0);
+  const Eigen::Vector3d u = unit_vector_from_angles(0.6, 2.2);
+  basis.evaluate_with_gradient(u, full.data(), grad_full.data());
+  basis.evaluate_with_gradient(u, part.data(), grad_part.data(), 1);
+  for (int l = 0; l <= 12; ++l)
+    for (int m = -l; m <= l; ++m) {
+      const int k = sh_index(l, m);
+      if (std::abs(m) <= 1) {
+        EXPECT_EQ(part[k], full[k]);
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(grad_part[3 * k + c], grad_full[3 * k + c]);
+      } else {
+        EXPECT_EQ(part[k], 7.0);  // untouched
+      }
+    }
+}
+
 TEST(RealSH, RejectsZeroDirection) {
   const RealSHBasis basis(2);
   std::vector<double> v(basis.count());
