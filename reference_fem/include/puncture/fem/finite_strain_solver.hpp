@@ -1,0 +1,188 @@
+// finite_strain_solver.hpp: quasi-static total-Lagrangian finite-strain solver
+// on a distributed hexahedral mesh (deal.II, Trilinos, MPI).
+//
+// In:  a parallel::distributed::Triangulation<3> (coordinates in m; each
+//      cell's material_id indexes `materials`), the per-material laws
+//      (hyperelastic_materials.hpp), SolverSettings; per load step the
+//      prescribed total displacements of some degrees of freedom (m) and
+//      optional dead-load tractions (Pa, per reference area).
+// Out: the displacement field u (m, FE_Q^3 of the chosen degree), internal
+//      forces (N) on any set of dofs (reactions), per-cell fields (J, von
+//      Mises Cauchy stress in Pa, maximum principal stretch).
+//
+// Formulation. Residual R(u) = f_int(u) - f_ext = dE/du of the reduced energy
+//   E(u) = sum_cells int Psi_iso(C) dV + int Psi_vol(Jtilde) dV - f_ext . u
+// where Jtilde is the dilatation:
+//   * VolumetricFormulation::one_field:   Jtilde = J pointwise (classical
+//     compressible formulation; locks for nu -> 0.5 with low-order elements);
+//   * VolumetricFormulation::three_field: Hu-Washizu u-p-Jtilde (step-44) with
+//     discontinuous pressure and dilatation of degree k-1 (Q1-P0 = mean
+//     dilatation, Q2-P1). Both extra fields are eliminated exactly at the
+//     element level: Jtilde = Pi(J) (L2 projection on the cell in the
+//     reference volume), p = Pi(dPsi_vol/dJ(Jtilde)); the condensed tangent is
+//     K_uu + B^T M^{-1} K_JJ M^{-1} B. The global system is displacement-only
+//     and symmetric, so it is solved with CG + Trilinos AMG.
+// Removed ("void") cells use small-strain linear elasticity with
+// void_stiffness_fraction x the layer's Young's modulus (no J, never inverts).
+//
+// Newton: each iteration prescribes the remaining gap (target - u) on the
+// constrained dofs, solves K du = -R, and backtracks (halving) while the trial
+// state has an inverted element (J <= 0 or a non-finite value) or, once the
+// constraints are met, while the free residual does not decrease. On failure
+// the state of the last converged step is restored and solve_step() reports
+// it (the caller cuts the load step). Nothing non-finite is ever kept.
+#pragma once
+
+#include <deal.II/base/point.h>
+#include <deal.II/distributed/tria.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <puncture/fem/hyperelastic_materials.hpp>
+
+namespace puncture::fem {
+
+enum class VolumetricFormulation { one_field, three_field };
+
+/// Numerical settings of the solver.
+struct SolverSettings {
+  unsigned int degree = 1;  ///< displacement element degree: 1 (Q1) or 2 (Q2)
+  VolumetricFormulation formulation = VolumetricFormulation::three_field;
+  int max_newton_iterations = 25;
+  /// Converged when the free residual <= tolerance x force scale (the larger of
+  /// the reaction norm, the external load norm and the largest free residual of
+  /// the step) and the prescribed values are met.
+  double newton_tolerance = 1e-8;
+  double absolute_residual_floor_N = 1e-13;  ///< converged below this whatever the scale
+  int max_line_search_halvings = 8;
+  double linear_relative_tolerance = 1e-10;  ///< CG stop: ||r|| <= tol ||b||
+  bool direct_linear_solver = false;         ///< Amesos KLU instead of CG + AMG
+  double void_stiffness_fraction = 1e-4;     ///< E_void / E_layer for removed cells
+  bool verbose = false;                      ///< convergence table on rank 0
+};
+
+/// What one solve_step() did.
+struct NewtonReport {
+  bool converged = false;
+  int iterations = 0;           ///< Newton iterations (linear solves)
+  int linear_iterations = 0;    ///< total CG iterations
+  double residual_N = 0.0;      ///< final free residual norm
+  double force_scale_N = 0.0;   ///< scale the tolerance multiplied
+  std::string failure;          ///< why it failed (empty if converged)
+  std::vector<std::string> table;  ///< one line per iteration
+};
+
+/// A degree of freedom with its support point in the reference configuration.
+struct DofPoint {
+  dealii::types::global_dof_index dof;
+  unsigned int component;  ///< 0 = x, 1 = y, 2 = z
+  dealii::Point<3> X;      ///< m
+};
+
+/// Per locally owned active cell (index = active_cell_index; other entries 0).
+struct CellFields {
+  std::vector<double> jacobian;                  ///< cell mean of J
+  std::vector<double> von_mises_Pa;              ///< cell mean of the von Mises Cauchy stress
+  std::vector<double> max_principal_stretch;     ///< cell maximum over quadrature points
+  std::vector<double> material_id;
+  std::vector<double> removed;                   ///< 1 for removed (void) cells
+};
+
+class FiniteStrainSolver {
+ public:
+  using Triangulation = dealii::parallel::distributed::Triangulation<3>;
+  using CellIterator = dealii::DoFHandler<3>::active_cell_iterator;
+
+  FiniteStrainSolver(Triangulation& triangulation, std::vector<LayerMaterial> materials,
+                     const SolverSettings& settings);
+  ~FiniteStrainSolver();
+
+  /// Distributes the dofs, builds the sparsity pattern, sets u = 0.
+  void setup();
+
+  MPI_Comm mpi_communicator() const;
+  const dealii::DoFHandler<3>& dof_handler() const { return dof_handler_; }
+  const dealii::FESystem<3>& fe() const { return fe_; }
+  dealii::types::global_dof_index n_dofs() const { return dof_handler_.n_dofs(); }
+  const SolverSettings& settings() const { return settings_; }
+
+  /// Every locally relevant dof with its support point (m) and component.
+  std::vector<DofPoint> locally_relevant_dof_points() const;
+
+  /// Target total displacements (m) of prescribed dofs. Give at least every
+  /// locally relevant prescribed dof; every rank must agree on shared ones.
+  void set_prescribed_displacements(std::map<dealii::types::global_dof_index, double> targets);
+  const std::map<dealii::types::global_dof_index, double>& prescribed_displacements() const {
+    return targets_;
+  }
+
+  /// Dead-load traction (Pa, per reference area) on faces with this boundary id.
+  void set_dead_load_traction(dealii::types::boundary_id id, const dealii::Tensor<1, 3>& traction_Pa);
+
+  /// Marks cells removed (void material) where predicate(cell) is true.
+  /// Cells already removed stay removed.
+  void remove_cells(const std::function<bool(const CellIterator&)>& predicate);
+  bool is_removed(const CellIterator& cell) const;
+
+  /// Newton solve of the current load step. On failure the previous
+  /// converged state is restored.
+  NewtonReport solve_step();
+
+  /// Ghosted total displacement (m).
+  const dealii::TrilinosWrappers::MPI::Vector& solution() const { return solution_ghosted_; }
+  /// u at one locally relevant dof (m).
+  double displacement(dealii::types::global_dof_index dof) const { return solution_ghosted_[dof]; }
+
+  /// Sum of the internal force (N) f_int - f_ext on the given dofs at the
+  /// last converged state: each dof counted once (by its owner), MPI-summed.
+  /// For prescribed dofs this is the force the supports apply to the body.
+  double sum_of_residual(const std::vector<dealii::types::global_dof_index>& dofs) const;
+
+  /// Maximum principal stretch over the quadrature points of the locally
+  /// owned, not removed cells selected by predicate (MPI max; 1 if none).
+  double max_principal_stretch(const std::function<bool(const CellIterator&)>& predicate) const;
+
+  CellFields cell_fields() const;
+
+ private:
+  struct AssemblyResult {
+    bool valid = true;  ///< false: an inverted or non-finite quadrature point somewhere
+  };
+  AssemblyResult assemble(const dealii::TrilinosWrappers::MPI::Vector& u_ghosted, bool with_matrix,
+                          const dealii::AffineConstraints<double>* constraints);
+  dealii::AffineConstraints<double> increment_constraints() const;
+  unsigned int solve_linear(dealii::TrilinosWrappers::MPI::Vector& du);
+  double free_residual_norm() const;
+  double reaction_norm() const;
+  double external_load_norm() const;
+  double max_constraint_gap() const;
+
+  Triangulation& triangulation_;
+  std::vector<LayerMaterial> materials_;
+  SolverSettings settings_;
+  dealii::FESystem<3> fe_;
+  dealii::DoFHandler<3> dof_handler_;
+  dealii::IndexSet locally_owned_;
+  dealii::IndexSet locally_relevant_;
+
+  std::map<dealii::types::global_dof_index, double> targets_;
+  std::map<dealii::types::boundary_id, dealii::Tensor<1, 3>> tractions_;
+  std::vector<char> removed_;  ///< per active cell index
+
+  dealii::TrilinosWrappers::SparseMatrix tangent_;
+  dealii::TrilinosWrappers::MPI::Vector rhs_;            ///< -R with constraints applied
+  dealii::TrilinosWrappers::MPI::Vector residual_;       ///< R = f_int - f_ext, unconstrained
+  dealii::TrilinosWrappers::MPI::Vector solution_;       ///< owned
+  dealii::TrilinosWrappers::MPI::Vector solution_ghosted_;
+};
+
+}  // namespace puncture::fem

@@ -1,0 +1,240 @@
+// hyperelastic_materials.hpp: the continuum material laws of the FEM reference
+// (header-only, in the manner of deal.II step-44: one small class per law).
+//
+// Every law is written in the reference (material) configuration as a function
+// of the right Cauchy-Green tensor C = F^T F (dimensionless, symmetric 3x3):
+//   energy(C)   strain energy per unit reference volume, J/m^3 = Pa
+//   stress(C)   second Piola-Kirchhoff stress S = 2 dPsi/dC, Pa
+//   tangent(C)  material elasticity tensor CC = 4 d^2Psi/dC dC, Pa
+//               (minor symmetries; major symmetry holds for these laws)
+//
+// The strain energy is split (Holzapfel 2000, Sec. 6.4; step-44):
+//   Psi(C) = Psi_iso(Cbar) + Psi_vol(J),  Cbar = J^{-2/3} C,  J = sqrt(det C).
+// Isochoric laws:
+//   NeoHookean:   Psi_iso = mu/2 (I1bar - 3)
+//   MooneyRivlin: Psi_iso = c10 (I1bar - 3) + c01 (I2bar - 3),  mu = 2 (c10 + c01)
+// Volumetric law (step-44 and the deal.II code gallery Cook membrane):
+//   VolumetricLaw: Psi_vol = kappa/4 (J^2 - 1 - 2 ln J),
+//                  kappa = E / (3 (1 - 2 nu)), mu = E / (2 (1 + nu)).
+// How the volumetric term enters the finite-element equations (pointwise J, or
+// the projected dilatation of the Hu-Washizu three-field formulation) is the
+// solver's business (finite_strain_solver.hpp); here it is a function of one
+// scalar J (or Jtilde).
+#pragma once
+
+#include <deal.II/base/symmetric_tensor.h>
+#include <deal.II/base/tensor.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <variant>
+
+#include <puncture/scene.hpp>
+
+namespace puncture::fem {
+
+using SymTensor2 = dealii::SymmetricTensor<2, 3>;
+using SymTensor4 = dealii::SymmetricTensor<4, 3>;
+
+/// (A (.) A)_{ABCD} = 1/2 (A_AC A_BD + A_AD A_BC): the symmetrised product
+/// that appears in d(C^{-1})/dC = -(C^{-1} (.) C^{-1}).
+inline SymTensor4 symmetric_product(const SymTensor2& A) {
+  SymTensor4 out;
+  for (unsigned a = 0; a < 3; ++a)
+    for (unsigned b = a; b < 3; ++b)
+      for (unsigned c = 0; c < 3; ++c)
+        for (unsigned d = c; d < 3; ++d)
+          out[a][b][c][d] = 0.5 * (A[a][c] * A[b][d] + A[a][d] * A[b][c]);
+  return out;
+}
+
+/// Pushes the fictitious stress and tangent of an isochoric law to the
+/// isochoric S and CC (Holzapfel 2000, Eq. 6.89 and 6.168):
+///   S_iso  = J^{-2/3} Dev(Sbar),  Dev(X) = X - 1/3 (X : C) C^{-1}
+///   CC_iso = P : CCbar : P^T + 2/3 Tr(J^{-2/3} Sbar) Ptilde
+///            - 2/3 (C^{-1} x S_iso + S_iso x C^{-1})
+/// with P = I - 1/3 C^{-1} x C, Ptilde = C^{-1} (.) C^{-1} - 1/3 C^{-1} x C^{-1},
+/// CCbar = J^{-4/3} (4 d^2 Psi / dCbar dCbar) = J^{-4/3} CC_hat.
+/// In: C, Sbar = 2 dPsi/dCbar, CC_hat (may be null for laws linear in Cbar).
+inline void isochoric_push(const SymTensor2& C, const SymTensor2& Sbar, const SymTensor4* CC_hat,
+                           SymTensor2& S_iso, SymTensor4& CC_iso) {
+  const double J = std::sqrt(dealii::determinant(C));
+  const SymTensor2 C_inv = dealii::invert(C);
+  const double J_m23 = std::pow(J, -2.0 / 3.0);
+  const double Sbar_C = dealii::scalar_product(Sbar, C);  // Tr(Sbar)
+  S_iso = J_m23 * (Sbar - (Sbar_C / 3.0) * C_inv);
+  const SymTensor4 Cinv_x_Cinv = dealii::outer_product(C_inv, C_inv);
+  const SymTensor4 P_tilde = symmetric_product(C_inv) - (1.0 / 3.0) * Cinv_x_Cinv;
+  CC_iso = (2.0 / 3.0) * J_m23 * Sbar_C * P_tilde -
+           (2.0 / 3.0) * (dealii::outer_product(C_inv, S_iso) + dealii::outer_product(S_iso, C_inv));
+  if (CC_hat != nullptr) {
+    const SymTensor4 identity = dealii::identity_tensor<3>();
+    const SymTensor4 P = identity - (1.0 / 3.0) * dealii::outer_product(C_inv, C);
+    const SymTensor4 P_T = identity - (1.0 / 3.0) * dealii::outer_product(C, C_inv);
+    CC_iso += std::pow(J, -4.0 / 3.0) * (P * (*CC_hat) * P_T);
+  }
+}
+
+/// Isochoric compressible neo-Hookean law: Psi_iso = mu/2 (I1bar - 3).
+class NeoHookean {
+ public:
+  explicit NeoHookean(double shear_modulus_Pa) : mu_(shear_modulus_Pa) {
+    if (!(mu_ > 0.0)) throw std::invalid_argument("NeoHookean: shear modulus must be > 0");
+  }
+  double shear_modulus_Pa() const { return mu_; }
+
+  double energy(const SymTensor2& C) const {
+    const double J = std::sqrt(dealii::determinant(C));
+    return 0.5 * mu_ * (std::pow(J, -2.0 / 3.0) * dealii::trace(C) - 3.0);
+  }
+  SymTensor2 stress(const SymTensor2& C) const {
+    SymTensor2 S;
+    SymTensor4 CC;
+    stress_and_tangent(C, S, CC);
+    return S;
+  }
+  SymTensor4 tangent(const SymTensor2& C) const {
+    SymTensor2 S;
+    SymTensor4 CC;
+    stress_and_tangent(C, S, CC);
+    return CC;
+  }
+  /// Sbar = mu I; CC_hat = 0.
+  void stress_and_tangent(const SymTensor2& C, SymTensor2& S, SymTensor4& CC) const {
+    const SymTensor2 Sbar = mu_ * dealii::unit_symmetric_tensor<3>();
+    isochoric_push(C, Sbar, nullptr, S, CC);
+  }
+
+ private:
+  double mu_;  ///< shear modulus, Pa
+};
+
+/// Isochoric Mooney-Rivlin law: Psi_iso = c10 (I1bar - 3) + c01 (I2bar - 3),
+/// I2bar = 1/2 (I1bar^2 - tr(Cbar^2)); small-strain shear modulus 2 (c10 + c01).
+class MooneyRivlin {
+ public:
+  MooneyRivlin(double c10_Pa, double c01_Pa) : c10_(c10_Pa), c01_(c01_Pa) {
+    if (!(c10_ >= 0.0 && c01_ >= 0.0 && c10_ + c01_ > 0.0))
+      throw std::invalid_argument("MooneyRivlin: need c10 >= 0, c01 >= 0, c10 + c01 > 0");
+  }
+  double shear_modulus_Pa() const { return 2.0 * (c10_ + c01_); }
+
+  double energy(const SymTensor2& C) const {
+    const double J = std::sqrt(dealii::determinant(C));
+    const SymTensor2 Cbar = std::pow(J, -2.0 / 3.0) * C;
+    const double I1 = dealii::trace(Cbar);
+    const double I2 = 0.5 * (I1 * I1 - dealii::scalar_product(Cbar, Cbar));
+    return c10_ * (I1 - 3.0) + c01_ * (I2 - 3.0);
+  }
+  SymTensor2 stress(const SymTensor2& C) const {
+    SymTensor2 S;
+    SymTensor4 CC;
+    stress_and_tangent(C, S, CC);
+    return S;
+  }
+  SymTensor4 tangent(const SymTensor2& C) const {
+    SymTensor2 S;
+    SymTensor4 CC;
+    stress_and_tangent(C, S, CC);
+    return CC;
+  }
+  /// Sbar = 2 (c10 + c01 I1bar) I - 2 c01 Cbar;  CC_hat = 4 c01 (I x I - II).
+  void stress_and_tangent(const SymTensor2& C, SymTensor2& S, SymTensor4& CC) const {
+    const double J = std::sqrt(dealii::determinant(C));
+    const SymTensor2 Cbar = std::pow(J, -2.0 / 3.0) * C;
+    const SymTensor2 I = dealii::unit_symmetric_tensor<3>();
+    const SymTensor2 Sbar = 2.0 * (c10_ + c01_ * dealii::trace(Cbar)) * I - 2.0 * c01_ * Cbar;
+    const SymTensor4 CC_hat =
+        4.0 * c01_ * (dealii::outer_product(I, I) - dealii::identity_tensor<3>());
+    isochoric_push(C, Sbar, &CC_hat, S, CC);
+  }
+
+ private:
+  double c10_;  ///< Pa
+  double c01_;  ///< Pa
+};
+
+/// Volumetric energy Psi_vol(J) = kappa/4 (J^2 - 1 - 2 ln J) (step-44). Its
+/// pressure p = dPsi/dJ = kappa/2 (J - 1/J) and stiffness d2Psi/dJ2 =
+/// kappa/2 (1 + 1/J^2) stay finite for every J > 0 and grow without bound as
+/// J -> 0, so a compressed element resists inversion.
+class VolumetricLaw {
+ public:
+  explicit VolumetricLaw(double bulk_modulus_Pa) : kappa_(bulk_modulus_Pa) {
+    if (!(kappa_ > 0.0)) throw std::invalid_argument("VolumetricLaw: bulk modulus must be > 0");
+  }
+  double bulk_modulus_Pa() const { return kappa_; }
+  double energy(double J) const { return 0.25 * kappa_ * (J * J - 1.0 - 2.0 * std::log(J)); }
+  double pressure(double J) const { return 0.5 * kappa_ * (J - 1.0 / J); }  ///< Pa
+  double dpressure_dJ(double J) const { return 0.5 * kappa_ * (1.0 + 1.0 / (J * J)); }  ///< Pa
+
+ private:
+  double kappa_;  ///< bulk modulus, Pa
+};
+
+/// The material of one layer: an isochoric law plus the volumetric law, built
+/// from the scene's ContinuumMaterial (E, nu, model, Mooney-Rivlin C01 share).
+class LayerMaterial {
+ public:
+  explicit LayerMaterial(const ContinuumMaterial& m)
+      : iso_(make_isochoric(m)), vol_(bulk_modulus(m)), youngs_modulus_Pa_(m.youngs_modulus_Pa),
+        poisson_ratio_(m.poisson_ratio) {}
+
+  static double shear_modulus(const ContinuumMaterial& m) {
+    check(m);
+    return m.youngs_modulus_Pa / (2.0 * (1.0 + m.poisson_ratio));
+  }
+  static double bulk_modulus(const ContinuumMaterial& m) {
+    check(m);
+    return m.youngs_modulus_Pa / (3.0 * (1.0 - 2.0 * m.poisson_ratio));
+  }
+
+  double youngs_modulus_Pa() const { return youngs_modulus_Pa_; }
+  double poisson_ratio() const { return poisson_ratio_; }
+  const VolumetricLaw& volumetric() const { return vol_; }
+
+  double isochoric_energy(const SymTensor2& C) const {
+    return std::visit([&](const auto& law) { return law.energy(C); }, iso_);
+  }
+  void isochoric_stress_and_tangent(const SymTensor2& C, SymTensor2& S, SymTensor4& CC) const {
+    std::visit([&](const auto& law) { law.stress_and_tangent(C, S, CC); }, iso_);
+  }
+
+ private:
+  static void check(const ContinuumMaterial& m) {
+    if (!(m.youngs_modulus_Pa > 0.0) || !std::isfinite(m.youngs_modulus_Pa))
+      throw std::invalid_argument("material: Young's modulus must be > 0");
+    if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))
+      throw std::invalid_argument("material: Poisson's ratio must lie in (-1, 0.5)");
+  }
+  static std::variant<NeoHookean, MooneyRivlin> make_isochoric(const ContinuumMaterial& m) {
+    const double mu = shear_modulus(m);
+    if (m.model == "neo_hookean") return NeoHookean(mu);
+    if (m.model == "mooney_rivlin") {
+      const double f = m.mooney_rivlin_c01_fraction;
+      if (!(f >= 0.0 && f <= 1.0))
+        throw std::invalid_argument("material: mooney_rivlin_c01_fraction must lie in [0, 1]");
+      return MooneyRivlin(0.5 * mu * (1.0 - f), 0.5 * mu * f);
+    }
+    throw std::invalid_argument("material: unknown model '" + m.model +
+                                "' (expected neo_hookean or mooney_rivlin)");
+  }
+
+  std::variant<NeoHookean, MooneyRivlin> iso_;
+  VolumetricLaw vol_;
+  double youngs_modulus_Pa_;
+  double poisson_ratio_;
+};
+
+/// Volumetric contribution at fixed pressure p (Pa) to S and CC:
+///   S_vol = p J C^{-1},  CC_vol = p J (C^{-1} x C^{-1} - 2 C^{-1} (.) C^{-1}).
+/// With p = dPsi_vol/dJ evaluated pointwise (one-field formulation) the full
+/// volumetric tangent adds J^2 d2Psi/dJ2 C^{-1} x C^{-1}.
+inline void add_volumetric_at_fixed_pressure(const SymTensor2& C_inv, double J, double p,
+                                             SymTensor2& S, SymTensor4& CC) {
+  S += (p * J) * C_inv;
+  CC += (p * J) * (dealii::outer_product(C_inv, C_inv) - 2.0 * symmetric_product(C_inv));
+}
+
+}  // namespace puncture::fem

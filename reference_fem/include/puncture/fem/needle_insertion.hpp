@@ -1,0 +1,109 @@
+// needle_insertion.hpp: the FEM reference of a needle insertion into the
+// layered slab of a Scene (the one function the command-line program calls).
+//
+// In:  a Scene (SI units; geometry convention of scene.hpp: sample axis = z,
+//      skin top at z = 0, needle along -z on the axis, depth = -z_tip),
+//      FemRunOptions, an MPI communicator.
+// Out: FemRunSummary, and in options.output_dir (created if missing; every
+//      file written under a temporary name and renamed when complete):
+//        fem_force_depth.csv      time_s, depth_mm, velocity_mm_per_s, force_N,
+//                                 <layer>_state (untouched|pressed|punctured)...
+//        fem_surface_profile.csv  step, depth_mm, r_mm, uz_mm, surface: u_z(r) of
+//                                 the top surface of the layer the needle
+//                                 currently presses (the intact layer)
+//        fem_recovery_profile.csv layer, phase (before|after breakthrough),
+//                                 depth_mm, r_mm, uz_mm: spring-back of the
+//                                 punctured surface (reference for resumption)
+//        fem_newton_log.txt       the Newton convergence table of every step
+//        fem_summary.json         events, peak force, counts, timings, files
+//        fem_fields_*.vtu/.pvtu, fem_fields.pvd (if write_vtu)
+//
+// Model: bonded layers; base fixed (u = 0); lateral surface r = D/2 fixed
+// (u = 0: sample held in a rigid ring). The needle tip is a rigid flat
+// cylinder of the scene's radius: a node of the current top interface with
+// r <= needle radius joins the contact set when the tip reaches it (its
+// current z >= z_tip); from then on u_z = z_tip - Z and its lateral
+// displacement is held (no slip under the flat tip). Needle force (N, > 0
+// resisting the insertion) = -(sum of the z reactions on the contact dofs),
+// each dof counted by its owning rank, then MPI-summed. When the layer's
+// puncture criterion is met (critical force, or critical maximum principal
+// stretch in the cells touching the contact patch) its cells with centre
+// inside the needle radius become void (linear material with
+// void_stiffness_fraction x E; see finite_strain_solver.hpp), the contact set
+// is released, the same depth is re-solved (spring-back, recorded) and the
+// tip goes on to the next interface. Quasi-static load steps of
+// scene.fem.load_step_m from the start height to the target depth; a step
+// that fails (no convergence, inverted elements) is halved, down to 1/256 of
+// the load step, then the run stops with an error. The FEM stops at the
+// target depth: dwell and withdrawal are not simulated.
+#pragma once
+
+#include <mpi.h>
+
+#include <string>
+#include <vector>
+
+#include <deal.II/distributed/tria.h>
+
+#include <puncture/meshing/layered_cylinder_mesh.hpp>
+#include <puncture/scene.hpp>
+
+namespace puncture::fem {
+
+struct FemRunOptions {
+  std::string output_dir;        ///< created if missing
+  int refinement_override = -1;  ///< >= 0 replaces scene.fem.refinement
+  int degree_override = -1;      ///< 1 or 2 replaces scene.fem.element_degree
+  bool write_vtu = true;
+  // Beyond the command line (tests, studies):
+  meshing::SlabMeshOptions mesh;      ///< coarse hex mesh resolution
+  std::string formulation = "three_field";  ///< "three_field" (locking-free) or "one_field"
+  double stop_depth_m = -1.0;         ///< > 0: stop at this depth (before the target)
+  int max_vtu_frames = 40;            ///< at most about this many VTU frames (plus events)
+  bool verbose = true;                ///< progress and Newton tables on rank 0's stdout
+  bool write_files = true;            ///< false: no files at all (tests)
+};
+
+struct PunctureEvent {
+  int layer = -1;
+  std::string layer_name;
+  double depth_m = 0.0;     ///< tip depth when the criterion was met
+  double force_N = 0.0;     ///< needle force just before breakthrough
+  double force_after_N = 0.0;  ///< needle force after the spring-back
+  double max_stretch = 1.0; ///< max principal stretch at the tip before breakthrough
+  double time_s = 0.0;
+};
+
+struct FemRunSummary {
+  std::vector<PunctureEvent> punctures;
+  double peak_force_N = 0.0;
+  double peak_force_depth_m = 0.0;
+  int load_steps = 0;         ///< converged (sub)steps solved
+  int step_cuts = 0;          ///< halvings of the load step
+  int newton_iterations = 0;  ///< total
+  int linear_iterations = 0;  ///< total
+  double wall_time_s = 0.0;
+  double solve_time_s = 0.0;  ///< time inside Newton solves
+  std::size_t n_dofs = 0;
+  std::size_t n_cells = 0;
+  int n_ranks = 1;
+  int degree = 1;
+  int refinement = 0;
+  std::vector<double> time_s, depth_m, force_N;  ///< the rows of the force-depth CSV
+  std::vector<std::string> files_written;
+};
+
+/// Builds the distributed triangulation of the scene's slab: hex mesh from
+/// meshing::build_layered_cylinder_mesh, material id = layer index, boundary
+/// ids 0 = top (z = 0), 1 = base, 2 = lateral; `refinement` global
+/// refinements (lateral faces follow the cylinder).
+void build_slab_triangulation(const Scene& scene, const meshing::SlabMeshOptions& options,
+                              int refinement, dealii::parallel::distributed::Triangulation<3>& tria);
+
+/// Runs the insertion (see the file comment). Throws std::runtime_error with a
+/// clear message if the solver cannot continue (after writing the rows
+/// computed so far, with "status": "failed" in the summary), and
+/// std::invalid_argument for scenes it cannot model (e.g. angle != 0).
+FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& options, MPI_Comm comm);
+
+}  // namespace puncture::fem
