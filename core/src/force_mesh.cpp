@@ -132,7 +132,8 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   for (int i = 1; i < n; ++i) max_degree = std::max(max_degree, lattice_.neighbour_count(i));
   omega_max_sq_ = (K + 2.0 * ks * max_degree) / mass_kg_;
   const double cm = c / mass_kg_;
-  dt_crit_s_ = (-cm + std::sqrt(cm * cm + 16.0 * omega_max_sq_)) / (2.0 * omega_max_sq_);
+  // Root of omega^2 dt^2 + 2 (c/m) dt = 4 (Jury condition of the damped symplectic Euler step).
+  dt_crit_s_ = (-cm + std::sqrt(cm * cm + 4.0 * omega_max_sq_)) / omega_max_sq_;
   if (c > 0.0) dt_crit_s_ = std::min(dt_crit_s_, 2.0 / cm);
   const double dt = settings.time_step_s;
   const double substeps_needed = std::ceil(dt / (settings.explicit_safety * dt_crit_s_));

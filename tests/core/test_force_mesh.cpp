@@ -246,3 +246,32 @@ TEST(ForceMesh, RejectsBadParameters) {
   EXPECT_THROW(parse_mesh_integrator("rk4"), std::invalid_argument);
   EXPECT_EQ(parse_mesh_integrator("quasi_static"), MeshIntegrator::QuasiStatic);
 }
+
+// The damped stability limit used for dt_crit, checked on a plain symplectic
+// Euler loop written here on the dense matrices with the exact omega_max: a
+// step 5 % below the limit stays bounded, 5 % above it blows up. (This is why
+// the mesh substeps: without substepping the second case is what it would do.)
+TEST(ForceMesh, DampedCriticalStepFormulaIsSharp) {
+  ForceMeshParams p = params(3);
+  const ForceMesh mesh = make_mesh(p, MeshIntegrator::Explicit);
+  const Eigen::MatrixXd A = dense_stiffness(mesh);
+  const int nf = mesh.node_count() - 1;
+  const Eigen::MatrixXd Kff = A.bottomRightCorner(nf, nf);
+  const double m = mesh.node_mass_kg(), c = p.node_damping_N_s_per_m;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Kff);
+  const double w2 = es.eigenvalues().maxCoeff() / m;
+  // Closed form for a damped oscillator under symplectic Euler: omega dt < 2 (sqrt(1 + zeta^2) - zeta).
+  const double omega = std::sqrt(w2), zeta = c / (2.0 * m * omega);
+  const double dt_exact = 2.0 / omega * (std::sqrt(1.0 + zeta * zeta) - zeta);
+  EXPECT_LE(mesh.critical_time_step_s(), dt_exact);  // the Gershgorin version is on the safe side
+  auto growth = [&](double dt) {
+    Eigen::VectorXd z = es.eigenvectors().col(nf - 1), v = Eigen::VectorXd::Zero(nf);  // highest mode
+    for (int s = 0; s < 2000; ++s) {
+      v += dt * (-(Kff * z) - c * v) / m;
+      z += dt * v;
+    }
+    return z.norm();
+  };
+  EXPECT_LT(growth(0.95 * dt_exact), 1.0);
+  EXPECT_GT(growth(1.05 * dt_exact), 1e6);
+}

@@ -40,9 +40,10 @@
 //   QuasiStatic: equilibrium every step, z = u z_0 with the unit-deflection
 //       influence vector u precomputed at construction (O(N) per step).
 //   Explicit:    symplectic Euler (v += dt a; z += dt v) with the damping
-//       evaluated explicitly. Stable for omega dt < 2 (sqrt(1+zeta^2) - zeta),
-//       i.e. dt < dt_crit, the root of omega_max^2 dt^2 + (c/m) dt = 4 (and
-//       dt < 2 m / c). omega_max^2 <= max_i (K + 2 k_s deg_i) / m is the
+//       evaluated explicitly. A mode omega is stable for
+//       omega dt < 2 (sqrt(1 + zeta^2) - zeta), zeta = c / (2 m omega), i.e.
+//       omega^2 dt^2 + 2 (c/m) dt < 4, and dt < 2 m / c (Jury conditions of
+//       the 2 x 2 step matrix); dt_crit is that limit for omega_max. omega_max^2 <= max_i (K + 2 k_s deg_i) / m is the
 //       Gershgorin bound on the eigenvalues of M^-1 K_ff, so dt_crit is safe.
 //       When dt > safety * dt_crit the step is split into substeps (the
 //       contact deflection is interpolated linearly across them); if more
