@@ -1,0 +1,58 @@
+// `puncture fem`: the deal.II reference along the scene's insertion. Runs
+// unchanged under `mpirun -np N puncture fem ...`; rank 0 prints.
+#include <iostream>
+
+#include "puncture/apps/commands.hpp"
+#include "puncture/scene_io.hpp"
+
+#ifdef PUNCTURE_HAVE_FEM
+#include <deal.II/base/mpi.h>
+
+#include "puncture/fem/needle_insertion.hpp"
+#endif
+
+namespace puncture::apps {
+
+int fem_command(const FemOptions& options, std::ostream& out, std::ostream& err) {
+#ifdef PUNCTURE_HAVE_FEM
+  int argc = 1;
+  char program[] = "puncture";
+  char* argv_storage[] = {program, nullptr};
+  char** argv = argv_storage;
+  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  const bool root = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
+  const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
+  try {
+    const Scene scene = load_scene(scene_path);
+    fem::FemRunOptions fem_options;
+    fem_options.output_dir =
+        (options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_fem") : options.output_dir).string();
+    fem_options.refinement_override = options.refinement;
+    fem_options.degree_override = options.degree;
+    fem_options.write_vtu = options.write_vtu;
+    const fem::FemRunSummary summary = fem::run_needle_insertion(scene, fem_options, MPI_COMM_WORLD);
+    if (root) {
+      out << "\nFEM puncture events (" << summary.punctures.size() << "):\n";
+      for (const auto& e : summary.punctures)
+        out << "  " << e.layer_name << "  depth = " << e.depth_m * 1e3 << " mm   force = " << e.force_N << " N\n";
+      out << "FEM: " << summary.n_dofs << " DoFs, " << summary.n_ranks << " rank(s), " << summary.load_steps
+          << " load steps, " << summary.newton_iterations << " Newton iterations, " << summary.wall_time_s
+          << " s\nOutputs in " << fem_options.output_dir << "/ (fem_force_depth.csv, fem_summary.json, fem_fields.pvd)\n";
+    }
+    return 0;
+  } catch (const SceneError& e) {
+    if (root) err << "error: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    if (root) err << "error: " << scene_path.string() << ": " << e.what() << '\n';
+    return 1;
+  }
+#else
+  (void)options;
+  (void)out;
+  err << "error: this build has no FEM reference (configure with -DPUNCTURE_WITH_FEM=ON)\n";
+  return 1;
+#endif
+}
+
+}  // namespace puncture::apps

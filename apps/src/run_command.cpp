@@ -1,0 +1,264 @@
+// `puncture run`: the real-time SHF + MSM model along a scene's scripted
+// insertion, with CSV, JSON summary, SH fit-error table and ParaView frames.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "puncture/apps/commands.hpp"
+#include "puncture/apps/provenance.hpp"
+#include "puncture/io/output_session.hpp"
+#include "puncture/io/pvd.hpp"
+#include "puncture/io/vtk_polydata.hpp"
+#include "puncture/model/force_mesh_field.hpp"
+#include "puncture/model/realtime_model.hpp"
+#include "puncture/scene_io.hpp"
+
+namespace puncture::apps {
+
+std::filesystem::path default_scene_path() {
+  const std::filesystem::path local = "scenes/default.json";
+  if (std::filesystem::exists(local)) return local;
+  return std::filesystem::path(PUNCTURE_SOURCE_DIR) / "scenes" / "default.json";
+}
+
+namespace {
+
+constexpr double kMm = 1e-3;
+constexpr int kSurfaceBandsTheta = 48;
+constexpr int kSurfaceAzimuths = 72;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())));
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
+std::string fmt(double x, int precision = 17) {
+  std::ostringstream s;
+  s << std::setprecision(precision) << x;
+  return s.str();
+}
+
+/// realtime_curve.csv: one row per haptic tick.
+std::string curve_csv(const Scene& scene, const ScriptedRunResult& run) {
+  std::ostringstream csv;
+  csv << "time_s,depth_mm,velocity_mm_per_s,force_N";
+  for (const Layer& l : scene.layers)
+    csv << ',' << l.name << "_state," << l.name << "_surface_force_N," << l.name << "_damping_force_N," << l.name
+        << "_deformed_rings";
+  csv << '\n';
+  for (const TickResult& t : run.ticks) {
+    csv << fmt(t.time_s) << ',' << fmt(t.depth_m / kMm) << ',' << fmt(t.velocity_m_per_s / kMm) << ','
+        << fmt(t.total_force_N);
+    for (const LayerTickResult& l : t.layers)
+      csv << ',' << to_string(l.state) << ',' << fmt(l.surface_force_N) << ',' << fmt(l.damping_force_N) << ','
+          << l.deformed_rings;
+    csv << '\n';
+  }
+  return csv.str();
+}
+
+/// sh_fit_error.csv: the SH degree accuracy knob, per layer.
+std::string fit_error_csv(const std::vector<LayerFitErrorEntry>& rows) {
+  std::ostringstream csv;
+  csv << "layer,degree,top_face_max_error_mm,top_face_rms_error_mm,whole_surface_rms_error_mm,condition_number\n";
+  for (const auto& e : rows)
+    csv << e.layer << ',' << e.row.degree << ',' << fmt(e.row.top_face_max_error_m / kMm, 6) << ','
+        << fmt(e.row.top_face_rms_error_m / kMm, 6) << ',' << fmt(e.row.whole_surface_rms_error_m / kMm, 6) << ','
+        << fmt(e.row.condition_number, 6) << '\n';
+  return csv.str();
+}
+
+/// Writes the surfaces and force meshes of every layer for one frame.
+class FrameWriter {
+ public:
+  FrameWriter(io::OutputSession& session, const RealtimeModel& model, const Scene& scene)
+      : session_(session), scene_(scene) {
+    for (const LayerSurface* s : model.surfaces) {
+      Eigen::MatrixX3d v;
+      Eigen::MatrixX3i t;
+      s->tessellate(kSurfaceBandsTheta, kSurfaceAzimuths, v, t);
+      rest_vertices_.push_back(v);
+      triangles_.push_back(t);
+    }
+  }
+
+  void write(const PunctureSimulator& sim, const TickResult& tick, int frame) {
+    char index[16];
+    std::snprintf(index, sizeof index, "%04d", frame);
+    const std::size_t n_layers = sim.layer_count();
+    for (std::size_t k = 0; k < n_layers; ++k) {
+      const std::string& name = scene_.layers[k].name;
+      const double state = static_cast<double>(tick.layers[k].state);
+      // Layer surface: SH surface displaced by the force-mesh displacement field.
+      Eigen::MatrixX3d vertices = rest_vertices_[k];
+      Eigen::VectorXd deflection = Eigen::VectorXd::Zero(vertices.rows());
+      const ForceMesh* mesh = sim.force_mesh(k);
+      if (mesh && mesh->node_count() > 0) {
+        const Eigen::Matrix3Xd displacement = sim.node_positions(k) - sim.node_rest_positions(k);
+        const LatticeDisplacementField field = LatticeDisplacementField::of(*mesh);
+        for (Eigen::Index i = 0; i < vertices.rows(); ++i) {
+          const Eigen::Vector3d p = vertices.row(i).transpose();
+          if (p.z() < layer_top_z(k) - 1e-9) continue;  // only the top face carries the force mesh
+          const Eigen::Vector3d d = field.displacement_at(p, displacement);
+          vertices.row(i) += d.transpose();
+          deflection[i] = -d.z() / kMm;
+        }
+      }
+      const std::string surface_file = "frames/" + name + "_surface_" + index + ".vtp";
+      io::write_polydata(session_, surface_file, vertices, triangles_[k],
+                         {{"deflection_mm", deflection},
+                          {"layer_state", Eigen::VectorXd::Constant(vertices.rows(), state)}},
+                         {});
+      entries_.push_back({tick.time_s, static_cast<int>(k), surface_file});
+
+      if (mesh && mesh->node_count() > 0) {
+        const Eigen::Matrix3Xd& pos = sim.node_positions(k);
+        const Eigen::MatrixX3d nodes = pos.transpose();
+        Eigen::VectorXd ring(mesh->node_count()), node_deflection(mesh->node_count());
+        const Eigen::Matrix3Xd disp = pos - sim.node_rest_positions(k);
+        for (int i = 0; i < mesh->node_count(); ++i) {
+          ring[i] = sim.node_rings(k)[static_cast<std::size_t>(i)];
+          node_deflection[i] = -disp(2, i) / kMm;
+        }
+        if (lattice_tris_.size() <= k) lattice_tris_.resize(n_layers);
+        if (lattice_tris_[k].rows() == 0) lattice_tris_[k] = lattice_triangles(mesh->lattice());
+        const std::string mesh_file = "frames/" + name + "_force_mesh_" + index + ".vtp";
+        io::write_polydata(session_, mesh_file, nodes, lattice_tris_[k],
+                           {{"ring", ring}, {"deflection_mm", node_deflection}}, {});
+        entries_.push_back({tick.time_s, static_cast<int>(n_layers + k), mesh_file});
+      }
+    }
+    ++frames_;
+  }
+
+  void finish() {
+    if (!entries_.empty()) io::write_pvd(session_, "realtime.pvd", entries_);
+  }
+  int frames() const { return frames_; }
+
+ private:
+  double layer_top_z(std::size_t k) const { return -scene_.layer_top_depth_m(k); }
+  io::OutputSession& session_;
+  const Scene& scene_;
+  std::vector<Eigen::MatrixX3d> rest_vertices_;
+  std::vector<Eigen::MatrixX3i> triangles_;
+  std::vector<Eigen::MatrixX3i> lattice_tris_;
+  std::vector<io::PvdEntry> entries_;
+  int frames_ = 0;
+};
+
+nlohmann::json summary_json(const Scene& scene, const RealtimeModel& model, const ScriptedRunResult& run,
+                            const std::string& command_line) {
+  nlohmann::json j;
+  j["provenance"] = provenance_json(command_line);
+  j["scene"] = {{"name", scene.name}, {"file", scene.source_path}};
+  j["settings"] = nlohmann::json::parse(scene_to_json_text(scene));
+  nlohmann::json events = nlohmann::json::array();
+  for (const PunctureEvent& e : run.events)
+    events.push_back({{"layer", std::string(e.layer_name)},
+                      {"time_s", e.time_s},
+                      {"depth_mm", e.depth_m / kMm},
+                      {"surface_force_N", e.surface_force_N},
+                      {"total_force_N", e.total_force_N}});
+  j["puncture_events"] = events;
+  double peak = 0.0, peak_depth = 0.0;
+  std::vector<double> layer_peak(scene.layers.size(), 0.0);
+  for (const TickResult& t : run.ticks) {
+    if (std::abs(t.total_force_N) > std::abs(peak)) peak = t.total_force_N, peak_depth = t.depth_m;
+    for (std::size_t k = 0; k < t.layers.size(); ++k)
+      layer_peak[k] = std::max(layer_peak[k], t.layers[k].surface_force_N);
+  }
+  j["peak_force_N"] = peak;
+  j["peak_force_depth_mm"] = peak_depth / kMm;
+  nlohmann::json layers = nlohmann::json::array();
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    const LayerSurfaceFitInfo& f = model.fits[k];
+    layers.push_back({{"name", scene.layers[k].name},
+                      {"peak_surface_force_N", layer_peak[k]},
+                      {"final_state", to_string(run.ticks.empty() ? LayerState::Untouched : run.ticks.back().layers[k].state)},
+                      {"sh_degree", f.degree},
+                      {"sh_top_face_max_error_mm", f.top_face_max_error_m / kMm},
+                      {"sh_fit_condition_number", f.report.condition_number}});
+  }
+  j["layers"] = layers;
+  std::vector<double> us(run.tick_wall_time_s.size());
+  std::transform(run.tick_wall_time_s.begin(), run.tick_wall_time_s.end(), us.begin(), [](double s) { return s * 1e6; });
+  j["tick_timing_us"] = {{"median", median(us)}, {"p99", quantile(us, 0.99)}, {"ticks", us.size()},
+                         {"note", "wall time of tick() measured inside this run; see results/ for benchmarks"}};
+  j["time_step_s"] = run.time_step_s;
+  return j;
+}
+
+}  // namespace
+
+int run_command(const RunOptions& options, std::ostream& out, std::ostream& err) {
+  const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
+  try {
+    const Scene scene = load_scene(scene_path);
+    const std::filesystem::path dir =
+        options.output_dir.empty() ? std::filesystem::path("out") / scene.name : options.output_dir;
+    if (!options.quiet) out << "[run] scene " << scene_path.string() << " (" << scene.layers.size() << " layers, SH degree "
+                            << scene.realtime.sh_degree << ", integrator " << scene.realtime.integrator << ")\n";
+
+    RealtimeModel model = build_realtime_model(scene);
+    io::OutputSession session(dir);
+
+    std::vector<int> degrees{4, 8, 12, 16, 24, 32};
+    if (std::find(degrees.begin(), degrees.end(), scene.realtime.sh_degree) == degrees.end())
+      degrees.push_back(scene.realtime.sh_degree);
+    std::sort(degrees.begin(), degrees.end());
+    session.write_text("sh_fit_error.csv", fit_error_csv(scene_fit_error_sweep(scene, degrees)));
+
+    const bool frames = options.write_frames && scene.effects.surface_output;
+    std::optional<FrameWriter> writer;
+    if (frames) writer.emplace(session, model, scene);
+    FrameCallback on_frame;
+    if (writer) on_frame = [&](const PunctureSimulator& sim, const TickResult& t, int f) { writer->write(sim, t, f); };
+    ProgressCallback on_progress;
+    if (!options.quiet)
+      on_progress = [&](double f) { out << "[run] " << std::setw(3) << static_cast<int>(std::lround(100 * f)) << " %\n" << std::flush; };
+
+    const ScriptedRunResult run = run_scripted_insertion(model, scene, on_frame, on_progress);
+    if (writer) writer->finish();
+
+    session.write_text("realtime_curve.csv", curve_csv(scene, run));
+    const std::string command_line = "puncture run " + scene_path.string() + " -o " + dir.string();
+    session.write_text("summary.json", summary_json(scene, model, run, command_line).dump(2) + "\n");
+    session.commit();
+
+    out << "\nPuncture events (" << run.events.size() << "):\n";
+    for (const PunctureEvent& e : run.events)
+      out << "  " << std::left << std::setw(8) << e.layer_name << std::right << " t = " << std::fixed
+          << std::setprecision(3) << e.time_s << " s   depth = " << std::setprecision(2) << e.depth_m / kMm
+          << " mm   surface force = " << std::setprecision(3) << e.surface_force_N << " N   needle force = "
+          << e.total_force_N << " N\n";
+    out.unsetf(std::ios::floatfield);
+    out << "\nOutputs in " << dir.string() << "/:\n"
+        << "  realtime_curve.csv  force, depth, per-layer states and forces per haptic tick\n"
+        << "  summary.json        puncture events, peak forces, SH fit, tick timing, settings\n"
+        << "  sh_fit_error.csv    SH surface fit error versus degree l\n";
+    if (writer)
+      out << "  realtime.pvd        " << writer->frames() << " frames of layer surfaces and force meshes (open in ParaView)\n";
+    return 0;
+  } catch (const SceneError& e) {
+    err << "error: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    err << "error: " << scene_path.string() << ": " << e.what() << '\n';
+    return 1;
+  }
+}
+
+}  // namespace puncture::apps
