@@ -28,8 +28,8 @@ struct ForceMeshParams {
   double virtual_stiffness_N_per_m = 160.0;  ///< K: virtual spring per node, along the normal
   int rings_w = 8;                           ///< w: number of concentric hexagonal rings (ring 1 = contact node)
   double spacing_L_m = 2e-3;                 ///< L: rest length of the surface springs
-  double surface_stiffness_N_per_m = 50.0;   ///< k_s: out-of-plane (membrane) stiffness of one surface spring
-  double deformed_threshold_m = 0.2e-3;      ///< a ring counts as deformed when its mean deflection exceeds this
+  double surface_stiffness_N_per_m = 200.0;  ///< k_s: out-of-plane (membrane) stiffness of one surface spring
+  double deformed_threshold_m = 0.01e-3;     ///< a ring counts as deformed when its mean deflection exceeds this
   double node_damping_N_s_per_m = 0.05;      ///< viscous damping of each node (dynamics of the mesh)
 };
 

@@ -17,12 +17,15 @@ Eigen::MatrixX3i lattice_triangles(const HexLattice& lattice) {
     return grid[(q + w - 1) * side + r + w - 1];
   };
   std::vector<Eigen::Vector3i> tris;
-  for (int i = 0; i < lattice.node_count(); ++i) {
-    const int q = lattice.axial[i].x(), r = lattice.axial[i].y();
-    // Up triangle (q,r),(q+1,r),(q,r+1) and down triangle (q+1,r),(q+1,r+1),(q,r+1).
-    const int a = at(q + 1, r), b = at(q, r + 1), c = at(q + 1, r + 1);
-    if (a >= 0 && b >= 0) tris.emplace_back(i, a, b);
-    if (a >= 0 && b >= 0 && c >= 0) tris.emplace_back(a, c, b);
+  // Anchor (q, r) runs over the whole square of axial coordinates: a down
+  // triangle can exist where its anchor is not a node.
+  for (int q = -w; q <= w - 1; ++q) {
+    for (int r = -w; r <= w - 1; ++r) {
+      // Up triangle (q,r),(q+1,r),(q,r+1) and down triangle (q+1,r),(q+1,r+1),(q,r+1).
+      const int o = at(q, r), a = at(q + 1, r), b = at(q, r + 1), c = at(q + 1, r + 1);
+      if (o >= 0 && a >= 0 && b >= 0) tris.emplace_back(o, a, b);
+      if (a >= 0 && b >= 0 && c >= 0) tris.emplace_back(a, c, b);
+    }
   }
   Eigen::MatrixX3i out(static_cast<Eigen::Index>(tris.size()), 3);
   for (std::size_t t = 0; t < tris.size(); ++t) out.row(static_cast<Eigen::Index>(t)) = tris[t].transpose();
