@@ -1,0 +1,157 @@
+// Needle insertion on coarse slabs: indentation stiffness against Sneddon's
+// flat punch, puncture sequence with spring-back, output files, hard cases.
+#include <deal.II/base/mpi.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "fem_test_scenes.hpp"
+
+using namespace puncture;
+using namespace puncture::fem;
+using namespace puncture::fem::testing;
+
+namespace {
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  const auto dir = std::filesystem::path(PUNCTURE_BINARY_DIR) / "test_output" / name;
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+FemRunOptions quiet_options(const std::string& dir) {
+  FemRunOptions o;
+  o.output_dir = dir;
+  o.mesh = coarse_mesh();
+  o.verbose = false;
+  o.write_files = !dir.empty();
+  o.write_vtu = false;
+  return o;
+}
+
+}  // namespace
+
+TEST(NeedleInsertion, SmallIndentationStiffnessMatchesSneddonFlatPunch) {
+  // One thick layer (h = 20 a, sample radius 16 a): the initial slope of the
+  // force-depth curve of a rigid flat cylinder of radius a is Sneddon's
+  // 2 E a / (1 - nu^2) (half-space, frictionless). The bonded punch, finite
+  // layer and the coarse mesh stiffen it a little: expect +0..20 %.
+  Scene s;
+  s.name = "sneddon";
+  const double a = 0.635e-3, E = 1e4, nu = 0.45;
+  s.sample.diameter_m = 32 * a;
+  // Two layers of the same material: the thin top one only grades the mesh
+  // (element height about a/3 under the punch, growing downward).
+  s.layers = {make_layer("top", 0.5e-3, E, nu, 1e9), make_layer("bulk", 20 * a - 0.5e-3, E, nu, 1e9)};
+  s.needle.radius_m = a;
+  s.insertion.start_height_m = 0.0;
+  s.insertion.target_depth_m = 0.04e-3;
+  s.fem.load_step_m = 0.02e-3;
+  FemRunOptions o = quiet_options("");
+  o.mesh.sectors = 12;
+  o.mesh.radial_grading = 1.3;
+  o.mesh.elements_through_skin = 2;
+  o.mesh.thickness_grading = 1.3;
+  const FemRunSummary r = run_needle_insertion(s, o, MPI_COMM_WORLD);
+  ASSERT_GE(r.depth_m.size(), 2u);
+  const double slope = r.force_N.back() / r.depth_m.back();
+  const double sneddon = 2.0 * E * a / (1.0 - nu * nu);
+  EXPECT_GT(slope, 0.97 * sneddon);
+  EXPECT_LT(slope, 1.25 * sneddon);
+}
+
+TEST(NeedleInsertion, PuncturesSkinThenFatWithSpringBackAndWritesFiles) {
+  const Scene s = small_three_layer_scene();
+  const auto dir = fresh_dir("three_layers");
+  FemRunOptions o = quiet_options(dir.string());
+  o.write_vtu = true;
+  o.stop_depth_m = 3.0e-3;
+  const FemRunSummary r = run_needle_insertion(s, o, MPI_COMM_WORLD);
+
+  // No force before the tip reaches the skin; finite forces everywhere.
+  for (std::size_t i = 0; i < r.depth_m.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(r.force_N[i]));
+    if (r.depth_m[i] < 0.0) EXPECT_EQ(r.force_N[i], 0.0);
+  }
+  ASSERT_GE(r.punctures.size(), 2u);
+  EXPECT_EQ(r.punctures[0].layer_name, "skin");
+  EXPECT_EQ(r.punctures[1].layer_name, "fat");
+  EXPECT_GE(r.punctures[0].force_N, s.layers[0].puncture.critical_force_N);
+  EXPECT_GE(r.punctures[1].force_N, s.layers[1].puncture.critical_force_N);
+  EXPECT_LT(r.punctures[1].depth_m, 3.0e-3 + 1e-12);
+  EXPECT_GT(r.punctures[1].depth_m, r.punctures[0].depth_m);
+  // The force drops at breakthrough (the skin's resistance is gone).
+  EXPECT_LT(r.punctures[0].force_after_N, 0.8 * r.punctures[0].force_N);
+  // Before the skin breaks, the force grows with depth.
+  for (std::size_t i = 1; i < r.depth_m.size() && r.depth_m[i] < r.punctures[0].depth_m; ++i)
+    if (r.depth_m[i] > 0.0) EXPECT_GT(r.force_N[i], r.force_N[i - 1]);
+
+  // Files: CSV header, summary JSON, recovery profile, VTU series.
+  std::ifstream csv(dir / "fem_force_depth.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "time_s,depth_mm,velocity_mm_per_s,force_N,skin_state,fat_state,muscle_state");
+  std::ifstream js(dir / "fem_summary.json");
+  const auto j = nlohmann::json::parse(js);
+  EXPECT_EQ(j["status"], "completed");
+  EXPECT_EQ(j["punctures"].size(), r.punctures.size());
+  EXPECT_TRUE(std::filesystem::exists(dir / "fem_fields.pvd"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "fem_surface_profile.csv"));
+  std::ifstream rec(dir / "fem_recovery_profile.csv");
+  std::string line;
+  int before = 0, after = 0;
+  double uz_axis_before = 0.0, uz_axis_after = 0.0;
+  std::getline(rec, line);
+  while (std::getline(rec, line)) {
+    std::stringstream ss(line);
+    std::string layer, phase, depth, r_mm, uz;
+    std::getline(ss, layer, ',');
+    std::getline(ss, phase, ',');
+    std::getline(ss, depth, ',');
+    std::getline(ss, r_mm, ',');
+    std::getline(ss, uz, ',');
+    if (layer != "0") continue;
+    // At the needle edge r = a the skin surface rises after breakthrough.
+    if (std::abs(std::stod(r_mm) - 0.635) < 1e-6) {
+      if (phase == "before") uz_axis_before = std::stod(uz), ++before;
+      if (phase == "after") uz_axis_after = std::stod(uz), ++after;
+    }
+  }
+  EXPECT_EQ(before, 1);
+  EXPECT_EQ(after, 1);
+  EXPECT_GT(uz_axis_after, uz_axis_before);
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    EXPECT_NE(e.path().extension(), ".part") << e.path();
+}
+
+TEST(NeedleInsertion, HardCaseThinSkinNearlyIncompressibleDeepIndentationStaysFinite) {
+  // Thin skin (0.8 mm) on thick muscle, nu = 0.499, indentation to 2.5 mm
+  // (three skin thicknesses) without puncture: converges (cutting steps if
+  // needed) with finite, increasing forces.
+  Scene s;
+  s.name = "hard_case";
+  s.sample.diameter_m = 0.016;
+  s.layers = {make_layer("skin", 0.8e-3, 1e5, 0.499, 1e9), make_layer("muscle", 8e-3, 1e4, 0.499, 1e9)};
+  s.insertion.start_height_m = 0.0;
+  s.insertion.target_depth_m = 2.5e-3;
+  s.fem.load_step_m = 0.5e-3;
+  const FemRunSummary r = run_needle_insertion(s, quiet_options(""), MPI_COMM_WORLD);
+  ASSERT_FALSE(r.force_N.empty());
+  EXPECT_NEAR(r.depth_m.back(), 2.5e-3, 1e-12);
+  for (std::size_t i = 1; i < r.force_N.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(r.force_N[i]));
+    EXPECT_GT(r.force_N[i], r.force_N[i - 1]);
+  }
+  EXPECT_TRUE(r.punctures.empty());
+}
+
+TEST(NeedleInsertion, RejectsObliqueInsertion) {
+  Scene s = small_three_layer_scene();
+  s.insertion.angle_deg = 10.0;
+  EXPECT_THROW(run_needle_insertion(s, quiet_options(""), MPI_COMM_WORLD), std::invalid_argument);
+}
