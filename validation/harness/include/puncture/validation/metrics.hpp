@@ -1,0 +1,159 @@
+// metrics.hpp: insertion curves (force against depth) and how far a model's
+// curve lies from a reference curve.
+//
+// InsertionCurve: one sample per row, SI units inside. Read from a CSV file
+// with one reader for the real-time model's realtime_curve.csv, the FEM's
+// fem_force_depth.csv and a MEASURED insertion curve:
+//   * optional metadata lines at the top, "# key: value" (e.g.
+//     "# needle_gauge: 18", "# speed_mm_per_s: 10", "# source: ..."),
+//     kept in InsertionCurve::metadata; other lines starting with '#' are
+//     comments;
+//   * a header line; required columns time_s, depth_mm, velocity_mm_per_s,
+//     force_N (any order); optional columns <layer>_state with values
+//     untouched | pressed | punctured; every other column is ignored;
+//   * one row per sample. Depth is the tip depth below the undeformed skin
+//     surface (positive down), velocity > 0 while inserting, force > 0 when
+//     it resists insertion.
+// Every problem throws CurveFormatError naming file, line and column.
+//
+// Comparison (compare_curves, model against reference):
+//   * only the INSERTION phase is compared: samples with velocity > 0 up to
+//     the deepest sample; depths must increase strictly in that phase;
+//   * the model force is interpolated piecewise linearly at the reference
+//     depths; reference samples outside the model's depth range are skipped
+//     (CurveComparison::n_compared counts the ones used);
+//   * per layer (matched by name): the pressed interval is the depth range
+//     where the reference's <layer>_state is "pressed" (the model's states
+//     when the reference has none); force RMSE inside it (N, and relative to
+//     the reference peak force); the puncture event of a curve is the first
+//     insertion sample whose state is "punctured": its depth, and as its force
+//     the maximum force over that layer's pressed samples just before it.
+#pragma once
+
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "puncture/model/realtime_model.hpp"
+#include "puncture/puncture_force.hpp"
+#include "puncture/scene.hpp"
+
+namespace puncture::validation {
+
+class CurveFormatError : public std::runtime_error {
+ public:
+  CurveFormatError(const std::string& file, int line, const std::string& column, const std::string& what);
+  const std::string& file() const { return file_; }
+  int line() const { return line_; }            ///< 1-based, 0 when not tied to a line
+  const std::string& column() const { return column_; }  ///< column name, empty when not tied to one
+
+ private:
+  std::string file_;
+  int line_;
+  std::string column_;
+};
+
+struct InsertionCurve {
+  std::string source;                              ///< file name or a description
+  std::string content_hash;                        ///< FNV-1a 64 of the file bytes (hex), empty if not from a file
+  std::map<std::string, std::string> metadata;     ///< "# key: value" lines
+  std::vector<double> time_s;
+  std::vector<double> depth_m;
+  std::vector<double> velocity_m_per_s;
+  std::vector<double> force_N;
+  std::vector<std::string> layer_names;            ///< from the <layer>_state columns, file order
+  std::vector<std::vector<LayerState>> layer_states;  ///< [layer][sample]
+
+  std::size_t size() const { return time_s.size(); }
+  bool has_layer_states() const { return !layer_names.empty(); }
+  /// Index into layer_names, or -1.
+  int layer_index(const std::string& name) const;
+  /// Metadata value as a number (throws CurveFormatError if present but not a number).
+  bool metadata_number(const std::string& key, double& value) const;
+};
+
+InsertionCurve read_insertion_curve(const std::filesystem::path& path);
+InsertionCurve parse_insertion_curve(const std::string& text, const std::string& source_name);
+/// The curve of a real-time run (total force, per-layer states).
+InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, const std::string& source = "realtime");
+/// CSV text in the reader's schema (depth and velocity in mm, states), metadata first.
+std::string insertion_curve_csv(const InsertionCurve& curve);
+
+/// Indices of the insertion-phase samples (velocity > 0, up to the deepest
+/// sample). Throws CurveFormatError (with the sample's time) if depth does not
+/// increase strictly there, or if the phase is empty.
+std::vector<std::size_t> insertion_phase(const InsertionCurve& curve);
+
+/// Piecewise-linear interpolation y(x) on strictly increasing x; false if
+/// query lies outside [x.front(), x.back()].
+bool interpolate_linear(const std::vector<double>& x, const std::vector<double>& y, double query, double& value);
+
+struct PunctureEventMetrics {
+  bool found = false;
+  double depth_m = 0.0;
+  double force_N = 0.0;
+};
+
+struct LayerMetrics {
+  std::string layer;
+  bool has_pressed_interval = false;
+  double pressed_from_depth_m = 0.0;
+  double pressed_to_depth_m = 0.0;
+  std::size_t n_samples = 0;               ///< compared samples inside the pressed interval
+  double force_rmse_N = 0.0;
+  double force_rmse_relative = 0.0;        ///< force_rmse_N / reference peak force
+  PunctureEventMetrics reference_puncture;
+  PunctureEventMetrics model_puncture;
+  double puncture_depth_error_m = 0.0;     ///< model - reference (0 unless both punctured)
+  double puncture_force_error_N = 0.0;     ///< model - reference (0 unless both punctured)
+};
+
+struct CurveComparison {
+  std::size_t n_compared = 0;
+  double reference_peak_force_N = 0.0;     ///< max |force| over the reference insertion phase
+  double force_rmse_N = 0.0;               ///< over all compared samples
+  double force_rmse_relative = 0.0;
+  double compared_from_depth_m = 0.0;
+  double compared_to_depth_m = 0.0;
+  std::vector<LayerMetrics> layers;        ///< one per layer name found in either curve (reference order first)
+  const LayerMetrics* layer(const std::string& name) const;
+};
+
+/// max_depth_m: compare only reference samples not deeper than this.
+CurveComparison compare_curves(const InsertionCurve& model, const InsertionCurve& reference,
+                               double max_depth_m = std::numeric_limits<double>::infinity());
+
+/// Puncture event of one layer on a curve (see the header comment).
+PunctureEventMetrics puncture_event(const InsertionCurve& curve, const std::string& layer);
+
+// ---------------------------------------------------------------------------
+// Deflection profile of a layer surface at one needle depth.
+// Model side: the force mesh's ring deflections dZ_j (m, positive INTO the
+// tissue, j = 1..w) at ring radii r_j = (j - 1) L. Reference side: u_z(r) of
+// the surface (m, z up, so the deflection into the tissue is -u_z) at radii r
+// (strictly increasing). Rings outside the reference radii are skipped.
+struct RadialProfile {
+  int step = 0;
+  double depth_m = 0.0;
+  std::vector<double> r_m;
+  std::vector<double> uz_m;
+};
+struct DeflectionProfileError {
+  std::size_t n_rings = 0;              ///< rings compared
+  double rmse_m = 0.0;
+  double max_abs_error_m = 0.0;
+  double relative_rmse = 0.0;           ///< rmse / max reference deflection over the compared rings
+};
+DeflectionProfileError deflection_profile_error(const std::vector<double>& ring_deflection_m, double spacing_L_m,
+                                                const RadialProfile& reference);
+
+/// fem_surface_profile.csv (columns step, depth_mm, r_mm, uz_mm): one profile per step.
+std::vector<RadialProfile> read_surface_profiles(const std::filesystem::path& path);
+std::vector<RadialProfile> parse_surface_profiles(const std::string& text, const std::string& source_name);
+/// The profile whose depth is nearest to depth_m (throws std::invalid_argument if none).
+const RadialProfile& profile_nearest_depth(const std::vector<RadialProfile>& profiles, double depth_m);
+
+}  // namespace puncture::validation

@@ -1,0 +1,420 @@
+#include "puncture/validation/metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "text_fields.hpp"
+
+namespace puncture::validation {
+
+namespace {
+
+constexpr double kMm = 1e-3;
+
+std::string read_file_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw CurveFormatError(path.string(), 0, "", "cannot open file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+bool parse_state(const std::string& text, LayerState& state) {
+  if (text == "untouched") state = LayerState::Untouched;
+  else if (text == "pressed") state = LayerState::Pressed;
+  else if (text == "punctured") state = LayerState::Punctured;
+  else return false;
+  return true;
+}
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s << std::setprecision(17) << x;
+  return s.str();
+}
+
+std::string describe_time(const InsertionCurve& c, std::size_t i) {
+  std::ostringstream s;
+  s << "sample " << i + 1 << " (time_s = " << c.time_s[i] << ")";
+  return s.str();
+}
+
+}  // namespace
+
+CurveFormatError::CurveFormatError(const std::string& file, int line, const std::string& column, const std::string& what)
+    : std::runtime_error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " +
+                         (column.empty() ? std::string() : "column '" + column + "': ") + what),
+      file_(file),
+      line_(line),
+      column_(column) {}
+
+int InsertionCurve::layer_index(const std::string& name) const {
+  for (std::size_t k = 0; k < layer_names.size(); ++k)
+    if (layer_names[k] == name) return static_cast<int>(k);
+  return -1;
+}
+
+bool InsertionCurve::metadata_number(const std::string& key, double& value) const {
+  const auto it = metadata.find(key);
+  if (it == metadata.end()) return false;
+  if (!detail::parse_finite(it->second, value))
+    throw CurveFormatError(source, 0, "", "metadata '" + key + "' is not a finite number: '" + it->second + "'");
+  return true;
+}
+
+InsertionCurve parse_insertion_curve(const std::string& text, const std::string& source_name) {
+  InsertionCurve curve;
+  curve.source = source_name;
+  std::istringstream in(text);
+  std::string raw;
+  int line_no = 0;
+  std::vector<std::string> header;
+  int col_time = -1, col_depth = -1, col_vel = -1, col_force = -1;
+  std::vector<int> state_cols;
+  bool in_preamble = true;
+  while (std::getline(in, raw)) {
+    ++line_no;
+    const std::string line = detail::trim(raw);
+    if (line.empty()) continue;
+    if (line[0] == '#') {
+      if (in_preamble) {
+        const std::string body = detail::trim(line.substr(1));
+        const auto colon = body.find(':');
+        if (colon != std::string::npos && colon > 0) {
+          const std::string key = detail::trim(body.substr(0, colon));
+          if (key.find(' ') == std::string::npos) curve.metadata[key] = detail::trim(body.substr(colon + 1));
+        }
+      }
+      continue;
+    }
+    in_preamble = false;
+    const std::vector<std::string> fields = detail::split_csv_line(line);
+    if (header.empty()) {
+      header = fields;
+      for (std::size_t j = 0; j < header.size(); ++j) {
+        const std::string& h = header[j];
+        if (h.empty()) throw CurveFormatError(source_name, line_no, "", "empty column name in header (column " + std::to_string(j + 1) + ")");
+        for (std::size_t k = 0; k < j; ++k)
+          if (header[k] == h) throw CurveFormatError(source_name, line_no, h, "duplicate column name");
+        const int jj = static_cast<int>(j);
+        if (h == "time_s") col_time = jj;
+        else if (h == "depth_mm") col_depth = jj;
+        else if (h == "velocity_mm_per_s") col_vel = jj;
+        else if (h == "force_N") col_force = jj;
+        else if (h.size() > 6 && h.compare(h.size() - 6, 6, "_state") == 0) {
+          state_cols.push_back(jj);
+          curve.layer_names.push_back(h.substr(0, h.size() - 6));
+        }
+      }
+      const std::pair<int, const char*> required[] = {
+          {col_time, "time_s"}, {col_depth, "depth_mm"}, {col_vel, "velocity_mm_per_s"}, {col_force, "force_N"}};
+      for (const auto& [col, name] : required)
+        if (col < 0) throw CurveFormatError(source_name, line_no, name, "required column missing from the header");
+      curve.layer_states.resize(state_cols.size());
+      continue;
+    }
+    if (fields.size() != header.size())
+      throw CurveFormatError(source_name, line_no, "",
+                             "expected " + std::to_string(header.size()) + " fields, got " + std::to_string(fields.size()));
+    auto number = [&](int col, double scale) {
+      double v = 0.0;
+      if (!detail::parse_finite(fields[static_cast<std::size_t>(col)], v))
+        throw CurveFormatError(source_name, line_no, header[static_cast<std::size_t>(col)],
+                               "not a finite number: '" + fields[static_cast<std::size_t>(col)] + "'");
+      return v * scale;
+    };
+    curve.time_s.push_back(number(col_time, 1.0));
+    curve.depth_m.push_back(number(col_depth, kMm));
+    curve.velocity_m_per_s.push_back(number(col_vel, kMm));
+    curve.force_N.push_back(number(col_force, 1.0));
+    for (std::size_t k = 0; k < state_cols.size(); ++k) {
+      LayerState s;
+      const std::string& f = fields[static_cast<std::size_t>(state_cols[k])];
+      if (!parse_state(f, s))
+        throw CurveFormatError(source_name, line_no, header[static_cast<std::size_t>(state_cols[k])],
+                               "layer state must be untouched, pressed or punctured (got '" + f + "')");
+      curve.layer_states[k].push_back(s);
+    }
+    if (curve.size() >= 2 && !(curve.time_s.back() > curve.time_s[curve.size() - 2]))
+      throw CurveFormatError(source_name, line_no, "time_s", "time must increase strictly");
+  }
+  if (header.empty()) throw CurveFormatError(source_name, 0, "", "no header line");
+  if (curve.size() == 0) throw CurveFormatError(source_name, 0, "", "no data rows");
+  return curve;
+}
+
+InsertionCurve read_insertion_curve(const std::filesystem::path& path) {
+  const std::string bytes = read_file_bytes(path);
+  InsertionCurve c = parse_insertion_curve(bytes, path.string());
+  c.content_hash = detail::fnv1a64_hex(bytes);
+  return c;
+}
+
+InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, const std::string& source) {
+  InsertionCurve c;
+  c.source = source;
+  for (const Layer& l : scene.layers) c.layer_names.push_back(l.name);
+  c.layer_states.resize(scene.layers.size());
+  const std::size_t n = run.ticks.size();
+  c.time_s.reserve(n), c.depth_m.reserve(n), c.velocity_m_per_s.reserve(n), c.force_N.reserve(n);
+  for (auto& s : c.layer_states) s.reserve(n);
+  for (const TickResult& t : run.ticks) {
+    c.time_s.push_back(t.time_s);
+    c.depth_m.push_back(t.depth_m);
+    c.velocity_m_per_s.push_back(t.velocity_m_per_s);
+    c.force_N.push_back(t.total_force_N);
+    for (std::size_t k = 0; k < c.layer_states.size() && k < t.layers.size(); ++k)
+      c.layer_states[k].push_back(t.layers[k].state);
+  }
+  return c;
+}
+
+std::string insertion_curve_csv(const InsertionCurve& curve) {
+  std::ostringstream csv;
+  for (const auto& [k, v] : curve.metadata) csv << "# " << k << ": " << v << '\n';
+  csv << "time_s,depth_mm,velocity_mm_per_s,force_N";
+  for (const auto& name : curve.layer_names) csv << ',' << name << "_state";
+  csv << '\n';
+  for (std::size_t i = 0; i < curve.size(); ++i) {
+    csv << fmt(curve.time_s[i]) << ',' << fmt(curve.depth_m[i] / kMm) << ',' << fmt(curve.velocity_m_per_s[i] / kMm)
+        << ',' << fmt(curve.force_N[i]);
+    for (const auto& states : curve.layer_states) csv << ',' << to_string(states[i]);
+    csv << '\n';
+  }
+  return csv.str();
+}
+
+std::vector<std::size_t> insertion_phase(const InsertionCurve& curve) {
+  if (curve.size() == 0) throw CurveFormatError(curve.source, 0, "", "empty curve");
+  const std::size_t deepest = static_cast<std::size_t>(
+      std::max_element(curve.depth_m.begin(), curve.depth_m.end()) - curve.depth_m.begin());
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i <= deepest; ++i) {
+    if (!(curve.velocity_m_per_s[i] > 0.0)) continue;
+    if (!idx.empty() && !(curve.depth_m[i] > curve.depth_m[idx.back()]))
+      throw CurveFormatError(curve.source, 0, "depth_mm",
+                             "depth does not increase strictly during the insertion phase (velocity > 0) at " +
+                                 describe_time(curve, i));
+    idx.push_back(i);
+  }
+  if (idx.empty()) throw CurveFormatError(curve.source, 0, "velocity_mm_per_s", "no insertion phase (no sample with velocity > 0)");
+  return idx;
+}
+
+bool interpolate_linear(const std::vector<double>& x, const std::vector<double>& y, double query, double& value) {
+  if (x.empty() || x.size() != y.size() || !(query >= x.front()) || !(query <= x.back())) return false;
+  const auto it = std::upper_bound(x.begin(), x.end(), query);
+  if (it == x.end()) {
+    value = y.back();
+    return true;
+  }
+  const std::size_t hi = static_cast<std::size_t>(it - x.begin());
+  if (hi == 0) {
+    value = y.front();
+    return true;
+  }
+  const std::size_t lo = hi - 1;
+  const double t = (query - x[lo]) / (x[hi] - x[lo]);
+  value = y[lo] + t * (y[hi] - y[lo]);
+  return true;
+}
+
+PunctureEventMetrics puncture_event(const InsertionCurve& curve, const std::string& layer) {
+  PunctureEventMetrics e;
+  const int k = curve.layer_index(layer);
+  if (k < 0) return e;
+  const auto& states = curve.layer_states[static_cast<std::size_t>(k)];
+  const std::vector<std::size_t> phase = insertion_phase(curve);
+  for (std::size_t p = 0; p < phase.size(); ++p) {
+    if (states[phase[p]] != LayerState::Punctured) continue;
+    e.found = true;
+    e.depth_m = curve.depth_m[phase[p]];
+    // Maximum force over the contiguous pressed samples just before the event;
+    // the previous sample's force if the layer broke without a pressed sample.
+    double peak = -std::numeric_limits<double>::infinity();
+    std::size_t q = p;
+    while (q > 0 && states[phase[q - 1]] == LayerState::Pressed) peak = std::max(peak, curve.force_N[phase[--q]]);
+    if (!std::isfinite(peak)) peak = curve.force_N[phase[p > 0 ? p - 1 : p]];
+    e.force_N = peak;
+    return e;
+  }
+  return e;
+}
+
+const LayerMetrics* CurveComparison::layer(const std::string& name) const {
+  for (const auto& l : layers)
+    if (l.layer == name) return &l;
+  return nullptr;
+}
+
+CurveComparison compare_curves(const InsertionCurve& model, const InsertionCurve& reference, double max_depth_m) {
+  const std::vector<std::size_t> ref_phase = insertion_phase(reference);
+  const std::vector<std::size_t> mod_phase = insertion_phase(model);
+  std::vector<double> mx, my;
+  mx.reserve(mod_phase.size()), my.reserve(mod_phase.size());
+  for (std::size_t i : mod_phase) mx.push_back(model.depth_m[i]), my.push_back(model.force_N[i]);
+
+  CurveComparison out;
+  for (std::size_t i : ref_phase) out.reference_peak_force_N = std::max(out.reference_peak_force_N, std::abs(reference.force_N[i]));
+
+  // Errors at every compared reference sample.
+  std::vector<std::size_t> compared;  // reference sample indices
+  std::vector<double> error;
+  double sq = 0.0;
+  for (std::size_t i : ref_phase) {
+    if (reference.depth_m[i] > max_depth_m) continue;
+    double f = 0.0;
+    if (!interpolate_linear(mx, my, reference.depth_m[i], f)) continue;
+    compared.push_back(i);
+    error.push_back(f - reference.force_N[i]);
+    sq += error.back() * error.back();
+  }
+  out.n_compared = compared.size();
+  if (!compared.empty()) {
+    out.force_rmse_N = std::sqrt(sq / static_cast<double>(compared.size()));
+    out.compared_from_depth_m = reference.depth_m[compared.front()];
+    out.compared_to_depth_m = reference.depth_m[compared.back()];
+  }
+  const double peak = out.reference_peak_force_N;
+  out.force_rmse_relative = peak > 0.0 ? out.force_rmse_N / peak : 0.0;
+
+  std::vector<std::string> names = reference.layer_names;
+  for (const auto& n : model.layer_names)
+    if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+  for (const std::string& name : names) {
+    LayerMetrics lm;
+    lm.layer = name;
+    const bool from_reference = reference.layer_index(name) >= 0;
+    const InsertionCurve& states_curve = from_reference ? reference : model;
+    const auto& states = states_curve.layer_states[static_cast<std::size_t>(states_curve.layer_index(name))];
+    const std::vector<std::size_t>& phase = from_reference ? ref_phase : mod_phase;
+    for (std::size_t i : phase) {
+      if (states[i] != LayerState::Pressed) continue;
+      const double d = states_curve.depth_m[i];
+      if (!lm.has_pressed_interval) lm.pressed_from_depth_m = lm.pressed_to_depth_m = d;
+      lm.has_pressed_interval = true;
+      lm.pressed_from_depth_m = std::min(lm.pressed_from_depth_m, d);
+      lm.pressed_to_depth_m = std::max(lm.pressed_to_depth_m, d);
+    }
+    if (lm.has_pressed_interval) {
+      double s = 0.0;
+      for (std::size_t c = 0; c < compared.size(); ++c) {
+        const double d = reference.depth_m[compared[c]];
+        if (d < lm.pressed_from_depth_m || d > lm.pressed_to_depth_m) continue;
+        ++lm.n_samples;
+        s += error[c] * error[c];
+      }
+      if (lm.n_samples > 0) lm.force_rmse_N = std::sqrt(s / static_cast<double>(lm.n_samples));
+      lm.force_rmse_relative = peak > 0.0 ? lm.force_rmse_N / peak : 0.0;
+    }
+    lm.reference_puncture = puncture_event(reference, name);
+    lm.model_puncture = puncture_event(model, name);
+    if (lm.reference_puncture.found && lm.model_puncture.found) {
+      lm.puncture_depth_error_m = lm.model_puncture.depth_m - lm.reference_puncture.depth_m;
+      lm.puncture_force_error_N = lm.model_puncture.force_N - lm.reference_puncture.force_N;
+    }
+    out.layers.push_back(lm);
+  }
+  return out;
+}
+
+DeflectionProfileError deflection_profile_error(const std::vector<double>& ring_deflection_m, double spacing_L_m,
+                                                const RadialProfile& reference) {
+  if (!(spacing_L_m > 0.0) || !std::isfinite(spacing_L_m))
+    throw std::invalid_argument("deflection_profile_error: spacing L must be finite and > 0");
+  if (reference.r_m.size() != reference.uz_m.size() || reference.r_m.size() < 2)
+    throw std::invalid_argument("deflection_profile_error: the reference profile needs >= 2 (r, u_z) points of equal count");
+  for (std::size_t i = 1; i < reference.r_m.size(); ++i)
+    if (!(reference.r_m[i] > reference.r_m[i - 1]))
+      throw std::invalid_argument("deflection_profile_error: reference radii must increase strictly");
+  DeflectionProfileError e;
+  double sq = 0.0, ref_max = 0.0;
+  for (std::size_t j = 0; j < ring_deflection_m.size(); ++j) {
+    if (!std::isfinite(ring_deflection_m[j]))
+      throw std::invalid_argument("deflection_profile_error: non-finite ring deflection at ring " + std::to_string(j + 1));
+    const double r = static_cast<double>(j) * spacing_L_m;
+    double uz = 0.0;
+    if (!interpolate_linear(reference.r_m, reference.uz_m, r, uz)) continue;
+    const double ref_deflection = -uz;
+    const double diff = ring_deflection_m[j] - ref_deflection;
+    sq += diff * diff;
+    e.max_abs_error_m = std::max(e.max_abs_error_m, std::abs(diff));
+    ref_max = std::max(ref_max, std::abs(ref_deflection));
+    ++e.n_rings;
+  }
+  if (e.n_rings > 0) e.rmse_m = std::sqrt(sq / static_cast<double>(e.n_rings));
+  e.relative_rmse = ref_max > 0.0 ? e.rmse_m / ref_max : 0.0;
+  return e;
+}
+
+std::vector<RadialProfile> parse_surface_profiles(const std::string& text, const std::string& source_name) {
+  std::istringstream in(text);
+  std::string raw;
+  int line_no = 0;
+  std::vector<std::string> header;
+  int c_step = -1, c_depth = -1, c_r = -1, c_uz = -1;
+  std::vector<RadialProfile> out;
+  while (std::getline(in, raw)) {
+    ++line_no;
+    const std::string line = detail::trim(raw);
+    if (line.empty() || line[0] == '#') continue;
+    const auto fields = detail::split_csv_line(line);
+    if (header.empty()) {
+      header = fields;
+      for (std::size_t j = 0; j < header.size(); ++j) {
+        const int jj = static_cast<int>(j);
+        if (header[j] == "step") c_step = jj;
+        else if (header[j] == "depth_mm") c_depth = jj;
+        else if (header[j] == "r_mm") c_r = jj;
+        else if (header[j] == "uz_mm") c_uz = jj;
+      }
+      const std::pair<int, const char*> required[] = {{c_step, "step"}, {c_depth, "depth_mm"}, {c_r, "r_mm"}, {c_uz, "uz_mm"}};
+      for (const auto& [col, name] : required)
+        if (col < 0) throw CurveFormatError(source_name, line_no, name, "required column missing from the header");
+      continue;
+    }
+    if (fields.size() != header.size())
+      throw CurveFormatError(source_name, line_no, "",
+                             "expected " + std::to_string(header.size()) + " fields, got " + std::to_string(fields.size()));
+    auto number = [&](int col) {
+      double v = 0.0;
+      if (!detail::parse_finite(fields[static_cast<std::size_t>(col)], v))
+        throw CurveFormatError(source_name, line_no, header[static_cast<std::size_t>(col)],
+                               "not a finite number: '" + fields[static_cast<std::size_t>(col)] + "'");
+      return v;
+    };
+    const double step = number(c_step);
+    if (step != std::floor(step)) throw CurveFormatError(source_name, line_no, "step", "must be an integer");
+    const int s = static_cast<int>(step);
+    const double depth = number(c_depth) * kMm, r = number(c_r) * kMm, uz = number(c_uz) * kMm;
+    if (out.empty() || out.back().step != s) {
+      for (const auto& p : out)
+        if (p.step == s) throw CurveFormatError(source_name, line_no, "step", "rows of step " + std::to_string(s) + " are not contiguous");
+      out.push_back(RadialProfile{s, depth, {}, {}});
+    } else {
+      if (depth != out.back().depth_m) throw CurveFormatError(source_name, line_no, "depth_mm", "depth changes within one step");
+      if (!(r > out.back().r_m.back())) throw CurveFormatError(source_name, line_no, "r_mm", "radius must increase strictly within a step");
+    }
+    out.back().r_m.push_back(r);
+    out.back().uz_m.push_back(uz);
+  }
+  if (out.empty()) throw CurveFormatError(source_name, 0, "", "no profile rows");
+  return out;
+}
+
+std::vector<RadialProfile> read_surface_profiles(const std::filesystem::path& path) {
+  return parse_surface_profiles(read_file_bytes(path), path.string());
+}
+
+const RadialProfile& profile_nearest_depth(const std::vector<RadialProfile>& profiles, double depth_m) {
+  if (profiles.empty()) throw std::invalid_argument("profile_nearest_depth: no profiles");
+  const RadialProfile* best = &profiles.front();
+  for (const auto& p : profiles)
+    if (std::abs(p.depth_m - depth_m) < std::abs(best->depth_m - depth_m)) best = &p;
+  return *best;
+}
+
+}  // namespace puncture::validation
