@@ -1,0 +1,311 @@
+#!/usr/bin/env bash
+# Haptic-tick benchmarks: builds the Google Benchmark programs (Release, -j2)
+# if needed, runs them with 5 repetitions (medians), keeps the raw JSON and
+# writes results/benchmarks/tick_benchmarks.md (one table per benchmark
+# family: median time per tick in us, ratio to the default configuration,
+# and a header naming the command, machine, date and git revision).
+#
+# Usage: scripts/benchmarks.sh [extra Google Benchmark flags, e.g.
+#        --benchmark_filter=BM_tick_phase]
+# Env:   PUNCTURE_BENCH_BUILD_DIR  build directory (default ./build-bench)
+#        PUNCTURE_BENCH_OUT        output directory (default results/benchmarks)
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${PUNCTURE_BENCH_BUILD_DIR:-$root/build-bench}"
+out="${PUNCTURE_BENCH_OUT:-$root/results/benchmarks}"
+command_line="scripts/benchmarks.sh${*:+ $*}"
+
+if [[ ! -f "$build/CMakeCache.txt" ]]; then
+  cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPUNCTURE_WITH_FEM=OFF -DPUNCTURE_WITH_VTK=OFF \
+    -DPUNCTURE_BUILD_TESTS=ON -DPUNCTURE_BUILD_BENCHMARKS=ON
+fi
+build_type="$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "$build/CMakeCache.txt")"
+if [[ "$build_type" != "Release" ]]; then
+  echo "benchmarks.sh: $build is configured as '$build_type'; timings need a Release build" >&2
+  exit 1
+fi
+cmake --build "$build" -j2 --target bench_tick bench_effects
+
+mkdir -p "$out"
+common=(--benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+        --benchmark_out_format=json)
+for bench in bench_tick bench_effects; do
+  echo "== $bench"
+  "$build/tests/benchmarks/$bench" "${common[@]}" --benchmark_out="$out/$bench.json" "$@"
+done
+
+revision="$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+if [[ -n "$(git -C "$root" status --porcelain -- core tests/benchmarks scenes 2>/dev/null)" ]]; then
+  revision="$revision (+ uncommitted changes in core/, tests/benchmarks/ or scenes/)"
+fi
+
+python3 - "$out" "$command_line" "$revision" <<'PY'
+"""Turns the Google Benchmark JSON files into results/benchmarks/tick_benchmarks.md."""
+import datetime
+import json
+import os
+import socket
+import sys
+
+out_dir, command_line, revision = sys.argv[1], sys.argv[2], sys.argv[3]
+TO_US = {"ns": 1e-3, "us": 1.0, "ms": 1e3, "s": 1e6}
+
+
+def cpu_model():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return "unknown"
+
+
+rows = {}     # run_name -> {"median_us", "cv", counters...}
+contexts = []
+for name in ("bench_tick", "bench_effects"):
+    path = os.path.join(out_dir, name + ".json")
+    if not os.path.exists(path):
+        continue
+    with open(path) as f:
+        data = json.load(f)
+    contexts.append(data.get("context", {}))
+    for b in data["benchmarks"]:
+        if b.get("error_occurred"):
+            rows.setdefault(b["run_name"], {})["error"] = b.get("error_message", "error")
+            continue
+        agg = b.get("aggregate_name")
+        r = rows.setdefault(b["run_name"], {})
+        t_us = b["real_time"] * TO_US[b.get("time_unit", "ns")]
+        if agg == "median":
+            r["median_us"] = t_us
+            r["median_cpu_us"] = b["cpu_time"] * TO_US[b.get("time_unit", "ns")]
+            for key, value in b.items():
+                if key in ("phase_ticks", "punctures", "mesh_nodes_all_layers", "ticks_per_insertion") or \
+                        (key.endswith("_us") and isinstance(value, (int, float))):
+                    r["counter:" + key] = value
+        elif agg == "mean":
+            r["mean_us"] = t_us
+        elif agg == "stddev":
+            r["stddev_us"] = t_us
+        elif agg is None:  # no repetitions: a single run
+            r.setdefault("median_us", t_us)
+
+
+def get(name):
+    return rows.get(name, {})
+
+
+def fmt_time(us):
+    if us is None:
+        return "n/a"
+    if us >= 100:
+        return f"{us:.0f}"
+    if us >= 1:
+        return f"{us:.2f}"
+    return f"{us:.4f}"
+
+
+def fmt_ratio(value, ref):
+    if value is None or ref is None or ref == 0:
+        return "n/a"
+    return f"{value / ref:.2f}"
+
+
+def spread(r):
+    if "stddev_us" in r and r.get("mean_us"):
+        return f"{100.0 * r['stddev_us'] / r['mean_us']:.1f}"
+    return "n/a"
+
+
+def fmt_count(r, key):
+    return str(int(r["counter:" + key])) if "counter:" + key in r else "n/a"
+
+
+def table(header, lines):
+    md = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    md += ["| " + " | ".join(line) + " |" for line in lines]
+    return "\n".join(md)
+
+
+def time_row(label, name, ref_name, extra=()):
+    r, ref = get(name), get(ref_name)
+    if "error" in r:
+        return [label, *[""] * len(extra), "error: " + r["error"], "", "", ""]
+    return [label, *[fmt_count(r, k) if k in ("phase_ticks", "punctures", "mesh_nodes_all_layers") else k
+                     for k in extra],
+            fmt_time(r.get("median_us")), fmt_time(r.get("median_cpu_us")),
+            fmt_ratio(r.get("median_us"), ref.get("median_us")), spread(r)]
+
+
+ctx = contexts[0] if contexts else {}
+now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+md = []
+md.append("# Haptic tick benchmarks")
+md.append("")
+md.append(f"- Command: `{command_line}` (Google Benchmark, `--benchmark_repetitions=5 "
+          "--benchmark_report_aggregates_only=true`; every time below is the median of the 5 "
+          "repetitions, wall-clock time per iteration)")
+md.append(f"- Machine: {cpu_model()}, {os.cpu_count()} cores, host `{socket.gethostname()}`"
+          + (f", {ctx.get('mhz_per_cpu')} MHz" if ctx.get("mhz_per_cpu") else ""))
+md.append(f"- Date: {now}")
+md.append(f"- Git revision: {revision}")
+md.append(f"- Build: CMake Release; Google Benchmark library build type: {ctx.get('library_build_type', 'n/a')}")
+md.append("- Raw data: `bench_tick.json`, `bench_effects.json` next to this file")
+md.append("- Spread: coefficient of variation (stddev / mean) of the wall time over the 5 repetitions, %")
+md.append("- Columns: `median us / tick` is wall-clock time (what the 1 kHz loop sees), `CPU us / tick` the "
+          "process CPU time; they differ when other processes compete for the 2 cores (load average at the "
+          f"start of bench_tick: {', '.join(f'{x:.2f}' for x in ctx.get('load_avg', [])) or 'n/a'}). "
+          "Ratios use the wall-clock median.")
+md.append("")
+md.append("The haptic tick is stateful, so every benchmark replays the scene's scripted insertion "
+          "(tick i at t = i ms) over a tick range ('phase') and rebuilds the simulator outside the "
+          "timed region when the range ends (tests/benchmarks/bench_replay.hpp). One iteration is "
+          "one `PunctureSimulator::tick()`. Default configuration: scenes/default.json, every effect "
+          "on, SH degree l = 16, implicit force-mesh integrator, w = 8 / 4 / 10 (skin / fat / muscle).")
+md.append("")
+
+whole = get("BM_tick_phase/whole_insertion").get("median_us")
+dist = get("BM_tick_distribution/whole_insertion")
+p50_all, p50_press = dist.get("counter:p50_us"), dist.get("counter:press_p50_us")
+if p50_all is not None and p50_press is not None:
+    verdict = "met" if max(p50_all, p50_press) <= 10.0 else "NOT met"
+    md.append(f"**Target: median tick <= 10 us (default scene, all effects on, l = 16): {verdict}.** "
+              f"Median single tick over the whole insertion {fmt_time(p50_all)} us; over the ticks that press "
+              f"the skin (the most expensive phase) {fmt_time(p50_press)} us, p99 "
+              f"{fmt_time(dist.get('counter:press_p99_us'))} us (table 'Single-tick distribution').")
+    md.append("")
+if whole is not None:
+    phase_means = [(p, get(f"BM_tick_phase/{p}")) for p in
+                   ("press_skin", "after_skin_break", "inside_punctured", "whole_insertion")]
+    worst_name, worst = max(((p, r) for p, r in phase_means if r.get("median_us") is not None),
+                            key=lambda pr: pr[1]["median_us"])
+    md.append(f"Mean tick per phase (median of 5 repetitions): whole insertion {fmt_time(whole)} us wall / "
+              f"{fmt_time(get('BM_tick_phase/whole_insertion').get('median_cpu_us'))} us CPU; slowest phase "
+              f"{worst_name}: {fmt_time(worst['median_us'])} us wall / {fmt_time(worst.get('median_cpu_us'))} us CPU "
+              f"({100.0 * worst['median_us'] / 1000.0:.2f} % of the 1 ms haptic period). A phase mean includes "
+              "the rare ticks during which the process is preempted, so under load it exceeds the median tick.")
+    md.append("")
+
+md.append("## Tick by phase of the insertion (default scene)")
+md.append("")
+md.append("press_skin: the skin is pressed (force mesh active) until it breaks; after_skin_break: the "
+          "ceil(1/eta_r) ticks after the skin broke (skin resumption running, fat pressed); "
+          "inside_punctured: after the last puncture until the target depth (damping of every "
+          "punctured layer, resumption in its first ticks); whole_insertion: approach, insertion, "
+          "dwell and withdrawal. Ratio: to whole_insertion.")
+md.append("")
+md.append(table(["phase", "ticks in phase", "median us / tick", "CPU us / tick", "ratio", "spread %"],
+                [time_row(p, f"BM_tick_phase/{p}", "BM_tick_phase/whole_insertion", ("phase_ticks",))
+                 for p in ("press_skin", "after_skin_break", "inside_punctured", "whole_insertion")]))
+md.append("")
+
+md.append("## Single-tick distribution (default scene)")
+md.append("")
+md.append("BM_tick_distribution: every tick of whole insertions timed one by one with steady_clock "
+          "(adds ~20-50 ns per tick); percentiles over all ticks of one benchmark run, then the median "
+          "over the 5 repetitions. The mean per phase above hides the slow ticks; these are what a 1 kHz "
+          "loop must absorb.")
+md.append("")
+r = get("BM_tick_distribution/whole_insertion")
+def counter(key):
+    v = r.get("counter:" + key)
+    return fmt_time(v) if v is not None else "n/a"
+md.append(table(["ticks", "p50 us", "p90 us", "p99 us", "max us"],
+                [["all ticks of the insertion", counter("p50_us"), counter("p90_us"), counter("p99_us"),
+                  counter("max_us")],
+                 ["press_skin ticks", counter("press_p50_us"), "", counter("press_p99_us"),
+                  counter("press_max_us")]]))
+md.append("")
+
+md.append("## Force-mesh integrator")
+md.append("")
+md.append("Ratio: to the default (implicit) for the same phase.")
+md.append("")
+lines = []
+for integ in ("quasi_static", "explicit", "implicit"):
+    for phase in ("press_skin", "whole_insertion"):
+        lines.append(time_row(f"{integ} / {phase}", f"BM_tick_integrator/{integ}/{phase}",
+                              f"BM_tick_phase/{phase}", ("punctures",)))
+md.append(table(["integrator / phase", "punctures", "median us / tick", "CPU us / tick", "ratio", "spread %"], lines))
+md.append("")
+
+md.append("## Rings w (every layer)")
+md.append("")
+md.append("All layers get the same w; L is kept where (w - 1) L <= 0.9 R (R = 30 mm sample radius) "
+          "and shrunk to 0.9 R / (w - 1) otherwise, so the mesh stays inside the sample. A mesh of w "
+          "rings has 1 + 3 w (w - 1) nodes; larger w needs more deflection before ring w is deformed, "
+          "so the number of punctures reached by the 30 mm insertion changes with w (column "
+          "punctures), and with it what the whole insertion contains. Ratio: to the default scene "
+          "(w = 8 / 4 / 10) for the same phase.")
+md.append("")
+lines = []
+for w in (2, 4, 8, 16, 32):
+    for phase in ("press_skin", "whole_insertion"):
+        lines.append(time_row(f"{w} / {phase}", f"BM_tick_rings_w/{w}/{phase}", f"BM_tick_phase/{phase}",
+                              ("mesh_nodes_all_layers", "phase_ticks", "punctures")))
+md.append(table(["w / phase", "mesh nodes (3 layers)", "ticks in phase", "punctures", "median us / tick", "CPU us / tick",
+                 "ratio", "spread %"], lines))
+md.append("")
+
+md.append("## SH degree l")
+md.append("")
+md.append("Where l enters: the SH layer surface is queried inside the tick only by the contact ray "
+          "(`LayerSurface::intersect_ray`) once per layer, the first tick that layer is reached; the "
+          "force-mesh nodes are projected onto the surface at construction. So the per-tick cost "
+          "should not depend on l; the ray query and the model construction do (tables below). "
+          "Ratio: to l = 16 (default) for the same phase.")
+md.append("")
+lines = []
+for l in (4, 8, 16, 24, 32):
+    for phase in ("press_skin", "whole_insertion"):
+        lines.append(time_row(f"{l} / {phase}", f"BM_tick_sh_degree/{l}/{phase}", f"BM_tick_phase/{phase}",
+                              ("punctures",)))
+md.append(table(["l / phase", "punctures", "median us / tick", "CPU us / tick", "ratio", "spread %"], lines))
+md.append("")
+md.append("### The SH query alone: `LayerSurface::intersect_ray` on the skin surface")
+md.append("")
+md.append("on_axis: the needle axis (the query the tick makes; it hits the parameterisation's north "
+          "pole); off_axis: vertical rays at 64 lateral positions spread over 0.8 R. Ratio: to l = 16.")
+md.append("")
+lines = []
+for l in (4, 8, 16, 24, 32):
+    for mode in ("on_axis", "off_axis"):
+        lines.append(time_row(f"{l} / {mode}", f"BM_sh_intersect_ray/{l}/{mode}",
+                              f"BM_sh_intersect_ray/16/{mode}"))
+md.append(table(["l / rays", "median us / query", "CPU us / query", "ratio", "spread %"], lines))
+md.append("")
+md.append("### Model construction (outside the haptic loop): `build_realtime_model`")
+md.append("")
+md.append("SH fit of the three layer surfaces + force-mesh layout + implicit factorisation. Ratio: to l = 16.")
+md.append("")
+lines = []
+for l in (4, 8, 16, 24, 32):
+    r = get(f"BM_build_realtime_model/{l}")
+    ref = get("BM_build_realtime_model/16").get("median_us")
+    ms = r.get("median_us") / 1e3 if r.get("median_us") is not None else None
+    lines.append([str(l), f"{ms:.2f}" if ms is not None else "n/a", fmt_ratio(r.get("median_us"), ref), spread(r)])
+md.append(table(["l", "median ms / build", "ratio", "spread %"], lines))
+md.append("")
+
+md.append("## Effects on / off")
+md.append("")
+md.append("An effect that is off is not constructed (tests/core/model/test_effects_off.cpp checks the "
+          "objects are absent and the forces exactly 0). surface_force_off also removes resumption "
+          "(it needs the force mesh) and every layer then breaks as soon as the tip passes its "
+          "surface; surface_output does not enter the tick. Ratio: to all_on for the same phase.")
+md.append("")
+lines = []
+for cfg in ("all_on", "surface_force_off", "damping_off", "resumption_off", "all_off"):
+    for phase in ("whole_insertion", "inside_punctured"):
+        lines.append(time_row(f"{cfg} / {phase}", f"BM_effects/{cfg}/{phase}", f"BM_effects/all_on/{phase}",
+                              ("phase_ticks", "punctures")))
+md.append(table(["effects / phase", "ticks in phase", "punctures", "median us / tick", "CPU us / tick", "ratio", "spread %"],
+                lines))
+md.append("")
+
+with open(os.path.join(out_dir, "tick_benchmarks.md"), "w") as f:
+    f.write("\n".join(md))
+print("wrote", os.path.join(out_dir, "tick_benchmarks.md"))
+PY

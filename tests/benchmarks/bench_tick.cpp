@@ -1,0 +1,228 @@
+// bench_tick.cpp: cost of one haptic tick of the real-time model (default
+// scene, every effect on, SH degree l = 16 unless a family varies it).
+//
+// Families (time per iteration = per tick; see bench_replay.hpp for how the
+// stateful tick is replayed):
+//   BM_tick_phase/<phase>               default scene; phases press_skin,
+//       after_skin_break, inside_punctured, whole_insertion
+//   BM_tick_integrator/<name>/<phase>   force-mesh integrator quasi_static,
+//       explicit, implicit (the default) for press_skin and whole_insertion
+//   BM_tick_rings_w/<w>/<phase>         every layer's w set to 2..32; L scaled
+//       down where needed so (w - 1) L <= 0.9 R (sample radius R)
+//   BM_tick_sh_degree/<l>/<phase>       SH degree of the layer surfaces
+//   BM_sh_intersect_ray/<l>/<on_axis|off_axis>  LayerSurface::intersect_ray
+//       alone (the only SH query inside the tick, once per layer when it is
+//       first reached)
+//   BM_tick_distribution/whole_insertion   one iteration = one whole insertion
+//       with every tick timed by steady_clock (~20 ns overhead per tick);
+//       counters: percentiles of the single-tick wall time (us) over all
+//       ticks and over the press_skin ticks (the haptic loop cares about
+//       the slow ticks, which a mean per phase hides)
+//   BM_build_realtime_model/<l>         SH fit + simulator construction
+//       (outside the haptic loop; ms)
+// Run through scripts/benchmarks.sh, which writes results/benchmarks/.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bench_replay.hpp"
+
+namespace puncture::bench {
+namespace {
+
+/// A scene, its model (fitted surfaces) and its insertion script, built once
+/// per configuration and shared by every benchmark run of that configuration.
+struct Setup {
+  Scene scene;
+  RealtimeModel model;
+  InsertionScript script;
+};
+
+const Setup& setup_for(const std::string& key, const Scene& scene) {
+  static std::map<std::string, std::unique_ptr<Setup>> cache;
+  auto it = cache.find(key);
+  if (it == cache.end()) {
+    validate_scene(scene, "bench_tick:" + key);
+    auto s = std::make_unique<Setup>();
+    s->scene = scene;
+    s->model = build_realtime_model(s->scene);
+    s->script = make_script(s->scene, s->model);
+    it = cache.emplace(key, std::move(s)).first;
+  }
+  return *it->second;
+}
+
+TickRange phase_range(const InsertionScript& script, const std::string& phase) {
+  if (phase == "press_skin") return script.press_skin;
+  if (phase == "after_skin_break") return script.after_skin_break;
+  if (phase == "inside_punctured") return script.inside_punctured;
+  if (phase == "whole_insertion") return script.whole;
+  throw std::invalid_argument("unknown phase " + phase);
+}
+
+void run_phase(benchmark::State& state, const std::string& key, const Scene& scene, const std::string& phase) {
+  const Setup& s = setup_for(key, scene);
+  run_replay(state, s.scene, s.model, s.script, phase_range(s.script, phase));
+}
+
+/// Every layer gets w rings; L shrinks where needed so the mesh stays inside
+/// 0.9 of the sample radius.
+Scene scene_with_rings(int w) {
+  Scene scene = default_scene();
+  const double radius_m = 0.5 * scene.sample.diameter_m;
+  for (Layer& layer : scene.layers) {
+    layer.force_mesh.rings_w = w;
+    if (w > 1)
+      layer.force_mesh.spacing_L_m = std::min(layer.force_mesh.spacing_L_m, 0.9 * radius_m / (w - 1));
+  }
+  return scene;
+}
+
+Scene scene_with_degree(int l) {
+  Scene scene = default_scene();
+  scene.realtime.sh_degree = l;
+  return scene;
+}
+
+Scene scene_with_integrator(const std::string& name) {
+  Scene scene = default_scene();
+  scene.realtime.integrator = name;
+  return scene;
+}
+
+void register_all() {
+  const std::vector<std::string> phases{"press_skin", "after_skin_break", "inside_punctured", "whole_insertion"};
+  const std::vector<std::string> scaling_phases{"press_skin", "whole_insertion"};
+
+  for (const std::string& phase : phases)
+    benchmark::RegisterBenchmark(("BM_tick_phase/" + phase).c_str(), [phase](benchmark::State& st) {
+      run_phase(st, "default", default_scene(), phase);
+    });
+
+  benchmark::RegisterBenchmark("BM_tick_distribution/whole_insertion", [](benchmark::State& st) {
+    const Setup& s = setup_for("default", default_scene());
+    const TickRange press = s.script.press_skin;
+    std::vector<double> all_us, press_us;
+    all_us.reserve(64 * s.script.needle.size());
+    press_us.reserve(64 * press.size());
+    for (auto _ : st) {
+      st.PauseTiming();
+      PunctureSimulator sim(s.scene, copy_surfaces(s.model));
+      st.ResumeTiming();
+      for (std::size_t i = 0; i < s.script.needle.size(); ++i) {
+        const auto start = std::chrono::steady_clock::now();
+        const TickResult& r = sim.tick(s.script.needle[i]);
+        const auto stop = std::chrono::steady_clock::now();
+        benchmark::DoNotOptimize(r.total_force_N);
+        const double us = std::chrono::duration<double, std::micro>(stop - start).count();
+        all_us.push_back(us);
+        if (i >= press.begin && i < press.end) press_us.push_back(us);
+      }
+    }
+    const auto percentile = [](std::vector<double>& v, double q) {
+      if (v.empty()) return 0.0;
+      const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())));
+      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+      return v[k];
+    };
+    st.counters["p50_us"] = percentile(all_us, 0.50);
+    st.counters["p90_us"] = percentile(all_us, 0.90);
+    st.counters["p99_us"] = percentile(all_us, 0.99);
+    st.counters["max_us"] = all_us.empty() ? 0.0 : *std::max_element(all_us.begin(), all_us.end());
+    st.counters["press_p50_us"] = percentile(press_us, 0.50);
+    st.counters["press_p99_us"] = percentile(press_us, 0.99);
+    st.counters["press_max_us"] = press_us.empty() ? 0.0 : *std::max_element(press_us.begin(), press_us.end());
+    st.counters["ticks_per_insertion"] = static_cast<double>(s.script.needle.size());
+  })->Unit(benchmark::kMillisecond);
+
+  for (const std::string& integrator : {std::string("quasi_static"), std::string("explicit"), std::string("implicit")})
+    for (const std::string& phase : scaling_phases)
+      benchmark::RegisterBenchmark(("BM_tick_integrator/" + integrator + "/" + phase).c_str(),
+                                   [integrator, phase](benchmark::State& st) {
+                                     run_phase(st, "integrator=" + integrator, scene_with_integrator(integrator),
+                                               phase);
+                                   });
+
+  for (int w : {2, 4, 8, 16, 32})
+    for (const std::string& phase : scaling_phases)
+      benchmark::RegisterBenchmark(("BM_tick_rings_w/" + std::to_string(w) + "/" + phase).c_str(),
+                                   [w, phase](benchmark::State& st) {
+                                     const Setup& s = setup_for("w=" + std::to_string(w), scene_with_rings(w));
+                                     int nodes = 0;
+                                     for (std::size_t k = 0; k < s.model.simulator->layer_count(); ++k)
+                                       nodes += s.model.simulator->force_mesh(k)->node_count();
+                                     run_replay(st, s.scene, s.model, s.script, phase_range(s.script, phase));
+                                     st.counters["mesh_nodes_all_layers"] = nodes;
+                                   });
+
+  for (int l : {4, 8, 16, 24, 32})
+    for (const std::string& phase : scaling_phases)
+      benchmark::RegisterBenchmark(("BM_tick_sh_degree/" + std::to_string(l) + "/" + phase).c_str(),
+                                   [l, phase](benchmark::State& st) {
+                                     run_phase(st, "l=" + std::to_string(l), scene_with_degree(l), phase);
+                                   });
+
+  // The SH query alone: the skin's top face hit by the needle axis (what the
+  // tick asks when a layer is first reached), and by vertical rays at 64
+  // lateral positions spread over 0.8 R (off the pole of the parameterisation).
+  for (int l : {4, 8, 16, 24, 32})
+    for (const bool on_axis : {true, false})
+      benchmark::RegisterBenchmark(
+          ("BM_sh_intersect_ray/" + std::to_string(l) + (on_axis ? "/on_axis" : "/off_axis")).c_str(),
+          [l, on_axis](benchmark::State& st) {
+            const Scene scene = default_scene();
+            const LayerDisc disc = layer_disc(scene, 0);
+            const LayerSurface surface = LayerSurface::fit(disc.top_z_m, disc.bottom_z_m, disc.radius_m, l);
+            std::vector<Eigen::Vector3d> origins;
+            if (on_axis) {
+              origins.emplace_back(0.0, 0.0, 0.01);
+            } else {
+              for (int i = 0; i < 64; ++i) {
+                // Golden-angle spiral: even coverage of the disc r <= 0.8 R.
+                const double r = 0.8 * disc.radius_m * std::sqrt((i + 0.5) / 64.0);
+                const double a = 2.399963229728653 * i;
+                origins.emplace_back(r * std::cos(a), r * std::sin(a), 0.01);
+              }
+            }
+            const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
+            std::size_t i = 0, misses = 0;
+            double s = 0.0, z_sum = 0.0;
+            SurfacePoint hit;
+            for (auto _ : st) {
+              if (!surface.intersect_ray(origins[i], down, s, hit)) ++misses;
+              z_sum += hit.position.z();
+              benchmark::DoNotOptimize(z_sum);
+              i = (i + 1) % origins.size();
+            }
+            if (misses > 0) st.SkipWithError("a benchmark ray missed the skin surface");
+          });
+
+  for (int l : {4, 8, 16, 24, 32})
+    benchmark::RegisterBenchmark(("BM_build_realtime_model/" + std::to_string(l)).c_str(),
+                                 [l](benchmark::State& st) {
+                                   const Scene scene = scene_with_degree(l);
+                                   for (auto _ : st) {
+                                     RealtimeModel m = build_realtime_model(scene);
+                                     benchmark::DoNotOptimize(m.simulator.get());
+                                   }
+                                 })
+        ->Unit(benchmark::kMillisecond);
+}
+
+}  // namespace
+}  // namespace puncture::bench
+
+int main(int argc, char** argv) {
+  puncture::bench::register_all();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
