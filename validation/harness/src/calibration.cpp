@@ -192,7 +192,11 @@ struct StageContext {
     double total = 0.0;
     for (std::size_t r = 0; r < references->size(); ++r) {
       const InsertionCurve& ref = (*references)[r].curve;
-      const InsertionCurve model = simulate_insertion_curve(objective_scene(s, ref, *options, max_depth_m[r]), cache);
+      // The model runs the whole insertion (so its breakthrough of the stage's
+      // layer is found wherever it happens); the force is compared down to
+      // max_depth_m only.
+      const InsertionCurve model = simulate_insertion_curve(
+          objective_scene(s, ref, *options, std::numeric_limits<double>::infinity()), cache);
       const CurveComparison c = compare_curves(model, ref, max_depth_m[r]);
       if (c.n_compared == 0) return kFailedObjective;
       const double peak = c.reference_peak_force_N > 0.0 ? c.reference_peak_force_N : 1.0;
@@ -251,8 +255,8 @@ const char* nlopt_result_name(nlopt::result r) {
   }
 }
 
-/// Local derivative-free minimisation in log space; returns NLopt's code name.
-std::string run_nlopt(StageContext& ctx, nlopt::algorithm algorithm, std::vector<double> x) {
+/// One local derivative-free minimisation in log space; returns NLopt's code name.
+std::string run_nlopt_once(StageContext& ctx, nlopt::algorithm algorithm, std::vector<double> x, int max_evaluations) {
   const unsigned n = static_cast<unsigned>(ctx.parameters.size());
   // NLopt's BOBYQA needs at least two variables; one variable goes to Nelder-Mead.
   if (n < 2 && algorithm == nlopt::LN_BOBYQA) algorithm = nlopt::LN_NELDERMEAD;
@@ -267,7 +271,7 @@ std::string run_nlopt(StageContext& ctx, nlopt::algorithm algorithm, std::vector
   opt.set_upper_bounds(hi);
   opt.set_initial_step(step);
   opt.set_min_objective(nlopt_objective, &ctx);
-  opt.set_maxeval(ctx.options->max_evaluations_per_stage);
+  opt.set_maxeval(max_evaluations);
   opt.set_xtol_abs(ctx.options->log_x_tolerance);
   opt.set_ftol_abs(1e-14);
   double f = 0.0;
@@ -278,6 +282,28 @@ std::string run_nlopt(StageContext& ctx, nlopt::algorithm algorithm, std::vector
   } catch (const std::runtime_error& e) {
     return std::string("failure: ") + e.what();
   }
+}
+
+/// Local minimisation with restarts: the objective has narrow curved valleys
+/// (K against the threshold) and small steps where a breakthrough moves by
+/// one tick, on which BOBYQA's trust region can collapse early. While a run
+/// improves the best objective by more than 1 % and evaluations remain, a new
+/// run starts from the best point with fresh initial steps.
+std::string run_nlopt(StageContext& ctx, nlopt::algorithm algorithm, const std::vector<double>& x0) {
+  const int budget = ctx.options->max_evaluations_per_stage;
+  const int start_evaluations = ctx.evaluations;
+  std::string record;
+  std::vector<double> x = x0;
+  for (int run = 0; run < 20; ++run) {
+    const int left = budget - (ctx.evaluations - start_evaluations);
+    if (left < 2 * static_cast<int>(ctx.parameters.size()) + 2) break;
+    const double before = ctx.best;
+    record = run_nlopt_once(ctx, algorithm, x, left);
+    if (!ctx.best_x.empty()) x = ctx.best_x;
+    if (!(ctx.best < before - 0.01 * std::abs(before))) break;
+    if (run > 0) record += " (restart " + std::to_string(run) + ")";
+  }
+  return record;
 }
 
 // --- simulated annealing (GSL gsl_siman, fixed-size state) ---
@@ -323,7 +349,7 @@ std::string run_annealing(StageContext& ctx, const std::vector<double>& x0) {
   gsl_rng_free(rng);
   g_anneal_ctx = nullptr;
   std::string record = "annealing";
-  if (a.polish_with_bobyqa) record += " + bobyqa: " + run_nlopt(ctx, nlopt::LN_BOBYQA, ctx.best_x);
+  if (a.polish_locally) record += " + nelder_mead: " + run_nlopt(ctx, nlopt::LN_NELDERMEAD, ctx.best_x);
   return record;
 }
 
@@ -630,7 +656,7 @@ std::string tuned_preset_provenance_json(const std::string& name, const Calibrat
     const AnnealingSettings& a = options.annealing;
     opt["annealing"] = {{"iters_fixed_T", a.iters_fixed_T}, {"step_size", a.step_size}, {"t_initial", a.t_initial},
                         {"mu_t", a.mu_t},                   {"t_min", a.t_min},         {"seed", a.seed},
-                        {"polish_with_bobyqa", a.polish_with_bobyqa}};
+                        {"polish_locally", a.polish_locally}};
   }
   nlohmann::json stages = nlohmann::json::array();
   for (const CalibrationStageRecord& s : result.stages)

@@ -1,0 +1,216 @@
+// Calibration: identifiability tests. The reference is produced by the
+// real-time model itself with KNOWN parameter values; the calibration starts
+// from perturbed values and must find the known ones again.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "puncture/io/output_session.hpp"
+#include "puncture/scene_io.hpp"
+#include "puncture/validation/calibration.hpp"
+
+namespace pv = puncture::validation;
+using puncture::Scene;
+
+namespace {
+
+/// Three-layer Table 2 slab with a quasi-static force mesh; insertion to
+/// 12 mm (through skin, fat and into muscle) at 10 mm/s. Low SH degree keeps
+/// the fit cheap; a 5 kHz tick (2 um of travel) samples the breakthroughs finely.
+Scene truth_scene() {
+  const std::string json = R"({
+    "schema_version": 1, "name": "calibration_truth",
+    "sample": { "diameter_mm": 60.0 },
+    "needle": { "radius_mm": 0.635, "tip": "blunt" },
+    "layers": [
+      { "name": "skin", "thickness_mm": 0.8, "density_kg_per_m3": 1100,
+        "force_mesh": { "K_N_per_mm": 0.16, "w": 8, "L_mm": 2.0, "surface_stiffness_N_per_mm": 0.2,
+                        "deformed_threshold_mm": 0.01, "node_damping_N_s_per_m": 0.05 },
+        "damping_d_N_s_per_m2": 3000, "resumption_rate": 0.05,
+        "material": { "model": "neo_hookean", "youngs_modulus_kPa": 35.0, "poisson_ratio": 0.48 },
+        "puncture": { "criterion": "critical_force", "critical_force_N": 1.5 } },
+      { "name": "fat", "thickness_mm": 8.4, "density_kg_per_m3": 920,
+        "force_mesh": { "K_N_per_mm": 0.08, "w": 4, "L_mm": 1.0, "surface_stiffness_N_per_mm": 0.05,
+                        "deformed_threshold_mm": 0.15, "node_damping_N_s_per_m": 0.05 },
+        "damping_d_N_s_per_m2": 1000, "resumption_rate": 0.05,
+        "material": { "model": "neo_hookean", "youngs_modulus_kPa": 2.0, "poisson_ratio": 0.48 },
+        "puncture": { "criterion": "critical_force", "critical_force_N": 0.8 } },
+      { "name": "muscle", "thickness_mm": 39.0, "density_kg_per_m3": 1060,
+        "force_mesh": { "K_N_per_mm": 0.23, "w": 10, "L_mm": 2.5, "surface_stiffness_N_per_mm": 0.2,
+                        "deformed_threshold_mm": 0.0007, "node_damping_N_s_per_m": 0.5 },
+        "damping_d_N_s_per_m2": 3000, "resumption_rate": 0.05,
+        "material": { "model": "neo_hookean", "youngs_modulus_kPa": 15.0, "poisson_ratio": 0.48 },
+        "puncture": { "criterion": "critical_force", "critical_force_N": 1.5 } }
+    ],
+    "insertion": { "start_height_mm": 1.0, "speed_mm_per_s": 10.0, "target_depth_mm": 12.0,
+                   "dwell_s": 0.0, "withdrawal_speed_mm_per_s": 50.0, "angle_deg": 0.0 },
+    "realtime": { "sh_degree": 8, "haptic_rate_Hz": 5000, "integrator": "quasi_static", "frame_rate_Hz": 10 },
+    "models": ["realtime"],
+    "effects": ["surface_force", "damping", "resumption"]
+  })";
+  return puncture::parse_scene(json, "calibration_truth");
+}
+
+}  // namespace
+
+TEST(Calibration, SyntheticReferencePuncturesSkinAndFat) {
+  // Sanity of the test set-up itself: the reference shows both breakthroughs.
+  const Scene truth = truth_scene();
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  EXPECT_TRUE(pv::puncture_event(ref, "skin").found);
+  EXPECT_TRUE(pv::puncture_event(ref, "fat").found);
+  // Cached surfaces give the same curve as build_realtime_model.
+  const pv::SurfaceCache cache(truth);
+  const pv::InsertionCurve again = pv::simulate_insertion_curve(truth, &cache);
+  EXPECT_EQ(again.force_N, ref.force_N);
+  Scene other = truth;
+  other.layers[0].thickness_m *= 1.1;
+  EXPECT_FALSE(cache.matches(other));
+  EXPECT_THROW(cache.build(other), std::invalid_argument);
+}
+
+TEST(Calibration, RecoversPerturbedSkinStiffnessAndThreshold) {
+  const auto start_time = std::chrono::steady_clock::now();
+  const Scene truth = truth_scene();
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+
+  Scene start = truth;
+  start.layers[0].force_mesh.virtual_stiffness_N_per_m *= 1.3;
+  start.layers[0].force_mesh.deformed_threshold_m *= 1.2;
+
+  pv::CalibrationOptions options;
+  options.layers = {"skin"};
+  int progress_calls = 0, last_count = 0;
+  const pv::CalibrationResult r = pv::calibrate(start, ref, options, [&](const pv::CalibrationProgress& p) {
+    ++progress_calls;
+    EXPECT_GT(p.evaluations, last_count);
+    last_count = p.evaluations;
+  });
+  EXPECT_EQ(progress_calls, r.evaluations);
+
+  const auto& tuned = r.tuned_scene.layers[0].force_mesh;
+  const auto& want = truth.layers[0].force_mesh;
+  EXPECT_NEAR(tuned.virtual_stiffness_N_per_m / want.virtual_stiffness_N_per_m, 1.0, 0.03);
+  EXPECT_NEAR(tuned.deformed_threshold_m / want.deformed_threshold_m, 1.0, 0.03);
+  EXPECT_LT(r.objective_after, 0.05 * r.objective_before);
+  // Untouched: other layers, d (no rate information in the reference), w, k_s, L.
+  EXPECT_FALSE(r.damping_tuned);
+  EXPECT_EQ(r.tuned_scene.layers[0].damping_N_s_per_m2, start.layers[0].damping_N_s_per_m2);
+  EXPECT_EQ(tuned.rings_w, want.rings_w);
+  EXPECT_EQ(tuned.surface_stiffness_N_per_m, want.surface_stiffness_N_per_m);
+  EXPECT_EQ(r.tuned_scene.layers[1].force_mesh.virtual_stiffness_N_per_m,
+            truth.layers[1].force_mesh.virtual_stiffness_N_per_m);
+  EXPECT_EQ(r.tuned_scene.realtime.integrator, "quasi_static");
+  // Metrics after calibration over the whole insertion phase.
+  ASSERT_EQ(r.after.size(), 1u);
+  const pv::LayerMetrics* skin = r.after[0].layer("skin");
+  ASSERT_NE(skin, nullptr);
+  ASSERT_TRUE(skin->model_puncture.found);
+  EXPECT_LT(std::abs(skin->puncture_depth_error_m), 0.02e-3);
+  EXPECT_LT(r.after[0].force_rmse_relative, r.before[0].force_rmse_relative);
+
+  // The preset: a scene load_scene accepts with the tuned values, plus provenance.
+  const auto dir = std::filesystem::temp_directory_path() / "puncture_test_calibration_preset";
+  std::filesystem::remove_all(dir);
+  const std::vector<pv::ReferenceCurve> refs{{ref, "synthetic"}};
+  {
+    puncture::io::OutputSession session(dir);
+    pv::write_tuned_preset(session, "skin_tuned", r, refs, options);
+    session.commit();
+  }
+  const Scene loaded = puncture::load_scene(dir / "skin_tuned.json");
+  EXPECT_EQ(loaded.name, "skin_tuned");
+  EXPECT_NEAR(loaded.layers[0].force_mesh.virtual_stiffness_N_per_m, tuned.virtual_stiffness_N_per_m,
+              1e-9 * tuned.virtual_stiffness_N_per_m);
+  EXPECT_NEAR(loaded.layers[0].force_mesh.deformed_threshold_m, tuned.deformed_threshold_m,
+              1e-9 * tuned.deformed_threshold_m);
+  std::ifstream prov_in(dir / "skin_tuned.provenance.json");
+  const nlohmann::json prov = nlohmann::json::parse(prov_in);
+  EXPECT_EQ(prov.at("references").at(0).at("kind"), "synthetic");
+  EXPECT_TRUE(prov.at("references").at(0).contains("metrics_before"));
+  EXPECT_TRUE(prov.at("references").at(0).contains("metrics_after"));
+  EXPECT_EQ(prov.at("optimiser").at("method"), "nelder_mead");
+  EXPECT_FALSE(prov.at("damping").at("tuned").get<bool>());
+  EXPECT_TRUE(prov.contains("date_utc"));
+  EXPECT_TRUE(prov.contains("project_version"));
+  std::filesystem::remove_all(dir);
+
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  RecordProperty("seconds", std::to_string(seconds));
+}
+
+TEST(Calibration, DampingIsTunedOnlyWithRateInformation) {
+  const Scene truth = truth_scene();
+  pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  Scene start = truth;
+  start.layers[0].damping_N_s_per_m2 *= 0.7;
+
+  pv::CalibrationOptions options;
+  options.layers = {"skin"};
+  options.parameters.virtual_stiffness = false;
+  options.parameters.deformed_threshold = false;
+
+  // Quasi-static-like reference without rate information: d stays.
+  const pv::CalibrationResult fixed = pv::calibrate(start, ref, options);
+  EXPECT_FALSE(fixed.damping_tuned);
+  EXPECT_EQ(fixed.tuned_scene.layers[0].damping_N_s_per_m2, start.layers[0].damping_N_s_per_m2);
+
+  // Marked rate dependent (a measured curve): d of the skin is recovered from
+  // the damping force d h v the needle feels after the skin broke.
+  ref.metadata["rate_dependent"] = "true";
+  ref.metadata["speed_mm_per_s"] = "10";
+  const pv::CalibrationResult tuned = pv::calibrate(start, ref, options);
+  EXPECT_TRUE(tuned.damping_tuned);
+  EXPECT_NEAR(tuned.tuned_scene.layers[0].damping_N_s_per_m2 / truth.layers[0].damping_N_s_per_m2, 1.0, 0.03);
+}
+
+TEST(Calibration, BobyqaImprovesTheFit) {
+  const Scene truth = truth_scene();
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  Scene start = truth;
+  start.layers[0].force_mesh.virtual_stiffness_N_per_m *= 1.3;
+  start.layers[0].force_mesh.deformed_threshold_m *= 1.2;
+  pv::CalibrationOptions options;
+  options.layers = {"skin"};
+  options.method = pv::CalibrationMethod::Bobyqa;
+  const pv::CalibrationResult r = pv::calibrate(start, ref, options);
+  EXPECT_LT(r.objective_after, 1e-3 * r.objective_before);
+  EXPECT_NEAR(r.tuned_scene.layers[0].force_mesh.virtual_stiffness_N_per_m /
+                  truth.layers[0].force_mesh.virtual_stiffness_N_per_m,
+              1.0, 0.1);
+}
+
+TEST(Calibration, SimulatedAnnealingImprovesTheFit) {
+  const Scene truth = truth_scene();
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  Scene start = truth;
+  start.layers[0].force_mesh.virtual_stiffness_N_per_m *= 1.3;
+  start.layers[0].force_mesh.deformed_threshold_m *= 1.2;
+  pv::CalibrationOptions options;
+  options.layers = {"skin"};
+  options.method = pv::CalibrationMethod::SimulatedAnnealing;
+  options.annealing.iters_fixed_T = 10;
+  options.annealing.t_min = 1e-3;
+  const pv::CalibrationResult r = pv::calibrate(start, ref, options);
+  EXPECT_LT(r.objective_after, 0.05 * r.objective_before);
+  EXPECT_NEAR(r.tuned_scene.layers[0].force_mesh.virtual_stiffness_N_per_m /
+                  truth.layers[0].force_mesh.virtual_stiffness_N_per_m,
+              1.0, 0.05);
+}
+
+TEST(Calibration, RejectsBadInput) {
+  const Scene truth = truth_scene();
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  pv::CalibrationOptions options;
+  options.layers = {"bone"};
+  EXPECT_THROW(pv::calibrate(truth, ref, options), std::invalid_argument);
+  options.layers.clear();
+  options.bound_factor = 1.0;
+  EXPECT_THROW(pv::calibrate(truth, ref, options), std::invalid_argument);
+  EXPECT_THROW(pv::calibrate(truth, std::vector<pv::ReferenceCurve>{}, pv::CalibrationOptions{}), std::invalid_argument);
+  EXPECT_THROW(pv::parse_calibration_method("genetic"), std::invalid_argument);
+  EXPECT_EQ(pv::parse_calibration_method("nelder_mead"), pv::CalibrationMethod::NelderMead);
+}
