@@ -142,6 +142,31 @@ TEST(Calibration, RecoversPerturbedSkinStiffnessAndThreshold) {
   RecordProperty("seconds", std::to_string(seconds));
 }
 
+TEST(Calibration, SequentialStagesRecoverTheFatBelowTheSkin) {
+  // Skin and fat both perturbed; the skin stage runs first, then the fat
+  // stage on the reference down to the fat breakthrough.
+  const Scene truth = truth_scene();
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  Scene start = truth;
+  start.layers[0].force_mesh.virtual_stiffness_N_per_m *= 0.8;
+  start.layers[1].force_mesh.virtual_stiffness_N_per_m *= 1.25;
+  start.layers[1].force_mesh.deformed_threshold_m *= 0.85;
+  pv::CalibrationOptions options;
+  options.layers = {"fat", "skin"};  // processed top to bottom whatever the order given
+  const pv::CalibrationResult r = pv::calibrate(start, ref, options);
+  ASSERT_EQ(r.calibrated_layers, (std::vector<std::string>{"skin", "fat"}));
+  ASSERT_GE(r.stages.size(), 2u);
+  EXPECT_EQ(r.stages[0].stage.rfind("skin", 0), 0u);
+  for (std::size_t k : {0u, 1u}) {
+    const auto& tuned = r.tuned_scene.layers[k].force_mesh;
+    const auto& want = truth.layers[k].force_mesh;
+    EXPECT_NEAR(tuned.virtual_stiffness_N_per_m / want.virtual_stiffness_N_per_m, 1.0, 0.03) << k;
+    EXPECT_NEAR(tuned.deformed_threshold_m / want.deformed_threshold_m, 1.0, 0.03) << k;
+  }
+  EXPECT_EQ(r.tuned_scene.layers[2].force_mesh.virtual_stiffness_N_per_m,
+            truth.layers[2].force_mesh.virtual_stiffness_N_per_m);
+}
+
 TEST(Calibration, DampingIsTunedOnlyWithRateInformation) {
   const Scene truth = truth_scene();
   pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
