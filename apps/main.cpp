@@ -1,43 +1,101 @@
 // puncture: command-line front end of the needle-puncture framework.
-//   puncture run [SCENE] [-o DIR]      real-time SHF + MSM model
-//   puncture fem [SCENE] [-o DIR]      deal.II FEM reference (mpirun-able)
+//   puncture run       [SCENE] [-o DIR]   real-time SHF + MSM model
+//   puncture fem       [SCENE] [-o DIR]   deal.II FEM reference (mpirun-able)
+//   puncture validate  [SCENE] [-o DIR]   both models on the same insertion, metrics, report
+//   puncture calibrate [SCENE] [--reference CSV] [-o DIR]   tuned preset
+//   puncture sweep     [SCENE] [-o DIR]   accuracy versus time of every fidelity knob
+//   puncture grade SCORES.csv [-o DIR]    comprehensive weighted grading (paper Sec. 3.3)
 #include <CLI/CLI.hpp>
 #include <iostream>
 
 #include "puncture/apps/commands.hpp"
 
 int main(int argc, char** argv) {
+  using namespace puncture::apps;
   CLI::App app{"puncture: virtual needle-puncture simulation (real-time SHF + MSM model, FEM reference)"};
   app.require_subcommand(1);
+  std::string scene, output, cache;
 
-  puncture::apps::RunOptions run;
-  std::string run_scene, run_out;
+  RunOptions run;
   auto* run_cmd = app.add_subcommand("run", "Run the real-time model along the scene's scripted insertion");
-  run_cmd->add_option("scene", run_scene, "Scene file (JSON); default: scenes/default.json");
-  run_cmd->add_option("-o,--output", run_out, "Output directory; default: out/<scene name>");
+  run_cmd->add_option("scene", scene, "Scene file (JSON); default: scenes/default.json");
+  run_cmd->add_option("-o,--output", output, "Output directory; default: out/<scene name>");
   run_cmd->add_flag("--no-frames", [&](std::int64_t) { run.write_frames = false; }, "Do not write VTK frames");
   run_cmd->add_flag("-q,--quiet", run.quiet, "No progress output");
 
-  puncture::apps::FemOptions fem;
-  std::string fem_scene, fem_out;
+  FemOptions fem;
   auto* fem_cmd = app.add_subcommand("fem", "Run the deal.II FEM reference along the same insertion (MPI-aware)");
-  fem_cmd->add_option("scene", fem_scene, "Scene file (JSON); default: scenes/default.json");
-  fem_cmd->add_option("-o,--output", fem_out, "Output directory; default: out/<scene name>_fem");
+  fem_cmd->add_option("scene", scene, "Scene file (JSON); default: scenes/default.json");
+  fem_cmd->add_option("-o,--output", output, "Output directory; default: out/<scene name>_fem");
   fem_cmd->add_option("--refinement", fem.refinement, "Global refinements (overrides the scene)")->check(CLI::Range(0, 4));
   fem_cmd->add_option("--degree", fem.degree, "Element degree 1 (Q1) or 2 (Q2) (overrides the scene)")->check(CLI::Range(1, 2));
   fem_cmd->add_flag("--no-vtu", [&](std::int64_t) { fem.write_vtu = false; }, "Do not write .vtu field output");
 
+  ValidateOptions validate;
+  auto* validate_cmd = app.add_subcommand("validate", "Real-time model against the FEM reference on the same insertion");
+  validate_cmd->add_option("scene", scene, "Scene file (JSON); default: scenes/default.json");
+  validate_cmd->add_option("-o,--output", output, "Report directory; default: out/<scene name>_validation");
+  validate_cmd->add_option("--cache", cache, "FEM cache directory; default: out/.fem_cache");
+  validate_cmd->add_option("--refinement", validate.refinement, "FEM refinement (overrides the scene)")->check(CLI::Range(0, 4));
+  validate_cmd->add_option("--degree", validate.degree, "FEM element degree (overrides the scene)")->check(CLI::Range(1, 2));
+  validate_cmd->add_flag("-q,--quiet", validate.quiet, "No progress output");
+
+  CalibrateOptions calibrate;
+  std::string reference;
+  auto* calibrate_cmd = app.add_subcommand("calibrate", "Tune K, threshold (and optionally w, L, k_s, d) per layer; write a preset");
+  calibrate_cmd->add_option("scene", scene, "Scene file (JSON); default: scenes/default.json");
+  calibrate_cmd->add_option("--reference", reference,
+                            "Measured insertion curve (CSV: time_s, depth_mm, velocity_mm_per_s, force_N); "
+                            "default: the scene's FEM reference (cached)");
+  calibrate_cmd->add_option("-o,--output", output, "Output directory; default: out/<scene name>_calibration");
+  calibrate_cmd->add_option("--cache", cache, "FEM cache directory; default: out/.fem_cache");
+  calibrate_cmd->add_option("--method", calibrate.method, "nelder_mead (default), bobyqa or simulated_annealing")
+      ->check(CLI::IsMember({"nelder_mead", "bobyqa", "simulated_annealing"}));
+  calibrate_cmd->add_option("--name", calibrate.preset_name, "Preset name; default: <scene name>_tuned");
+  calibrate_cmd->add_option("--layers", calibrate.layers, "Layers to calibrate; default: all");
+  calibrate_cmd->add_flag("-q,--quiet", calibrate.quiet, "No progress output");
+
+  SweepOptions sweep;
+  auto* sweep_cmd = app.add_subcommand("sweep", "What accuracy costs in time: every fidelity knob against the finest FEM");
+  sweep_cmd->add_option("scene", scene, "Scene file (JSON); default: scenes/default.json");
+  sweep_cmd->add_option("-o,--output", output, "Output directory; default: out/<scene name>_accuracy_cost");
+  sweep_cmd->add_option("--cache", cache, "FEM cache directory; default: out/.fem_cache");
+  sweep_cmd->add_flag("--no-fem-knobs", [&](std::int64_t) { sweep.include_fem_knobs = false; },
+                      "Do not sweep FEM refinement and degree");
+  sweep_cmd->add_flag("-q,--quiet", sweep.quiet, "No progress output");
+
+  GradeOptions grade;
+  std::string scores;
+  auto* grade_cmd = app.add_subcommand("grade", "Comprehensive weighted grading of models from a CSV of scores");
+  grade_cmd->add_option("scores", scores, "CSV: model, resident, then one column per indicator")->required();
+  grade_cmd->add_option("-o,--output", output, "Output directory; default: out/grading");
+  grade_cmd->add_option("--mu", grade.mu, "Preference coefficient (share of the subjective weights), default 0.4");
+
   CLI11_PARSE(app, argc, argv);
 
   if (*run_cmd) {
-    run.scene = run_scene;
-    run.output_dir = run_out;
-    return puncture::apps::run_command(run, std::cout, std::cerr);
+    run.scene = scene, run.output_dir = output;
+    return run_command(run, std::cout, std::cerr);
   }
   if (*fem_cmd) {
-    fem.scene = fem_scene;
-    fem.output_dir = fem_out;
-    return puncture::apps::fem_command(fem, std::cout, std::cerr);
+    fem.scene = scene, fem.output_dir = output;
+    return fem_command(fem, std::cout, std::cerr);
+  }
+  if (*validate_cmd) {
+    validate.scene = scene, validate.output_dir = output, validate.cache_dir = cache;
+    return validate_command(validate, std::cout, std::cerr);
+  }
+  if (*calibrate_cmd) {
+    calibrate.scene = scene, calibrate.output_dir = output, calibrate.cache_dir = cache, calibrate.reference = reference;
+    return calibrate_command(calibrate, std::cout, std::cerr);
+  }
+  if (*sweep_cmd) {
+    sweep.scene = scene, sweep.output_dir = output, sweep.cache_dir = cache;
+    return sweep_command(sweep, std::cout, std::cerr);
+  }
+  if (*grade_cmd) {
+    grade.scores = scores, grade.output_dir = output;
+    return grade_command(grade, std::cout, std::cerr);
   }
   return 1;
 }

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 namespace puncture::apps {
 
@@ -36,5 +37,55 @@ struct FemOptions {
 
 /// `puncture fem`: the deal.II reference along the same insertion (MPI-aware).
 int fem_command(const FemOptions& options, std::ostream& out, std::ostream& err);
+
+struct ValidateOptions {
+  std::filesystem::path scene;
+  std::filesystem::path output_dir;   ///< empty: out/<scene name>_validation
+  std::filesystem::path cache_dir;    ///< empty: out/.fem_cache
+  int refinement = -1;                ///< FEM refinement, -1: from the scene
+  int degree = -1;                    ///< FEM degree, -1: from the scene
+  bool write_vtk = true;              ///< VTK report (.vtp, .vtu, validation.pvd); false: CSV, PNG, md only
+  bool quiet = false;
+};
+
+/// `puncture validate`: real-time model and FEM reference (cached) on the
+/// identical insertion; metrics per layer; report folder (CSV, PNG, VTK, md).
+int validate_command(const ValidateOptions& options, std::ostream& out, std::ostream& err);
+
+struct CalibrateOptions {
+  std::filesystem::path scene;
+  std::filesystem::path reference;    ///< measured curve CSV; empty: FEM reference of the scene (cached)
+  std::filesystem::path output_dir;   ///< empty: out/<scene name>_calibration
+  std::filesystem::path cache_dir;    ///< empty: out/.fem_cache
+  std::string method = "nelder_mead"; ///< nelder_mead, bobyqa, simulated_annealing
+  std::string preset_name;            ///< empty: <scene name>_tuned
+  std::vector<std::string> layers;    ///< empty: all
+  bool quiet = false;
+};
+
+/// `puncture calibrate`: tunes the force-mesh parameters against a reference
+/// and writes a tuned preset (a scene `puncture run` accepts) + provenance.
+int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::ostream& err);
+
+struct GradeOptions {
+  std::filesystem::path scores;       ///< CSV: model,resident,<one column per indicator>
+  std::filesystem::path output_dir;   ///< empty: out/grading
+  double mu = 0.4;                    ///< preference coefficient (subjective share)
+};
+
+/// `puncture grade`: comprehensive weighted grading (seed paper Sec. 3.3).
+int grade_command(const GradeOptions& options, std::ostream& out, std::ostream& err);
+
+struct SweepOptions {
+  std::filesystem::path scene;
+  std::filesystem::path output_dir;   ///< empty: out/<scene name>_accuracy_cost
+  std::filesystem::path cache_dir;    ///< empty: out/.fem_cache
+  bool include_fem_knobs = true;      ///< also sweep FEM refinement and degree (slow)
+  bool quiet = false;
+};
+
+/// `puncture sweep`: what accuracy costs in time: error against the finest FEM
+/// and time per step for each fidelity knob; table + Pareto plot.
+int sweep_command(const SweepOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace puncture::apps

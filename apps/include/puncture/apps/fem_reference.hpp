@@ -1,0 +1,52 @@
+// fem_reference.hpp: the FEM reference of a scene, computed once and cached
+// on disk, keyed by a hash of everything that affects it (the scene's
+// geometry, materials, puncture criteria, needle, insertion and FEM settings,
+// the mesh options, the refinement/degree overrides and the program version).
+//
+// In:  a Scene, options (cache directory, overrides), a stream for progress.
+// Out: the directory holding fem_force_depth.csv, fem_surface_profile.csv,
+//      fem_recovery_profile.csv, fem_summary.json, fem_fields.pvd (+ .vtu),
+//      the hash, and whether it came from the cache.
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+
+#include "puncture/scene.hpp"
+
+#ifdef PUNCTURE_HAVE_FEM
+#include <puncture/meshing/layered_cylinder_mesh.hpp>
+#endif
+
+namespace puncture::apps {
+
+struct FemReferenceOptions {
+  std::filesystem::path cache_dir = "out/.fem_cache";
+  int refinement = -1;  ///< -1: from the scene
+  int degree = -1;      ///< -1: from the scene
+  bool write_vtu = true;
+  bool verbose = true;
+#ifdef PUNCTURE_HAVE_FEM
+  meshing::SlabMeshOptions mesh;  ///< hex mesh resolution (tests and studies use coarser ones)
+#endif
+};
+
+struct FemReference {
+  std::filesystem::path dir;
+  std::string hash;
+  bool from_cache = false;
+};
+
+/// Hash (hex) of everything that affects the FEM result of `scene` with `options`.
+std::string fem_reference_hash(const Scene& scene, const FemReferenceOptions& options);
+
+/// Returns the cached reference or runs the FEM (in this process, MPI
+/// initialised once per process by ensure_mpi()) and caches it.
+FemReference obtain_fem_reference(const Scene& scene, const FemReferenceOptions& options, std::ostream& out);
+
+/// Initialises MPI (and deal.II's MPI-dependent libraries) once per process;
+/// later calls do nothing. Finalised at exit.
+void ensure_mpi();
+
+}  // namespace puncture::apps

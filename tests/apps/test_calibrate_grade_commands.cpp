@@ -1,0 +1,111 @@
+// `puncture calibrate` against a measured-style reference curve, and
+// `puncture grade` on a scores file: outputs, the preset round trip through
+// `puncture run`, and bad input.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "puncture/apps/commands.hpp"
+#include "puncture/scene_io.hpp"
+
+namespace fs = std::filesystem;
+
+namespace puncture::apps {
+namespace {
+
+const fs::path kSourceDir = PUNCTURE_SOURCE_DIR;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("puncture_cmd_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+TEST(CalibrateCommand, RecoversSkinStiffnessFromAReferenceCurveAndWritesARunnablePreset) {
+  const fs::path work = fresh_dir("calibrate");
+  fs::create_directories(work);
+  // The "measured" reference: the default scene with the skin's K raised by 25 %.
+  Scene truth = load_scene(kSourceDir / "scenes" / "default.json");
+  const double true_K = 1.25 * truth.layers[0].force_mesh.virtual_stiffness_N_per_m;
+  truth.layers[0].force_mesh.virtual_stiffness_N_per_m = true_K;
+  truth.name = "truth";
+  std::ofstream(work / "truth.json") << scene_to_json_text(truth);
+  RunOptions run;
+  run.scene = work / "truth.json";
+  run.output_dir = work / "truth_run";
+  run.write_frames = false;
+  run.quiet = true;
+  std::ostringstream out, err;
+  ASSERT_EQ(run_command(run, out, err), 0) << err.str();
+
+  CalibrateOptions options;
+  options.scene = kSourceDir / "scenes" / "default.json";
+  options.reference = work / "truth_run" / "realtime_curve.csv";
+  options.output_dir = work / "calibration";
+  options.layers = {"skin"};
+  options.quiet = true;
+  ASSERT_EQ(calibrate_command(options, out, err), 0) << err.str();
+
+  const fs::path preset = work / "calibration" / "default_tuned.json";
+  ASSERT_TRUE(fs::exists(preset));
+  EXPECT_TRUE(fs::exists(work / "calibration" / "default_tuned.provenance.json"));
+  EXPECT_TRUE(fs::exists(work / "calibration" / "calibration_summary.md"));
+  const Scene tuned = load_scene(preset);
+  EXPECT_NEAR(tuned.layers[0].force_mesh.virtual_stiffness_N_per_m, true_K, 0.05 * true_K);
+
+  // The preset is a scene `puncture run` accepts.
+  RunOptions rerun;
+  rerun.scene = preset;
+  rerun.output_dir = work / "preset_run";
+  rerun.write_frames = false;
+  rerun.quiet = true;
+  EXPECT_EQ(run_command(rerun, out, err), 0) << err.str();
+  fs::remove_all(work);
+}
+
+TEST(CalibrateCommand, MissingReferenceFileIsAnErrorWithNoOutput) {
+  const fs::path dir = fresh_dir("calibrate_bad");
+  CalibrateOptions options;
+  options.scene = kSourceDir / "scenes" / "default.json";
+  options.reference = "/nonexistent/curve.csv";
+  options.output_dir = dir;
+  options.quiet = true;
+  std::ostringstream out, err;
+  EXPECT_NE(calibrate_command(options, out, err), 0);
+  EXPECT_NE(err.str().find("/nonexistent/curve.csv"), std::string::npos) << err.str();
+  EXPECT_FALSE(fs::exists(dir));
+}
+
+TEST(GradeCommand, GradesModelsFromAScoresFile) {
+  const fs::path dir = fresh_dir("grade");
+  fs::create_directories(dir);
+  // Two models, two residents, the paper's seven indicators. Model B scores
+  // one point more on every indicator, so its comprehensive score is exactly
+  // one more than A's (the weights sum to 1 for each model).
+  std::ofstream(dir / "scores.csv") << "model,resident,texture,force,puncture,environment,realtime,training,stability\n"
+                                       "A,r1,7,8,6,7,9,8,7\n"
+                                       "A,r2,8,7,7,6,8,9,8\n"
+                                       "B,r1,8,9,7,8,10,9,8\n"
+                                       "B,r2,9,8,8,7,9,10,9\n";
+  GradeOptions options;
+  options.scores = dir / "scores.csv";
+  options.output_dir = dir / "out";
+  std::ostringstream out, err;
+  ASSERT_EQ(grade_command(options, out, err), 0) << err.str();
+  EXPECT_TRUE(fs::exists(dir / "out" / "grading_summary.csv"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "grading_schemes.csv"));
+  EXPECT_NE(out.str().find("A"), std::string::npos);
+
+  options.mu = 1.5;
+  EXPECT_NE(grade_command(options, out, err), 0);
+  options.mu = 0.4;
+  options.scores = dir / "missing.csv";
+  EXPECT_NE(grade_command(options, out, err), 0);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace puncture::apps
