@@ -97,7 +97,22 @@ TEST(GradeCommand, GradesModelsFromAScoresFile) {
   ASSERT_EQ(grade_command(options, out, err), 0) << err.str();
   EXPECT_TRUE(fs::exists(dir / "out" / "grading_summary.csv"));
   EXPECT_TRUE(fs::exists(dir / "out" / "grading_schemes.csv"));
-  EXPECT_NE(out.str().find("A"), std::string::npos);
+  std::ifstream summary(dir / "out" / "grading_summary.csv");
+  std::string header, row_a, row_b;
+  std::getline(summary, header);
+  std::getline(summary, row_a);
+  std::getline(summary, row_b);
+  ASSERT_EQ(header.rfind("model,n_schemes,mean_score,", 0), 0u) << header;
+  auto mean_of = [](const std::string& row) {
+    std::stringstream s(row);
+    std::string model, n, mean;
+    std::getline(s, model, ',');
+    std::getline(s, n, ',');
+    std::getline(s, mean, ',');
+    return std::stod(mean);
+  };
+  EXPECT_EQ(row_a.substr(0, 2), "A,");
+  EXPECT_NEAR(mean_of(row_b) - mean_of(row_a), 1.0, 1e-12);
 
   options.mu = 1.5;
   EXPECT_NE(grade_command(options, out, err), 0);
