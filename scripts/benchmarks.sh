@@ -7,47 +7,70 @@
 #
 # Usage: scripts/benchmarks.sh [extra Google Benchmark flags, e.g.
 #        --benchmark_filter=BM_tick_phase]
+#        scripts/benchmarks.sh --report-only   (rewrite the markdown from the
+#        JSON files and run_info.json of the last run)
 # Env:   PUNCTURE_BENCH_BUILD_DIR  build directory (default ./build-bench)
 #        PUNCTURE_BENCH_OUT        output directory (default results/benchmarks)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${PUNCTURE_BENCH_BUILD_DIR:-$root/build-bench}"
 out="${PUNCTURE_BENCH_OUT:-$root/results/benchmarks}"
-command_line="scripts/benchmarks.sh${*:+ $*}"
-
-if [[ ! -f "$build/CMakeCache.txt" ]]; then
-  cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPUNCTURE_WITH_FEM=OFF -DPUNCTURE_WITH_VTK=OFF \
-    -DPUNCTURE_BUILD_TESTS=ON -DPUNCTURE_BUILD_BENCHMARKS=ON
-fi
-build_type="$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "$build/CMakeCache.txt")"
-if [[ "$build_type" != "Release" ]]; then
-  echo "benchmarks.sh: $build is configured as '$build_type'; timings need a Release build" >&2
-  exit 1
-fi
-cmake --build "$build" -j2 --target bench_tick bench_effects
-
-mkdir -p "$out"
-common=(--benchmark_repetitions=5 --benchmark_report_aggregates_only=true
-        --benchmark_out_format=json)
-for bench in bench_tick bench_effects; do
-  echo "== $bench"
-  "$build/tests/benchmarks/$bench" "${common[@]}" --benchmark_out="$out/$bench.json" "$@"
-done
-
-revision="$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)"
-if [[ -n "$(git -C "$root" status --porcelain -- core tests/benchmarks scenes 2>/dev/null)" ]]; then
-  revision="$revision (+ uncommitted changes in core/, tests/benchmarks/ or scenes/)"
+report_only=0
+if [[ "${1:-}" == "--report-only" ]]; then
+  # Rewrite the markdown from the JSON and run_info.json of an earlier run.
+  report_only=1
+  shift
 fi
 
-python3 - "$out" "$command_line" "$revision" <<'PY'
+if (( ! report_only )); then
+  if [[ ! -f "$build/CMakeCache.txt" ]]; then
+    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPUNCTURE_WITH_FEM=OFF -DPUNCTURE_WITH_VTK=OFF \
+      -DPUNCTURE_BUILD_TESTS=ON -DPUNCTURE_BUILD_BENCHMARKS=ON
+  fi
+  build_type="$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "$build/CMakeCache.txt")"
+  if [[ "$build_type" != "Release" ]]; then
+    echo "benchmarks.sh: $build is configured as '$build_type'; timings need a Release build" >&2
+    exit 1
+  fi
+  cmake --build "$build" -j2 --target bench_tick bench_effects
+
+  mkdir -p "$out"
+  revision="$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+  if [[ -n "$(git -C "$root" status --porcelain -- core tests/benchmarks scenes 2>/dev/null)" ]]; then
+    revision="$revision (+ uncommitted changes in core/, tests/benchmarks/ or scenes/)"
+  fi
+  started_utc="$(date -u '+%Y-%m-%d %H:%M UTC')"
+  load_before="$(cut -d' ' -f1-3 /proc/loadavg)"
+  common=(--benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+          --benchmark_out_format=json)
+  for bench in bench_tick bench_effects; do
+    echo "== $bench"
+    "$build/tests/benchmarks/$bench" "${common[@]}" --benchmark_out="$out/$bench.json" "$@"
+  done
+  load_after="$(cut -d' ' -f1-3 /proc/loadavg)"
+  python3 - "$out/run_info.json" "scripts/benchmarks.sh${*:+ $*}" "$revision" "$started_utc" \
+    "$load_before" "$load_after" <<'PY'
+import json, sys
+path, command, revision, started, load_before, load_after = sys.argv[1:7]
+with open(path, "w") as f:
+    json.dump({"command": command, "revision": revision, "started_utc": started,
+               "load_average_before": load_before, "load_average_after": load_after}, f, indent=1)
+PY
+fi
+
+python3 - "$out" <<'PY'
 """Turns the Google Benchmark JSON files into results/benchmarks/tick_benchmarks.md."""
 import datetime
 import json
 import os
+import re
 import socket
 import sys
 
-out_dir, command_line, revision = sys.argv[1], sys.argv[2], sys.argv[3]
+out_dir = sys.argv[1]
+with open(os.path.join(out_dir, "run_info.json")) as f:
+    run_info = json.load(f)
+command_line, revision = run_info["command"], run_info["revision"]
 TO_US = {"ns": 1e-3, "us": 1.0, "ms": 1e3, "s": 1e6}
 
 
@@ -72,6 +95,8 @@ for name in ("bench_tick", "bench_effects"):
         data = json.load(f)
     contexts.append(data.get("context", {}))
     for b in data["benchmarks"]:
+        # Fixed-iteration benchmarks carry "/iterations:N" in their name.
+        b["run_name"] = re.sub(r"/iterations:\d+", "", b["run_name"])
         if b.get("error_occurred"):
             rows.setdefault(b["run_name"], {})["error"] = b.get("error_message", "error")
             continue
@@ -136,11 +161,11 @@ def time_row(label, name, ref_name, extra=()):
     return [label, *[fmt_count(r, k) if k in ("phase_ticks", "punctures", "mesh_nodes_all_layers") else k
                      for k in extra],
             fmt_time(r.get("median_us")), fmt_time(r.get("median_cpu_us")),
-            fmt_ratio(r.get("median_us"), ref.get("median_us")), spread(r)]
+            fmt_ratio(r.get("median_cpu_us"), ref.get("median_cpu_us")), spread(r)]
 
 
 ctx = contexts[0] if contexts else {}
-now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+now = run_info["started_utc"]
 md = []
 md.append("# Haptic tick benchmarks")
 md.append("")
@@ -154,10 +179,12 @@ md.append(f"- Git revision: {revision}")
 md.append(f"- Build: CMake Release; Google Benchmark library build type: {ctx.get('library_build_type', 'n/a')}")
 md.append("- Raw data: `bench_tick.json`, `bench_effects.json` next to this file")
 md.append("- Spread: coefficient of variation (stddev / mean) of the wall time over the 5 repetitions, %")
+md.append("- The Debian libbenchmark package reports itself as a debug build; that concerns the timing "
+          "harness only, the project code is compiled Release (-O3)")
 md.append("- Columns: `median us / tick` is wall-clock time (what the 1 kHz loop sees), `CPU us / tick` the "
-          "process CPU time; they differ when other processes compete for the 2 cores (load average at the "
-          f"start of bench_tick: {', '.join(f'{x:.2f}' for x in ctx.get('load_avg', [])) or 'n/a'}). "
-          "Ratios use the wall-clock median.")
+          "process CPU time; they differ when other processes compete for the 2 cores (load average "
+          f"{run_info['load_average_before']} before the run, {run_info['load_average_after']} after). "
+          "Ratios use the CPU-time medians, which other processes disturb less.")
 md.append("")
 md.append("The haptic tick is stateful, so every benchmark replays the scene's scripted insertion "
           "(tick i at t = i ms) over a tick range ('phase') and rebuilds the simulator outside the "
@@ -186,6 +213,17 @@ if whole is not None:
               f"{worst_name}: {fmt_time(worst['median_us'])} us wall / {fmt_time(worst.get('median_cpu_us'))} us CPU "
               f"({100.0 * worst['median_us'] / 1000.0:.2f} % of the 1 ms haptic period). A phase mean includes "
               "the rare ticks during which the process is preempted, so under load it exceeds the median tick.")
+    md.append("")
+
+same = [(n, get(n)) for n in ("BM_tick_phase/press_skin", "BM_tick_integrator/implicit/press_skin",
+                              "BM_tick_sh_degree/16/press_skin")]
+same = [(n, r) for n, r in same if r.get("median_cpu_us") is not None]
+if len(same) > 1:
+    cpu = [r["median_cpu_us"] for _, r in same]
+    md.append("Measurement noise: the default configuration's press_skin phase is measured three times "
+              "(" + ", ".join(f"`{n}` {fmt_time(r['median_cpu_us'])} us CPU" for n, r in same) + f"); their "
+              f"spread (max / min = {max(cpu) / min(cpu):.2f}) is the run-to-run noise of this shared machine, "
+              "so ratios closer to 1 than that are not differences.")
     md.append("")
 
 md.append("## Tick by phase of the insertion (default scene)")
@@ -285,7 +323,8 @@ for l in (4, 8, 16, 24, 32):
     r = get(f"BM_build_realtime_model/{l}")
     ref = get("BM_build_realtime_model/16").get("median_us")
     ms = r.get("median_us") / 1e3 if r.get("median_us") is not None else None
-    lines.append([str(l), f"{ms:.2f}" if ms is not None else "n/a", fmt_ratio(r.get("median_us"), ref), spread(r)])
+    lines.append([str(l), f"{ms:.2f}" if ms is not None else "n/a",
+                  fmt_ratio(r.get("median_cpu_us"), get("BM_build_realtime_model/16").get("median_cpu_us")), spread(r)])
 md.append(table(["l", "median ms / build", "ratio", "spread %"], lines))
 md.append("")
 

@@ -63,14 +63,16 @@ void register_all() {
       {"all_off", false, false, false},
   };
   for (const EffectsConfig& config : configs)
-    for (const std::string phase : {"whole_insertion", "inside_punctured"})
+    for (const std::string phase : {"whole_insertion", "inside_punctured"}) {
+      // Built now, so the iteration count can follow the phase length.
+      const Setup& s = setup_for(config);
+      const TickRange range = phase == "whole_insertion" ? s.script.whole : s.script.inside_punctured;
       benchmark::RegisterBenchmark(("BM_effects/" + config.name + "/" + phase).c_str(),
-                                   [config, phase](benchmark::State& st) {
-                                     const Setup& s = setup_for(config);
-                                     const TickRange range =
-                                         phase == "whole_insertion" ? s.script.whole : s.script.inside_punctured;
+                                   [&s, range](benchmark::State& st) {
                                      run_replay(st, s.scene, s.model, s.script, range);
-                                   });
+                                   })
+          ->Iterations(replay_iterations(range));
+    }
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <memory>
@@ -139,6 +140,17 @@ class TickReplay {
   std::unique_ptr<PunctureSimulator> simulator_;
   std::size_t next_ = 0;
 };
+
+/// Fixed iteration count of a replay benchmark: whole replays of the range,
+/// about 20000 timed ticks but at least 3 and at most 200 replays. Fixed,
+/// because the untimed restarts (a fresh simulator advanced to range.begin)
+/// cost far more than the ticks they serve when the range is short or late:
+/// Google Benchmark's own iteration search would spend minutes in them.
+inline benchmark::IterationCount replay_iterations(TickRange range) {
+  if (range.size() == 0) return 1;
+  const std::size_t replays = std::clamp<std::size_t>((20000 + range.size() - 1) / range.size(), 3, 200);
+  return static_cast<benchmark::IterationCount>(replays * range.size());
+}
 
 /// The benchmark loop: one iteration = one tick; restarts are untimed.
 /// Adds counters: the phase length in ticks and the number of punctures in

@@ -66,9 +66,21 @@ TickRange phase_range(const InsertionScript& script, const std::string& phase) {
   throw std::invalid_argument("unknown phase " + phase);
 }
 
-void run_phase(benchmark::State& state, const std::string& key, const Scene& scene, const std::string& phase) {
+/// Registers a replay of `phase` of the configuration `key` (built now, so
+/// the iteration count can follow the phase length).
+void register_phase(const std::string& name, const std::string& key, const Scene& scene, const std::string& phase,
+                    bool count_nodes = false) {
   const Setup& s = setup_for(key, scene);
-  run_replay(state, s.scene, s.model, s.script, phase_range(s.script, phase));
+  const TickRange range = phase_range(s.script, phase);
+  benchmark::RegisterBenchmark(name.c_str(), [&s, range, count_nodes](benchmark::State& st) {
+    run_replay(st, s.scene, s.model, s.script, range);
+    if (count_nodes) {
+      int nodes = 0;
+      for (std::size_t k = 0; k < s.model.simulator->layer_count(); ++k)
+        nodes += s.model.simulator->force_mesh(k)->node_count();
+      st.counters["mesh_nodes_all_layers"] = nodes;
+    }
+  })->Iterations(replay_iterations(range));
 }
 
 /// Every layer gets w rings; L shrinks where needed so the mesh stays inside
@@ -101,9 +113,7 @@ void register_all() {
   const std::vector<std::string> scaling_phases{"press_skin", "whole_insertion"};
 
   for (const std::string& phase : phases)
-    benchmark::RegisterBenchmark(("BM_tick_phase/" + phase).c_str(), [phase](benchmark::State& st) {
-      run_phase(st, "default", default_scene(), phase);
-    });
+    register_phase("BM_tick_phase/" + phase, "default", default_scene(), phase);
 
   benchmark::RegisterBenchmark("BM_tick_distribution/whole_insertion", [](benchmark::State& st) {
     const Setup& s = setup_for("default", default_scene());
@@ -139,34 +149,22 @@ void register_all() {
     st.counters["press_p99_us"] = percentile(press_us, 0.99);
     st.counters["press_max_us"] = press_us.empty() ? 0.0 : *std::max_element(press_us.begin(), press_us.end());
     st.counters["ticks_per_insertion"] = static_cast<double>(s.script.needle.size());
-  })->Unit(benchmark::kMillisecond);
+  })->Unit(benchmark::kMillisecond)->Iterations(10);
 
   for (const std::string& integrator : {std::string("quasi_static"), std::string("explicit"), std::string("implicit")})
     for (const std::string& phase : scaling_phases)
-      benchmark::RegisterBenchmark(("BM_tick_integrator/" + integrator + "/" + phase).c_str(),
-                                   [integrator, phase](benchmark::State& st) {
-                                     run_phase(st, "integrator=" + integrator, scene_with_integrator(integrator),
-                                               phase);
-                                   });
+      register_phase("BM_tick_integrator/" + integrator + "/" + phase, "integrator=" + integrator,
+                     scene_with_integrator(integrator), phase);
 
   for (int w : {2, 4, 8, 16, 32})
     for (const std::string& phase : scaling_phases)
-      benchmark::RegisterBenchmark(("BM_tick_rings_w/" + std::to_string(w) + "/" + phase).c_str(),
-                                   [w, phase](benchmark::State& st) {
-                                     const Setup& s = setup_for("w=" + std::to_string(w), scene_with_rings(w));
-                                     int nodes = 0;
-                                     for (std::size_t k = 0; k < s.model.simulator->layer_count(); ++k)
-                                       nodes += s.model.simulator->force_mesh(k)->node_count();
-                                     run_replay(st, s.scene, s.model, s.script, phase_range(s.script, phase));
-                                     st.counters["mesh_nodes_all_layers"] = nodes;
-                                   });
+      register_phase("BM_tick_rings_w/" + std::to_string(w) + "/" + phase, "w=" + std::to_string(w),
+                     scene_with_rings(w), phase, true);
 
   for (int l : {4, 8, 16, 24, 32})
     for (const std::string& phase : scaling_phases)
-      benchmark::RegisterBenchmark(("BM_tick_sh_degree/" + std::to_string(l) + "/" + phase).c_str(),
-                                   [l, phase](benchmark::State& st) {
-                                     run_phase(st, "l=" + std::to_string(l), scene_with_degree(l), phase);
-                                   });
+      register_phase("BM_tick_sh_degree/" + std::to_string(l) + "/" + phase, "l=" + std::to_string(l),
+                     scene_with_degree(l), phase);
 
   // The SH query alone: the skin's top face hit by the needle axis (what the
   // tick asks when a layer is first reached), and by vertical rays at 64
