@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "puncture/apps/commands.hpp"
+#include "puncture/apps/fem_reference.hpp"
 #include "puncture/scene_io.hpp"
 
 #ifdef PUNCTURE_HAVE_FEM
@@ -15,11 +16,7 @@ namespace puncture::apps {
 
 int fem_command(const FemOptions& options, std::ostream& out, std::ostream& err) {
 #ifdef PUNCTURE_HAVE_FEM
-  int argc = 1;
-  char program[] = "puncture";
-  char* argv_storage[] = {program, nullptr};
-  char** argv = argv_storage;
-  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  ensure_mpi();
   const bool root = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
   try {

@@ -11,6 +11,7 @@
 
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/provenance.hpp"
+#include "run_outputs.hpp"
 #include "puncture/io/output_session.hpp"
 #include "puncture/io/pvd.hpp"
 #include "puncture/io/vtk_polydata.hpp"
@@ -29,8 +30,6 @@ std::filesystem::path default_scene_path() {
 namespace {
 
 constexpr double kMm = 1e-3;
-constexpr int kSurfaceBandsTheta = 48;
-constexpr int kSurfaceAzimuths = 72;
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -79,85 +78,6 @@ std::string fit_error_csv(const std::vector<LayerFitErrorEntry>& rows) {
         << fmt(e.row.condition_number, 6) << '\n';
   return csv.str();
 }
-
-/// Writes the surfaces and force meshes of every layer for one frame.
-class FrameWriter {
- public:
-  FrameWriter(io::OutputSession& session, const RealtimeModel& model, const Scene& scene)
-      : session_(session), scene_(scene) {
-    for (const LayerSurface* s : model.surfaces) {
-      Eigen::MatrixX3d v;
-      Eigen::MatrixX3i t;
-      s->tessellate(kSurfaceBandsTheta, kSurfaceAzimuths, v, t);
-      rest_vertices_.push_back(v);
-      triangles_.push_back(t);
-    }
-  }
-
-  void write(const PunctureSimulator& sim, const TickResult& tick, int frame) {
-    char index[16];
-    std::snprintf(index, sizeof index, "%04d", frame);
-    const std::size_t n_layers = sim.layer_count();
-    for (std::size_t k = 0; k < n_layers; ++k) {
-      const std::string& name = scene_.layers[k].name;
-      const double state = static_cast<double>(tick.layers[k].state);
-      // Layer surface: SH surface displaced by the force-mesh displacement field.
-      Eigen::MatrixX3d vertices = rest_vertices_[k];
-      Eigen::VectorXd deflection = Eigen::VectorXd::Zero(vertices.rows());
-      const ForceMesh* mesh = sim.force_mesh(k);
-      if (mesh && mesh->node_count() > 0) {
-        const Eigen::Matrix3Xd displacement = sim.node_positions(k) - sim.node_rest_positions(k);
-        const LatticeDisplacementField field = LatticeDisplacementField::of(*mesh);
-        for (Eigen::Index i = 0; i < vertices.rows(); ++i) {
-          const Eigen::Vector3d p = vertices.row(i).transpose();
-          if (p.z() < layer_top_z(k) - 1e-9) continue;  // only the top face carries the force mesh
-          const Eigen::Vector3d d = field.displacement_at(p, displacement);
-          vertices.row(i) += d.transpose();
-          deflection[i] = -d.z() / kMm;
-        }
-      }
-      const std::string surface_file = "frames/" + name + "_surface_" + index + ".vtp";
-      io::write_polydata(session_, surface_file, vertices, triangles_[k],
-                         {{"deflection_mm", deflection},
-                          {"layer_state", Eigen::VectorXd::Constant(vertices.rows(), state)}},
-                         {});
-      entries_.push_back({tick.time_s, static_cast<int>(k), surface_file});
-
-      if (mesh && mesh->node_count() > 0) {
-        const Eigen::Matrix3Xd& pos = sim.node_positions(k);
-        const Eigen::MatrixX3d nodes = pos.transpose();
-        Eigen::VectorXd ring(mesh->node_count()), node_deflection(mesh->node_count());
-        const Eigen::Matrix3Xd disp = pos - sim.node_rest_positions(k);
-        for (int i = 0; i < mesh->node_count(); ++i) {
-          ring[i] = sim.node_rings(k)[static_cast<std::size_t>(i)];
-          node_deflection[i] = -disp(2, i) / kMm;
-        }
-        if (lattice_tris_.size() <= k) lattice_tris_.resize(n_layers);
-        if (lattice_tris_[k].rows() == 0) lattice_tris_[k] = lattice_triangles(mesh->lattice());
-        const std::string mesh_file = "frames/" + name + "_force_mesh_" + index + ".vtp";
-        io::write_polydata(session_, mesh_file, nodes, lattice_tris_[k],
-                           {{"ring", ring}, {"deflection_mm", node_deflection}}, {});
-        entries_.push_back({tick.time_s, static_cast<int>(n_layers + k), mesh_file});
-      }
-    }
-    ++frames_;
-  }
-
-  void finish() {
-    if (!entries_.empty()) io::write_pvd(session_, "realtime.pvd", entries_);
-  }
-  int frames() const { return frames_; }
-
- private:
-  double layer_top_z(std::size_t k) const { return -scene_.layer_top_depth_m(k); }
-  io::OutputSession& session_;
-  const Scene& scene_;
-  std::vector<Eigen::MatrixX3d> rest_vertices_;
-  std::vector<Eigen::MatrixX3i> triangles_;
-  std::vector<Eigen::MatrixX3i> lattice_tris_;
-  std::vector<io::PvdEntry> entries_;
-  int frames_ = 0;
-};
 
 nlohmann::json summary_json(const Scene& scene, const RealtimeModel& model, const ScriptedRunResult& run,
                             const std::string& command_line) {

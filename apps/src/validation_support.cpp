@@ -1,0 +1,364 @@
+// validation_support.cpp: see validation_support.hpp.
+#include "validation_support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+
+#include "puncture/apps/commands.hpp"
+
+namespace puncture::apps {
+
+namespace {
+
+constexpr double kMm = 1e-3;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::vector<std::string> split_csv_line(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  std::istringstream s(line);
+  while (std::getline(s, field, ',')) fields.push_back(field);
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+double to_double(const std::string& text, const std::string& file, int line) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
+    throw std::runtime_error(file + ":" + std::to_string(line) + ": not a finite number: '" + text + "'");
+  return v;
+}
+
+/// Rows of a CSV as maps column -> text.
+std::vector<std::map<std::string, std::string>> read_csv_rows(const std::filesystem::path& path) {
+  std::istringstream in(read_text(path));
+  std::string line;
+  if (!std::getline(in, line)) throw std::runtime_error(path.string() + ": empty file");
+  const std::vector<std::string> header = split_csv_line(line);
+  std::vector<std::map<std::string, std::string>> rows;
+  int n = 1;
+  while (std::getline(in, line)) {
+    ++n;
+    if (line.empty()) continue;
+    const std::vector<std::string> f = split_csv_line(line);
+    if (f.size() != header.size())
+      throw std::runtime_error(path.string() + ":" + std::to_string(n) + ": " + std::to_string(f.size()) +
+                               " fields, header has " + std::to_string(header.size()));
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < f.size(); ++i) row[header[i]] = f[i];
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+/// Appends (r, uz) to the profile, keeping r strictly increasing.
+void append_point(validation::RadialProfile& p, double r_m, double uz_m) {
+  if (!p.r_m.empty() && r_m <= p.r_m.back()) return;
+  p.r_m.push_back(r_m);
+  p.uz_m.push_back(uz_m);
+}
+
+}  // namespace
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path.string());
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+FemResultFiles read_fem_result(const std::filesystem::path& dir, const Scene& scene) {
+  FemResultFiles fem;
+  fem.curve = validation::read_insertion_curve(dir / "fem_force_depth.csv");
+  fem.summary = nlohmann::json::parse(read_text(dir / "fem_summary.json"));
+  if (fem.summary.contains("punctures"))
+    for (const auto& p : fem.summary["punctures"])
+      fem.puncture_depth_m[p.at("name").get<std::string>()] = p.at("depth_mm").get<double>() * kMm;
+
+  {  // surface profiles, one per (step, surface)
+    const auto path = dir / "fem_surface_profile.csv";
+    int line = 1;
+    for (const auto& row : read_csv_rows(path)) {
+      ++line;
+      const std::string surface = row.at("surface");
+      const int step = static_cast<int>(to_double(row.at("step"), path.string(), line));
+      auto& list = fem.profiles[surface];
+      if (list.empty() || list.back().step != step) {
+        validation::RadialProfile p;
+        p.step = step;
+        p.depth_m = to_double(row.at("depth_mm"), path.string(), line) * kMm;
+        list.push_back(p);
+      }
+      append_point(list.back(), to_double(row.at("r_mm"), path.string(), line) * kMm,
+                   to_double(row.at("uz_mm"), path.string(), line) * kMm);
+    }
+  }
+  {  // spring-back profiles
+    const auto path = dir / "fem_recovery_profile.csv";
+    int line = 1;
+    for (const auto& row : read_csv_rows(path)) {
+      ++line;
+      const int layer = static_cast<int>(to_double(row.at("layer"), path.string(), line));
+      if (layer < 0 || layer >= static_cast<int>(scene.layers.size()))
+        throw std::runtime_error(path.string() + ":" + std::to_string(line) + ": layer index out of range");
+      const std::string& name = scene.layers[static_cast<std::size_t>(layer)].name;
+      auto& target = row.at("phase") == "before" ? fem.before_breakthrough[name] : fem.after_breakthrough[name];
+      target.depth_m = to_double(row.at("depth_mm"), path.string(), line) * kMm;
+      append_point(target, to_double(row.at("r_mm"), path.string(), line) * kMm,
+                   to_double(row.at("uz_mm"), path.string(), line) * kMm);
+    }
+  }
+  const auto pvd = dir / "fem_fields.pvd";
+  if (std::filesystem::is_regular_file(pvd)) {
+    const std::string text = read_text(pvd);
+    const std::regex dataset(R"re(<DataSet[^>]*timestep="([^"]+)"[^>]*file="([^"]+)")re");
+    const std::regex source(R"re(Source="([^"]+)")re");
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), dataset); it != std::sregex_iterator(); ++it) {
+      FemFrame f;
+      f.time_s = to_double((*it)[1], pvd.string(), 0);
+      f.pvtu = (*it)[2];
+      f.files.push_back(f.pvtu);
+      const std::filesystem::path pvtu_dir = std::filesystem::path(f.pvtu).parent_path();
+      const std::string pvtu_text = read_text(dir / f.pvtu);
+      for (auto s = std::sregex_iterator(pvtu_text.begin(), pvtu_text.end(), source); s != std::sregex_iterator(); ++s)
+        f.files.push_back((pvtu_dir / std::string((*s)[1])).string());
+      fem.frame_times_s.push_back(f.time_s);
+      fem.frames.push_back(std::move(f));
+    }
+  }
+  return fem;
+}
+
+double fem_deflection_at_mm(const FemResultFiles& fem, const Scene& scene, std::size_t layer, double r_m,
+                            double time_s) {
+  const auto it = fem.profiles.find(scene.layers[layer].name);
+  if (it == fem.profiles.end() || it->second.empty()) return kNaN;
+  const double depth = scene.insertion.speed_m_per_s * time_s - scene.insertion.start_height_m;
+  const validation::RadialProfile& p = validation::profile_nearest_depth(it->second, depth);
+  if (std::abs(p.depth_m - depth) > 0.5 * scene.fem.load_step_m + 1e-9) return kNaN;
+  double uz = kNaN;
+  if (!validation::interpolate_linear(p.r_m, p.uz_m, r_m, uz)) return kNaN;
+  return -uz / kMm;
+}
+
+RingRecorder::RingRecorder(const Scene& scene) {
+  for (const Layer& l : scene.layers) {
+    offset_.push_back(stride_);
+    const int w = scene.effects.surface_force ? l.force_mesh.rings_w : 0;
+    rings_per_layer_.push_back(w);
+    stride_ += static_cast<std::size_t>(w);
+  }
+}
+
+void RingRecorder::record(const PunctureSimulator& sim) {
+  const std::size_t base = data_.size();
+  data_.resize(base + stride_, 0.0);
+  std::vector<int> count;
+  for (std::size_t k = 0; k < sim.layer_count() && k < rings_per_layer_.size(); ++k) {
+    const Eigen::Matrix3Xd& pos = sim.node_positions(k);
+    const Eigen::Matrix3Xd& rest = sim.node_rest_positions(k);
+    const std::vector<int>& ring = sim.node_rings(k);
+    const int w = rings_per_layer_[k];
+    if (pos.cols() == 0 || w == 0) continue;
+    count.assign(static_cast<std::size_t>(w), 0);
+    double* out = data_.data() + base + offset_[k];
+    for (Eigen::Index i = 0; i < pos.cols(); ++i) {
+      const int j = ring[static_cast<std::size_t>(i)] - 1;
+      if (j < 0 || j >= w) continue;
+      out[j] += -(pos(2, i) - rest(2, i));
+      ++count[static_cast<std::size_t>(j)];
+    }
+    for (int j = 0; j < w; ++j)
+      if (count[static_cast<std::size_t>(j)] > 0) out[j] /= count[static_cast<std::size_t>(j)];
+  }
+  ++ticks_;
+}
+
+std::vector<double> RingRecorder::rings(std::size_t tick, std::size_t layer) const {
+  if (tick >= ticks_ || layer >= rings_per_layer_.size()) throw std::out_of_range("RingRecorder::rings");
+  const double* begin = data_.data() + tick * stride_ + offset_[layer];
+  return std::vector<double>(begin, begin + rings_per_layer_[layer]);
+}
+
+LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size_t k, const ScriptedRunResult& run,
+                                                   const RingRecorder& recorder, const FemResultFiles& fem) {
+  LayerDeflectionComparison c;
+  const Layer& layer = scene.layers[k];
+  const double L = layer.force_mesh.spacing_L_m;
+  if (!scene.effects.surface_force || recorder.ticks() != run.ticks.size() || run.ticks.empty()) return c;
+
+  // Insertion phase of the real-time run: up to the deepest tick.
+  std::size_t deepest = 0;
+  for (std::size_t i = 0; i < run.ticks.size(); ++i)
+    if (run.ticks[i].depth_m > run.ticks[deepest].depth_m) deepest = i;
+  std::size_t broke = run.ticks.size();
+  for (std::size_t i = 0; i < run.ticks.size(); ++i)
+    if (run.ticks[i].layers[k].state == LayerState::Punctured) {
+      broke = i;
+      break;
+    }
+  const double realtime_pre_depth =
+      broke < run.ticks.size() && broke > 0 ? run.ticks[broke - 1].depth_m : run.ticks[deepest].depth_m;
+
+  std::vector<validation::RadialProfile> candidates;
+  if (const auto it = fem.profiles.find(layer.name); it != fem.profiles.end()) candidates = it->second;
+  if (const auto it = fem.before_breakthrough.find(layer.name); it != fem.before_breakthrough.end())
+    candidates.push_back(it->second);
+  const auto fem_break = fem.puncture_depth_m.find(layer.name);
+  const double fem_break_depth =
+      fem_break == fem.puncture_depth_m.end() ? std::numeric_limits<double>::infinity() : fem_break->second;
+
+  if (!candidates.empty()) {
+    const double compare_depth = std::min(realtime_pre_depth, fem_break_depth);
+    std::size_t tick = run.ticks.size();
+    for (std::size_t i = 0; i <= deepest && i < broke; ++i)
+      if (run.ticks[i].velocity_m_per_s > 0.0 && run.ticks[i].depth_m <= compare_depth + 1e-12) tick = i;
+    if (tick < run.ticks.size()) {
+      c.realtime_depth_m = run.ticks[tick].depth_m;
+      c.realtime_rings_m = recorder.rings(tick, k);
+      c.fem = validation::profile_nearest_depth(candidates, c.realtime_depth_m);
+      c.fem_depth_m = c.fem.depth_m;
+      c.error = validation::deflection_profile_error(c.realtime_rings_m, L, c.fem);
+      c.compared = c.error.n_rings > 0;
+    }
+  }
+
+  const auto after = fem.after_breakthrough.find(layer.name);
+  if (after != fem.after_breakthrough.end() && broke < run.ticks.size()) {
+    const auto delay_ticks = static_cast<std::size_t>(std::ceil(1.0 / layer.resumption_rate - 1e-9));
+    const std::size_t tick = std::min(run.ticks.size() - 1, broke + delay_ticks);
+    c.recovery_delay_s = run.ticks[tick].time_s - run.ticks[broke].time_s;
+    c.realtime_recovered_rings_m = recorder.rings(tick, k);
+    c.fem_after = after->second;
+    c.recovery_error = validation::deflection_profile_error(c.realtime_recovered_rings_m, L, c.fem_after);
+    c.recovery_compared = c.recovery_error.n_rings > 0;
+  }
+  return c;
+}
+
+std::vector<std::string> run_plot_script(const std::string& script, const std::filesystem::path& dir,
+                                         std::ostream& out, std::ostream& err) {
+  std::filesystem::path path = std::filesystem::path(PUNCTURE_SOURCE_DIR) / "scripts" / script;
+  if (!std::filesystem::exists(path)) path = std::filesystem::path("scripts") / script;
+  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  if (!std::filesystem::exists(path)) {
+    err << "warning: " << script << " not found: no PNG plots\n";
+  } else {
+    const std::string log = (dir / ".plot.log").string();
+    const std::string command = python + " '" + path.string() + "' '" + dir.string() + "' > '" + log + "' 2>&1";
+    const int status = std::system(command.c_str());
+    if (status != 0) {
+      err << "warning: plotting failed (" << command << "):\n";
+      std::ifstream in(log);
+      err << in.rdbuf();
+    } else {
+      out << "[plot] " << script << " done\n";
+    }
+    std::error_code ignored;
+    std::filesystem::remove(log, ignored);
+  }
+  std::vector<std::string> pngs;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".png") pngs.push_back(e.path().filename().string());
+  std::sort(pngs.begin(), pngs.end());
+  return pngs;
+}
+
+namespace {
+std::string num(double x, int precision = 4) {
+  if (!std::isfinite(x)) return "–";
+  std::ostringstream s;
+  s << std::setprecision(precision) << x;
+  return s.str();
+}
+std::string num(const nlohmann::json& j, const char* key, double scale = 1.0, int precision = 4) {
+  if (!j.contains(key) || !j[key].is_number()) return "–";
+  return num(j[key].get<double>() * scale, precision);
+}
+}  // namespace
+
+std::string validation_summary_markdown(const Scene& scene, const std::string& command_line,
+                                        const nlohmann::json& provenance, const FemReference& reference,
+                                        const FemResultFiles& fem, const validation::CurveComparison& cmp,
+                                        const nlohmann::json& layers, const std::vector<std::string>& plots,
+                                        bool has_vtk) {
+  std::ostringstream md;
+  md << "# Validation: " << scene.name << "\n\n";
+  md << "Real-time SHF + MSM model against the deal.II FEM reference on the identical insertion ("
+     << num(scene.insertion.speed_m_per_s / kMm) << " mm/s to " << num(scene.insertion.target_depth_m / kMm)
+     << " mm), aligned on depth. Only the insertion phase is compared (the FEM is quasi-static and stops at the "
+        "target depth).\n\n";
+  md << "## Provenance\n\n";
+  md << "- command: `" << command_line << "`\n";
+  md << "- program " << provenance.value("program_version", "") << ", git revision "
+     << provenance.value("git_revision", "") << "\n";
+  md << "- machine: " << provenance.value("machine", "") << "\n";
+  md << "- date (UTC): " << provenance.value("date_utc", "") << "\n";
+  md << "- scene: `" << scene.source_path << "`\n";
+  md << "- FEM reference: key `" << reference.hash << "` (" << (reference.from_cache ? "from the cache" : "computed")
+     << "), " << fem.summary.value("n_dofs", 0) << " DoFs, Q" << fem.summary.value("element_degree", 0)
+     << ", refinement " << fem.summary.value("refinement", 0) << ", " << fem.summary.value("load_steps", 0)
+     << " load steps, " << num(fem.summary.value("wall_time_s", 0.0), 3) << " s wall time\n";
+  md << "- real-time model: SH degree " << scene.realtime.sh_degree << ", integrator " << scene.realtime.integrator
+     << ", haptic rate " << num(scene.realtime.haptic_rate_Hz) << " Hz\n\n";
+
+  md << "## Force against depth\n\n";
+  md << "Force RMSE over the compared insertion (" << num(cmp.compared_from_depth_m / kMm) << " to "
+     << num(cmp.compared_to_depth_m / kMm) << " mm, " << cmp.n_compared << " FEM samples): **"
+     << num(cmp.force_rmse_N) << " N**, " << num(100 * cmp.force_rmse_relative, 3) << " % of the FEM peak "
+     << num(cmp.reference_peak_force_N) << " N.\n\n";
+  md << "| layer | force RMSE (N) | RMSE / FEM peak | FEM puncture depth (mm) | real-time puncture depth (mm) | "
+        "depth error (mm) | force error (N) | deflection RMSE before breakthrough (mm) | max error (mm) | "
+        "recovery RMSE (mm) |\n";
+  md << "|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& j : layers) {
+    const std::string name = j["layer"].get<std::string>();
+    const validation::LayerMetrics* m = cmp.layer(name);
+    md << "| " << name << " | " << num(j, "force_rmse_N") << " | " << num(j, "force_rmse_relative") << " | "
+       << (m && m->reference_puncture.found ? num(m->reference_puncture.depth_m / kMm) : "not punctured") << " | "
+       << (m && m->model_puncture.found ? num(m->model_puncture.depth_m / kMm) : "not punctured") << " | "
+       << num(j, "puncture_depth_error_mm") << " | " << num(j, "puncture_force_error_N") << " | "
+       << (j.contains("deflection") ? num(j["deflection"], "rmse_mm") : "–") << " | "
+       << (j.contains("deflection") ? num(j["deflection"], "max_abs_error_mm") : "–") << " | "
+       << (j.contains("recovery") ? num(j["recovery"], "rmse_mm") : "–") << " |\n";
+  }
+  md << "\nDepth and force errors are real-time minus FEM. The deflection is compared at the last depth at which "
+        "the layer is intact in both models: ring deflections Delta Z_j at r = (j - 1) L against the FEM's -u_z "
+        "of the layer's top surface at the same distance from the needle. The recovery compares the FEM's "
+        "spring-back (same depth, after the material along the needle path was removed) with the real-time "
+        "ring deflections ceil(1 / eta_r) haptic steps after its breakthrough.\n\n";
+
+  if (!plots.empty()) {
+    md << "## Plots\n\n";
+    for (const std::string& p : plots) md << "![" << p << "](" << p << ")\n\n";
+  }
+  md << "## Files\n\n";
+  md << "| file | content |\n|---|---|\n";
+  md << "| [force_depth_aligned.csv](force_depth_aligned.csv) | FEM insertion samples with the real-time force at "
+        "the same depths |\n";
+  md << "| [realtime_curve.csv](realtime_curve.csv) | real-time curve (every haptic tick, per-layer states) |\n";
+  md << "| [fem_force_depth.csv](fem_force_depth.csv) | FEM curve (every load step, per-layer states) |\n";
+  md << "| [layer_metrics.csv](layer_metrics.csv) | per-layer metrics (the table above, full precision) |\n";
+  md << "| [deflection_profiles.csv](deflection_profiles.csv) | deflection against r, both models, before and "
+        "after breakthrough |\n";
+  md << "| [fem_recovery_profile.csv](fem_recovery_profile.csv) | FEM spring-back profiles |\n";
+  md << "| [validation_metrics.json](validation_metrics.json) | all metrics, FEM summary, provenance |\n";
+  if (has_vtk)
+    md << "| [validation.pvd](validation.pvd) | ParaView: open this one file. Part 0: FEM fields (`fem/*.vtu`) "
+          "at x = 0; the real-time layer surfaces and force meshes (`realtime/*.vtp`) stand beside it, shifted by "
+          "one sample diameter (" << num(scene.sample.diameter_m / kMm) << " mm) in +x, with point fields "
+          "`deflection_mm` and `deflection_error_mm` (real-time minus FEM at the same r and depth) |\n";
+  return md.str();
+}
+
+}  // namespace puncture::apps

@@ -1,0 +1,115 @@
+// validation_support.hpp (internal to apps/src): pieces shared by `puncture
+// validate` and `puncture sweep`.
+//
+//   read_fem_result(dir, scene)      the FEM reference files of one cache entry:
+//                                    curve, summary, surface profiles per layer,
+//                                    spring-back profiles, VTK frames
+//   RingRecorder                     ring deflections Delta Z_j (m, > 0 into the
+//                                    tissue) of every layer at every haptic tick
+//   compare_layer_deflection(...)    Delta Z_j against the FEM u_z before and
+//                                    after a layer's breakthrough
+//   fem_deflection_at_mm(...)        FEM deflection of a layer's top surface at
+//                                    radius r and time t (for error fields)
+//   run_plot_script(name, dir, ...)  /usr/bin/python3 scripts/<name> <dir>
+//   validation_summary_markdown(...) validation_summary.md
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "puncture/apps/fem_reference.hpp"
+#include "puncture/model/realtime_model.hpp"
+#include "puncture/scene.hpp"
+#include "puncture/validation/metrics.hpp"
+
+namespace puncture::apps {
+
+/// Whole file as text; throws std::runtime_error naming the file.
+std::string read_text(const std::filesystem::path& path);
+
+struct FemFrame {
+  double time_s = 0.0;
+  std::string pvtu;                ///< relative to the reference directory
+  std::vector<std::string> files;  ///< pvtu and its pieces, relative to the reference directory
+};
+
+struct FemResultFiles {
+  validation::InsertionCurve curve;  ///< fem_force_depth.csv
+  nlohmann::json summary;            ///< fem_summary.json
+  /// fem_surface_profile.csv split by the surface (layer name) column, depth order.
+  std::map<std::string, std::vector<validation::RadialProfile>> profiles;
+  /// fem_recovery_profile.csv: the layer's top surface just before and just
+  /// after its breakthrough (same depth), by layer name.
+  std::map<std::string, validation::RadialProfile> before_breakthrough, after_breakthrough;
+  std::map<std::string, double> puncture_depth_m;  ///< from fem_summary.json
+  std::vector<FemFrame> frames;                    ///< from fem_fields.pvd (empty without VTU)
+  std::vector<double> frame_times_s;
+};
+FemResultFiles read_fem_result(const std::filesystem::path& dir, const Scene& scene);
+
+/// FEM deflection (mm, > 0 into the tissue) of layer `layer`'s top surface at
+/// radius r_m at time time_s (tip depth = speed t - start height), from the
+/// surface profile within half a load step of that depth; NaN if the FEM has
+/// no profile of that layer there.
+double fem_deflection_at_mm(const FemResultFiles& fem, const Scene& scene, std::size_t layer, double r_m,
+                            double time_s);
+
+class RingRecorder {
+ public:
+  explicit RingRecorder(const Scene& scene);
+  /// Appends the current ring deflections of every layer (call once per tick).
+  void record(const PunctureSimulator& sim);
+  std::size_t ticks() const { return ticks_; }
+  /// Delta Z_j, j = 1..w, of layer k at recorded tick i (m, > 0 into the tissue).
+  std::vector<double> rings(std::size_t tick, std::size_t layer) const;
+
+ private:
+  std::vector<int> rings_per_layer_;
+  std::vector<std::size_t> offset_;
+  std::size_t stride_ = 0;
+  std::size_t ticks_ = 0;
+  std::vector<double> data_;
+};
+
+struct LayerDeflectionComparison {
+  bool compared = false;
+  double realtime_depth_m = std::numeric_limits<double>::quiet_NaN();  ///< tip depth of the tick used
+  double fem_depth_m = std::numeric_limits<double>::quiet_NaN();       ///< depth of the FEM profile used
+  std::vector<double> realtime_rings_m;
+  validation::RadialProfile fem;
+  validation::DeflectionProfileError error;
+
+  bool recovery_compared = false;
+  double recovery_delay_s = std::numeric_limits<double>::quiet_NaN();  ///< time after the real-time breakthrough
+  std::vector<double> realtime_recovered_rings_m;
+  validation::RadialProfile fem_after;
+  validation::DeflectionProfileError recovery_error;
+};
+
+/// Before breakthrough: the last insertion depth at which layer k is intact in
+/// both models (the smaller of the two pre-breakthrough depths); the real-time
+/// Delta Z_j at that tick against the FEM profile of the layer nearest in
+/// depth. After: the FEM spring-back profile against the real-time rings
+/// ceil(1 / eta_r) ticks after the real-time breakthrough.
+LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size_t k, const ScriptedRunResult& run,
+                                                   const RingRecorder& recorder, const FemResultFiles& fem);
+
+/// Runs /usr/bin/python3 (else python3) <source>/scripts/<script> <dir>; a
+/// failure is reported on `err` as a warning. Returns the *.png file names in
+/// dir afterwards (sorted).
+std::vector<std::string> run_plot_script(const std::string& script, const std::filesystem::path& dir,
+                                         std::ostream& out, std::ostream& err);
+
+std::string validation_summary_markdown(const Scene& scene, const std::string& command_line,
+                                        const nlohmann::json& provenance, const FemReference& reference,
+                                        const FemResultFiles& fem, const validation::CurveComparison& cmp,
+                                        const nlohmann::json& layers, const std::vector<std::string>& plots,
+                                        bool has_vtk);
+
+}  // namespace puncture::apps

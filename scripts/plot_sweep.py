@@ -1,0 +1,71 @@
+#!/usr/bin/python3
+"""Pareto plot of a `puncture sweep` folder (matplotlib; run with /usr/bin/python3).
+
+In:  DIR/accuracy_cost.csv (model, knob, value, status, force_rmse_N,
+     time_per_step_s, ...).
+Out: DIR/pareto.png: force RMSE against the finest FEM versus time per step,
+     log axes, one marker series per knob, the non-dominated points joined.
+"""
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def num(text):
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: plot_sweep.py SWEEP_DIR")
+    d = sys.argv[1]
+    with open(os.path.join(d, "accuracy_cost.csv"), newline="") as f:
+        rows = [r for r in csv.DictReader(f) if r["status"] == "ok"]
+    points = []
+    for r in rows:
+        t, e = num(r["time_per_step_s"]), num(r["force_rmse_N"])
+        if t > 0 and math.isfinite(t) and math.isfinite(e):
+            points.append((t, max(e, 1e-6), r))
+    fig, ax = plt.subplots(figsize=(8, 5.5))
+    knobs = []
+    for _, _, r in points:
+        key = (r["model"], r["knob"])
+        if key not in knobs:
+            knobs.append(key)
+    markers = "osD^v<>ph*"
+    for i, key in enumerate(knobs):
+        sel = [(t, e, r) for t, e, r in points if (r["model"], r["knob"]) == key]
+        ax.scatter([p[0] for p in sel], [p[1] for p in sel], marker=markers[i % len(markers)], s=36,
+                   label=f"{key[0]}: {key[1]}")
+        for t, e, r in sel:
+            ax.annotate(r["value"], (t, e), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    front, best = [], math.inf
+    for t, e, _ in sorted(points, key=lambda p: p[0]):
+        if e < best:
+            front.append((t, e))
+            best = e
+    if len(front) > 1:
+        ax.plot([p[0] for p in front], [p[1] for p in front], "k--", lw=0.8, label="Pareto front")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time per step (s): real-time = median haptic tick, FEM = per load step")
+    ax.set_ylabel("force RMSE against the finest FEM (N)")
+    ax.set_title("What accuracy costs in time")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "pareto.png"), dpi=120)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    main()
