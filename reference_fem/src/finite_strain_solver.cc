@@ -17,7 +17,11 @@
 #include <deal.II/lac/trilinos_solver.h>
 #include <deal.II/lac/vector.h>
 
+#include <Epetra_MultiVector.h>
+#include <Teuchos_ParameterList.hpp>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -206,6 +210,9 @@ void FiniteStrainSolver::setup() {
   solution_ = 0.0;
   solution_ghosted_ = solution_;
   removed_.assign(triangulation_.n_active_cells(), 0);
+  owned_support_.clear();
+  for (const auto& p : locally_relevant_dof_points())
+    if (locally_owned_.is_element(p.dof)) owned_support_[p.dof] = {p.component, p.X};
   assemble(solution_ghosted_, false, nullptr);
 }
 
@@ -430,14 +437,36 @@ unsigned int FiniteStrainSolver::solve_linear(TrilinosWrappers::MPI::Vector& du)
   if (!settings_.direct_linear_solver) {
     SolverControl control(std::max<unsigned>(2000, 10 * std::sqrt(double(n_dofs()))),
                           settings_.linear_relative_tolerance * rhs_norm);
+    // Smoothed-aggregation AMG (ML) with the six rigid-body modes of 3D
+    // elasticity as near null space (translations and rotations evaluated at
+    // the support points of the locally owned dofs).
     TrilinosWrappers::PreconditionAMG amg;
     TrilinosWrappers::PreconditionAMG::AdditionalData data;
     data.elliptic = true;
     data.higher_order_elements = settings_.degree > 1;
     data.smoother_sweeps = 2;
     data.aggregation_threshold = 0.02;
-    DoFTools::extract_constant_modes(dof_handler_, ComponentMask(3, true), data.constant_modes);
-    amg.initialize(tangent_, data);
+    Teuchos::ParameterList parameters;
+    std::unique_ptr<Epetra_MultiVector> unused_modes;
+    data.set_parameters(parameters, unused_modes, tangent_);
+    const Epetra_Map& map = tangent_.trilinos_matrix().DomainMap();
+    Epetra_MultiVector rigid_body_modes(map, 6);
+    const int n_local = map.NumMyElements();
+    for (int li = 0; li < n_local; ++li) {
+      const types::global_dof_index dof = map.GID(li);
+      const auto it = owned_support_.find(dof);
+      if (it == owned_support_.end()) continue;
+      const unsigned c = it->second.first;
+      const Point<3>& X = it->second.second;
+      rigid_body_modes[c][li] = 1.0;  // translations
+      // rotations about x, y, z: (0,-z,y), (z,0,-x), (-y,x,0)
+      const double rot[3][3] = {{0.0, -X[2], X[1]}, {X[2], 0.0, -X[0]}, {-X[1], X[0], 0.0}};
+      for (unsigned r = 0; r < 3; ++r) rigid_body_modes[3 + r][li] = rot[r][c];
+    }
+    parameters.set("null space: type", "pre-computed");
+    parameters.set("null space: dimension", 6);
+    parameters.set("null space: vectors", rigid_body_modes.Values());
+    amg.initialize(tangent_, parameters);
     try {
       SolverCG<TrilinosWrappers::MPI::Vector> cg(control);
       cg.solve(tangent_, du, rhs_, amg);
@@ -456,9 +485,21 @@ unsigned int FiniteStrainSolver::solve_linear(TrilinosWrappers::MPI::Vector& du)
     }
     du = 0.0;
   }
+  // Sparse direct solve (MUMPS through Amesos; KLU if MUMPS is missing).
   SolverControl control(1, 0);
-  TrilinosWrappers::SolverDirect direct(control);
-  direct.solve(tangent_, du, rhs_);
+  try {
+    TrilinosWrappers::SolverDirect direct(control,
+                                          TrilinosWrappers::SolverDirect::AdditionalData(false, "Amesos_Mumps"));
+    direct.solve(tangent_, du, rhs_);
+  } catch (const std::exception& e) {
+    static bool warned = false;
+    if (!warned && Utilities::MPI::this_mpi_process(mpi_communicator()) == 0)
+      std::cerr << "fem: MUMPS direct solver failed (" << e.what() << "); using KLU" << std::endl;
+    warned = true;
+    du = 0.0;
+    TrilinosWrappers::SolverDirect direct(control);
+    direct.solve(tangent_, du, rhs_);
+  }
   return 1;
 }
 
@@ -487,7 +528,11 @@ NewtonReport FiniteStrainSolver::solve_step() {
 
   for (int it = 0;; ++it) {
     const AffineConstraints<double> constraints = increment_constraints();
-    if (!assemble(solution_ghosted_, true, &constraints).valid)
+    const auto t_assemble = std::chrono::steady_clock::now();
+    const bool assembled_valid = assemble(solution_ghosted_, true, &constraints).valid;
+    const double assemble_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t_assemble).count();
+    if (!assembled_valid)
       return fail("inverted or non-finite state at the start of an iteration");
     const double free = free_residual_norm();
     const double gap = max_constraint_gap();
@@ -514,7 +559,9 @@ NewtonReport FiniteStrainSolver::solve_step() {
       report.iterations = it;
       return fail("no convergence in " + std::to_string(it) + " Newton iterations");
     }
+    const auto t_solve = std::chrono::steady_clock::now();
     const unsigned lin_its = solve_linear(du);
+    const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_solve).count();
     report.linear_iterations += lin_its;
     constraints.distribute(du);
     if (!std::isfinite(du.l2_norm())) return fail("non-finite Newton update");
@@ -545,7 +592,8 @@ NewtonReport FiniteStrainSolver::solve_step() {
       trial = solution_;
       trial.add(alpha, du);
     }
-    line << "  lin_its " << lin_its << "  alpha " << std::defaultfloat << alpha;
+    line << "  lin_its " << lin_its << "  alpha " << std::defaultfloat << alpha << "  t_assemble "
+         << std::setprecision(3) << assemble_s << " s  t_solve " << solve_s << " s";
     report.table.push_back(line.str());
     if (settings_.verbose && root) std::cout << "      " << report.table.back() << std::endl;
     solution_ = trial;

@@ -160,6 +160,12 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
   settings.max_newton_iterations = scene.fem.max_newton_iterations;
   settings.newton_tolerance = scene.fem.newton_tolerance;
   settings.verbose = false;
+  if (options.linear_solver != "auto" && options.linear_solver != "direct" && options.linear_solver != "iterative")
+    throw std::invalid_argument("fem: linear_solver must be auto, direct or iterative");
+  const std::size_t approx_dofs = 3 * tria.n_global_active_cells() * degree * degree * degree;
+  settings.direct_linear_solver =
+      options.linear_solver == "direct" ||
+      (options.linear_solver == "auto" && approx_dofs <= options.direct_solver_max_dofs);
   FiniteStrainSolver solver(tria, materials, settings);
   solver.setup();
 
@@ -172,7 +178,8 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
   {
     std::ostringstream s;
     s << "fem: scene '" << scene.name << "', " << summary.n_cells << " cells, Q" << degree << " ("
-      << options.formulation << "), " << summary.n_dofs << " dofs, " << summary.n_ranks << " rank(s)";
+       << options.formulation << "), " << summary.n_dofs << " dofs, "
+      << (settings.direct_linear_solver ? "MUMPS" : "CG+AMG") << ", " << summary.n_ranks << " rank(s)";
     log(s.str());
   }
 
@@ -260,7 +267,10 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
       summary.linear_iterations += report.linear_iterations;
       newton_log << "depth " << format_double(depth * 1e3, 6) << " mm, contact nodes " << contact.size()
                  << (report.converged ? "" : ", FAILED: " + report.failure) << "\n";
-      for (const auto& line : report.table) newton_log << "  " << line << "\n";
+      for (const auto& line : report.table) {
+        newton_log << "  " << line << "\n";
+        log("      " + line);
+      }
       if (!report.converged) return false;
       solution_is_stale = false;
       bool more = false;

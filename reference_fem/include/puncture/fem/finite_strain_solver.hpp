@@ -64,8 +64,8 @@ struct SolverSettings {
   double newton_tolerance = 1e-8;
   double absolute_residual_floor_N = 1e-13;  ///< converged below this whatever the scale
   int max_line_search_halvings = 8;
-  double linear_relative_tolerance = 1e-10;  ///< CG stop: ||r|| <= tol ||b||
-  bool direct_linear_solver = false;         ///< Amesos KLU instead of CG + AMG
+  double linear_relative_tolerance = 1e-9;   ///< CG stop: ||r|| <= tol ||b||
+  bool direct_linear_solver = false;         ///< sparse direct (MUMPS) instead of CG + AMG
   double void_stiffness_fraction = 1e-4;     ///< E_void / E_layer for removed cells
   bool verbose = false;                      ///< convergence table on rank 0
 };
@@ -177,6 +177,8 @@ class FiniteStrainSolver {
   std::map<dealii::types::global_dof_index, double> targets_;
   std::map<dealii::types::boundary_id, dealii::Tensor<1, 3>> tractions_;
   std::vector<char> removed_;  ///< per active cell index
+  /// locally owned dof -> (component, support point), for the AMG near null space
+  std::map<dealii::types::global_dof_index, std::pair<unsigned int, dealii::Point<3>>> owned_support_;
 
   dealii::TrilinosWrappers::SparseMatrix tangent_;
   dealii::TrilinosWrappers::MPI::Vector rhs_;            ///< -R with constraints applied

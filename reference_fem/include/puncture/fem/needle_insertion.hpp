@@ -58,6 +58,11 @@ struct FemRunOptions {
   // Beyond the command line (tests, studies):
   meshing::SlabMeshOptions mesh;      ///< coarse hex mesh resolution
   std::string formulation = "three_field";  ///< "three_field" (locking-free) or "one_field"
+  /// "auto" (sparse direct MUMPS up to direct_solver_max_dofs, else CG + AMG
+  /// with the rigid-body modes; measured on the default scene: CG + AMG is
+  /// faster from about 10k dofs on), "direct" or "iterative".
+  std::string linear_solver = "auto";
+  std::size_t direct_solver_max_dofs = 5000;
   double stop_depth_m = -1.0;         ///< > 0: stop at this depth (before the target)
   int max_vtu_frames = 40;            ///< at most about this many VTU frames (plus events)
   bool verbose = true;                ///< progress and Newton tables on rank 0's stdout

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# fem_benchmark.sh: speed of the FEM reference versus problem size and ranks.
+#
+# Three mesh sizes of the default scene (8, 16 and 24 cells around the
+# circumference, Q1), each on 1 and 2 MPI ranks: an indentation to DEPTH_MM
+# (default 0.5 mm, two load steps of the scene); time per Newton iteration and
+# per load step. With FULL=1 also the full insertion of the default scene at
+# its default resolution (wall time of `puncture_fem_study run`).
+#
+# Usage: scripts/fem_benchmark.sh [BUILD_DIR]   (default: build)
+# Writes results/fem_benchmark.md.
+set -euo pipefail
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+BUILD=${1:-$ROOT/build}
+EXE=$BUILD/reference_fem/puncture_fem_study
+SCENE=${SCENE:-$ROOT/scenes/default.json}
+DEPTH=${DEPTH_MM:-0.5}
+OUT=$ROOT/results/fem_benchmark.md
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+MPIRUN=${MPIRUN:-mpirun --oversubscribe}
+
+rows=$(mktemp)
+trap 'rm -f "$rows" "$OUT.part"' EXIT
+for sectors in 8 16 24; do
+  for ranks in 1 2; do
+    printf '| %s ' "$sectors" >> "$rows"
+    $MPIRUN -np "$ranks" "$EXE" bench "$SCENE" "$DEPTH" "$sectors" 0 1 | tail -n 1 >> "$rows"
+  done
+done
+full=""
+if [ "${FULL:-0}" = "1" ]; then
+  t0=$(date +%s)
+  "$EXE" run "$SCENE" "$(mktemp -d)" > /dev/null
+  full="Full insertion of $(basename "$SCENE") at its default resolution, 1 rank: $(( $(date +%s) - t0 )) s."
+fi
+{
+  echo "# FEM reference: time per Newton iteration and per load step"
+  echo
+  echo "Command: \`scripts/fem_benchmark.sh\` (DEPTH_MM=$DEPTH, scene $(basename "$SCENE"))."
+  echo "Machine: $(uname -srm), $(nproc) cores ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'))."
+  echo "Date: $(date -u '+%Y-%m-%d %H:%M UTC'). Load average at the end: $(cut -d' ' -f1-3 /proc/loadavg)."
+  echo
+  echo "Q1-P0 three-field, CG + ML AMG (rigid-body near null space). Times include assembly,"
+  echo "line search and linear solves (s)."
+  echo
+  echo "| sectors | ranks | dofs | load steps | Newton its | s / Newton it | s / load step | wall (s) |"
+  echo "|---|---|---|---|---|---|---|---|"
+  cat "$rows"
+  echo
+  echo "$full"
+} > "$OUT.part"
+mv "$OUT.part" "$OUT"
+echo "wrote $OUT"
