@@ -43,8 +43,8 @@ fi
   echo "Q1-P0 three-field, CG + ML AMG (rigid-body near null space). Times include assembly,"
   echo "line search and linear solves (s)."
   echo
-  echo "| sectors | ranks | dofs | load steps | Newton its | s / Newton it | s / load step | wall (s) |"
-  echo "|---|---|---|---|---|---|---|---|"
+  echo "| sectors | ranks | dofs | load steps | Newton its | CG its / Newton it | s / Newton it | s / load step | wall (s) |"
+  echo "|---|---|---|---|---|---|---|---|---|"
   cat "$rows"
   echo
   echo "$full"

@@ -467,7 +467,8 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
       }
       const double force = any_contact() ? needle_force() : 0.0;
       if (!std::isfinite(force)) throw std::runtime_error("fem: non-finite needle force");
-      record_row(depth, force);
+      // (A puncture at the end of the step already recorded this depth.)
+      if (!(rows.back().depth_m == depth && rows.back().force_N == force)) record_row(depth, force);
       ++record_index;
       if (current_layer < n_layers)
         for (const auto& [r, uz] : surface_profile(current_layer))

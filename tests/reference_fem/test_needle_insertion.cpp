@@ -155,3 +155,21 @@ TEST(NeedleInsertion, RejectsObliqueInsertion) {
   s.insertion.angle_deg = 10.0;
   EXPECT_THROW(run_needle_insertion(s, quiet_options(""), MPI_COMM_WORLD), std::invalid_argument);
 }
+
+TEST(NeedleInsertion, CriticalStretchCriterionPuncturesWhenTheTipStretchIsReached) {
+  Scene s = small_three_layer_scene();
+  s.layers[0].puncture.kind = PunctureCriterion::Kind::CriticalStretch;
+  s.layers[0].puncture.critical_stretch = 1.25;
+  FemRunOptions o = quiet_options("");
+  o.stop_depth_m = 1.5e-3;
+  const FemRunSummary r = run_needle_insertion(s, o, MPI_COMM_WORLD);
+  ASSERT_FALSE(r.punctures.empty());
+  EXPECT_EQ(r.punctures[0].layer_name, "skin");
+  EXPECT_GE(r.punctures[0].max_stretch, 1.25);
+  EXPECT_GT(r.punctures[0].depth_m, 0.0);
+  // Depth rows never go backwards and every force is finite.
+  for (std::size_t i = 1; i < r.depth_m.size(); ++i) {
+    EXPECT_GE(r.depth_m[i], r.depth_m[i - 1]);
+    EXPECT_TRUE(std::isfinite(r.force_N[i]));
+  }
+}
