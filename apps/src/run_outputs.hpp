@@ -39,7 +39,8 @@ struct FrameWriterOptions {
   int surface_azimuths = 72;
   /// Optional reference deflection (mm, > 0 into the tissue) of layer k at
   /// radius r_m from the needle axis at time t_s; NaN where there is none.
-  /// When set, the surfaces carry deflection_error_mm = model - reference.
+  /// When set, the surfaces carry deflection_error_mm = model - reference (0
+  /// where the reference has no value) and reference_available (1 or 0).
   std::function<double(std::size_t layer, double r_m, double time_s)> reference_deflection_mm;
 };
 
@@ -84,14 +85,17 @@ class FrameWriter {
       std::vector<std::pair<std::string, Eigen::VectorXd>> fields{
           {"deflection_mm", deflection}, {"layer_state", Eigen::VectorXd::Constant(vertices.rows(), state)}};
       if (options_.reference_deflection_mm) {
-        Eigen::VectorXd error = Eigen::VectorXd::Constant(vertices.rows(), std::numeric_limits<double>::quiet_NaN());
+        // VTK arrays must be finite: 0 where the reference has no value, flagged by reference_available.
+        Eigen::VectorXd error = Eigen::VectorXd::Zero(vertices.rows());
+        Eigen::VectorXd available = Eigen::VectorXd::Zero(vertices.rows());
         for (Eigen::Index i = 0; i < vertices.rows(); ++i) {
           const Eigen::Vector3d p = rest_vertices_[k].row(i).transpose();
           if (p.z() < layer_top_z(k) - 1e-9) continue;
           const double reference = options_.reference_deflection_mm(k, std::hypot(p.x(), p.y()), tick.time_s);
-          if (std::isfinite(reference)) error[i] = deflection[i] - reference;
+          if (std::isfinite(reference)) error[i] = deflection[i] - reference, available[i] = 1.0;
         }
         fields.emplace_back("deflection_error_mm", error);
+        fields.emplace_back("reference_available", available);
       }
       vertices.rowwise() += offset;
       const std::string surface_file = options_.directory + "/" + name + "_surface_" + index + ".vtp";

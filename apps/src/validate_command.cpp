@@ -219,6 +219,7 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
     const nlohmann::json provenance = provenance_json(command_line);
     session.write_text("realtime_curve.csv", validation::insertion_curve_csv(realtime_curve));
     session.write_text("fem_force_depth.csv", read_text(reference.dir / "fem_force_depth.csv"));
+    session.write_text("fem_curve.csv", validation::insertion_curve_csv(fem.curve));
     session.write_text("force_depth_aligned.csv", aligned_curves_csv(realtime_curve, fem.curve));
     session.write_text("layer_metrics.csv", layer_metrics_csv(scene, cmp, defl));
     session.write_text("deflection_profiles.csv", deflection_profiles_csv(scene, defl));

@@ -1,0 +1,305 @@
+// FEM reference cache (key invariance, second call served from the cache) and
+// `puncture validate` end to end on a small three-layer scene with a coarse mesh.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "puncture/apps/commands.hpp"
+#include "puncture/apps/fem_reference.hpp"
+#include "puncture/scene_io.hpp"
+#include "puncture/validation/metrics.hpp"
+
+namespace fs = std::filesystem;
+
+namespace puncture::apps {
+namespace {
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("puncture_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+Layer make_layer(const std::string& name, double thickness_m, double E_Pa, double critical_force_N) {
+  Layer l;
+  l.name = name;
+  l.thickness_m = thickness_m;
+  l.material.youngs_modulus_Pa = E_Pa;
+  l.material.poisson_ratio = 0.45;
+  l.puncture.kind = PunctureCriterion::Kind::CriticalForce;
+  l.puncture.critical_force_N = critical_force_N;
+  l.force_mesh.rings_w = 4;
+  l.force_mesh.spacing_L_m = 1e-3;
+  return l;
+}
+
+/// Three layers in a 16 mm sample, 3 mm insertion: the FEM finishes in seconds.
+Scene small_scene() {
+  Scene s;
+  s.name = "validate_test";
+  s.sample.diameter_m = 0.016;
+  s.layers = {make_layer("skin", 0.8e-3, 2.0e5, 0.05), make_layer("fat", 2.5e-3, 2.0e4, 0.03),
+              make_layer("muscle", 4.0e-3, 5.0e4, 100.0)};
+  s.insertion.start_height_m = 0.5e-3;
+  s.insertion.speed_m_per_s = 0.01;
+  s.insertion.target_depth_m = 3e-3;
+  s.insertion.dwell_s = 0.05;
+  s.fem.load_step_m = 0.25e-3;
+  s.realtime.sh_degree = 8;
+  return s;
+}
+
+#ifdef PUNCTURE_HAVE_FEM
+FemReferenceOptions coarse_options(const fs::path& cache) {
+  FemReferenceOptions o;
+  o.cache_dir = cache;
+  o.verbose = false;
+  o.write_vtu = false;
+  o.mesh.elements_through_skin = 1;
+  o.mesh.sectors = 8;
+  o.mesh.radial_grading = 1.6;
+  o.mesh.thickness_grading = 1.6;
+  return o;
+}
+#endif
+
+TEST(FemReferenceHash, IgnoresRealtimeOnlyFields) {
+  const Scene base = small_scene();
+  const FemReferenceOptions options;
+  const std::string h = fem_reference_hash(base, options);
+  EXPECT_EQ(h.size(), 32u);
+  std::vector<std::pair<std::string, std::function<void(Scene&)>>> realtime_only{
+      {"K", [](Scene& s) { s.layers[0].force_mesh.virtual_stiffness_N_per_m *= 2; }},
+      {"w", [](Scene& s) { s.layers[1].force_mesh.rings_w += 3; }},
+      {"L", [](Scene& s) { s.layers[2].force_mesh.spacing_L_m *= 1.5; }},
+      {"d", [](Scene& s) { s.layers[0].damping_N_s_per_m2 *= 3; }},
+      {"surface stiffness", [](Scene& s) { s.layers[0].force_mesh.surface_stiffness_N_per_m *= 2; }},
+      {"resumption rate", [](Scene& s) { s.layers[1].resumption_rate = 0.2; }},
+      {"sh_degree", [](Scene& s) { s.realtime.sh_degree = 24; }},
+      {"integrator", [](Scene& s) { s.realtime.integrator = "explicit"; }},
+      {"haptic rate", [](Scene& s) { s.realtime.haptic_rate_Hz = 2000; }},
+      {"dwell", [](Scene& s) { s.insertion.dwell_s = 3.0; }},
+      {"withdrawal", [](Scene& s) { s.insertion.withdrawal_speed_m_per_s = 0.05; }},
+      {"effects", [](Scene& s) { s.effects.resumption = false; }},
+      {"name", [](Scene& s) { s.name = "renamed"; }},
+  };
+  for (const auto& [what, change] : realtime_only) {
+    Scene s = base;
+    change(s);
+    EXPECT_EQ(fem_reference_hash(s, options), h) << "a change of " << what << " must hit the cache";
+  }
+}
+
+TEST(FemReferenceHash, ChangesWithEverythingTheFemSees) {
+  const Scene base = small_scene();
+  const FemReferenceOptions options;
+  const std::string h = fem_reference_hash(base, options);
+  std::vector<std::pair<std::string, std::function<void(Scene&)>>> fem_relevant{
+      {"E", [](Scene& s) { s.layers[1].material.youngs_modulus_Pa *= 1.0000001; }},
+      {"nu", [](Scene& s) { s.layers[2].material.poisson_ratio = 0.49; }},
+      {"material model", [](Scene& s) { s.layers[0].material.model = "mooney_rivlin"; }},
+      {"thickness", [](Scene& s) { s.layers[0].thickness_m = 1.0e-3; }},
+      {"critical force", [](Scene& s) { s.layers[1].puncture.critical_force_N = 0.04; }},
+      {"criterion kind", [](Scene& s) { s.layers[1].puncture.kind = PunctureCriterion::Kind::CriticalStretch; }},
+      {"diameter", [](Scene& s) { s.sample.diameter_m = 0.02; }},
+      {"needle radius", [](Scene& s) { s.needle.radius_m = 0.5e-3; }},
+      {"speed", [](Scene& s) { s.insertion.speed_m_per_s = 0.02; }},
+      {"target depth", [](Scene& s) { s.insertion.target_depth_m = 4e-3; }},
+      {"start height", [](Scene& s) { s.insertion.start_height_m = 1e-3; }},
+      {"load step", [](Scene& s) { s.fem.load_step_m = 0.2e-3; }},
+      {"scene refinement", [](Scene& s) { s.fem.refinement = 1; }},
+      {"newton tolerance", [](Scene& s) { s.fem.newton_tolerance = 1e-9; }},
+  };
+  std::map<std::string, std::string> seen{{h, "base"}};
+  for (const auto& [what, change] : fem_relevant) {
+    Scene s = base;
+    change(s);
+    const std::string changed = fem_reference_hash(s, options);
+    EXPECT_NE(changed, h) << "a change of " << what << " must change the key";
+    EXPECT_TRUE(seen.emplace(changed, what).second) << what << " collides with " << seen[changed];
+  }
+  FemReferenceOptions refined = options;
+  refined.refinement = 1;
+  EXPECT_NE(fem_reference_hash(base, refined), h) << "refinement override";
+  FemReferenceOptions q2 = options;
+  q2.degree = 2;
+  EXPECT_NE(fem_reference_hash(base, q2), h) << "degree override";
+  // An override equal to the scene's own value is the same FEM.
+  FemReferenceOptions same = options;
+  same.refinement = base.fem.refinement;
+  same.degree = base.fem.element_degree;
+  EXPECT_EQ(fem_reference_hash(base, same), h);
+#ifdef PUNCTURE_HAVE_FEM
+  FemReferenceOptions mesh = options;
+  mesh.mesh.sectors = 8;
+  EXPECT_NE(fem_reference_hash(base, mesh), h) << "mesh options";
+#endif
+  // Output-only options are not part of the key.
+  FemReferenceOptions other_dir = options;
+  other_dir.cache_dir = "elsewhere";
+  other_dir.write_vtu = false;
+  other_dir.verbose = false;
+  EXPECT_EQ(fem_reference_hash(base, other_dir), h);
+}
+
+#ifdef PUNCTURE_HAVE_FEM
+TEST(FemReferenceCache, SecondCallComesFromTheCacheWithoutRunning) {
+  const fs::path cache = fresh_dir("fem_cache");
+  const Scene scene = small_scene();
+  std::ostringstream out;
+  const FemReference first = obtain_fem_reference(scene, coarse_options(cache), out);
+  EXPECT_FALSE(first.from_cache);
+  EXPECT_EQ(first.dir, cache / first.hash);
+  for (const char* f : {"fem_force_depth.csv", "fem_surface_profile.csv", "fem_recovery_profile.csv",
+                        "fem_summary.json", "fem_reference_key.json"})
+    EXPECT_TRUE(fs::is_regular_file(first.dir / f)) << f;
+  // Nothing but the finished entry is left in the cache directory.
+  std::size_t entries = 0;
+  for (const auto& e : fs::directory_iterator(cache)) {
+    ++entries;
+    EXPECT_EQ(e.path().filename().string(), first.hash);
+  }
+  EXPECT_EQ(entries, 1u);
+  // The cached curve is the FEM's insertion: it reaches the target depth with the skin punctured.
+  std::ifstream csv(first.dir / "fem_force_depth.csv");
+  std::string line, last;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("time_s,depth_mm,velocity_mm_per_s,force_N,skin_state", 0), 0u) << line;
+  while (std::getline(csv, line))
+    if (!line.empty()) last = line;
+  std::istringstream fields(last);
+  std::string time, depth, velocity, force, skin;
+  std::getline(fields, time, ',');
+  std::getline(fields, depth, ',');
+  std::getline(fields, velocity, ',');
+  std::getline(fields, force, ',');
+  std::getline(fields, skin, ',');
+  EXPECT_NEAR(std::stod(depth), scene.insertion.target_depth_m * 1e3, 1e-9);
+  EXPECT_EQ(skin, "punctured");
+
+  const auto stamp = fs::last_write_time(first.dir / "fem_summary.json");
+  // A realtime-only change: same key, served from the cache, files untouched.
+  Scene retuned = scene;
+  retuned.layers[0].force_mesh.virtual_stiffness_N_per_m *= 4;
+  retuned.realtime.sh_degree = 12;
+  const FemReference second = obtain_fem_reference(retuned, coarse_options(cache), out);
+  EXPECT_TRUE(second.from_cache);
+  EXPECT_EQ(second.dir, first.dir);
+  EXPECT_EQ(fs::last_write_time(first.dir / "fem_summary.json"), stamp);
+  fs::remove_all(cache);
+}
+
+TEST(ValidateCommand, ReportOfASmallSceneAndSecondRunFromCache) {
+  const fs::path work = fresh_dir("validate");
+  fs::create_directories(work);
+  const fs::path scene_file = work / "small.json";
+  std::ofstream(scene_file) << scene_to_json_text(small_scene());
+  ValidateOptions options;
+  options.scene = scene_file;
+  options.output_dir = work / "report";
+  options.cache_dir = work / "cache";
+  options.quiet = true;
+  std::ostringstream out, err;
+  ASSERT_EQ(validate_command(options, out, err), 0) << err.str();
+  const fs::path dir = options.output_dir;
+  for (const char* f : {"validation_summary.md", "layer_metrics.csv", "force_depth_aligned.csv",
+                        "deflection_profiles.csv", "realtime_curve.csv", "fem_force_depth.csv", "fem_curve.csv",
+                        "validation_metrics.json", "validation.pvd"})
+    EXPECT_TRUE(fs::is_regular_file(dir / f)) << f;
+
+  // The aligned table carries the FEM's own insertion samples and the real-time
+  // force interpolated at the same depths (checked against both curve files).
+  const validation::InsertionCurve fem = validation::read_insertion_curve(dir / "fem_curve.csv");
+  const validation::InsertionCurve rt = validation::read_insertion_curve(dir / "realtime_curve.csv");
+  std::vector<double> rt_depth, rt_force;
+  for (std::size_t i : validation::insertion_phase(rt)) rt_depth.push_back(rt.depth_m[i]), rt_force.push_back(rt.force_N[i]);
+  std::ifstream aligned(dir / "force_depth_aligned.csv");
+  std::string line;
+  std::getline(aligned, line);
+  EXPECT_EQ(line, "depth_mm,fem_force_N,realtime_force_N,difference_N");
+  std::size_t rows = 0, checked = 0;
+  const std::vector<std::size_t> fem_phase = validation::insertion_phase(fem);
+  while (std::getline(aligned, line)) {
+    ASSERT_LT(rows, fem_phase.size());
+    std::istringstream s(line);
+    std::string depth, f_fem, f_rt;
+    std::getline(s, depth, ',');
+    std::getline(s, f_fem, ',');
+    std::getline(s, f_rt, ',');
+    const std::size_t i = fem_phase[rows++];
+    EXPECT_NEAR(std::stod(depth), fem.depth_m[i] * 1e3, 1e-9);
+    EXPECT_NEAR(std::stod(f_fem), fem.force_N[i], 1e-9);
+    // Linear interpolation by hand between the bracketing real-time ticks.
+    const double d = fem.depth_m[i];
+    for (std::size_t j = 0; j + 1 < rt_depth.size(); ++j)
+      if (rt_depth[j] <= d && d <= rt_depth[j + 1]) {
+        const double t = (d - rt_depth[j]) / (rt_depth[j + 1] - rt_depth[j]);
+        EXPECT_NEAR(std::stod(f_rt), rt_force[j] + t * (rt_force[j + 1] - rt_force[j]), 1e-9);
+        ++checked;
+        break;
+      }
+  }
+  EXPECT_EQ(rows, fem_phase.size());
+  EXPECT_GT(checked, rows / 2);
+
+  // ParaView collection: the FEM fields (part 0) and the real-time surfaces beside them.
+  std::ifstream pvd_in(dir / "validation.pvd");
+  std::stringstream pvd;
+  pvd << pvd_in.rdbuf();
+  EXPECT_NE(pvd.str().find("part=\"0\" file=\"fem/"), std::string::npos);
+  EXPECT_NE(pvd.str().find("file=\"realtime/skin_surface_"), std::string::npos);
+
+  // Summary: provenance and links.
+  std::ifstream md_in(dir / "validation_summary.md");
+  std::stringstream md;
+  md << md_in.rdbuf();
+  EXPECT_NE(md.str().find("git revision"), std::string::npos);
+  EXPECT_NE(md.str().find("(layer_metrics.csv)"), std::string::npos);
+
+  // Metrics: the skin breaks in the FEM; its deflection before breakthrough was compared.
+  std::ifstream metrics_in(dir / "validation_metrics.json");
+  const nlohmann::json metrics = nlohmann::json::parse(metrics_in);
+  EXPECT_FALSE(metrics.at("fem_reference").at("from_cache").get<bool>());
+  EXPECT_TRUE(metrics.at("layers").at(0).at("fem_punctured").get<bool>());
+  EXPECT_TRUE(metrics.at("layers").at(0).contains("deflection"));
+
+  // Second validation of a retuned scene: the FEM comes from the cache.
+  Scene retuned = small_scene();
+  retuned.layers[0].force_mesh.virtual_stiffness_N_per_m *= 2;
+  std::ofstream(scene_file) << scene_to_json_text(retuned);
+  options.write_vtk = false;
+  options.output_dir = work / "report2";
+  ASSERT_EQ(validate_command(options, out, err), 0) << err.str();
+  std::ifstream metrics2_in(options.output_dir / "validation_metrics.json");
+  EXPECT_TRUE(nlohmann::json::parse(metrics2_in).at("fem_reference").at("from_cache").get<bool>());
+  EXPECT_FALSE(fs::exists(options.output_dir / "validation.pvd"));
+  fs::remove_all(work);
+}
+#endif
+
+TEST(ValidateCommand, BadSceneExitsWithTwoAndWritesNothing) {
+  const fs::path work = fresh_dir("validate_bad");
+  fs::create_directories(work);
+  std::ofstream(work / "bad.json") << "{ \"schema_version\": 1, \"layers\": 3 }";
+  ValidateOptions options;
+  options.scene = work / "bad.json";
+  options.output_dir = work / "report";
+  options.cache_dir = work / "cache";
+  options.quiet = true;
+  std::ostringstream out, err;
+  EXPECT_EQ(validate_command(options, out, err), 2);
+  EXPECT_NE(err.str().find("bad.json"), std::string::npos) << err.str();
+  EXPECT_FALSE(fs::exists(options.output_dir));
+  EXPECT_FALSE(fs::exists(options.cache_dir));
+  fs::remove_all(work);
+}
+
+}  // namespace
+}  // namespace puncture::apps
