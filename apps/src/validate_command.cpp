@@ -121,7 +121,7 @@ std::string deflection_profiles_csv(const Scene& scene, const std::vector<LayerD
       fem(name, "before_breakthrough", d.fem);
     }
     if (d.recovery_compared) {
-      rings(name, "after_breakthrough", d.realtime_depth_m, d.realtime_recovered_rings_m, L);
+      rings(name, "after_breakthrough", d.recovery_realtime_depth_m, d.realtime_recovered_rings_m, L);
       fem(name, "after_breakthrough", d.fem_after);
     }
   }

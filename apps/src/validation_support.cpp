@@ -67,6 +67,25 @@ void append_point(validation::RadialProfile& p, double r_m, double uz_m) {
   p.uz_m.push_back(uz_m);
 }
 
+/// The FEM profile at `depth`: linear in depth between the two recorded
+/// profiles that bracket it when they share their radii (the same surface
+/// nodes), else the nearest one.
+validation::RadialProfile fem_profile_at_depth(std::vector<validation::RadialProfile> profiles, double depth) {
+  std::sort(profiles.begin(), profiles.end(), [](const auto& a, const auto& b) { return a.depth_m < b.depth_m; });
+  for (std::size_t i = 0; i + 1 < profiles.size(); ++i) {
+    const validation::RadialProfile& a = profiles[i];
+    const validation::RadialProfile& b = profiles[i + 1];
+    if (a.depth_m <= depth && depth <= b.depth_m && b.depth_m > a.depth_m && a.r_m == b.r_m) {
+      const double t = (depth - a.depth_m) / (b.depth_m - a.depth_m);
+      validation::RadialProfile p = a;
+      p.depth_m = depth;
+      for (std::size_t j = 0; j < p.uz_m.size(); ++j) p.uz_m[j] = (1 - t) * a.uz_m[j] + t * b.uz_m[j];
+      return p;
+    }
+  }
+  return validation::profile_nearest_depth(profiles, depth);
+}
+
 }  // namespace
 
 validation::InsertionCurve read_fem_curve(const std::filesystem::path& path) {
@@ -266,7 +285,7 @@ LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size
     if (tick < run.ticks.size()) {
       c.realtime_depth_m = run.ticks[tick].depth_m;
       c.realtime_rings_m = recorder.rings(tick, k);
-      c.fem = validation::profile_nearest_depth(candidates, c.realtime_depth_m);
+      c.fem = fem_profile_at_depth(candidates, c.realtime_depth_m);
       c.fem_depth_m = c.fem.depth_m;
       c.error = validation::deflection_profile_error(c.realtime_rings_m, L, c.fem);
       c.compared = c.error.n_rings > 0;
@@ -278,6 +297,7 @@ LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size
     const auto delay_ticks = static_cast<std::size_t>(std::ceil(1.0 / layer.resumption_rate - 1e-9));
     const std::size_t tick = std::min(run.ticks.size() - 1, broke + delay_ticks);
     c.recovery_delay_s = run.ticks[tick].time_s - run.ticks[broke].time_s;
+    c.recovery_realtime_depth_m = run.ticks[tick].depth_m;
     c.realtime_recovered_rings_m = recorder.rings(tick, k);
     c.fem_after = after->second;
     c.recovery_error = validation::deflection_profile_error(c.realtime_recovered_rings_m, L, c.fem_after);

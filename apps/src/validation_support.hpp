@@ -95,6 +95,7 @@ struct LayerDeflectionComparison {
 
   bool recovery_compared = false;
   double recovery_delay_s = std::numeric_limits<double>::quiet_NaN();  ///< time after the real-time breakthrough
+  double recovery_realtime_depth_m = std::numeric_limits<double>::quiet_NaN();  ///< tip depth then
   std::vector<double> realtime_recovered_rings_m;
   validation::RadialProfile fem_after;
   validation::DeflectionProfileError recovery_error;
@@ -102,8 +103,8 @@ struct LayerDeflectionComparison {
 
 /// Before breakthrough: the last insertion depth at which layer k is intact in
 /// both models (the smaller of the two pre-breakthrough depths); the real-time
-/// Delta Z_j at that tick against the FEM profile of the layer nearest in
-/// depth. After: the FEM spring-back profile against the real-time rings
+/// Delta Z_j at that tick against the FEM profile of the layer at that depth
+/// (linear between the two recorded load steps that bracket it). After: the FEM spring-back profile against the real-time rings
 /// ceil(1 / eta_r) ticks after the real-time breakthrough.
 LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size_t k, const ScriptedRunResult& run,
                                                    const RingRecorder& recorder, const FemResultFiles& fem);
