@@ -284,6 +284,55 @@ TEST(ValidateCommand, ReportOfASmallSceneAndSecondRunFromCache) {
 }
 #endif
 
+#ifdef PUNCTURE_HAVE_FEM
+TEST(SweepCommand, TableOfEveryRealtimeKnobAgainstTheFem) {
+  const fs::path work = fresh_dir("sweep");
+  fs::create_directories(work);
+  const fs::path scene_file = work / "small.json";
+  std::ofstream(scene_file) << scene_to_json_text(small_scene());
+  SweepOptions options;
+  options.scene = scene_file;
+  options.output_dir = work / "sweep";
+  options.cache_dir = work / "cache";
+  options.include_fem_knobs = false;
+  options.quiet = true;
+  std::ostringstream out, err;
+  ASSERT_EQ(sweep_command(options, out, err), 0) << err.str();
+  for (const char* f : {"accuracy_cost.csv", "accuracy_cost.md", "accuracy_cost.json"})
+    EXPECT_TRUE(fs::is_regular_file(options.output_dir / f)) << f;
+  std::ifstream csv(options.output_dir / "accuracy_cost.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("model,knob,value,baseline,status,force_rmse_N", 0), 0u) << line;
+  std::map<std::string, int> variants;
+  int baselines = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> f;
+    std::istringstream s(line);
+    for (std::string x; std::getline(s, x, ',');) f.push_back(x);
+    ASSERT_GE(f.size(), 11u) << line;
+    ++variants[f[0] + ":" + f[1]];
+    if (f[3] == "1") ++baselines;
+    if (f[0] == "fem") {
+      // The only FEM setting is the reference itself: zero error.
+      EXPECT_EQ(std::stod(f[5]), 0.0);
+      EXPECT_GT(std::stod(f[10]), 0.0);
+    } else if (f[4] == "ok") {
+      EXPECT_GT(std::stod(f[10]), 0.0) << "tick time, " << line;
+      EXPECT_TRUE(std::isfinite(std::stod(f[5]))) << line;
+    }
+  }
+  EXPECT_EQ(variants["fem:refinement_degree"], 1);
+  EXPECT_GE(variants["realtime:sh_degree"], 5);
+  EXPECT_GE(variants["realtime:rings_w_delta"], 4);
+  EXPECT_EQ(variants["realtime:spacing_L_factor"], 5);
+  EXPECT_EQ(variants["realtime:integrator"], 3);
+  EXPECT_EQ(variants["realtime:haptic_rate_Hz"], 5);
+  EXPECT_EQ(baselines, 6);  // one per knob
+  fs::remove_all(work);
+}
+#endif
+
 TEST(ValidateCommand, BadSceneExitsWithTwoAndWritesNothing) {
   const fs::path work = fresh_dir("validate_bad");
   fs::create_directories(work);
