@@ -236,7 +236,8 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
     for (const auto& [n, hold] : contact) dofs.push_back(nodes[n].dof[2]);
     // The z reaction is what the needle applies to the tissue; the tissue
     // pushes back on the needle with the opposite force (upward, > 0).
-    return -solver.sum_of_residual(dofs);
+    const double force = -solver.sum_of_residual(dofs);
+    return force == 0.0 ? 0.0 : force;  // no "-0" in the CSV
   };
   auto tip_stretch = [&](std::size_t layer) {
     return solver.max_principal_stretch([&](const FiniteStrainSolver::CellIterator& cell) {
