@@ -197,7 +197,7 @@ int sweep_command(const SweepOptions& options, std::ostream& out, std::ostream& 
       fo.write_vtu = false;
       fo.verbose = !options.quiet;
       FemResult r{k, obtain_fem_reference(scene, fo, out), {}, {}};
-      r.curve = read_fem_curve(r.ref.dir / "fem_force_depth.csv");
+      r.curve = validation::read_insertion_curve(r.ref.dir / "fem_force_depth.csv");
       r.summary = nlohmann::json::parse(read_text(r.ref.dir / "fem_summary.json"));
       fem_results.push_back(std::move(r));
     }

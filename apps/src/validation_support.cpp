@@ -88,46 +88,6 @@ validation::RadialProfile fem_profile_at_depth(std::vector<validation::RadialPro
 
 }  // namespace
 
-validation::InsertionCurve read_fem_curve(const std::filesystem::path& path) {
-  std::istringstream in(read_text(path));
-  std::string line, fixed;
-  if (!std::getline(in, line)) throw std::runtime_error(path.string() + ": empty file");
-  fixed = line + "\n";
-  const std::vector<std::string> header = split_csv_line(line);
-  const auto column = [&](const char* name) {
-    const auto it = std::find(header.begin(), header.end(), name);
-    if (it == header.end()) throw std::runtime_error(path.string() + ": no column " + name);
-    return static_cast<std::size_t>(it - header.begin());
-  };
-  const std::size_t time_col = column("time_s"), depth_col = column("depth_mm");
-  std::vector<std::string> previous;
-  int repeats = 0, n = 1;
-  while (std::getline(in, line)) {
-    ++n;
-    if (line.empty()) continue;
-    std::vector<std::string> f = split_csv_line(line);
-    if (f.size() != header.size())
-      throw std::runtime_error(path.string() + ":" + std::to_string(n) + ": wrong number of fields");
-    if (!previous.empty() && f[time_col] == previous[time_col]) {
-      std::vector<std::string> a = f, b = previous;
-      a[time_col] = b[time_col] = a[depth_col] = b[depth_col] = "";
-      if (a == b) continue;  // the same state recorded twice
-      ++repeats;
-      char buffer[40];
-      std::snprintf(buffer, sizeof buffer, "%.17g", to_double(f[time_col], path.string(), n) + 1e-9 * repeats);
-      f[time_col] = buffer;
-      std::snprintf(buffer, sizeof buffer, "%.17g", to_double(f[depth_col], path.string(), n) + 1e-6 * repeats);
-      f[depth_col] = buffer;
-    } else {
-      repeats = 0;
-      previous = f;
-    }
-    for (std::size_t i = 0; i < f.size(); ++i) fixed += (i ? "," : "") + f[i];
-    fixed += "\n";
-  }
-  return validation::parse_insertion_curve(fixed, path.string());
-}
-
 std::string read_text(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot read " + path.string());
@@ -138,7 +98,7 @@ std::string read_text(const std::filesystem::path& path) {
 
 FemResultFiles read_fem_result(const std::filesystem::path& dir, const Scene& scene) {
   FemResultFiles fem;
-  fem.curve = read_fem_curve(dir / "fem_force_depth.csv");
+  fem.curve = validation::read_insertion_curve(dir / "fem_force_depth.csv");
   fem.summary = nlohmann::json::parse(read_text(dir / "fem_summary.json"));
   if (fem.summary.contains("punctures"))
     for (const auto& p : fem.summary["punctures"])

@@ -33,13 +33,6 @@ namespace puncture::apps {
 /// Whole file as text; throws std::runtime_error naming the file.
 std::string read_text(const std::filesystem::path& path);
 
-/// fem_force_depth.csv for the metrics: the FEM records a breakthrough as rows
-/// at one depth (needle force before, then after the spring-back, then the
-/// step's own row, a repeat of the latter). Exact repeats are dropped; a row
-/// that differs is placed 1 nm deeper and 1 ns later than the one before, so
-/// depth and time increase strictly (validation::read_insertion_curve) and
-/// the force drop stays vertical.
-validation::InsertionCurve read_fem_curve(const std::filesystem::path& path);
 
 struct FemFrame {
   double time_s = 0.0;

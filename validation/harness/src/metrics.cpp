@@ -138,8 +138,17 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
                                "layer state must be untouched, pressed or punctured (got '" + f + "')");
       curve.layer_states[k].push_back(s);
     }
-    if (curve.size() >= 2 && !(curve.time_s.back() > curve.time_s[curve.size() - 2]))
-      throw CurveFormatError(source_name, line_no, "time_s", "time must increase strictly");
+    // Time increases; a repeated time is allowed only at the same depth: a
+    // force drop at one instant (a quasi-static reference records the state
+    // before and after a breakthrough at the same load step).
+    if (curve.size() >= 2) {
+      const std::size_t n = curve.size();
+      const bool later = curve.time_s[n - 1] > curve.time_s[n - 2];
+      const bool same_instant = curve.time_s[n - 1] == curve.time_s[n - 2] && curve.depth_m[n - 1] == curve.depth_m[n - 2];
+      if (!later && !same_instant)
+        throw CurveFormatError(source_name, line_no, "time_s",
+                               "time must increase (a repeated time is allowed only at the same depth)");
+    }
   }
   if (header.empty()) throw CurveFormatError(source_name, 0, "", "no header line");
   if (curve.size() == 0) throw CurveFormatError(source_name, 0, "", "no data rows");
@@ -194,10 +203,11 @@ std::vector<std::size_t> insertion_phase(const InsertionCurve& curve) {
   std::vector<std::size_t> idx;
   for (std::size_t i = 0; i <= deepest; ++i) {
     if (!(curve.velocity_m_per_s[i] > 0.0)) continue;
-    if (!idx.empty() && !(curve.depth_m[i] > curve.depth_m[idx.back()]))
+    // Non-decreasing: a repeated depth is a force drop at one instant
+    // (interpolation then takes the value after the drop).
+    if (!idx.empty() && !(curve.depth_m[i] >= curve.depth_m[idx.back()]))
       throw CurveFormatError(curve.source, 0, "depth_mm",
-                             "depth does not increase strictly during the insertion phase (velocity > 0) at " +
-                                 describe_time(curve, i));
+                             "depth decreases during the insertion phase (velocity > 0) at " + describe_time(curve, i));
     idx.push_back(i);
   }
   if (idx.empty()) throw CurveFormatError(curve.source, 0, "velocity_mm_per_s", "no insertion phase (no sample with velocity > 0)");
@@ -264,8 +274,14 @@ CurveComparison compare_curves(const InsertionCurve& model, const InsertionCurve
   std::vector<std::size_t> compared;  // reference sample indices
   std::vector<double> error;
   double sq = 0.0;
-  for (std::size_t i : ref_phase) {
+  for (std::size_t p = 0; p < ref_phase.size(); ++p) {
+    const std::size_t i = ref_phase[p];
     if (reference.depth_m[i] > max_depth_m) continue;
+    // A depth recorded twice is a force drop at one instant: the force there
+    // is not one value, so those samples are not compared.
+    const bool drop = (p > 0 && reference.depth_m[ref_phase[p - 1]] == reference.depth_m[i]) ||
+                      (p + 1 < ref_phase.size() && reference.depth_m[ref_phase[p + 1]] == reference.depth_m[i]);
+    if (drop) continue;
     double f = 0.0;
     if (!interpolate_linear(mx, my, reference.depth_m[i], f)) continue;
     compared.push_back(i);

@@ -18,7 +18,7 @@
 //
 // Comparison (compare_curves, model against reference):
 //   * only the INSERTION phase is compared: samples with velocity > 0 up to
-//     the deepest sample; depths must increase strictly in that phase;
+//     the deepest sample; depths must not decrease in that phase (a repeated depth is a force drop at one instant);
 //   * the model force is interpolated piecewise linearly at the reference
 //     depths; reference samples outside the model's depth range are skipped
 //     (CurveComparison::n_compared counts the ones used);
@@ -83,8 +83,8 @@ InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, 
 std::string insertion_curve_csv(const InsertionCurve& curve);
 
 /// Indices of the insertion-phase samples (velocity > 0, up to the deepest
-/// sample). Throws CurveFormatError (with the sample's time) if depth does not
-/// increase strictly there, or if the phase is empty.
+/// sample). Throws CurveFormatError (with the sample's time) if depth
+/// decreases there, or if the phase is empty.
 std::vector<std::size_t> insertion_phase(const InsertionCurve& curve);
 
 /// Piecewise-linear interpolation y(x) on strictly increasing x; false if
