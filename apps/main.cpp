@@ -9,6 +9,7 @@
 #include <iostream>
 
 #include "puncture/apps/commands.hpp"
+#include "puncture/apps/fem_reference.hpp"
 
 int main(int argc, char** argv) {
   using namespace puncture::apps;
@@ -73,29 +74,34 @@ int main(int argc, char** argv) {
 
   CLI11_PARSE(app, argc, argv);
 
-  if (*run_cmd) {
-    run.scene = scene, run.output_dir = output;
-    return run_command(run, std::cout, std::cerr);
-  }
-  if (*fem_cmd) {
-    fem.scene = scene, fem.output_dir = output;
-    return fem_command(fem, std::cout, std::cerr);
-  }
-  if (*validate_cmd) {
-    validate.scene = scene, validate.output_dir = output, validate.cache_dir = cache;
-    return validate_command(validate, std::cout, std::cerr);
-  }
-  if (*calibrate_cmd) {
-    calibrate.scene = scene, calibrate.output_dir = output, calibrate.cache_dir = cache, calibrate.reference = reference;
-    return calibrate_command(calibrate, std::cout, std::cerr);
-  }
-  if (*sweep_cmd) {
-    sweep.scene = scene, sweep.output_dir = output, sweep.cache_dir = cache;
-    return sweep_command(sweep, std::cout, std::cerr);
-  }
-  if (*grade_cmd) {
-    grade.scores = scores, grade.output_dir = output;
-    return grade_command(grade, std::cout, std::cerr);
-  }
-  return 1;
+  const auto dispatch = [&]() -> int {
+    if (*run_cmd) {
+      run.scene = scene, run.output_dir = output;
+      return run_command(run, std::cout, std::cerr);
+    }
+    if (*fem_cmd) {
+      fem.scene = scene, fem.output_dir = output;
+      return fem_command(fem, std::cout, std::cerr);
+    }
+    if (*validate_cmd) {
+      validate.scene = scene, validate.output_dir = output, validate.cache_dir = cache;
+      return validate_command(validate, std::cout, std::cerr);
+    }
+    if (*calibrate_cmd) {
+      calibrate.scene = scene, calibrate.output_dir = output, calibrate.cache_dir = cache, calibrate.reference = reference;
+      return calibrate_command(calibrate, std::cout, std::cerr);
+    }
+    if (*sweep_cmd) {
+      sweep.scene = scene, sweep.output_dir = output, sweep.cache_dir = cache;
+      return sweep_command(sweep, std::cout, std::cerr);
+    }
+    if (*grade_cmd) {
+      grade.scores = scores, grade.output_dir = output;
+      return grade_command(grade, std::cout, std::cerr);
+    }
+    return 1;
+  };
+  const int exit_code = dispatch();
+  finalize_mpi();  // before static destruction (see fem_reference.hpp)
+  return exit_code;
 }

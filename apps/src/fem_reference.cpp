@@ -130,6 +130,15 @@ std::string fem_reference_hash(const Scene& scene, const FemReferenceOptions& op
   return fnv1a64_hex(text, 1469598103934665603ULL) + fnv1a64_hex(text, 0x84222325cbf29ce4ULL);
 }
 
+#ifdef PUNCTURE_HAVE_FEM
+namespace {
+std::unique_ptr<dealii::Utilities::MPI::MPI_InitFinalize>& mpi_session() {
+  static std::unique_ptr<dealii::Utilities::MPI::MPI_InitFinalize> session;
+  return session;
+}
+}  // namespace
+#endif
+
 void ensure_mpi() {
 #ifdef PUNCTURE_HAVE_FEM
   int initialised = 0;
@@ -143,9 +152,13 @@ void ensure_mpi() {
   static char program[] = "puncture";
   static char* argv_storage[] = {program, nullptr};
   static char** argv = argv_storage;
-  // Destroyed at exit (MPI_Finalize after every other static user is gone).
-  static std::unique_ptr<dealii::Utilities::MPI::MPI_InitFinalize> mpi =
-      std::make_unique<dealii::Utilities::MPI::MPI_InitFinalize>(argc, argv, 1);
+  mpi_session() = std::make_unique<dealii::Utilities::MPI::MPI_InitFinalize>(argc, argv, 1);
+#endif
+}
+
+void finalize_mpi() {
+#ifdef PUNCTURE_HAVE_FEM
+  mpi_session().reset();
 #endif
 }
 

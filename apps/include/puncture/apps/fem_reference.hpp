@@ -46,7 +46,12 @@ std::string fem_reference_hash(const Scene& scene, const FemReferenceOptions& op
 FemReference obtain_fem_reference(const Scene& scene, const FemReferenceOptions& options, std::ostream& out);
 
 /// Initialises MPI (and deal.II's MPI-dependent libraries) once per process;
-/// later calls do nothing. Finalised at exit.
+/// later calls do nothing.
 void ensure_mpi();
+
+/// Finalises what ensure_mpi() initialised (nothing if it was not called).
+/// Call it before main() returns: finalising from a static destructor at exit
+/// races with the destruction of other libraries' statics.
+void finalize_mpi();
 
 }  // namespace puncture::apps

@@ -1,0 +1,12 @@
+// main() of the apps suite: like gtest_main, but MPI (initialised by the
+// commands that run the FEM) is finalised before static destruction.
+#include <gtest/gtest.h>
+
+#include "puncture/apps/fem_reference.hpp"
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  const int result = RUN_ALL_TESTS();
+  puncture::apps::finalize_mpi();
+  return result;
+}
