@@ -5,6 +5,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/fem_reference.hpp"
 #include "puncture/apps/provenance.hpp"
@@ -34,7 +35,7 @@ std::string metrics_table(const validation::CalibrationResult& r) {
 
 int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::ostream& err) {
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
-  try {
+  return report_errors(err, "", [&]() -> int {
     const Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_calibration") : options.output_dir;
@@ -84,13 +85,7 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
     out << "\n" << metrics_table(result) << "\nTuned preset: " << (dir / (name + ".json")).string()
         << "\n  run it with: puncture run " << (dir / (name + ".json")).string() << '\n';
     return 0;
-  } catch (const SceneError& e) {
-    err << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    err << "error: " << e.what() << '\n';
-    return 1;
-  }
+  });
 }
 
 }  // namespace puncture::apps

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/provenance.hpp"
 #include "run_outputs.hpp"
@@ -125,7 +126,7 @@ nlohmann::json summary_json(const Scene& scene, const RealtimeModel& model, cons
 
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& err) {
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
-  try {
+  return report_errors(err, scene_path.string(), [&]() -> int {
     const Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / scene.name : options.output_dir;
@@ -172,13 +173,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     if (writer)
       out << "  realtime.pvd        " << writer->frames() << " frames of layer surfaces and force meshes (open in ParaView)\n";
     return 0;
-  } catch (const SceneError& e) {
-    err << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    err << "error: " << scene_path.string() << ": " << e.what() << '\n';
-    return 1;
-  }
+  });
 }
 
 }  // namespace puncture::apps

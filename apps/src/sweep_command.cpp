@@ -26,6 +26,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/fem_reference.hpp"
 #include "puncture/apps/provenance.hpp"
@@ -168,7 +169,7 @@ std::string table_markdown(const Scene& scene, const std::vector<SweepRow>& rows
 
 int sweep_command(const SweepOptions& options, std::ostream& out, std::ostream& err) {
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
-  try {
+  return report_errors(err, scene_path.string(), [&]() -> int {
     const Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_accuracy_cost") : options.output_dir;
@@ -292,13 +293,7 @@ int sweep_command(const SweepOptions& options, std::ostream& out, std::ostream& 
           << (r.status == "ok" ? "" : "   " + r.status) << '\n';
     out << "Table: " << (dir / "accuracy_cost.md").string() << '\n';
     return 0;
-  } catch (const SceneError& e) {
-    err << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    err << "error: " << scene_path.string() << ": " << e.what() << '\n';
-    return 1;
-  }
+  });
 }
 
 }  // namespace puncture::apps

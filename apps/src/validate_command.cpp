@@ -32,6 +32,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/fem_reference.hpp"
 #include "puncture/apps/provenance.hpp"
@@ -149,7 +150,7 @@ std::string aligned_curves_csv(const validation::InsertionCurve& realtime, const
 
 int validate_command(const ValidateOptions& options, std::ostream& out, std::ostream& err) {
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
-  try {
+  return report_errors(err, scene_path.string(), [&]() -> int {
     const Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_validation") : options.output_dir;
@@ -307,13 +308,7 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
     }
     out << "Report: " << (dir / "validation_summary.md").string() << '\n';
     return 0;
-  } catch (const SceneError& e) {
-    err << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    err << "error: " << scene_path.string() << ": " << e.what() << '\n';
-    return 1;
-  }
+  });
 }
 
 }  // namespace puncture::apps
