@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -68,6 +69,7 @@ std::vector<Node> group_nodes(const std::vector<DofPoint>& points, double length
 
 struct Row {
   double time_s, depth_m, velocity_m_per_s, force_N;
+  double tip_stretch;  ///< max principal stretch at the tip in the pressed layer (1: no contact)
   std::vector<LayerState> states;
 };
 
@@ -126,6 +128,7 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
   if (!(scene.insertion.speed_m_per_s > 0.0))
     throw std::invalid_argument("fem: insertion speed must be > 0");
   if (!(scene.fem.load_step_m > 0.0)) throw std::invalid_argument("fem: load_step_m must be > 0");
+  if (options.spring_back_stages < 1) throw std::invalid_argument("fem: spring_back_stages must be >= 1");
   const int degree = options.degree_override > 0 ? options.degree_override : scene.fem.element_degree;
   const int refinement = options.refinement_override >= 0 ? options.refinement_override : scene.fem.refinement;
   if (degree != 1 && degree != 2) throw std::invalid_argument("fem: element degree must be 1 or 2");
@@ -159,6 +162,7 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
     throw std::invalid_argument("fem: formulation must be three_field or one_field");
   settings.max_newton_iterations = scene.fem.max_newton_iterations;
   settings.newton_tolerance = scene.fem.newton_tolerance;
+  settings.max_stalled_iterations = 4;  // the load step is cut instead (see below)
   settings.verbose = false;
   if (options.linear_solver != "auto" && options.linear_solver != "direct" && options.linear_solver != "iterative")
     throw std::invalid_argument("fem: linear_solver must be auto, direct or iterative");
@@ -255,18 +259,20 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
   std::ostringstream newton_log;
   bool solution_is_stale = true;  // the state differs from the last solved one
   // Solves at tip depth `depth`, joining reached nodes until none is left.
-  auto solve_at = [&](double depth, NewtonReport& report) {
+  // predictor_scale: start the first pass from u + scale x the last increment.
+  auto solve_at = [&](double depth, NewtonReport& report, double predictor_scale) {
     const double z_tip = -depth;
     for (int pass = 0; pass < 8; ++pass) {
       const bool joined = join_reached_nodes(z_tip);
       if (!joined && !solution_is_stale && !any_contact()) return true;  // nothing to do
       apply_targets(z_tip);
       const auto t0 = std::chrono::steady_clock::now();
-      report = solver.solve_step();
+      report = solver.solve_step(pass == 0 && !joined ? predictor_scale : 0.0);
       summary.solve_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       summary.newton_iterations += report.iterations;
       summary.linear_iterations += report.linear_iterations;
       newton_log << "depth " << format_double(depth * 1e3, 6) << " mm, contact nodes " << contact.size()
+                 << (solver.has_anchor_springs() ? ", spring-back stage" : "")
                  << (report.converged ? "" : ", FAILED: " + report.failure) << "\n";
       for (const auto& line : report.table) {
         newton_log << "  " << line << "\n";
@@ -309,9 +315,9 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
     for (const auto& [key, acc] : by_r) profile.emplace_back(r_of[key], acc.first / acc.second);
     return profile;
   };
-  auto record_row = [&](double depth, double force) {
+  auto record_row = [&](double depth, double force, double stretch) {
     const double time = (depth + start_height) / speed;
-    rows.push_back({time, depth, speed, force, states});
+    rows.push_back({time, depth, speed, force, stretch, states});
     summary.time_s.push_back(time);
     summary.depth_m.push_back(depth);
     summary.force_N.push_back(force);
@@ -325,6 +331,10 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
   if (options.write_files && options.write_vtu)
     fields = std::make_unique<FieldOutputSeries>(out_dir, "fem_fields", comm);
   const double load_step = scene.fem.load_step_m;
+  // Puncture depths are located by bisection to within `resolution`: a step
+  // after which the criterion holds is undone and halved until it is short.
+  const double resolution =
+      options.puncture_depth_resolution_m > 0.0 ? options.puncture_depth_resolution_m : load_step / 4.0;
   const int n_steps = std::max(1, int(std::ceil((final_depth + start_height) / load_step - 1e-9)));
   const int vtu_stride = std::max(1, n_steps / std::max(1, options.max_vtu_frames));
   auto write_frame = [&](double depth) {
@@ -339,12 +349,13 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
     else if (fields) fields->write_collection();
     if (!root) return;
     std::ostringstream csv;
-    csv << "time_s,depth_mm,velocity_mm_per_s,force_N";
+    csv << "time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch";
     for (const auto& layer : scene.layers) csv << "," << layer.name << "_state";
     csv << "\n";
     for (const auto& r : rows) {
       csv << format_double(r.time_s) << "," << format_double(r.depth_m * 1e3) << ","
-          << format_double(r.velocity_m_per_s * 1e3) << "," << format_double(r.force_N);
+          << format_double(r.velocity_m_per_s * 1e3) << "," << format_double(r.force_N) << ","
+          << format_double(r.tip_stretch, 6);
       for (const auto s : r.states) csv << "," << to_string(s);
       csv << "\n";
     }
@@ -373,6 +384,9 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
     j["peak_force_depth_mm"] = summary.peak_force_depth_m * 1e3;
     j["load_steps"] = summary.load_steps;
     j["step_cuts"] = summary.step_cuts;
+    j["puncture_bisections"] = summary.bisections;
+    j["spring_back_stages"] = summary.spring_back_stages;
+    j["puncture_depth_resolution_mm"] = resolution * 1e3;
     j["newton_iterations"] = summary.newton_iterations;
     j["linear_iterations"] = summary.linear_iterations;
     j["wall_time_s"] = summary.wall_time_s;
@@ -388,21 +402,36 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
 
   // ---- 4. Load stepping ------------------------------------------------------------
   double depth = -start_height;
-  record_row(depth, 0.0);
+  record_row(depth, 0.0, 1.0);
   write_frame(depth);
   int record_index = 0;
+  double last_advance = 0.0;     // depth change of the last converged step in contact
+  bool predictor_valid = false;  // that step pressed the current layer like the next one will
+  double crossing_upper = std::numeric_limits<double>::infinity();  // criterion known to hold here
   try {
     for (int step = 1; step <= n_steps; ++step) {
       const double step_target = std::min(-start_height + step * load_step, final_depth);
       double increment = step_target - depth;
       while (depth < step_target - 1e-12 * load_step) {
-        const double trial_depth = std::min(depth + increment, step_target);
+        double trial_depth = std::min(depth + increment, step_target);
+        if (std::isfinite(crossing_upper)) {
+          // Bisecting toward a known crossing (the last part is taken whole).
+          const double remaining = crossing_upper - depth;
+          trial_depth = std::min(trial_depth, remaining <= resolution * (1.0 + 1e-9)
+                                                  ? crossing_upper
+                                                  : depth + 0.5 * remaining);
+        }
+        const double advance = trial_depth - depth;
         const auto contact_before = contact;
+        const auto states_before = states;
+        const FiniteStrainSolver::Snapshot snapshot = solver.snapshot();
+        const double predictor_scale =
+            predictor_valid && last_advance > 0.0 ? std::min(2.0, advance / last_advance) : 0.0;
         NewtonReport report;
-        if (!solve_at(trial_depth, report)) {
+        if (!solve_at(trial_depth, report, predictor_scale)) {
           contact = contact_before;
           solution_is_stale = true;
-          increment *= 0.5;
+          increment = 0.5 * advance;
           ++summary.step_cuts;
           log("  step cut at depth " + format_double(trial_depth * 1e3, 6) + " mm: " + report.failure);
           if (increment < load_step / 256.0)
@@ -411,11 +440,17 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
                                      format_double(increment * 1e3, 4) + " mm");
           continue;
         }
+        const double depth_before = depth;
+        const double last_advance_before = last_advance;
+        const bool predictor_valid_before = predictor_valid;
         depth = trial_depth;
         ++summary.load_steps;
-        increment = std::min(2.0 * increment, load_step);
+        increment = std::min(2.0 * advance, load_step);
+        if (trial_depth == crossing_upper) crossing_upper = std::numeric_limits<double>::infinity();
         const bool in_contact = any_contact();
         if (current_layer < n_layers && in_contact) states[current_layer] = LayerState::pressed;
+        predictor_valid = in_contact;
+        last_advance = advance;
 
         // Puncture criterion of the pressed layer.
         if (current_layer < n_layers && in_contact) {
@@ -425,7 +460,22 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
           const bool breaks = crit.kind == PunctureCriterion::Kind::CriticalForce
                                   ? force >= crit.critical_force_N
                                   : stretch >= crit.critical_stretch;
+          if (breaks && advance > resolution * (1.0 + 1e-9)) {
+            // Undo the step and bisect toward the crossing.
+            crossing_upper = depth;
+            solver.restore(snapshot);
+            contact = contact_before;
+            states = states_before;
+            depth = depth_before;
+            last_advance = last_advance_before;
+            predictor_valid = predictor_valid_before;
+            solution_is_stale = false;
+            ++summary.bisections;
+            continue;
+          }
           if (breaks) {
+            crossing_upper = std::numeric_limits<double>::infinity();
+            predictor_valid = false;
             const std::size_t layer = current_layer;
             PunctureEvent event;
             event.layer = int(layer);
@@ -434,23 +484,55 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
             event.force_N = force;
             event.max_stretch = stretch;
             event.time_s = (depth + start_height) / speed;
-            record_row(depth, force);
+            record_row(depth, force, stretch);
             for (const auto& [r, uz] : surface_profile(layer))
               recovery_csv << layer << ",before," << format_double(depth * 1e3) << ","
                            << format_double(r * 1e3) << "," << format_double(uz * 1e3) << "\n";
             // Remove the layer's material along the needle path, release the tip.
-            solver.remove_cells([&](const FiniteStrainSolver::CellIterator& cell) {
-              const Point<3> c = cell->center();
-              return cell->material_id() == layer && std::hypot(c[0], c[1]) < needle_radius;
-            });
+            // The spring-back is a homotopy in lambda = 1 -> 0 (see the header):
+            // the removed cells' frozen load is lambda x its value and the
+            // released contact nodes hang on anchor springs of lambda^2 x
+            // 100x the contact patch stiffness per node.
+            solver.remove_cells(
+                [&](const FiniteStrainSolver::CellIterator& cell) {
+                  const Point<3> c = cell->center();
+                  return cell->material_id() == layer && std::hypot(c[0], c[1]) < needle_radius;
+                },
+                /*release_gradually=*/true);
             states[layer] = LayerState::punctured;
+            const double indentation = std::max(depth - scene.layer_top_depth_m(layer), 1e-3 * needle_radius);
+            const std::size_t n_released = Utilities::MPI::sum(contact.size(), comm);
+            const double k0 = 100.0 * std::abs(force) / (indentation * std::max<std::size_t>(1, n_released));
+            std::map<types::global_dof_index, double> springs;
+            for (const auto& [n, hold] : contact)
+              for (unsigned c = 0; c < 3; ++c) springs[nodes[n].dof[c]] = k0;
             contact.clear();
             current_layer = layer + 1;
-            solution_is_stale = true;
-            NewtonReport spring_back;
-            if (!solve_at(depth, spring_back))
-              throw std::runtime_error("fem: spring-back after the puncture of " + event.layer_name +
-                                       " did not converge: " + spring_back.failure);
+            solver.set_anchor_springs(springs);
+            double lambda = 1.0;  // last converged stage
+            double d_lambda = 1.0 / options.spring_back_stages;
+            while (lambda > 0.0) {
+              const double next = lambda - d_lambda < 1e-3 ? 0.0 : lambda - d_lambda;
+              solver.set_released_force_fraction(next);
+              solver.set_anchor_spring_scale(next * next);
+              const auto stage_snapshot = solver.snapshot();
+              const auto stage_contact = contact;
+              solution_is_stale = true;
+              NewtonReport spring_back;
+              const bool ok = solve_at(depth, spring_back, 0.0);
+              ++summary.spring_back_stages;
+              if (!ok) {
+                solver.restore(stage_snapshot);
+                contact = stage_contact;
+                d_lambda *= 0.5;
+                if (d_lambda < 1.0 / (64.0 * options.spring_back_stages))
+                  throw std::runtime_error("fem: spring-back after the puncture of " + event.layer_name +
+                                           " did not converge: " + spring_back.failure);
+                continue;
+              }
+              lambda = next;
+            }
+            solver.set_anchor_springs({});
             const bool touching = any_contact();
             event.force_after_N = touching ? needle_force() : 0.0;
             if (current_layer < n_layers && touching) states[current_layer] = LayerState::pressed;
@@ -461,15 +543,19 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
             log("  PUNCTURE of " + event.layer_name + " at depth " + format_double(depth * 1e3, 5) +
                 " mm, force " + format_double(force, 5) + " N -> " + format_double(event.force_after_N, 5) +
                 " N");
-            record_row(depth, event.force_after_N);
+            const double stretch_after =
+                current_layer < n_layers && touching ? tip_stretch(current_layer) : 1.0;
+            record_row(depth, event.force_after_N, stretch_after);
             write_frame(depth);
           }
         }
       }
-      const double force = any_contact() ? needle_force() : 0.0;
+      const bool touching = any_contact();
+      const double force = touching ? needle_force() : 0.0;
+      const double stretch = touching && current_layer < n_layers ? tip_stretch(current_layer) : 1.0;
       if (!std::isfinite(force)) throw std::runtime_error("fem: non-finite needle force");
       // (A puncture at the end of the step already recorded this depth.)
-      if (!(rows.back().depth_m == depth && rows.back().force_N == force)) record_row(depth, force);
+      if (!(rows.back().depth_m == depth && rows.back().force_N == force)) record_row(depth, force, stretch);
       ++record_index;
       if (current_layer < n_layers)
         for (const auto& [r, uz] : surface_profile(current_layer))
@@ -478,7 +564,8 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
       if (step % vtu_stride == 0 || step == n_steps) write_frame(depth);
       std::ostringstream s;
       s << "  step " << std::setw(4) << step << "/" << n_steps << "  depth " << std::fixed << std::setprecision(3)
-        << depth * 1e3 << " mm  force " << std::setprecision(5) << force << " N  contact " << contact.size()
+        << depth * 1e3 << " mm  force " << std::setprecision(5) << force << " N  tip stretch "
+        << std::setprecision(4) << stretch << "  contact " << contact.size()
         << "  newton(total) " << summary.newton_iterations;
       log(s.str());
     }

@@ -171,15 +171,16 @@ TEST(FemReferenceCache, SecondCallComesFromTheCacheWithoutRunning) {
   std::ifstream csv(first.dir / "fem_force_depth.csv");
   std::string line, last;
   std::getline(csv, line);
-  EXPECT_EQ(line.rfind("time_s,depth_mm,velocity_mm_per_s,force_N,skin_state", 0), 0u) << line;
+  EXPECT_EQ(line.rfind("time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch,skin_state", 0), 0u) << line;
   while (std::getline(csv, line))
     if (!line.empty()) last = line;
   std::istringstream fields(last);
-  std::string time, depth, velocity, force, skin;
+  std::string time, depth, velocity, force, stretch, skin;
   std::getline(fields, time, ',');
   std::getline(fields, depth, ',');
   std::getline(fields, velocity, ',');
   std::getline(fields, force, ',');
+  std::getline(fields, stretch, ',');
   std::getline(fields, skin, ',');
   EXPECT_NEAR(std::stod(depth), scene.insertion.target_depth_m * 1e3, 1e-9);
   EXPECT_EQ(skin, "punctured");

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <map>
+#include <memory>
 
 #include <puncture/fem/finite_strain_solver.hpp>
 #include <puncture/fem/hyperelastic_materials.hpp>
@@ -329,4 +330,72 @@ TEST(CooksMembrane, Q1SixteenElementsPerEdgeMatchesCodeGallery) {
   // Code gallery table: Q1, 16 elements per edge: 14.13 mm.
   const double u = cook_tip_displacement_mm(16, 1);
   EXPECT_NEAR(u, 14.13, 0.02);
+}
+
+namespace {
+
+/// A compressed 10 mm cube (base fixed, top pushed down 1 mm) whose central
+/// column of cells is then removed; returns the solver after the compression.
+struct CompressedCube {
+  static constexpr double L = 10e-3;
+  parallel::distributed::Triangulation<3> tria{MPI_COMM_WORLD};
+  std::unique_ptr<FiniteStrainSolver> solver;
+  std::vector<DofPoint> points;
+  CompressedCube() {
+    GridGenerator::subdivided_hyper_cube(tria, 4, 0.0, L);
+    SolverSettings settings;
+    settings.newton_tolerance = 1e-10;
+    solver = std::make_unique<FiniteStrainSolver>(
+        tria, std::vector<LayerMaterial>{LayerMaterial(make_material("neo_hookean", 5e4, 0.45, 0.0))}, settings);
+    solver->setup();
+    points = solver->locally_relevant_dof_points();
+    std::map<types::global_dof_index, double> targets;
+    for (const auto& p : points) {
+      if (p.X[2] < 1e-9 * L) targets[p.dof] = 0.0;
+      if (p.X[2] > L * (1 - 1e-9)) targets[p.dof] = p.component == 2 ? -1e-3 : 0.0;
+    }
+    solver->set_prescribed_displacements(targets);
+    const NewtonReport r = solver->solve_step();
+    EXPECT_TRUE(r.converged) << r.failure;
+  }
+  static bool central(const FiniteStrainSolver::CellIterator& cell) {
+    const Point<3> c = cell->center();
+    return std::abs(c[0] - 0.5 * L) < 0.25 * L && std::abs(c[1] - 0.5 * L) < 0.25 * L;
+  }
+};
+
+}  // namespace
+
+TEST(GradualRemoval, FrozenLoadKeepsEquilibriumAndTheHomotopyEndsAtTheDirectRemoval) {
+  CompressedCube direct, gradual;
+  direct.solver->remove_cells(CompressedCube::central, /*release_gradually=*/false);
+  const NewtonReport r_direct = direct.solver->solve_step();
+  ASSERT_TRUE(r_direct.converged) << r_direct.failure;
+  EXPECT_GE(r_direct.iterations, 1);  // the removal unbalanced the body
+
+  gradual.solver->remove_cells(CompressedCube::central, /*release_gradually=*/true);
+  const NewtonReport r_start = gradual.solver->solve_step();
+  ASSERT_TRUE(r_start.converged) << r_start.failure;
+  EXPECT_EQ(r_start.iterations, 0);  // the frozen load at fraction 1 restores equilibrium
+  // Anchor springs on every free dof: they hold the state while the load goes.
+  std::map<types::global_dof_index, double> springs;
+  for (const auto& p : gradual.points) springs[p.dof] = 1e3;  // N/m
+  gradual.solver->set_anchor_springs(springs);
+  for (const double lambda : {0.5, 0.0}) {
+    gradual.solver->set_released_force_fraction(lambda);
+    gradual.solver->set_anchor_spring_scale(lambda);
+    const NewtonReport r = gradual.solver->solve_step();
+    ASSERT_TRUE(r.converged) << "lambda " << lambda << ": " << r.failure;
+  }
+  EXPECT_FALSE(gradual.solver->has_anchor_springs());
+  // Both paths end at the same equilibrium (same body, same loads).
+  double max_u = 0.0, max_diff = 0.0;
+  for (const auto& p : direct.points) max_u = std::max(max_u, std::abs(direct.solver->displacement(p.dof)));
+  for (std::size_t i = 0; i < direct.points.size(); ++i) {
+    ASSERT_EQ(direct.points[i].dof, gradual.points[i].dof);
+    max_diff = std::max(max_diff, std::abs(direct.solver->displacement(direct.points[i].dof) -
+                                           gradual.solver->displacement(gradual.points[i].dof)));
+  }
+  EXPECT_GT(max_u, 0.5e-3);
+  EXPECT_LT(max_diff, 1e-6 * max_u);
 }

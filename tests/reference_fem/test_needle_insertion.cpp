@@ -95,7 +95,7 @@ TEST(NeedleInsertion, PuncturesSkinThenFatWithSpringBackAndWritesFiles) {
   std::ifstream csv(dir / "fem_force_depth.csv");
   std::string header;
   std::getline(csv, header);
-  EXPECT_EQ(header, "time_s,depth_mm,velocity_mm_per_s,force_N,skin_state,fat_state,muscle_state");
+  EXPECT_EQ(header, "time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch,skin_state,fat_state,muscle_state");
   std::ifstream js(dir / "fem_summary.json");
   const auto j = nlohmann::json::parse(js);
   EXPECT_EQ(j["status"], "completed");

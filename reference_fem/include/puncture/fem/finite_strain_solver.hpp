@@ -31,6 +31,26 @@
 // constraints are met, while the free residual does not decrease. On failure
 // the state of the last converged step is restored and solve_step() reports
 // it (the caller cuts the load step). Nothing non-finite is ever kept.
+//
+// Cost. The linear solves are inexact (inexact Newton): CG stops at
+// linear_relative_tolerance x ||b|| or once the linear residual is a tenth of
+// the Newton target, whichever is looser; the Newton test uses the exact
+// residual, so the converged state is as accurate as with exact solves. The
+// AMG hierarchy is built at the first iteration of a step and reused by the
+// later ones. A step may start from an extrapolated state (solve_step's
+// predictor_scale: u + s x the previous step's increment), which removes most
+// of the first correction while the load path is smooth.
+//
+// Continuation (used for the spring-back after a puncture, where releasing a
+// deep indentation at once defeats Newton). Two homotopies the caller lowers
+// from 1 to 0 step by step:
+//  * gradual removal: remove_cells(..., true) keeps the internal forces the
+//    removed cells exerted at the moment of removal as a frozen nodal load,
+//    scaled by set_released_force_fraction() (the force-release technique of
+//    excavation analysis); at fraction 1 the state is still in equilibrium;
+//  * anchor springs (set_anchor_springs) tie chosen dofs to their
+//    displacement at that moment, with a stiffness scaled by
+//    set_anchor_spring_scale().
 #pragma once
 
 #include <deal.II/base/point.h>
@@ -38,6 +58,7 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 
@@ -64,7 +85,15 @@ struct SolverSettings {
   double newton_tolerance = 1e-8;
   double absolute_residual_floor_N = 1e-13;  ///< converged below this whatever the scale
   int max_line_search_halvings = 8;
-  double linear_relative_tolerance = 1e-9;   ///< CG stop: ||r|| <= tol ||b||
+  /// > 0: give up (so that a caller that can cut the step does so early)
+  /// after this many consecutive iterations whose line search had to shorten
+  /// the step to <= 1/8; 0: never (such iterations often recover).
+  int max_stalled_iterations = 0;
+  /// CG stop: ||r|| <= max(tol ||b||, 0.1 x Newton target); loose on purpose
+  /// (inexact Newton, see the file comment).
+  double linear_relative_tolerance = 1e-4;
+  /// Rebuild the AMG hierarchy at every Newton iteration (true) or once per step.
+  bool rebuild_preconditioner_every_iteration = false;
   bool direct_linear_solver = false;         ///< sparse direct (MUMPS) instead of CG + AMG
   double void_stiffness_fraction = 1e-4;     ///< E_void / E_layer for removed cells
   bool verbose = false;                      ///< convergence table on rank 0
@@ -129,13 +158,38 @@ class FiniteStrainSolver {
   void set_dead_load_traction(dealii::types::boundary_id id, const dealii::Tensor<1, 3>& traction_Pa);
 
   /// Marks cells removed (void material) where predicate(cell) is true.
-  /// Cells already removed stay removed.
-  void remove_cells(const std::function<bool(const CellIterator&)>& predicate);
+  /// Cells already removed stay removed. release_gradually: the internal
+  /// forces the newly removed cells exerted (minus those of their void
+  /// material) become a frozen load at fraction 1 (see the file comment);
+  /// otherwise the frozen load is cleared. Collective.
+  void remove_cells(const std::function<bool(const CellIterator&)>& predicate, bool release_gradually = false);
+  /// Fraction (0..1) of the frozen removal load still applied.
+  void set_released_force_fraction(double fraction);
   bool is_removed(const CellIterator& cell) const;
 
-  /// Newton solve of the current load step. On failure the previous
-  /// converged state is restored.
-  NewtonReport solve_step();
+  /// Newton solve of the current load step, starting from u + predictor_scale
+  /// x (increment of the last converged step) when that state is admissible
+  /// (0: start from u). On failure the previous converged state is restored.
+  NewtonReport solve_step(double predictor_scale = 0.0);
+
+  /// The state a caller can go back to (e.g. to bisect a load step): the
+  /// displacement and the last step's increment. Removed cells, prescribed
+  /// values and springs are not part of it.
+  struct Snapshot {
+    dealii::TrilinosWrappers::MPI::Vector solution, last_increment;
+  };
+  Snapshot snapshot() const { return {solution_, last_increment_}; }
+  /// Restores a snapshot and re-evaluates the residual (collective).
+  void restore(const Snapshot& snapshot);
+
+  /// Linear springs (N/m per dof) pulling the given dofs toward their current
+  /// displacement (anchor = u now). Prescribed dofs ignore their spring.
+  /// Replaces any earlier springs; an empty map removes them.
+  void set_anchor_springs(const std::map<dealii::types::global_dof_index, double>& stiffness_N_per_m);
+  /// Multiplies the stiffness given to set_anchor_springs (anchors kept); 0
+  /// switches the springs off.
+  void set_anchor_spring_scale(double scale);
+  bool has_anchor_springs() const { return !anchors_.empty() && anchor_scale_ > 0.0; }
 
   /// Ghosted total displacement (m).
   const dealii::TrilinosWrappers::MPI::Vector& solution() const { return solution_ghosted_; }
@@ -159,8 +213,12 @@ class FiniteStrainSolver {
   };
   AssemblyResult assemble(const dealii::TrilinosWrappers::MPI::Vector& u_ghosted, bool with_matrix,
                           const dealii::AffineConstraints<double>* constraints);
-  dealii::AffineConstraints<double> increment_constraints() const;
-  unsigned int solve_linear(dealii::TrilinosWrappers::MPI::Vector& du);
+  /// Constraints of the Newton update at state u (ghosted): du = target - u
+  /// on the prescribed dofs.
+  void increment_constraints(const dealii::TrilinosWrappers::MPI::Vector& u,
+                             dealii::AffineConstraints<double>& constraints) const;
+  unsigned int solve_linear(dealii::TrilinosWrappers::MPI::Vector& du, double absolute_tolerance,
+                            bool rebuild_preconditioner);
   double free_residual_norm() const;
   double reaction_norm() const;
   double external_load_norm() const;
@@ -180,6 +238,16 @@ class FiniteStrainSolver {
   /// locally owned dof -> (component, support point), for the AMG near null space
   std::map<dealii::types::global_dof_index, std::pair<unsigned int, dealii::Point<3>>> owned_support_;
 
+  struct AnchorSpring {
+    double stiffness_N_per_m;
+    double anchor_m;
+  };
+  std::map<dealii::types::global_dof_index, AnchorSpring> anchors_;  ///< locally owned dofs only
+  double anchor_scale_ = 1.0;
+  dealii::TrilinosWrappers::MPI::Vector released_force_;  ///< frozen removal load (N, owned)
+  double released_fraction_ = 0.0;
+  std::unique_ptr<dealii::TrilinosWrappers::PreconditionAMG> amg_;
+  dealii::TrilinosWrappers::MPI::Vector last_increment_;  ///< of the last converged step (owned)
   dealii::TrilinosWrappers::SparseMatrix tangent_;
   dealii::TrilinosWrappers::MPI::Vector rhs_;            ///< -R with constraints applied
   dealii::TrilinosWrappers::MPI::Vector residual_;       ///< R = f_int - f_ext, unconstrained

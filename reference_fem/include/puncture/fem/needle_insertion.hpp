@@ -7,6 +7,8 @@
 // Out: FemRunSummary, and in options.output_dir (created if missing; every
 //      file written under a temporary name and renamed when complete):
 //        fem_force_depth.csv      time_s, depth_mm, velocity_mm_per_s, force_N,
+//                                 tip_stretch (max principal stretch at the tip
+//                                 in the pressed layer; 1 without contact),
 //                                 <layer>_state (untouched|pressed|punctured)...
 //        fem_surface_profile.csv  step, depth_mm, r_mm, uz_mm, surface: u_z(r) of
 //                                 the top surface of the layer the needle
@@ -30,12 +32,21 @@
 // stretch in the cells touching the contact patch) its cells with centre
 // inside the needle radius become void (linear material with
 // void_stiffness_fraction x E; see finite_strain_solver.hpp), the contact set
-// is released, the same depth is re-solved (spring-back, recorded) and the
-// tip goes on to the next interface. Quasi-static load steps of
-// scene.fem.load_step_m from the start height to the target depth; a step
-// that fails (no convergence, inverted elements) is halved, down to 1/256 of
-// the load step, then the run stops with an error. The FEM stops at the
-// target depth: dwell and withdrawal are not simulated.
+// is released and the same depth is re-solved (spring-back, recorded) and the
+// tip goes on to the next interface. The spring-back is a homotopy in
+// lambda = 1 -> 0 over spring_back_stages stages: the internal force the
+// removed cells exerted is kept as a frozen load scaled by lambda (force
+// release, as in excavation analysis), and the released contact nodes hang
+// on anchor springs of lambda^2 x 100x the contact patch stiffness per node;
+// a stage that fails is retried from the last converged one with half the
+// lambda step. Quasi-static load steps of scene.fem.load_step_m
+// from the start height to the target depth; each step starts from the
+// previous step's increment, extrapolated. A step after which the puncture
+// criterion holds is undone and bisected until the crossing is located to
+// puncture_depth_resolution_m. A step that fails (no convergence, a stalled
+// line search, inverted elements) is halved, down to 1/256 of the load step,
+// then the run stops with an error. The FEM stops at the target depth: dwell
+// and withdrawal are not simulated.
 #pragma once
 
 #include <mpi.h>
@@ -64,6 +75,12 @@ struct FemRunOptions {
   std::string linear_solver = "auto";
   std::size_t direct_solver_max_dofs = 5000;
   double stop_depth_m = -1.0;         ///< > 0: stop at this depth (before the target)
+  /// Puncture depths are located to within this (m) by bisection; <= 0: a
+  /// quarter of the scene's load step.
+  double puncture_depth_resolution_m = -1.0;
+  /// Spring-back homotopy: stages from lambda = 1 to 0 (a failed stage is
+  /// retried from the last converged one with half the lambda step).
+  int spring_back_stages = 4;
   int max_vtu_frames = 40;            ///< at most about this many VTU frames (plus events)
   bool verbose = true;                ///< progress and Newton tables on rank 0's stdout
   bool write_files = true;            ///< false: no files at all (tests)
@@ -84,7 +101,9 @@ struct FemRunSummary {
   double peak_force_N = 0.0;
   double peak_force_depth_m = 0.0;
   int load_steps = 0;         ///< converged (sub)steps solved
-  int step_cuts = 0;          ///< halvings of the load step
+  int step_cuts = 0;          ///< halvings of the load step after a failed solve
+  int bisections = 0;         ///< steps undone to locate a puncture depth
+  int spring_back_stages = 0; ///< solves of the spring-back homotopies
   int newton_iterations = 0;  ///< total
   int linear_iterations = 0;  ///< total
   double wall_time_s = 0.0;
