@@ -54,6 +54,11 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"nelder_mead", "bobyqa", "simulated_annealing"}));
   calibrate_cmd->add_option("--name", calibrate.preset_name, "Preset name; default: <scene name>_tuned");
   calibrate_cmd->add_option("--layers", calibrate.layers, "Layers to calibrate; default: all");
+  calibrate_cmd->add_option("--also-tune", calibrate.also_tune,
+                            "Also tune: surface_stiffness, rings, spacing (comma separated)")
+      ->delimiter(',');
+  calibrate_cmd->add_option("--bound-factor", calibrate.bound_factor,
+                            "Each tuned parameter stays within [start / f, start * f]; default 1000");
   calibrate_cmd->add_flag("-q,--quiet", calibrate.quiet, "No progress output");
 
   SweepOptions sweep;

@@ -1,6 +1,10 @@
 // `puncture calibrate`: tunes the real-time model's force-mesh parameters
 // against a reference insertion curve (the scene's FEM reference, cached, or a
-// measured curve) and writes a tuned preset with its provenance.
+// measured curve) and writes a tuned preset with its provenance, the curves of
+// the reference and of the model before and after (calibration_curves.csv),
+// their plot (calibration_force_depth.png, scripts/plot_calibration.py) and
+// calibration_summary.md.
+#include <chrono>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -13,21 +17,37 @@
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/calibration.hpp"
 #include "puncture/validation/metrics.hpp"
+#include "validation_support.hpp"
 
 namespace puncture::apps {
 namespace {
 
 std::string metrics_table(const validation::CalibrationResult& r) {
   std::ostringstream s;
-  s << "| layer | force RMSE before (N) | after (N) | puncture depth error before (mm) | after (mm) |\n"
-       "|---|---|---|---|---|\n";
+  s << "| layer | force RMSE before (N) | after (N) | after (% of reference peak) | puncture depth error before (mm) "
+       "| after (mm) |\n"
+       "|---|---|---|---|---|---|\n";
   if (r.before.empty() || r.after.empty()) return s.str();
   for (const auto& before : r.before.front().layers) {
     const validation::LayerMetrics* after = r.after.front().layer(before.layer);
     s << "| " << before.layer << " | " << std::setprecision(4) << before.force_rmse_N << " | "
-      << (after ? after->force_rmse_N : 0.0) << " | " << before.puncture_depth_error_m * 1e3 << " | "
-      << (after ? after->puncture_depth_error_m * 1e3 : 0.0) << " |\n";
+      << (after ? after->force_rmse_N : 0.0) << " | " << std::setprecision(3)
+      << (after ? 100.0 * after->force_rmse_relative : 0.0) << " | " << std::setprecision(4)
+      << before.puncture_depth_error_m * 1e3 << " | " << (after ? after->puncture_depth_error_m * 1e3 : 0.0)
+      << " |\n";
   }
+  return s.str();
+}
+
+/// curve,time_s,depth_mm,force_N rows of the insertion phase of each curve.
+std::string curves_csv(const std::vector<std::pair<std::string, const validation::InsertionCurve*>>& curves) {
+  std::ostringstream s;
+  s << std::setprecision(9) << "curve,time_s,depth_mm,force_N\n";
+  for (const auto& [name, c] : curves)
+    for (std::size_t i = 0; i < c->size(); ++i) {
+      if (i > 0 && c->velocity_m_per_s[i] < 0.0) break;  // withdrawal: not compared
+      s << name << ',' << c->time_s[i] << ',' << c->depth_m[i] * 1e3 << ',' << c->force_N[i] << '\n';
+    }
   return s.str();
 }
 
@@ -46,6 +66,7 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
       if (!options.cache_dir.empty()) fem.cache_dir = options.cache_dir;
       fem.verbose = !options.quiet;
       const FemReference ref = obtain_fem_reference(scene, fem, out);
+      if (!is_mpi_root()) return 0;  // the other ranks only help with the FEM
       out << "[calibrate] FEM reference " << ref.hash << (ref.from_cache ? " (from cache)" : " (computed)") << '\n';
       reference.curve = validation::read_insertion_curve(ref.dir / "fem_force_depth.csv");
       reference.kind = "fem";
@@ -57,6 +78,20 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
     validation::CalibrationOptions calibration;
     calibration.method = validation::parse_calibration_method(options.method);
     calibration.layers = options.layers;
+    if (!(options.bound_factor > 1.0) || !std::isfinite(options.bound_factor))
+      throw std::invalid_argument("--bound-factor must be a finite number > 1");
+    calibration.bound_factor = options.bound_factor;
+    for (const std::string& name : options.also_tune) {
+      if (name == "surface_stiffness")
+        calibration.parameters.surface_stiffness = true;
+      else if (name == "rings")
+        calibration.parameters.rings = true;
+      else if (name == "spacing")
+        calibration.parameters.spacing = true;
+      else
+        throw std::invalid_argument("--also-tune: unknown parameter '" + name +
+                                    "' (surface_stiffness, rings or spacing)");
+    }
     validation::CalibrationProgressCallback progress;
     if (!options.quiet)
       progress = [&](const validation::CalibrationProgress& p) {
@@ -65,22 +100,42 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
               << p.best_objective << '\n'
               << std::flush;
       };
-    const validation::CalibrationResult result = validation::calibrate(scene, reference.curve, calibration, progress);
+    const auto t_start = std::chrono::steady_clock::now();
+    const validation::CalibrationResult result = validation::calibrate(scene, std::vector<validation::ReferenceCurve>{reference}, calibration, progress);
+    const double calibration_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+
+    // The model as the objective runs it, before and after, for the report.
+    const validation::InsertionCurve before_curve =
+        validation::simulate_insertion_curve(validation::calibration_run_scene(scene, reference, calibration));
+    const validation::InsertionCurve after_curve = validation::simulate_insertion_curve(
+        validation::calibration_run_scene(result.tuned_scene, reference, calibration));
 
     io::OutputSession session(dir);
     const std::string name = options.preset_name.empty() ? scene.name + "_tuned" : options.preset_name;
     validation::write_tuned_preset(session, name, result, {reference}, calibration);
+    session.write_text("calibration_curves.csv",
+                       "# made by: puncture calibrate " + scene_path.string() + " on " + machine_summary() + ", " +
+                           utc_timestamp() + "\n" +
+                           curves_csv({{reference.kind, &reference.curve},
+                                       {"before", &before_curve},
+                                       {"after", &after_curve}}));
     std::ostringstream md;
     md << "# Calibration of " << scene.name << "\n\nMade by `puncture calibrate " << scene_path.string()
        << (options.reference.empty() ? "" : " --reference " + options.reference.string()) << " -o " << dir.string()
        << "` on " << machine_summary() << ", " << utc_timestamp() << ".\n\nReference: " << reference.kind << " ("
        << reference.curve.source << "). Method: " << options.method << ", " << result.evaluations
-       << " model runs. Objective " << result.objective_before << " -> " << result.objective_after << ".\n\n"
+       << " model runs in " << std::setprecision(4) << calibration_s
+       << " s (wall, reference already available). Objective " << result.objective_before << " -> "
+       << result.objective_after << ".\n\n"
        << metrics_table(result) << "\nTuned preset: `" << name << ".json` (a scene `puncture run` accepts), provenance: `"
        << name << ".provenance.json`.\n";
     if (!result.damping_note.empty()) md << "\nDamping d: " << result.damping_note << "\n";
-    session.write_text("calibration_summary.md", md.str());
     session.commit();
+    const std::vector<std::string> plots = run_plot_script("plot_calibration.py", dir, out, err);
+    for (const std::string& p : plots) md << "\n![" << p << "](" << p << ")\n";
+    io::OutputSession md_session(dir);
+    md_session.write_text("calibration_summary.md", md.str());
+    md_session.commit();
 
     out << "\n" << metrics_table(result) << "\nTuned preset: " << (dir / (name + ".json")).string()
         << "\n  run it with: puncture run " << (dir / (name + ".json")).string() << '\n';

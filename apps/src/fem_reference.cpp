@@ -156,6 +156,20 @@ void ensure_mpi() {
 #endif
 }
 
+bool is_mpi_root() {
+#ifdef PUNCTURE_HAVE_FEM
+  int initialised = 0, finalised = 0;
+  MPI_Initialized(&initialised);
+  MPI_Finalized(&finalised);
+  if (!initialised || finalised) return true;
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  return rank == 0;
+#else
+  return true;
+#endif
+}
+
 void finalize_mpi() {
 #ifdef PUNCTURE_HAVE_FEM
   mpi_session().reset();

@@ -202,6 +202,7 @@ int sweep_command(const SweepOptions& options, std::ostream& out, std::ostream& 
       r.summary = nlohmann::json::parse(read_text(r.ref.dir / "fem_summary.json"));
       fem_results.push_back(std::move(r));
     }
+    if (!is_mpi_root()) return 0;  // the other ranks only help with the FEM
     const auto finest_it = std::max_element(fem_results.begin(), fem_results.end(), [](const auto& a, const auto& b) {
       return a.summary.value("n_dofs", 0.0) < b.summary.value("n_dofs", 0.0);
     });

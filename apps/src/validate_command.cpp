@@ -168,6 +168,7 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
     fem_options.write_vtu = vtk;
     fem_options.verbose = !options.quiet;
     const FemReference reference = obtain_fem_reference(scene, fem_options, out);
+    if (!is_mpi_root()) return 0;  // the other ranks only help with the FEM
     const FemResultFiles fem = read_fem_result(reference.dir, scene);
 
     // 2. Real-time model along the same trajectory.
@@ -206,7 +207,10 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
     const ScriptedRunResult run = run_scripted_insertion(model, every_tick, on_tick, on_progress);
 
     // 3. Force-depth metrics.
-    const validation::InsertionCurve realtime_curve = validation::curve_from_run(scene, run, "realtime");
+    // The FEM is quasi-static and frictionless: the damping force d h v has no
+    // counterpart there and is left out of the compared force (as in calibrate).
+    const validation::InsertionCurve realtime_curve =
+        validation::curve_from_run(scene, run, "realtime", /*include_damping=*/false);
     const validation::CurveComparison cmp = validation::compare_curves(realtime_curve, fem.curve);
 
     // 4-5. Deflection before breakthrough and recovery after it.

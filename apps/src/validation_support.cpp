@@ -336,7 +336,9 @@ std::string validation_summary_markdown(const Scene& scene, const std::string& c
   md << "Force RMSE over the compared insertion (" << num(cmp.compared_from_depth_m / kMm) << " to "
      << num(cmp.compared_to_depth_m / kMm) << " mm, " << cmp.n_compared << " FEM samples): **"
      << num(cmp.force_rmse_N) << " N**, " << num(100 * cmp.force_rmse_relative, 3) << " % of the FEM peak "
-     << num(cmp.reference_peak_force_N) << " N.\n\n";
+     << num(cmp.reference_peak_force_N) << " N. The real-time force compared is the total minus the damping "
+        "force d h v of the punctured layers: the FEM is quasi-static and frictionless and has no counterpart for it "
+        "(the same holds in `puncture calibrate`).\n\n";
   md << "| layer | force RMSE (N) | RMSE / FEM peak | FEM puncture depth (mm) | real-time puncture depth (mm) | "
         "depth error (mm) | force error (N) | deflection RMSE before breakthrough (mm) | max error (mm) | "
         "recovery RMSE (mm) |\n";

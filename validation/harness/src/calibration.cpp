@@ -53,6 +53,13 @@ std::vector<LayerParameters> layer_parameters(const Scene& scene) {
   return out;
 }
 
+bool reference_is_quasi_static(const ReferenceCurve& reference) {
+  if (reference_is_rate_dependent(reference.curve)) return false;
+  if (reference.kind == "fem") return true;
+  const auto it = reference.curve.metadata.find("quasi_static");
+  return it != reference.curve.metadata.end() && (it->second == "true" || it->second == "yes" || it->second == "1");
+}
+
 bool reference_is_rate_dependent(const InsertionCurve& curve) {
   const auto it = curve.metadata.find("rate_dependent");
   if (it == curve.metadata.end()) return false;
@@ -152,8 +159,14 @@ double reference_speed(const Scene& scene, const InsertionCurve& ref) {
 }
 
 /// The cheap model run for one reference (see the header comment).
-Scene objective_scene(const Scene& current, const InsertionCurve& ref, const CalibrationOptions& o, double max_depth_m) {
+Scene objective_scene(const Scene& current, const ReferenceCurve& reference, const CalibrationOptions& o,
+                      double max_depth_m) {
+  const InsertionCurve& ref = reference.curve;
   Scene s = current;
+  // A quasi-static, frictionless reference (the FEM) has nothing the damping
+  // force d h v could be compared with: the model runs without it (d itself
+  // stays in the tuned scene).
+  if (reference_is_quasi_static(reference)) s.effects.damping = false;
   s.realtime.integrator = o.integrator;
   s.effects.surface_output = false;
   s.insertion.speed_m_per_s = reference_speed(current, ref);
@@ -164,6 +177,14 @@ Scene objective_scene(const Scene& current, const InsertionCurve& ref, const Cal
     s.realtime.haptic_rate_Hz = std::max(s.realtime.haptic_rate_Hz, s.insertion.speed_m_per_s / o.objective_depth_step_m);
   return s;
 }
+
+}  // namespace
+
+Scene calibration_run_scene(const Scene& scene, const ReferenceCurve& reference, const CalibrationOptions& options) {
+  return objective_scene(scene, reference, options, std::numeric_limits<double>::infinity());
+}
+
+namespace {
 
 struct StageContext {
   const std::vector<ReferenceCurve>* references = nullptr;
@@ -196,7 +217,7 @@ struct StageContext {
       // layer is found wherever it happens); the force is compared down to
       // max_depth_m only.
       const InsertionCurve model = simulate_insertion_curve(
-          objective_scene(s, ref, *options, std::numeric_limits<double>::infinity()), cache);
+          objective_scene(s, (*references)[r], *options, std::numeric_limits<double>::infinity()), cache);
       const CurveComparison c = compare_curves(model, ref, max_depth_m[r]);
       if (c.n_compared == 0) return kFailedObjective;
       const double peak = c.reference_peak_force_N > 0.0 ? c.reference_peak_force_N : 1.0;
@@ -206,7 +227,10 @@ struct StageContext {
         if (!lm) continue;
         total += w.layer_rmse * lm->force_rmse_relative * lm->force_rmse_relative;
         if (lm->reference_puncture.found && lm->model_puncture.found) {
-          const double dz = lm->puncture_depth_error_m / s.layers[k].thickness_m;
+          // Depth scale: the layer's ring spacing L (the accuracy asked of a
+          // puncture depth), or its thickness if thinner.
+          const double depth_scale = std::min(s.layers[k].thickness_m, s.layers[k].force_mesh.spacing_L_m);
+          const double dz = lm->puncture_depth_error_m / depth_scale;
           const double f_ref = lm->reference_puncture.force_N > 0.0 ? lm->reference_puncture.force_N : peak;
           const double df = lm->puncture_force_error_N / f_ref;
           total += w.puncture_depth * dz * dz + w.puncture_force * df * df;
@@ -376,6 +400,63 @@ Parameter make_parameter(const Scene& start, std::size_t layer, ParamKind kind, 
   return {layer, kind, std::log(p0) - std::log(bound_factor), std::log(p0) + std::log(bound_factor)};
 }
 
+/// Pressing phase of a layer in a curve: from the first Pressed sample to the
+/// puncture. Returns false if the curve does not press and puncture it.
+bool pressing_phase(const InsertionCurve& c, const std::string& layer, double& deflection_m, double& force_rise_N) {
+  const int li = c.layer_index(layer);
+  const PunctureEventMetrics e = puncture_event(c, layer);
+  if (li < 0 || !e.found) return false;
+  const auto& states = c.layer_states[static_cast<std::size_t>(li)];
+  for (std::size_t i = 0; i < c.size(); ++i)
+    if (states[i] == LayerState::Pressed) {
+      deflection_m = e.depth_m - c.depth_m[i];
+      force_rise_N = e.force_N - c.force_N[i];
+      return deflection_m > 0.0 && force_rise_N > 0.0;
+    }
+  return false;
+}
+
+/// Scaled start of a layer's stage (two passes): the layer's stiffnesses (K,
+/// and k_s when it is tuned: their ratio, hence the ring profile, is kept) are
+/// scaled by the ratio of the reference's pressing slope to the model's, and
+/// the deformation threshold by the ratio of the deflections at breakthrough
+/// (z0 = threshold / u_w is linear in the threshold). This brings a start
+/// that is orders of magnitude off (Table 2 stiffnesses against the FEM) into
+/// the basin the local optimiser can handle. Values stay inside the bounds.
+Scene scaled_start(const Scene& candidate, std::size_t k, const ReferenceCurve& reference,
+                   const CalibrationOptions& options, const SurfaceCache& cache,
+                   const std::vector<Parameter>& parameters) {
+  const std::string& name = candidate.layers[k].name;
+  double z_ref = 0.0, f_ref = 0.0;
+  if (!pressing_phase(reference.curve, name, z_ref, f_ref)) return candidate;
+  Scene s = candidate;
+  auto clamp_to_bounds = [&](ParamKind kind) {
+    for (const Parameter& p : parameters)
+      if (p.kind == kind) {
+        double& v = param_ref(s, k, kind);
+        v = std::exp(std::clamp(std::log(v), p.lower_log, p.upper_log));
+      }
+  };
+  for (int pass = 0; pass < 2; ++pass) {
+    InsertionCurve model;
+    try {
+      model = simulate_insertion_curve(objective_scene(s, reference, options, std::numeric_limits<double>::infinity()), &cache);
+    } catch (const std::exception&) {
+      return candidate;
+    }
+    double z_model = 0.0, f_model = 0.0;
+    if (!pressing_phase(model, name, z_model, f_model)) break;
+    const double stiffness_ratio = (f_ref / z_ref) / (f_model / z_model);
+    const TunedParameterSet& t = options.parameters;
+    if (t.virtual_stiffness) param_ref(s, k, ParamKind::VirtualStiffness) *= stiffness_ratio;
+    if (t.surface_stiffness) param_ref(s, k, ParamKind::SurfaceStiffness) *= stiffness_ratio;
+    if (t.deformed_threshold) param_ref(s, k, ParamKind::DeformedThreshold) *= z_ref / z_model;
+    for (ParamKind kind : {ParamKind::VirtualStiffness, ParamKind::SurfaceStiffness, ParamKind::DeformedThreshold})
+      clamp_to_bounds(kind);
+  }
+  return s;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -478,14 +559,18 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
       for (ParamKind kind : kinds) ctx.parameters.push_back(make_parameter(scene, k, kind, options.bound_factor));
       if (ctx.parameters.size() > static_cast<std::size_t>(kMaxParameters))
         throw std::invalid_argument("calibrate: too many parameters in one stage");
-      const std::vector<double> x0 = log_values(candidate, ctx.parameters);
       CalibrationStageRecord rec;
       rec.stage = ctx.name;
-      rec.objective_start = ctx.evaluate(x0.data());
-      if (!have_start) {
-        result.objective_before += rec.objective_start;
+      if (!have_start) {  // the objective at the scene's own values
+        result.objective_before += ctx.evaluate(log_values(candidate, ctx.parameters).data());
         have_start = true;
       }
+      if (options.scaled_start) {
+        ctx.scene = scaled_start(candidate, k, references.front(), options, cache, ctx.parameters);
+        candidate = ctx.scene;
+      }
+      const std::vector<double> x0 = log_values(candidate, ctx.parameters);
+      rec.objective_start = ctx.evaluate(x0.data());
       rec.nlopt_result = ctx.parameters.empty() ? "nothing to tune" : run_stage(ctx, x0);
       rec.objective_best = ctx.best;
       rec.evaluations = ctx.evaluations;
@@ -523,15 +608,15 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
   result.evaluations = total_evaluations;
   const double inf = std::numeric_limits<double>::infinity();
   for (const ReferenceCurve& r : references) {
-    result.before.push_back(compare_curves(simulate_insertion_curve(objective_scene(scene, r.curve, options, inf), &cache), r.curve));
-    result.after.push_back(compare_curves(simulate_insertion_curve(objective_scene(current, r.curve, options, inf), &cache), r.curve));
+    result.before.push_back(compare_curves(simulate_insertion_curve(objective_scene(scene, r, options, inf), &cache), r.curve));
+    result.after.push_back(compare_curves(simulate_insertion_curve(objective_scene(current, r, options, inf), &cache), r.curve));
   }
   return result;
 }
 
 CalibrationResult calibrate(const Scene& scene, const InsertionCurve& reference, const CalibrationOptions& options,
                             const CalibrationProgressCallback& progress) {
-  std::string kind = "fem";
+  std::string kind = "curve";  // unknown origin: compared as it is (damping included)
   const auto it = reference.metadata.find("kind");
   if (it != reference.metadata.end()) kind = it->second;
   return calibrate(scene, std::vector<ReferenceCurve>{{reference, kind}}, options, progress);
@@ -605,7 +690,7 @@ std::string tuned_preset_provenance_json(const std::string& name, const Calibrat
   nlohmann::json refs = nlohmann::json::array();
   for (std::size_t r = 0; r < references.size(); ++r) {
     const InsertionCurve& c = references[r].curve;
-    const Scene s = objective_scene(result.tuned_scene, c, options, std::numeric_limits<double>::infinity());
+    const Scene s = objective_scene(result.tuned_scene, references[r], options, std::numeric_limits<double>::infinity());
     nlohmann::json rj{{"kind", references[r].kind},
                       {"source", c.source},
                       {"hash", c.content_hash.empty() ? nlohmann::json(nullptr) : nlohmann::json("fnv1a64:" + c.content_hash)},

@@ -162,9 +162,11 @@ InsertionCurve read_insertion_curve(const std::filesystem::path& path) {
   return c;
 }
 
-InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, const std::string& source) {
+InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, const std::string& source,
+                              bool include_damping) {
   InsertionCurve c;
   c.source = source;
+  if (!include_damping) c.metadata["force"] = "without damping (total minus d h v of every layer)";
   for (const Layer& l : scene.layers) c.layer_names.push_back(l.name);
   c.layer_states.resize(scene.layers.size());
   const std::size_t n = run.ticks.size();
@@ -174,7 +176,10 @@ InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, 
     c.time_s.push_back(t.time_s);
     c.depth_m.push_back(t.depth_m);
     c.velocity_m_per_s.push_back(t.velocity_m_per_s);
-    c.force_N.push_back(t.total_force_N);
+    double force = t.total_force_N;
+    if (!include_damping)
+      for (const auto& layer : t.layers) force -= layer.damping_force_N;
+    c.force_N.push_back(force);
     for (std::size_t k = 0; k < c.layer_states.size() && k < t.layers.size(); ++k)
       c.layer_states[k].push_back(t.layers[k].state);
   }

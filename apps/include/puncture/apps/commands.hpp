@@ -60,6 +60,12 @@ struct CalibrateOptions {
   std::string method = "nelder_mead"; ///< nelder_mead, bobyqa, simulated_annealing
   std::string preset_name;            ///< empty: <scene name>_tuned
   std::vector<std::string> layers;    ///< empty: all
+  /// Each tuned parameter stays within [start / f, start x f]. Wide by default:
+  /// against the FEM the Table 2 stiffnesses can be two orders of magnitude off.
+  double bound_factor = 1000.0;
+  /// Parameters tuned besides K and the deformation threshold:
+  /// "surface_stiffness" (k_s), "rings" (w), "spacing" (L).
+  std::vector<std::string> also_tune;
   bool quiet = false;
 };
 

@@ -49,6 +49,11 @@ FemReference obtain_fem_reference(const Scene& scene, const FemReferenceOptions&
 /// later calls do nothing.
 void ensure_mpi();
 
+/// True on MPI rank 0 and when MPI is not running. Under `mpirun -np N
+/// puncture validate|calibrate|sweep` every rank takes part in the FEM
+/// reference; only rank 0 goes on to the real-time model and the reports.
+bool is_mpi_root();
+
 /// Finalises what ensure_mpi() initialised (nothing if it was not called).
 /// Call it before main() returns: finalising from a static destructor at exit
 /// races with the destruction of other libraries' statics.

@@ -36,12 +36,13 @@
 // Objective of a stage, summed over the references (dimensionless):
 //   w_rmse (RMSE / peak)^2 over the compared samples
 //   + sum over the stage's layers: w_layer (layer RMSE / peak)^2
-//     + w_depth (puncture depth error / layer thickness)^2
+//     + w_depth (puncture depth error / min(ring spacing L, layer thickness))^2
 //     + w_force (puncture force error / reference puncture force)^2
 //     + w_missing if exactly one of model and reference punctures the layer.
 // Model runs: a copy of the scene with realtime.integrator =
 //   options.integrator (default "quasi_static"), no frames, dwell 0, a fast
-//   withdrawal (not compared), the insertion speed of the reference (its
+//   withdrawal (not compared), the damping effect off when the reference is
+//   quasi-static (reference_is_quasi_static: the FEM), the insertion speed of the reference (its
 //   metadata "speed_mm_per_s" if present, else the scene's), and a haptic rate
 //   raised so that one tick moves the needle at most objective_depth_step_m
 //   (sharper breakthrough depths; for the quasi-static mesh the tick rate does
@@ -126,6 +127,10 @@ struct CalibrationOptions {
   std::string integrator = "quasi_static";
   double objective_depth_step_m = 2e-6;  ///< breakthrough depth resolution of the objective's model runs
   double depth_margin_m = 1e-3;     ///< stage range beyond the layer's reference puncture depth
+  /// Start each layer's stage from the scene's values scaled to the first
+  /// reference's pressing slope and breakthrough deflection (see calibration.cpp,
+  /// scaled_start); the local optimiser then refines.
+  bool scaled_start = true;
   AnnealingSettings annealing;
 };
 
@@ -154,6 +159,10 @@ struct ReferenceCurve {
   InsertionCurve curve;
   std::string kind = "fem";
 };
+/// True for the FEM reference (kind "fem") or a curve whose metadata says
+/// "quasi_static: true" (or yes / 1): no rate dependence and no friction, so
+/// the model runs compared with it leave the damping force d h v out.
+bool reference_is_quasi_static(const ReferenceCurve& reference);
 /// True if the curve's metadata says "rate_dependent: true" (or yes / 1).
 bool reference_is_rate_dependent(const InsertionCurve& curve);
 
@@ -202,8 +211,15 @@ class SurfaceCache {
 /// then run_scripted_insertion) and returns its curve.
 InsertionCurve simulate_insertion_curve(const Scene& scene, const SurfaceCache* cache = nullptr);
 
+/// The scene of the model runs the objective compares with `reference`
+/// (integrator, speed, dwell, tick rate as described in the header comment;
+/// whole insertion): what a report should plot before and after.
+Scene calibration_run_scene(const Scene& scene, const ReferenceCurve& reference, const CalibrationOptions& options);
+
 CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve>& references,
                             const CalibrationOptions& options = {}, const CalibrationProgressCallback& progress = {});
+/// One reference curve; its kind is its "kind" metadata, else "curve" (not
+/// quasi-static unless its metadata says "quasi_static: true").
 CalibrationResult calibrate(const Scene& scene, const InsertionCurve& reference, const CalibrationOptions& options = {},
                             const CalibrationProgressCallback& progress = {});
 

@@ -78,7 +78,11 @@ struct InsertionCurve {
 InsertionCurve read_insertion_curve(const std::filesystem::path& path);
 InsertionCurve parse_insertion_curve(const std::string& text, const std::string& source_name);
 /// The curve of a real-time run (total force, per-layer states).
-InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, const std::string& source = "realtime");
+/// include_damping = false: the force is the total minus every layer's damping
+/// force d h v (what a quasi-static, frictionless reference can be compared
+/// with); the curve's metadata then says "force: without damping".
+InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, const std::string& source = "realtime",
+                              bool include_damping = true);
 /// CSV text in the reader's schema (depth and velocity in mm, states), metadata first.
 std::string insertion_curve_csv(const InsertionCurve& curve);
 
