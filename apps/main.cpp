@@ -57,6 +57,8 @@ int main(int argc, char** argv) {
   calibrate_cmd->add_option("--also-tune", calibrate.also_tune,
                             "Also tune: surface_stiffness, rings, spacing (comma separated)")
       ->delimiter(',');
+  calibrate_cmd->add_option("--integrator", calibrate.integrator,
+                            "Integrator of the model runs: quasi_static, explicit or implicit; default: the scene's");
   calibrate_cmd->add_option("--bound-factor", calibrate.bound_factor,
                             "Each tuned parameter stays within [start / f, start * f]; default 1000");
   calibrate_cmd->add_flag("-q,--quiet", calibrate.quiet, "No progress output");

@@ -81,6 +81,7 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
     if (!(options.bound_factor > 1.0) || !std::isfinite(options.bound_factor))
       throw std::invalid_argument("--bound-factor must be a finite number > 1");
     calibration.bound_factor = options.bound_factor;
+    calibration.integrator = options.integrator.empty() ? scene.realtime.integrator : options.integrator;
     for (const std::string& name : options.also_tune) {
       if (name == "surface_stiffness")
         calibration.parameters.surface_stiffness = true;
@@ -114,15 +115,29 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
     const std::string name = options.preset_name.empty() ? scene.name + "_tuned" : options.preset_name;
     validation::write_tuned_preset(session, name, result, {reference}, calibration);
     session.write_text("calibration_curves.csv",
-                       "# made by: puncture calibrate " + scene_path.string() + " on " + machine_summary() + ", " +
+                       "# made by: puncture calibrate " + scene_path.string() + " -o " + dir.string() + " on " +
+                           machine_summary() + ", " +
                            utc_timestamp() + "\n" +
                            curves_csv({{reference.kind, &reference.curve},
                                        {"before", &before_curve},
                                        {"after", &after_curve}}));
     std::ostringstream md;
-    md << "# Calibration of " << scene.name << "\n\nMade by `puncture calibrate " << scene_path.string()
-       << (options.reference.empty() ? "" : " --reference " + options.reference.string()) << " -o " << dir.string()
-       << "` on " << machine_summary() << ", " << utc_timestamp() << ".\n\nReference: " << reference.kind << " ("
+    std::string command_line = "puncture calibrate " + scene_path.string();
+    if (!options.reference.empty()) command_line += " --reference " + options.reference.string();
+    command_line += " -o " + dir.string() + " --name " + name + " --method " + options.method;
+    if (!options.also_tune.empty()) {
+      command_line += " --also-tune ";
+      for (std::size_t i = 0; i < options.also_tune.size(); ++i)
+        command_line += (i ? "," : "") + options.also_tune[i];
+    }
+    if (!options.layers.empty())
+      for (const std::string& l : options.layers) command_line += " --layers " + l;
+    {
+      std::ostringstream f;
+      f << options.bound_factor;
+      command_line += " --bound-factor " + f.str() + " --integrator " + calibration.integrator;
+    }
+    md << "# Calibration of " << scene.name << "\n\nMade by `" << command_line << "` on " << machine_summary() << ", " << utc_timestamp() << ".\n\nReference: " << reference.kind << " ("
        << reference.curve.source << "). Method: " << options.method << ", " << result.evaluations
        << " model runs in " << std::setprecision(4) << calibration_s
        << " s (wall, reference already available). Objective " << result.objective_before << " -> "

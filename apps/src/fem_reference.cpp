@@ -158,10 +158,13 @@ void ensure_mpi() {
 
 bool is_mpi_root() {
 #ifdef PUNCTURE_HAVE_FEM
-  int initialised = 0, finalised = 0;
-  MPI_Initialized(&initialised);
+  int finalised = 0;
   MPI_Finalized(&finalised);
-  if (!initialised || finalised) return true;
+  if (finalised) return true;
+  ensure_mpi();  // a cached reference does not start MPI, but mpirun may have started us
+  int initialised = 0;
+  MPI_Initialized(&initialised);
+  if (!initialised) return true;
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   return rank == 0;

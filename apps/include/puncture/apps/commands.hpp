@@ -66,6 +66,9 @@ struct CalibrateOptions {
   /// Parameters tuned besides K and the deformation threshold:
   /// "surface_stiffness" (k_s), "rings" (w), "spacing" (L).
   std::vector<std::string> also_tune;
+  /// Force-mesh integrator of the model runs; empty: the scene's own (what the
+  /// tuned preset will run with).
+  std::string integrator;
   bool quiet = false;
 };
 
