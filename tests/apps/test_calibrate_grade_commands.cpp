@@ -3,6 +3,8 @@
 // `puncture run`, and bad input.
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -46,8 +48,20 @@ TEST(CalibrateCommand, RecoversSkinStiffnessFromAReferenceCurveAndWritesARunnabl
   options.reference = work / "truth_run" / "realtime_curve.csv";
   options.output_dir = work / "calibration";
   options.layers = {"skin"};
+  options.integrator = "quasi_static";  // the fast runs (the scene's implicit one is the default)
   options.quiet = true;
   ASSERT_EQ(calibrate_command(options, out, err), 0) << err.str();
+  // The curves of the reference and of the model before and after, and their plot.
+  std::ifstream curves(work / "calibration" / "calibration_curves.csv");
+  std::string line;
+  std::getline(curves, line);
+  EXPECT_EQ(line.rfind("# made by: puncture calibrate", 0), 0u) << line;
+  std::getline(curves, line);
+  EXPECT_EQ(line, "curve,time_s,depth_mm,force_N");
+  std::set<std::string> names;
+  while (std::getline(curves, line)) names.insert(line.substr(0, line.find(',')));
+  EXPECT_EQ(names, (std::set<std::string>{"measured", "before", "after"}));
+  EXPECT_TRUE(fs::exists(work / "calibration" / "calibration_force_depth.png"));
 
   const fs::path preset = work / "calibration" / "default_tuned.json";
   ASSERT_TRUE(fs::exists(preset));
@@ -64,6 +78,29 @@ TEST(CalibrateCommand, RecoversSkinStiffnessFromAReferenceCurveAndWritesARunnabl
   rerun.quiet = true;
   EXPECT_EQ(run_command(rerun, out, err), 0) << err.str();
   fs::remove_all(work);
+}
+
+TEST(CalibrateCommand, UnknownExtraParameterIsAnErrorWithNoOutput) {
+  const auto dir = fs::temp_directory_path() / "puncture_calibrate_unknown_parameter";
+  const auto ref_dir = fs::temp_directory_path() / "puncture_calibrate_unknown_parameter_reference";
+  fs::remove_all(dir);
+  fs::create_directories(ref_dir);
+  {
+    std::ofstream ref(ref_dir / "curve.csv");
+    ref << "time_s,depth_mm,velocity_mm_per_s,force_N,skin_state\n0,0,10,0,pressed\n0.1,1,10,0.5,pressed\n"
+           "0.2,2,10,1.0,pressed\n";
+  }
+  CalibrateOptions options;
+  options.scene = kSourceDir / "scenes" / "default.json";
+  options.reference = ref_dir / "curve.csv";
+  options.output_dir = dir;
+  options.also_tune = {"stiffness_of_everything"};
+  options.quiet = true;
+  std::ostringstream out, err;
+  EXPECT_NE(calibrate_command(options, out, err), 0);
+  EXPECT_NE(err.str().find("--also-tune"), std::string::npos) << err.str();
+  EXPECT_FALSE(fs::exists(dir));
+  fs::remove_all(ref_dir);
 }
 
 TEST(CalibrateCommand, MissingReferenceFileIsAnErrorWithNoOutput) {
