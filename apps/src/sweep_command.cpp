@@ -107,6 +107,13 @@ SweepRow realtime_variant(const Scene& scene, const std::string& knob, const std
   row.baseline = baseline;
   row.time_kind = "median haptic tick wall time";
   try {
+    validate_scene(scene, "sweep variant " + knob + " = " + value);
+  } catch (const SceneError& e) {
+    // E.g. a spacing L that puts the force mesh outside the sample.
+    row.status = std::string("invalid: ") + e.what();
+    return row;
+  }
+  try {
     RealtimeModel model = build_realtime_model(scene);
     const ScriptedRunResult run = run_scripted_insertion(model, scene);
     row.time_per_step_s = median(run.tick_wall_time_s);
