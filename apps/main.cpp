@@ -59,6 +59,8 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   calibrate_cmd->add_option("--integrator", calibrate.integrator,
                             "Integrator of the model runs: quasi_static, explicit or implicit; default: the scene's");
+  calibrate_cmd->add_option("--depth-weight", calibrate.depth_weight,
+                            "Weight of the puncture-depth term (error in units of min(L, thickness)); default 0.1");
   calibrate_cmd->add_option("--bound-factor", calibrate.bound_factor,
                             "Each tuned parameter stays within [start / f, start * f]; default 1000");
   calibrate_cmd->add_flag("-q,--quiet", calibrate.quiet, "No progress output");

@@ -82,6 +82,9 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
       throw std::invalid_argument("--bound-factor must be a finite number > 1");
     calibration.bound_factor = options.bound_factor;
     calibration.integrator = options.integrator.empty() ? scene.realtime.integrator : options.integrator;
+    if (!(options.depth_weight >= 0.0) || !std::isfinite(options.depth_weight))
+      throw std::invalid_argument("--depth-weight must be a finite number >= 0");
+    calibration.weights.puncture_depth = options.depth_weight;
     for (const std::string& name : options.also_tune) {
       if (name == "surface_stiffness")
         calibration.parameters.surface_stiffness = true;
@@ -135,6 +138,7 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
     {
       std::ostringstream f;
       f << options.bound_factor;
+      f << " --depth-weight " << options.depth_weight;
       command_line += " --bound-factor " + f.str() + " --integrator " + calibration.integrator;
     }
     md << "# Calibration of " << scene.name << "\n\nMade by `" << command_line << "` on " << machine_summary() << ", " << utc_timestamp() << ".\n\nReference: " << reference.kind << " ("

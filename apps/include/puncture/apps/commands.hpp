@@ -69,6 +69,11 @@ struct CalibrateOptions {
   /// Force-mesh integrator of the model runs; empty: the scene's own (what the
   /// tuned preset will run with).
   std::string integrator;
+  /// Weight of the puncture-depth term of the objective (error in units of
+  /// min(L, thickness)); the force terms have weight 1. 0.1: a depth error of
+  /// one L weighs like a force RMSE of 32 % of the peak. With weight 1 the fat
+  /// of the default scene trades 20 % force RMSE for a 0.1 mm better depth.
+  double depth_weight = 0.1;
   bool quiet = false;
 };
 
