@@ -51,6 +51,20 @@ std::string curves_csv(const std::vector<std::pair<std::string, const validation
   return s.str();
 }
 
+/// The command line that reproduces this calibration, every setting spelled out.
+std::string command_line(const CalibrateOptions& options, const std::filesystem::path& scene_path,
+                         const std::filesystem::path& dir, const std::string& name, const std::string& integrator) {
+  std::ostringstream c;
+  c << "puncture calibrate " << scene_path.string();
+  if (!options.reference.empty()) c << " --reference " << options.reference.string();
+  c << " -o " << dir.string() << " --name " << name << " --method " << options.method;
+  for (std::size_t i = 0; i < options.also_tune.size(); ++i) c << (i ? "," : " --also-tune ") << options.also_tune[i];
+  for (const std::string& layer : options.layers) c << " --layers " << layer;
+  c << " --bound-factor " << options.bound_factor << " --depth-weight " << options.depth_weight << " --integrator "
+    << integrator;
+  return c.str();
+}
+
 }  // namespace
 
 int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::ostream& err) {
@@ -108,40 +122,18 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
     const validation::CalibrationResult result = validation::calibrate(scene, std::vector<validation::ReferenceCurve>{reference}, calibration, progress);
     const double calibration_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
 
-    // The model as the objective runs it, before and after, for the report.
-    const validation::InsertionCurve before_curve =
-        validation::simulate_insertion_curve(validation::calibration_run_scene(scene, reference, calibration));
-    const validation::InsertionCurve after_curve = validation::simulate_insertion_curve(
-        validation::calibration_run_scene(result.tuned_scene, reference, calibration));
-
     io::OutputSession session(dir);
     const std::string name = options.preset_name.empty() ? scene.name + "_tuned" : options.preset_name;
+    const std::string command = command_line(options, scene_path, dir, name, calibration.integrator);
     validation::write_tuned_preset(session, name, result, {reference}, calibration);
+    // The model curves the objective compared, before and after, for the report.
     session.write_text("calibration_curves.csv",
-                       "# made by: puncture calibrate " + scene_path.string() + " -o " + dir.string() + " on " +
-                           machine_summary() + ", " +
-                           utc_timestamp() + "\n" +
+                       "# made by: " + command + " on " + machine_summary() + ", " + utc_timestamp() + "\n" +
                            curves_csv({{reference.kind, &reference.curve},
-                                       {"before", &before_curve},
-                                       {"after", &after_curve}}));
+                                       {"before", &result.model_before.front()},
+                                       {"after", &result.model_after.front()}}));
     std::ostringstream md;
-    std::string command_line = "puncture calibrate " + scene_path.string();
-    if (!options.reference.empty()) command_line += " --reference " + options.reference.string();
-    command_line += " -o " + dir.string() + " --name " + name + " --method " + options.method;
-    if (!options.also_tune.empty()) {
-      command_line += " --also-tune ";
-      for (std::size_t i = 0; i < options.also_tune.size(); ++i)
-        command_line += (i ? "," : "") + options.also_tune[i];
-    }
-    if (!options.layers.empty())
-      for (const std::string& l : options.layers) command_line += " --layers " + l;
-    {
-      std::ostringstream f;
-      f << options.bound_factor;
-      f << " --depth-weight " << options.depth_weight;
-      command_line += " --bound-factor " + f.str() + " --integrator " + calibration.integrator;
-    }
-    md << "# Calibration of " << scene.name << "\n\nMade by `" << command_line << "` on " << machine_summary() << ", " << utc_timestamp() << ".\n\nReference: " << reference.kind << " ("
+    md << "# Calibration of " << scene.name << "\n\nMade by `" << command << "` on " << machine_summary() << ", " << utc_timestamp() << ".\n\nReference: " << reference.kind << " ("
        << reference.curve.source << "). Method: " << options.method << ", " << result.evaluations
        << " model runs in " << std::setprecision(4) << calibration_s
        << " s (wall, reference already available). Objective " << result.objective_before << " -> "

@@ -26,6 +26,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "puncture/io/content_hash.hpp"
+
 #ifdef PUNCTURE_HAVE_FEM
 #include <deal.II/base/mpi.h>
 
@@ -48,19 +50,6 @@ std::string exact(double x) {
   char buffer[40];
   std::snprintf(buffer, sizeof buffer, "%.17g", x);
   return buffer;
-}
-
-/// FNV-1a 64 of `bytes` with the given offset basis, 16 hex digits.
-std::string fnv1a64_hex(const std::string& bytes, unsigned long long basis) {
-  unsigned long long h = basis;
-  for (unsigned char c : bytes) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  static const char* digits = "0123456789abcdef";
-  std::string out(16, '0');
-  for (int i = 15; i >= 0; --i, h >>= 4) out[static_cast<std::size_t>(i)] = digits[h & 0xF];
-  return out;
 }
 
 const char* criterion_name(PunctureCriterion::Kind kind) {
@@ -127,7 +116,7 @@ bool reference_complete(const std::filesystem::path& dir, bool need_vtu) {
 std::string fem_reference_hash(const Scene& scene, const FemReferenceOptions& options) {
   const std::string text = fem_reference_key_text(scene, options);
   // Two FNV-1a 64 passes with different offset bases: a 128-bit key.
-  return fnv1a64_hex(text, 1469598103934665603ULL) + fnv1a64_hex(text, 0x84222325cbf29ce4ULL);
+  return io::fnv1a64_hex(text) + io::fnv1a64_hex(text, 0x84222325cbf29ce4ULL);
 }
 
 #ifdef PUNCTURE_HAVE_FEM

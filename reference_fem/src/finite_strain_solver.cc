@@ -254,8 +254,11 @@ void FiniteStrainSolver::set_dead_load_traction(types::boundary_id id, const Ten
 void FiniteStrainSolver::remove_cells(const std::function<bool(const CellIterator&)>& predicate,
                                       bool release_gradually) {
   released_fraction_ = 0.0;
-  assemble(solution_ghosted_, false, nullptr);
-  const TrilinosWrappers::MPI::Vector before(residual_);
+  TrilinosWrappers::MPI::Vector before;
+  if (release_gradually) {
+    assemble(solution_ghosted_, false, nullptr);  // without any earlier frozen load
+    before = residual_;
+  }
   for (const auto& cell : dof_handler_.active_cell_iterators())
     if (!cell->is_artificial() && predicate(cell)) removed_[cell->active_cell_index()] = 1;
   assemble(solution_ghosted_, false, nullptr);
@@ -265,7 +268,7 @@ void FiniteStrainSolver::remove_cells(const std::function<bool(const CellIterato
     released_force_ = before;
     released_force_ -= residual_;
     released_fraction_ = 1.0;
-    assemble(solution_ghosted_, false, nullptr);
+    residual_ = before;
   }
 }
 
@@ -284,21 +287,18 @@ void FiniteStrainSolver::set_anchor_springs(const std::map<types::global_dof_ind
     if (locally_owned_.is_element(dof)) anchors_[dof] = {k, solution_[dof]};
   }
   anchor_scale_ = 1.0;
-  assemble(solution_ghosted_, false, nullptr);
 }
 
 void FiniteStrainSolver::set_anchor_spring_scale(double scale) {
   if (!(scale >= 0.0) || !std::isfinite(scale))
     throw std::invalid_argument("FiniteStrainSolver: anchor spring scale must be finite and >= 0");
   anchor_scale_ = scale;
-  assemble(solution_ghosted_, false, nullptr);
 }
 
 void FiniteStrainSolver::set_released_force_fraction(double fraction) {
   if (!(fraction >= 0.0 && fraction <= 1.0))
     throw std::invalid_argument("FiniteStrainSolver: released force fraction must lie in [0, 1]");
   released_fraction_ = fraction;
-  assemble(solution_ghosted_, false, nullptr);
 }
 
 bool FiniteStrainSolver::is_removed(const CellIterator& cell) const {
@@ -504,6 +504,41 @@ double FiniteStrainSolver::max_constraint_gap() const {
   return Utilities::MPI::max(gap, mpi_communicator());
 }
 
+void FiniteStrainSolver::build_preconditioner() {
+  // Smoothed-aggregation AMG (ML) with the six rigid-body modes of 3D
+  // elasticity as near null space (translations and rotations evaluated at
+  // the support points of the locally owned dofs). No aggregation
+  // threshold: measured on the default slab, dropping weak connections
+  // (0.02-0.1) made neither the setup nor the CG cheaper.
+  amg_ = std::make_unique<TrilinosWrappers::PreconditionAMG>();
+  TrilinosWrappers::PreconditionAMG::AdditionalData data;
+  data.elliptic = true;
+  data.higher_order_elements = settings_.degree > 1;
+  data.smoother_sweeps = 2;
+  data.aggregation_threshold = 0.0;
+  Teuchos::ParameterList parameters;
+  std::unique_ptr<Epetra_MultiVector> unused_modes;
+  data.set_parameters(parameters, unused_modes, tangent_);
+  const Epetra_Map& map = tangent_.trilinos_matrix().DomainMap();
+  Epetra_MultiVector rigid_body_modes(map, 6);
+  const int n_local = map.NumMyElements();
+  for (int li = 0; li < n_local; ++li) {
+    const types::global_dof_index dof = map.GID(li);
+    const auto it = owned_support_.find(dof);
+    if (it == owned_support_.end()) continue;
+    const unsigned c = it->second.first;
+    const Point<3>& X = it->second.second;
+    rigid_body_modes[c][li] = 1.0;  // translations
+    // rotations about x, y, z: (0,-z,y), (z,0,-x), (-y,x,0)
+    const double rot[3][3] = {{0.0, -X[2], X[1]}, {X[2], 0.0, -X[0]}, {-X[1], X[0], 0.0}};
+    for (unsigned r = 0; r < 3; ++r) rigid_body_modes[3 + r][li] = rot[r][c];
+  }
+  parameters.set("null space: type", "pre-computed");
+  parameters.set("null space: dimension", 6);
+  parameters.set("null space: vectors", rigid_body_modes.Values());
+  amg_->initialize(tangent_, parameters);
+}
+
 unsigned int FiniteStrainSolver::solve_linear(TrilinosWrappers::MPI::Vector& du, double absolute_tolerance,
                                               bool rebuild_preconditioner) {
   du = 0.0;
@@ -512,40 +547,7 @@ unsigned int FiniteStrainSolver::solve_linear(TrilinosWrappers::MPI::Vector& du,
   if (!settings_.direct_linear_solver) {
     SolverControl control(std::max<unsigned>(2000, 10 * std::sqrt(double(n_dofs()))),
                           std::max(settings_.linear_relative_tolerance * rhs_norm, absolute_tolerance));
-    if (rebuild_preconditioner || !amg_) {
-    // Smoothed-aggregation AMG (ML) with the six rigid-body modes of 3D
-    // elasticity as near null space (translations and rotations evaluated at
-    // the support points of the locally owned dofs). No aggregation
-    // threshold: measured on the default slab, dropping weak connections
-    // (0.02-0.1) made neither the setup nor the CG cheaper.
-    amg_ = std::make_unique<TrilinosWrappers::PreconditionAMG>();
-    TrilinosWrappers::PreconditionAMG::AdditionalData data;
-    data.elliptic = true;
-    data.higher_order_elements = settings_.degree > 1;
-    data.smoother_sweeps = 2;
-    data.aggregation_threshold = 0.0;
-    Teuchos::ParameterList parameters;
-    std::unique_ptr<Epetra_MultiVector> unused_modes;
-    data.set_parameters(parameters, unused_modes, tangent_);
-    const Epetra_Map& map = tangent_.trilinos_matrix().DomainMap();
-    Epetra_MultiVector rigid_body_modes(map, 6);
-    const int n_local = map.NumMyElements();
-    for (int li = 0; li < n_local; ++li) {
-      const types::global_dof_index dof = map.GID(li);
-      const auto it = owned_support_.find(dof);
-      if (it == owned_support_.end()) continue;
-      const unsigned c = it->second.first;
-      const Point<3>& X = it->second.second;
-      rigid_body_modes[c][li] = 1.0;  // translations
-      // rotations about x, y, z: (0,-z,y), (z,0,-x), (-y,x,0)
-      const double rot[3][3] = {{0.0, -X[2], X[1]}, {X[2], 0.0, -X[0]}, {-X[1], X[0], 0.0}};
-      for (unsigned r = 0; r < 3; ++r) rigid_body_modes[3 + r][li] = rot[r][c];
-    }
-    parameters.set("null space: type", "pre-computed");
-    parameters.set("null space: dimension", 6);
-    parameters.set("null space: vectors", rigid_body_modes.Values());
-    amg_->initialize(tangent_, parameters);
-    }
+    if (rebuild_preconditioner || !amg_) build_preconditioner();
     const TrilinosWrappers::PreconditionAMG& amg = *amg_;
     try {
       SolverCG<TrilinosWrappers::MPI::Vector> cg(control);

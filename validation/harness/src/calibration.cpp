@@ -561,8 +561,13 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
         throw std::invalid_argument("calibrate: too many parameters in one stage");
       CalibrationStageRecord rec;
       rec.stage = ctx.name;
-      if (!have_start) {  // the objective at the scene's own values
-        result.objective_before += ctx.evaluate(log_values(candidate, ctx.parameters).data());
+      // The objective at the scene's own values: the "before" of the first
+      // candidate, and the stage's start unless the start is scaled.
+      double at_scene_values = kFailedObjective;
+      if (!have_start || !options.scaled_start)
+        at_scene_values = ctx.evaluate(log_values(candidate, ctx.parameters).data());
+      if (!have_start) {
+        result.objective_before += at_scene_values;
         have_start = true;
       }
       if (options.scaled_start) {
@@ -570,7 +575,7 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
         candidate = ctx.scene;
       }
       const std::vector<double> x0 = log_values(candidate, ctx.parameters);
-      rec.objective_start = ctx.evaluate(x0.data());
+      rec.objective_start = options.scaled_start ? ctx.evaluate(x0.data()) : at_scene_values;
       rec.nlopt_result = ctx.parameters.empty() ? "nothing to tune" : run_stage(ctx, x0);
       rec.objective_best = ctx.best;
       rec.evaluations = ctx.evaluations;
@@ -608,8 +613,10 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
   result.evaluations = total_evaluations;
   const double inf = std::numeric_limits<double>::infinity();
   for (const ReferenceCurve& r : references) {
-    result.before.push_back(compare_curves(simulate_insertion_curve(objective_scene(scene, r, options, inf), &cache), r.curve));
-    result.after.push_back(compare_curves(simulate_insertion_curve(objective_scene(current, r, options, inf), &cache), r.curve));
+    result.model_before.push_back(simulate_insertion_curve(objective_scene(scene, r, options, inf), &cache));
+    result.model_after.push_back(simulate_insertion_curve(objective_scene(current, r, options, inf), &cache));
+    result.before.push_back(compare_curves(result.model_before.back(), r.curve));
+    result.after.push_back(compare_curves(result.model_after.back(), r.curve));
   }
   return result;
 }

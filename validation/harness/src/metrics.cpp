@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "puncture/io/content_hash.hpp"
 #include "text_fields.hpp"
 
 namespace puncture::validation {
@@ -158,7 +159,7 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
 InsertionCurve read_insertion_curve(const std::filesystem::path& path) {
   const std::string bytes = read_file_bytes(path);
   InsertionCurve c = parse_insertion_curve(bytes, path.string());
-  c.content_hash = detail::fnv1a64_hex(bytes);
+  c.content_hash = io::fnv1a64_hex(bytes);
   return c;
 }
 

@@ -52,17 +52,4 @@ inline bool parse_finite(const std::string& text, double& value) {
   return std::isfinite(value);
 }
 
-/// 64-bit FNV-1a of a byte string, as 16 hex digits.
-inline std::string fnv1a64_hex(const std::string& bytes) {
-  unsigned long long h = 1469598103934665603ULL;
-  for (unsigned char c : bytes) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  static const char* digits = "0123456789abcdef";
-  std::string out(16, '0');
-  for (int i = 15; i >= 0; --i, h >>= 4) out[static_cast<std::size_t>(i)] = digits[h & 0xF];
-  return out;
-}
-
 }  // namespace puncture::validation::detail

@@ -163,7 +163,9 @@ class FiniteStrainSolver {
   /// material) become a frozen load at fraction 1 (see the file comment);
   /// otherwise the frozen load is cleared. Collective.
   void remove_cells(const std::function<bool(const CellIterator&)>& predicate, bool release_gradually = false);
-  /// Fraction (0..1) of the frozen removal load still applied.
+  /// Fraction (0..1) of the frozen removal load still applied. Like the
+  /// anchor-spring setters below, it takes effect at the next solve_step();
+  /// until then the residual queries report the last assembled state.
   void set_released_force_fraction(double fraction);
   bool is_removed(const CellIterator& cell) const;
 
@@ -219,6 +221,8 @@ class FiniteStrainSolver {
                              dealii::AffineConstraints<double>& constraints) const;
   unsigned int solve_linear(dealii::TrilinosWrappers::MPI::Vector& du, double absolute_tolerance,
                             bool rebuild_preconditioner);
+  /// ML AMG of the current tangent (rigid-body modes as near null space) into amg_.
+  void build_preconditioner();
   double free_residual_norm() const;
   double reaction_norm() const;
   double external_load_norm() const;

@@ -180,6 +180,8 @@ struct CalibrationResult {
   std::vector<LayerParameters> tuned;
   std::vector<CurveComparison> before;  ///< one per reference, full insertion phase
   std::vector<CurveComparison> after;
+  std::vector<InsertionCurve> model_before;  ///< the model curves those comparisons were made with
+  std::vector<InsertionCurve> model_after;
   double objective_before = 0.0;        ///< sum of the stage objectives at the start values
   double objective_after = 0.0;
   int evaluations = 0;
