@@ -120,12 +120,26 @@ ForceMeshParams read_force_mesh(ObjectReader r) {
   return p;
 }
 
-ContinuumMaterial read_material(ObjectReader r) {
+ContinuumMaterial read_material(ObjectReader r, const std::string& file) {
   ContinuumMaterial m;
   m.model = r.string("model", m.model);
   m.youngs_modulus_Pa = r.number("youngs_modulus_kPa") * 1e3;
   m.poisson_ratio = r.number("poisson_ratio");
   m.mooney_rivlin_c01_fraction = r.number("mooney_rivlin_c01_fraction", m.mooney_rivlin_c01_fraction);
+  if (r.has("ogden_alpha") && r.has("ogden_terms"))
+    r.fail(r.child("ogden_terms"), "give either ogden_alpha (one term) or ogden_terms, not both");
+  if (r.has("ogden_alpha")) m.ogden_terms = {OgdenTerm{1.0, r.number("ogden_alpha")}};
+  if (r.has("ogden_terms")) {
+    const json& terms = r.raw("ogden_terms");
+    if (!terms.is_array() || terms.empty())
+      r.fail(r.child("ogden_terms"), "must be a non-empty array of {mu_fraction, alpha} objects");
+    for (std::size_t i = 0; i < terms.size(); ++i) {
+      ObjectReader t(terms[i], r.child("ogden_terms") + "/" + std::to_string(i), file);
+      m.ogden_terms.push_back(OgdenTerm{t.number("mu_fraction"), t.number("alpha")});
+      t.reject_unknown_keys();
+    }
+  }
+  m.veronda_westmann_gamma = r.number("veronda_westmann_gamma", m.veronda_westmann_gamma);
   m.source = r.string("source", "");
   r.reject_unknown_keys();
   return m;
@@ -140,11 +154,26 @@ PunctureCriterion read_puncture(ObjectReader r) {
   } else if (kind == "critical_stretch") {
     c.kind = PunctureCriterion::Kind::CriticalStretch;
     c.critical_stretch = r.number("critical_stretch");
+  } else if (kind == "fracture_energy") {
+    c.kind = PunctureCriterion::Kind::FractureEnergy;
+    c.toughness_J_per_m2 = r.number("toughness_J_per_m2");
+    c.cohesive_strength_Pa = r.number("cohesive_strength_kPa") * 1e3;
   } else {
-    r.fail(r.child("criterion"), "unknown criterion '" + kind + "' (known: critical_force, critical_stretch)");
+    r.fail(r.child("criterion"),
+           "unknown criterion '" + kind + "' (known: fracture_energy, critical_force, critical_stretch)");
   }
+  c.source = r.string("source", "");
   r.reject_unknown_keys();
   return c;
+}
+
+ShaftFriction read_shaft_friction(ObjectReader r) {
+  ShaftFriction f;
+  f.dynamic_coefficient = r.number("coefficient");
+  f.static_coefficient = r.number("static_coefficient", f.dynamic_coefficient);
+  f.source = r.string("source", "");
+  r.reject_unknown_keys();
+  return f;
 }
 
 Layer read_layer(ObjectReader r, const std::string& file) {
@@ -155,8 +184,11 @@ Layer read_layer(ObjectReader r, const std::string& file) {
   l.force_mesh = read_force_mesh(ObjectReader(r.raw("force_mesh"), r.child("force_mesh"), file));
   l.damping_N_s_per_m2 = r.number("damping_d_N_s_per_m2");
   l.resumption_rate = r.number("resumption_rate", l.resumption_rate);
-  if (r.has("material")) l.material = read_material(ObjectReader(r.raw("material"), r.child("material"), file));
+  if (r.has("material"))
+    l.material = read_material(ObjectReader(r.raw("material"), r.child("material"), file), file);
   if (r.has("puncture")) l.puncture = read_puncture(ObjectReader(r.raw("puncture"), r.child("puncture"), file));
+  if (r.has("shaft_friction"))
+    l.shaft_friction = read_shaft_friction(ObjectReader(r.raw("shaft_friction"), r.child("shaft_friction"), file));
   r.reject_unknown_keys();
   return l;
 }
@@ -181,6 +213,8 @@ Scene read_scene(const json& root, const std::string& file) {
     ObjectReader o(r.raw("needle"), "/needle", file);
     s.needle.radius_m = o.number("radius_mm") * kMm;
     s.needle.tip = o.string("tip", s.needle.tip);
+    s.needle.inner_radius_m = o.number("inner_radius_mm", s.needle.inner_radius_m / kMm) * kMm;
+    s.needle.tip_angle_deg = o.number("tip_angle_deg", s.needle.tip_angle_deg);
     o.reject_unknown_keys();
   }
   {
@@ -212,11 +246,22 @@ Scene read_scene(const json& root, const std::string& file) {
   if (r.has("fem")) {
     ObjectReader o(r.raw("fem"), "/fem", file);
     FemSettings& f = s.fem;
+    f.geometry = o.string("geometry", f.geometry);
     f.refinement = o.integer("refinement", f.refinement);
     f.element_degree = o.integer("element_degree", f.element_degree);
     f.load_step_m = o.number("load_step_mm", f.load_step_m / kMm) * kMm;
     f.max_newton_iterations = o.integer("max_newton_iterations", f.max_newton_iterations);
     f.newton_tolerance = o.number("newton_tolerance", f.newton_tolerance);
+    f.cohesive_viscosity_s = o.number("cohesive_viscosity_s", f.cohesive_viscosity_s);
+    if (o.has("mesh")) {
+      ObjectReader m(o.raw("mesh"), "/fem/mesh", file);
+      FemMeshSettings& ms = f.mesh;
+      ms.elements_per_needle_radius = m.integer("elements_per_needle_radius", ms.elements_per_needle_radius);
+      ms.min_elements_per_layer = m.integer("min_elements_per_layer", ms.min_elements_per_layer);
+      ms.radial_growth = m.number("radial_growth", ms.radial_growth);
+      ms.path_element_size_mm = m.number("path_element_size_mm", ms.path_element_size_mm);
+      m.reject_unknown_keys();
+    }
     o.reject_unknown_keys();
   }
   if (r.has("models")) s.models = r.string_list("models", kModels, "model");
@@ -249,8 +294,14 @@ void validate_scene(const Scene& s, const std::string& file) {
   require(s.needle.radius_m > 0, file, "/needle/radius_mm", "> 0", s.needle.radius_m / kMm);
   require(s.needle.radius_m < 0.25 * sample_radius, file, "/needle/radius_mm",
           "smaller than a quarter of the sample radius", s.needle.radius_m / kMm);
-  if (s.needle.tip != "blunt")
-    throw SceneError(file, "/needle/tip", "unknown tip shape '" + s.needle.tip + "' (known: blunt)");
+  if (s.needle.tip != "blunt" && s.needle.tip != "bevel" && s.needle.tip != "hollow")
+    throw SceneError(file, "/needle/tip", "unknown tip shape '" + s.needle.tip + "' (known: blunt, bevel, hollow)");
+  if (s.needle.tip == "hollow")
+    require(s.needle.inner_radius_m > 0.2 * s.needle.radius_m && s.needle.inner_radius_m < 0.95 * s.needle.radius_m,
+            file, "/needle/inner_radius_mm", "between 0.2 and 0.95 times the outer radius",
+            s.needle.inner_radius_m / kMm);
+  require(s.needle.tip_angle_deg >= 5.0 && s.needle.tip_angle_deg <= 60.0, file, "/needle/tip_angle_deg",
+          "in [5, 60] degrees", s.needle.tip_angle_deg);
 
   if (s.layers.empty()) throw SceneError(file, "/layers", "must list at least one layer");
   std::set<std::string> names;
@@ -282,20 +333,54 @@ void validate_scene(const Scene& s, const std::string& file) {
     require(l.resumption_rate > 0 && l.resumption_rate <= 1, file, p + "/resumption_rate", "in (0, 1]",
             l.resumption_rate);
     const ContinuumMaterial& m = l.material;
-    if (m.model != "neo_hookean" && m.model != "mooney_rivlin")
+    if (m.model != "neo_hookean" && m.model != "mooney_rivlin" && m.model != "ogden" && m.model != "veronda_westmann")
       throw SceneError(file, p + "/material/model",
-                       "unknown material model '" + m.model + "' (known: neo_hookean, mooney_rivlin)");
+                       "unknown material model '" + m.model +
+                           "' (known: neo_hookean, mooney_rivlin, ogden, veronda_westmann)");
     require(m.youngs_modulus_Pa > 0, file, p + "/material/youngs_modulus_kPa", "> 0", m.youngs_modulus_Pa / 1e3);
     require(m.poisson_ratio > -1 && m.poisson_ratio < 0.5, file, p + "/material/poisson_ratio", "in (-1, 0.5)",
             m.poisson_ratio);
     require(m.mooney_rivlin_c01_fraction >= 0 && m.mooney_rivlin_c01_fraction < 1, file,
             p + "/material/mooney_rivlin_c01_fraction", "in [0, 1)", m.mooney_rivlin_c01_fraction);
-    if (l.puncture.kind == PunctureCriterion::Kind::CriticalForce)
-      require(l.puncture.critical_force_N > 0, file, p + "/puncture/critical_force_N", "> 0",
-              l.puncture.critical_force_N);
-    else
-      require(l.puncture.critical_stretch > 1, file, p + "/puncture/critical_stretch", "> 1",
-              l.puncture.critical_stretch);
+    if (m.model == "ogden") {
+      if (m.ogden_terms.empty())
+        throw SceneError(file, p + "/material/ogden_alpha", "missing: an ogden material needs ogden_alpha or ogden_terms");
+      double share = 0.0;
+      for (std::size_t k = 0; k < m.ogden_terms.size(); ++k) {
+        const OgdenTerm& t = m.ogden_terms[k];
+        const std::string tp = m.ogden_terms.size() == 1 && t.mu_fraction == 1.0
+                                   ? p + "/material/ogden_alpha"
+                                   : p + "/material/ogden_terms/" + std::to_string(k) + "/alpha";
+        require(std::abs(t.alpha) >= 0.1 && std::abs(t.alpha) <= 40, file, tp, "nonzero, with 0.1 <= |alpha| <= 40",
+                t.alpha);
+        require(t.mu_fraction * t.alpha > 0, file,
+                p + "/material/ogden_terms/" + std::to_string(k) + "/mu_fraction",
+                "of the same sign as alpha (each term must be stable: mu_p alpha_p > 0)", t.mu_fraction);
+        share += t.mu_fraction;
+      }
+      require(std::abs(share - 1.0) < 1e-9, file, p + "/material/ogden_terms",
+              "shares of the initial shear modulus summing to 1", share);
+    } else if (!m.ogden_terms.empty()) {
+      throw SceneError(file, p + "/material/ogden_terms", "only an ogden material takes Ogden terms");
+    }
+    require(m.veronda_westmann_gamma > 0 && m.veronda_westmann_gamma <= 100, file,
+            p + "/material/veronda_westmann_gamma", "in (0, 100]", m.veronda_westmann_gamma);
+    const PunctureCriterion& c = l.puncture;
+    if (c.kind == PunctureCriterion::Kind::CriticalForce)
+      require(c.critical_force_N > 0, file, p + "/puncture/critical_force_N", "> 0", c.critical_force_N);
+    else if (c.kind == PunctureCriterion::Kind::CriticalStretch)
+      require(c.critical_stretch > 1, file, p + "/puncture/critical_stretch", "> 1", c.critical_stretch);
+    else {
+      require(c.toughness_J_per_m2 > 0 && c.toughness_J_per_m2 <= 1e6, file, p + "/puncture/toughness_J_per_m2",
+              "in (0, 1e6] J/m^2", c.toughness_J_per_m2);
+      require(c.cohesive_strength_Pa > 0 && c.cohesive_strength_Pa <= 1e9, file,
+              p + "/puncture/cohesive_strength_kPa", "in (0, 1e6] kPa", c.cohesive_strength_Pa / 1e3);
+    }
+    const ShaftFriction& sf = l.shaft_friction;
+    require(sf.dynamic_coefficient >= 0 && sf.dynamic_coefficient <= 5, file, p + "/shaft_friction/coefficient",
+            "in [0, 5]", sf.dynamic_coefficient);
+    require(sf.static_coefficient >= sf.dynamic_coefficient && sf.static_coefficient <= 5, file,
+            p + "/shaft_friction/static_coefficient", "in [coefficient, 5]", sf.static_coefficient);
   }
 
   const Insertion& in = s.insertion;
@@ -322,12 +407,24 @@ void validate_scene(const Scene& s, const std::string& file) {
           "> 0 and <= haptic_rate_Hz", rt.frame_rate_Hz);
 
   const FemSettings& f = s.fem;
+  if (f.geometry != "axisymmetric" && f.geometry != "3d")
+    throw SceneError(file, "/fem/geometry", "unknown geometry '" + f.geometry + "' (known: axisymmetric, 3d)");
   require(f.refinement >= 0 && f.refinement <= 4, file, "/fem/refinement", "in [0, 4]", f.refinement);
   require(f.element_degree == 1 || f.element_degree == 2, file, "/fem/element_degree", "1 or 2", f.element_degree);
   require(f.load_step_m > 0, file, "/fem/load_step_mm", "> 0", f.load_step_m / kMm);
   require(f.max_newton_iterations >= 1, file, "/fem/max_newton_iterations", ">= 1", f.max_newton_iterations);
   require(f.newton_tolerance > 0 && f.newton_tolerance < 1, file, "/fem/newton_tolerance", "in (0, 1)",
           f.newton_tolerance);
+  require(f.cohesive_viscosity_s >= 0 && f.cohesive_viscosity_s <= 1, file, "/fem/cohesive_viscosity_s",
+          "in [0, 1] s", f.cohesive_viscosity_s);
+  require(f.mesh.elements_per_needle_radius >= 2 && f.mesh.elements_per_needle_radius <= 64, file,
+          "/fem/mesh/elements_per_needle_radius", "in [2, 64]", f.mesh.elements_per_needle_radius);
+  require(f.mesh.min_elements_per_layer >= 1 && f.mesh.min_elements_per_layer <= 200, file,
+          "/fem/mesh/min_elements_per_layer", "in [1, 200]", f.mesh.min_elements_per_layer);
+  require(f.mesh.radial_growth >= 1.0 && f.mesh.radial_growth <= 2.0, file, "/fem/mesh/radial_growth", "in [1, 2]",
+          f.mesh.radial_growth);
+  require(f.mesh.path_element_size_mm > 0 && f.mesh.path_element_size_mm <= 10, file,
+          "/fem/mesh/path_element_size_mm", "in (0, 10] mm", f.mesh.path_element_size_mm);
   if (s.models.empty()) throw SceneError(file, "/models", "must name at least one model (realtime, fem)");
 }
 
@@ -360,7 +457,10 @@ std::string scene_to_json_text(const Scene& s) {
   root["name"] = s.name;
   root["description"] = s.description;
   root["sample"] = {{"diameter_mm", s.sample.diameter_m / kMm}};
-  root["needle"] = {{"radius_mm", s.needle.radius_m / kMm}, {"tip", s.needle.tip}};
+  root["needle"] = {{"radius_mm", s.needle.radius_m / kMm},
+                    {"tip", s.needle.tip},
+                    {"inner_radius_mm", s.needle.inner_radius_m / kMm},
+                    {"tip_angle_deg", s.needle.tip_angle_deg}};
   json layers = json::array();
   for (const Layer& l : s.layers) {
     json j;
@@ -379,11 +479,26 @@ std::string scene_to_json_text(const Scene& s) {
                      {"youngs_modulus_kPa", l.material.youngs_modulus_Pa / 1e3},
                      {"poisson_ratio", l.material.poisson_ratio},
                      {"mooney_rivlin_c01_fraction", l.material.mooney_rivlin_c01_fraction},
+                     {"veronda_westmann_gamma", l.material.veronda_westmann_gamma},
                      {"source", l.material.source}};
-    if (l.puncture.kind == PunctureCriterion::Kind::CriticalForce)
-      j["puncture"] = {{"criterion", "critical_force"}, {"critical_force_N", l.puncture.critical_force_N}};
+    if (!l.material.ogden_terms.empty()) {
+      json terms = json::array();
+      for (const OgdenTerm& t : l.material.ogden_terms) terms.push_back({{"mu_fraction", t.mu_fraction}, {"alpha", t.alpha}});
+      j["material"]["ogden_terms"] = terms;
+    }
+    const PunctureCriterion& c = l.puncture;
+    if (c.kind == PunctureCriterion::Kind::CriticalForce)
+      j["puncture"] = {{"criterion", "critical_force"}, {"critical_force_N", c.critical_force_N}};
+    else if (c.kind == PunctureCriterion::Kind::CriticalStretch)
+      j["puncture"] = {{"criterion", "critical_stretch"}, {"critical_stretch", c.critical_stretch}};
     else
-      j["puncture"] = {{"criterion", "critical_stretch"}, {"critical_stretch", l.puncture.critical_stretch}};
+      j["puncture"] = {{"criterion", "fracture_energy"},
+                       {"toughness_J_per_m2", c.toughness_J_per_m2},
+                       {"cohesive_strength_kPa", c.cohesive_strength_Pa / 1e3}};
+    j["puncture"]["source"] = c.source;
+    j["shaft_friction"] = {{"coefficient", l.shaft_friction.dynamic_coefficient},
+                           {"static_coefficient", l.shaft_friction.static_coefficient},
+                           {"source", l.shaft_friction.source}};
     layers.push_back(j);
   }
   root["layers"] = layers;
@@ -398,11 +513,18 @@ std::string scene_to_json_text(const Scene& s) {
                       {"haptic_rate_Hz", s.realtime.haptic_rate_Hz},
                       {"integrator", s.realtime.integrator},
                       {"frame_rate_Hz", s.realtime.frame_rate_Hz}};
-  root["fem"] = {{"refinement", s.fem.refinement},
+  root["fem"] = {{"geometry", s.fem.geometry},
+                 {"refinement", s.fem.refinement},
                  {"element_degree", s.fem.element_degree},
                  {"load_step_mm", s.fem.load_step_m / kMm},
                  {"max_newton_iterations", s.fem.max_newton_iterations},
-                 {"newton_tolerance", s.fem.newton_tolerance}};
+                 {"newton_tolerance", s.fem.newton_tolerance},
+                 {"cohesive_viscosity_s", s.fem.cohesive_viscosity_s},
+                 {"mesh",
+                  {{"elements_per_needle_radius", s.fem.mesh.elements_per_needle_radius},
+                   {"min_elements_per_layer", s.fem.mesh.min_elements_per_layer},
+                   {"radial_growth", s.fem.mesh.radial_growth},
+                   {"path_element_size_mm", s.fem.mesh.path_element_size_mm}}}};
   root["models"] = s.models;
   json effects = json::array();
   if (s.effects.surface_force) effects.push_back("surface_force");

@@ -33,21 +33,60 @@ struct ForceMeshParams {
   double node_damping_N_s_per_m = 0.05;      ///< viscous damping of each node (dynamics of the mesh)
 };
 
-/// Continuum material of one layer for the FEM reference.
+/// One term of an Ogden law: its share of the initial shear modulus and its
+/// exponent (see ContinuumMaterial).
+struct OgdenTerm {
+  double mu_fraction = 1.0;  ///< mu_p / mu_0 (the shares of all terms sum to 1)
+  double alpha = 2.0;        ///< alpha_p (nonzero; alpha = 2 is neo-Hookean)
+};
+
+/// Continuum material of one layer for the FEM reference. Every law is
+/// isochoric + volumetric (reference_fem/include/puncture/fem/hyperelastic_materials.hpp);
+/// E and nu are the SMALL-STRAIN (initial) values: they fix the initial shear
+/// modulus mu_0 = E / (2 (1 + nu)) and the bulk modulus kappa = E / (3 (1 - 2 nu)),
+/// whatever the law does at large strain.
+///   neo_hookean:      mu_0/2 (I1bar - 3)
+///   mooney_rivlin:    c10 (I1bar - 3) + c01 (I2bar - 3), c01 = fraction x mu_0 / 2
+///   ogden:            sum_p 2 mu_p / alpha_p^2 (lambda1bar^alpha_p + lambda2bar^alpha_p + lambda3bar^alpha_p - 3),
+///                     mu_p = mu_fraction_p x mu_0 (strain-stiffening for alpha > 2)
+///   veronda_westmann: c1 (exp(gamma (I1bar - 3)) - 1) - c1 gamma / 2 (I2bar - 3), c1 = mu_0 / gamma
+///                     (exponential stiffening; Veronda & Westmann 1970)
 struct ContinuumMaterial {
-  std::string model = "neo_hookean";  ///< "neo_hookean" or "mooney_rivlin"
-  double youngs_modulus_Pa = 1e5;
-  double poisson_ratio = 0.45;
+  std::string model = "neo_hookean";  ///< "neo_hookean", "mooney_rivlin", "ogden" or "veronda_westmann"
+  double youngs_modulus_Pa = 1e5;     ///< initial (small-strain) Young's modulus
+  double poisson_ratio = 0.45;        ///< initial Poisson's ratio (sets the bulk modulus)
   double mooney_rivlin_c01_fraction = 0.0;  ///< share of the shear modulus carried by the C01 (I2) term
+  std::vector<OgdenTerm> ogden_terms;       ///< model "ogden": at least one term
+  double veronda_westmann_gamma = 1.0;      ///< model "veronda_westmann": exponent gamma (> 0)
   std::string source;                       ///< where the numbers come from
 };
 
 /// When the FEM reference counts a layer as punctured.
+///   fracture_energy: a cohesive crack along the needle path (bilinear
+///     traction-separation law with strength sigma_c and toughness G_c = area
+///     under the law) opens ahead of the needle's cutting edge; the layer
+///     breaks when its crack opens, and the crack advances with the tip
+///     (reference_fem/README.md). Mesh-independent once the mesh resolves the
+///     cohesive zone.
+///   critical_force / critical_stretch: the older criteria (needle force, or
+///     maximum principal stretch at the tip); the layer's crack opens at once.
 struct PunctureCriterion {
-  enum class Kind { CriticalForce, CriticalStretch };
+  enum class Kind { CriticalForce, CriticalStretch, FractureEnergy };
   Kind kind = Kind::CriticalForce;
   double critical_force_N = 1.0;     ///< needle force at which the layer breaks
   double critical_stretch = 1.5;     ///< maximum principal stretch at the tip at which it breaks
+  double toughness_J_per_m2 = 1000.0;    ///< G_c: fracture energy per unit crack area
+  double cohesive_strength_Pa = 1e6;     ///< sigma_c: peak traction of the cohesive law
+  std::string source;                    ///< where G_c and sigma_c come from
+};
+
+/// Friction between the needle shaft and the tissue of one layer in the FEM
+/// reference (Coulomb with a static and a dynamic coefficient, Karnopp-like
+/// stick-slip; regularised by a tangential penalty). 0 = frictionless.
+struct ShaftFriction {
+  double dynamic_coefficient = 0.0;  ///< mu_d: sliding friction coefficient (>= 0)
+  double static_coefficient = 0.0;   ///< mu_s >= mu_d: limit to break a sticking contact
+  std::string source;
 };
 
 struct Layer {
@@ -61,15 +100,28 @@ struct Layer {
   double resumption_rate = 0.05;  ///< eta_r of Eq. (8): drop of the recovery factor per haptic step
   ContinuumMaterial material;
   PunctureCriterion puncture;
+  ShaftFriction shaft_friction;  ///< FEM reference: needle shaft - tissue friction
 };
 
 struct Sample {
   double diameter_m = 0.06;  ///< lateral size: diameter of the cylindrical tissue sample
 };
 
+/// The needle. The real-time model uses the outer radius; the FEM reference
+/// also models the tip (reference_fem/README.md):
+///   "blunt":  a solid flat-ended cylinder (flat punch);
+///   "bevel":  a cutting tip; the FEM (axisymmetric) idealises the planar
+///             crack of width 2a that a bevel opens by a ring crack with the
+///             same face perimeter (radius 2a/pi) whose fracture energy per
+///             unit depth equals G_c x 2a, and a conical flank of
+///             tip_angle_deg that spreads the crack open to the shaft radius;
+///   "hollow": a coring needle: the lumen edge (inner_radius) cuts a ring
+///             crack, the wall's conical flank spreads the tissue to the shaft.
 struct Needle {
-  double radius_m = 0.635e-3;  ///< outer radius (18 G = 1.27 mm outer diameter)
-  std::string tip = "blunt";   ///< "blunt" (flat cylinder end); the only tip shape modelled so far
+  double radius_m = 0.635e-3;  ///< outer radius a (18 G = 1.27 mm outer diameter)
+  std::string tip = "blunt";   ///< "blunt", "bevel" or "hollow"
+  double inner_radius_m = 0.419e-3;  ///< "hollow": lumen radius (18 G thin wall: 0.838 mm inner diameter)
+  double tip_angle_deg = 20.0;       ///< "bevel"/"hollow": angle between the tip flank and the needle axis
 };
 
 /// Scripted straight insertion: approach from start_height above the skin,
@@ -91,13 +143,29 @@ struct RealtimeSettings {
   double frame_rate_Hz = 30.0;            ///< rate of the surface frames written for visualisation
 };
 
+/// Resolution of the FEM reference's mesh (meshing/). Element sizes follow
+/// the needle radius and each layer's thickness, so a scene cannot silently
+/// get a mesh too coarse to trust (reference_fem/README.md, "Mesh").
+struct FemMeshSettings {
+  int elements_per_needle_radius = 8;  ///< radial elements across the needle radius a (under the tip)
+  int min_elements_per_layer = 6;      ///< at least this many elements through every layer
+  double radial_growth = 1.25;         ///< geometric growth of the element size away from the needle
+  double path_element_size_mm = 0.25; ///< largest element height along the needle path
+};
+
 /// Settings of the FEM reference.
 struct FemSettings {
+  std::string geometry = "axisymmetric";  ///< "axisymmetric" (r-z, the default) or "3d" (flat punch, older criteria)
   int refinement = 0;             ///< global refinements of the base mesh
   int element_degree = 1;         ///< 1 (Q1) or 2 (Q2)
   double load_step_m = 0.25e-3;   ///< needle travel per quasi-static load step
   int max_newton_iterations = 25;
   double newton_tolerance = 1e-8;
+  FemMeshSettings mesh;
+  /// Viscous regularisation time of the cohesive damage (s): damage follows
+  /// its rate-independent value with this delay, so that an unstable crack
+  /// jump is traced over a few steps instead of defeating Newton.
+  double cohesive_viscosity_s = 2e-3;
 };
 
 /// Effects a scene can switch on. An effect that is off is not constructed.

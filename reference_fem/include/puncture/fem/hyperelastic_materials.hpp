@@ -10,9 +10,14 @@
 //
 // The strain energy is split (Holzapfel 2000, Sec. 6.4; step-44):
 //   Psi(C) = Psi_iso(Cbar) + Psi_vol(J),  Cbar = J^{-2/3} C,  J = sqrt(det C).
-// Isochoric laws:
-//   NeoHookean:   Psi_iso = mu/2 (I1bar - 3)
-//   MooneyRivlin: Psi_iso = c10 (I1bar - 3) + c01 (I2bar - 3),  mu = 2 (c10 + c01)
+// Isochoric laws (mu = initial shear modulus in every case):
+//   NeoHookean:      Psi_iso = mu/2 (I1bar - 3)
+//   MooneyRivlin:    Psi_iso = c10 (I1bar - 3) + c01 (I2bar - 3),  mu = 2 (c10 + c01)
+//   Ogden:           Psi_iso = sum_p 2 mu_p / alpha_p^2 (sum_a lambdabar_a^alpha_p - 3),
+//                    mu = sum_p mu_p (Ogden 1972; the normalisation of
+//                    Shergold, Fleck & Radford 2006 for skin)
+//   VerondaWestmann: Psi_iso = c1 (exp(gamma (I1bar - 3)) - 1) - c1 gamma/2 (I2bar - 3),
+//                    mu = c1 gamma (Veronda & Westmann 1970, J. Biomech. 3:111)
 // Volumetric law (step-44 and the deal.II code gallery Cook membrane):
 //   VolumetricLaw: Psi_vol = kappa/4 (J^2 - 1 - 2 ln J),
 //                  kappa = E / (3 (1 - 2 nu)), mu = E / (2 (1 + nu)).
@@ -29,6 +34,7 @@
 #include <stdexcept>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include <puncture/scene.hpp>
 
@@ -155,6 +161,154 @@ class MooneyRivlin {
   double c01_;  ///< Pa
 };
 
+/// Derivative of a spectral (isotropic) function of a symmetric tensor by the
+/// Daleckii-Krein formula. For G(X) = sum_a g(x_a) N_a (x) N_a (x_a, N_a the
+/// eigenvalues and eigenvectors of X):
+///   dG/dX = sum_{a,b} theta_ab (N_a (x) N_b) (x) (N_a (x) N_b)  (symmetrised),
+///   theta_aa = g'(x_a),  theta_ab = (g(x_a) - g(x_b)) / (x_a - x_b),
+/// with the divided difference replaced by g' at the mean where two
+/// eigenvalues (nearly) coincide, so the result is smooth through repeated
+/// eigenvalues (e.g. the undeformed state).
+template <class G, class DG>
+void spectral_function(const SymTensor2& X, const G& g, const DG& dg, SymTensor2& value, SymTensor4& derivative) {
+  const auto eig = dealii::eigenvectors(X, dealii::SymmetricTensorEigenvectorMethod::jacobi);
+  double x[3], gx[3];
+  dealii::Tensor<1, 3> N[3];
+  for (unsigned a = 0; a < 3; ++a) {
+    x[a] = eig[a].first;
+    N[a] = eig[a].second;
+    gx[a] = g(x[a]);
+  }
+  double theta[3][3];
+  for (unsigned a = 0; a < 3; ++a)
+    for (unsigned b = 0; b < 3; ++b) {
+      const double d = x[a] - x[b];
+      theta[a][b] = (a == b || std::abs(d) <= 1e-6 * std::max(1.0, std::abs(x[a])))
+                        ? dg(0.5 * (x[a] + x[b]))
+                        : (gx[a] - gx[b]) / d;
+    }
+  value = SymTensor2();
+  derivative = SymTensor4();
+  for (unsigned a = 0; a < 3; ++a)
+    for (unsigned i = 0; i < 3; ++i)
+      for (unsigned j = i; j < 3; ++j) value[i][j] += gx[a] * N[a][i] * N[a][j];
+  for (unsigned i = 0; i < 3; ++i)
+    for (unsigned j = i; j < 3; ++j)
+      for (unsigned k = 0; k < 3; ++k)
+        for (unsigned l = k; l < 3; ++l) {
+          double s = 0.0;
+          for (unsigned a = 0; a < 3; ++a)
+            for (unsigned b = 0; b < 3; ++b)
+              s += theta[a][b] * 0.5 * (N[a][i] * N[b][j] + N[b][i] * N[a][j]) * 0.5 *
+                   (N[a][k] * N[b][l] + N[b][k] * N[a][l]);
+          derivative[i][j][k][l] = s;
+        }
+}
+
+/// Isochoric N-term Ogden law (strain-stiffening for alpha > 2):
+///   Psi_iso = sum_p 2 mu_p / alpha_p^2 (sum_a cbar_a^(alpha_p/2) - 3),
+/// cbar_a the eigenvalues of Cbar (squared isochoric principal stretches).
+/// Initial shear modulus sum_p mu_p; alpha = 2 (one term) is neo-Hookean.
+/// Sbar = 2 dPsi/dCbar = sum_a g(cbar_a) N_a (x) N_a with
+/// g(c) = sum_p 2 mu_p / alpha_p c^(alpha_p/2 - 1); CC_hat = 2 dSbar/dCbar
+/// by the spectral derivative above.
+class Ogden {
+ public:
+  struct Term {
+    double mu_Pa;  ///< mu_p (mu_p alpha_p > 0)
+    double alpha;  ///< alpha_p (nonzero)
+  };
+  explicit Ogden(std::vector<Term> terms) : terms_(std::move(terms)) {
+    if (terms_.empty()) throw std::invalid_argument("Ogden: at least one term");
+    double mu = 0.0;
+    for (const Term& t : terms_) {
+      if (!(std::abs(t.alpha) > 0.0) || !std::isfinite(t.alpha) || !(t.mu_Pa * t.alpha > 0.0))
+        throw std::invalid_argument("Ogden: every term needs alpha != 0 and mu alpha > 0");
+      mu += t.mu_Pa;
+    }
+    if (!(mu > 0.0)) throw std::invalid_argument("Ogden: initial shear modulus must be > 0");
+  }
+  double shear_modulus_Pa() const {
+    double mu = 0.0;
+    for (const Term& t : terms_) mu += t.mu_Pa;
+    return mu;
+  }
+
+  double energy(const SymTensor2& C) const {
+    const double J = std::sqrt(dealii::determinant(C));
+    const auto c = dealii::eigenvalues(std::pow(J, -2.0 / 3.0) * C);
+    double psi = 0.0;
+    for (const Term& t : terms_) {
+      double sum = -3.0;
+      for (unsigned a = 0; a < 3; ++a) sum += std::pow(c[a], 0.5 * t.alpha);
+      psi += 2.0 * t.mu_Pa / (t.alpha * t.alpha) * sum;
+    }
+    return psi;
+  }
+  void stress_and_tangent(const SymTensor2& C, SymTensor2& S, SymTensor4& CC) const {
+    const double J = std::sqrt(dealii::determinant(C));
+    const SymTensor2 Cbar = std::pow(J, -2.0 / 3.0) * C;
+    auto g = [this](double c) {
+      double v = 0.0;
+      for (const Term& t : terms_) v += 2.0 * t.mu_Pa / t.alpha * std::pow(c, 0.5 * t.alpha - 1.0);
+      return v;
+    };
+    auto dg = [this](double c) {
+      double v = 0.0;
+      for (const Term& t : terms_)
+        v += 2.0 * t.mu_Pa / t.alpha * (0.5 * t.alpha - 1.0) * std::pow(c, 0.5 * t.alpha - 2.0);
+      return v;
+    };
+    SymTensor2 Sbar;
+    SymTensor4 dSbar;
+    spectral_function(Cbar, g, dg, Sbar, dSbar);
+    const SymTensor4 CC_hat = 2.0 * dSbar;
+    isochoric_push(C, Sbar, &CC_hat, S, CC);
+  }
+
+ private:
+  std::vector<Term> terms_;
+};
+
+/// Isochoric Veronda-Westmann law (exponential stiffening in I1bar):
+///   Psi_iso = c1 (exp(gamma (I1bar - 3)) - 1) - c1 gamma / 2 (I2bar - 3),
+/// initial shear modulus mu = c1 gamma. With Psi_1 = c1 gamma e, Psi_11 =
+/// c1 gamma^2 e (e = exp(gamma (I1bar - 3))) and Psi_2 = -c1 gamma / 2:
+///   Sbar   = 2 (Psi_1 + I1bar Psi_2) I - 2 Psi_2 Cbar,
+///   CC_hat = 4 ((Psi_11 + Psi_2) I x I - Psi_2 II).
+class VerondaWestmann {
+ public:
+  VerondaWestmann(double shear_modulus_Pa, double gamma) : c1_(shear_modulus_Pa / gamma), gamma_(gamma) {
+    if (!(shear_modulus_Pa > 0.0) || !(gamma > 0.0) || !std::isfinite(gamma))
+      throw std::invalid_argument("VerondaWestmann: need shear modulus > 0 and gamma > 0");
+  }
+  double shear_modulus_Pa() const { return c1_ * gamma_; }
+
+  double energy(const SymTensor2& C) const {
+    const double J = std::sqrt(dealii::determinant(C));
+    const SymTensor2 Cbar = std::pow(J, -2.0 / 3.0) * C;
+    const double I1 = dealii::trace(Cbar);
+    const double I2 = 0.5 * (I1 * I1 - dealii::scalar_product(Cbar, Cbar));
+    return c1_ * (std::exp(gamma_ * (I1 - 3.0)) - 1.0) - 0.5 * c1_ * gamma_ * (I2 - 3.0);
+  }
+  void stress_and_tangent(const SymTensor2& C, SymTensor2& S, SymTensor4& CC) const {
+    const double J = std::sqrt(dealii::determinant(C));
+    const SymTensor2 Cbar = std::pow(J, -2.0 / 3.0) * C;
+    const SymTensor2 I = dealii::unit_symmetric_tensor<3>();
+    const double I1 = dealii::trace(Cbar);
+    const double e = std::exp(gamma_ * (I1 - 3.0));
+    const double psi1 = c1_ * gamma_ * e, psi11 = c1_ * gamma_ * gamma_ * e, psi2 = -0.5 * c1_ * gamma_;
+    const SymTensor2 Sbar = 2.0 * (psi1 + I1 * psi2) * I - 2.0 * psi2 * Cbar;
+    const SymTensor4 CC_hat =
+        4.0 * ((psi11 + psi2) * dealii::outer_product(I, I) - psi2 * dealii::identity_tensor<3>());
+    isochoric_push(C, Sbar, &CC_hat, S, CC);
+  }
+
+ private:
+  double c1_;     ///< Pa
+  double gamma_;  ///< dimensionless
+};
+
 /// Volumetric energy Psi_vol(J) = kappa/4 (J^2 - 1 - 2 ln J) (step-44). Its
 /// pressure p = dPsi/dJ = kappa/2 (J - 1/J) and stiffness d2Psi/dJ2 =
 /// kappa/2 (1 + 1/J^2) stay finite for every J > 0 and grow without bound as
@@ -208,7 +362,8 @@ class LayerMaterial {
     if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))
       throw std::invalid_argument("material: Poisson's ratio must lie in (-1, 0.5)");
   }
-  static std::variant<NeoHookean, MooneyRivlin> make_isochoric(const ContinuumMaterial& m) {
+  static std::variant<NeoHookean, MooneyRivlin, Ogden, VerondaWestmann> make_isochoric(
+      const ContinuumMaterial& m) {
     const double mu = shear_modulus(m);
     if (m.model == "neo_hookean") return NeoHookean(mu);
     if (m.model == "mooney_rivlin") {
@@ -217,11 +372,17 @@ class LayerMaterial {
         throw std::invalid_argument("material: mooney_rivlin_c01_fraction must lie in [0, 1]");
       return MooneyRivlin(0.5 * mu * (1.0 - f), 0.5 * mu * f);
     }
+    if (m.model == "ogden") {
+      std::vector<Ogden::Term> terms;
+      for (const OgdenTerm& t : m.ogden_terms) terms.push_back({t.mu_fraction * mu, t.alpha});
+      return Ogden(terms);
+    }
+    if (m.model == "veronda_westmann") return VerondaWestmann(mu, m.veronda_westmann_gamma);
     throw std::invalid_argument("material: unknown model '" + m.model +
-                                "' (expected neo_hookean or mooney_rivlin)");
+                                "' (expected neo_hookean, mooney_rivlin, ogden or veronda_westmann)");
   }
 
-  std::variant<NeoHookean, MooneyRivlin> iso_;
+  std::variant<NeoHookean, MooneyRivlin, Ogden, VerondaWestmann> iso_;
   VolumetricLaw vol_;
   double youngs_modulus_Pa_;
   double poisson_ratio_;
