@@ -407,8 +407,20 @@ void validate_scene(const Scene& s, const std::string& file) {
           "> 0 and <= haptic_rate_Hz", rt.frame_rate_Hz);
 
   const FemSettings& f = s.fem;
-  if (f.geometry != "axisymmetric" && f.geometry != "3d")
-    throw SceneError(file, "/fem/geometry", "unknown geometry '" + f.geometry + "' (known: axisymmetric, 3d)");
+  if (f.geometry != "auto" && f.geometry != "axisymmetric" && f.geometry != "3d")
+    throw SceneError(file, "/fem/geometry", "unknown geometry '" + f.geometry + "' (known: auto, axisymmetric, 3d)");
+  const bool cutting_tip = s.needle.tip == "bevel" || s.needle.tip == "hollow";
+  for (std::size_t i = 0; i < s.layers.size(); ++i) {
+    if (s.layers[i].puncture.kind != PunctureCriterion::Kind::FractureEnergy) continue;
+    if (!cutting_tip)
+      throw SceneError(file, "/layers/" + std::to_string(i) + "/puncture/criterion",
+                       "fracture_energy needs a needle that cuts (needle tip bevel or hollow; got '" + s.needle.tip +
+                           "')");
+    if (f.geometry == "3d")
+      throw SceneError(file, "/fem/geometry",
+                       "the 3d reference models a flat punch with the critical_force and critical_stretch criteria "
+                       "only; fracture_energy needs geometry axisymmetric (or auto)");
+  }
   require(f.refinement >= 0 && f.refinement <= 4, file, "/fem/refinement", "in [0, 4]", f.refinement);
   require(f.element_degree == 1 || f.element_degree == 2, file, "/fem/element_degree", "1 or 2", f.element_degree);
   require(f.load_step_m > 0, file, "/fem/load_step_mm", "> 0", f.load_step_m / kMm);

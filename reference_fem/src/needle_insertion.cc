@@ -114,7 +114,26 @@ void build_slab_triangulation(const Scene& scene, const meshing::SlabMeshOptions
   if (refinement > 0) tria.refine_global(refinement);
 }
 
+namespace {
+FemRunSummary run_needle_insertion_3d(const Scene& scene, const FemRunOptions& options, MPI_Comm comm);
+}  // namespace
+
 FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& options, MPI_Comm comm) {
+  std::string geometry = scene.fem.geometry;
+  if (geometry == "auto") geometry = scene.needle.tip == "blunt" ? "3d" : "axisymmetric";
+  if (geometry == "axisymmetric") return run_axisymmetric_insertion(scene, options, comm);
+  if (scene.needle.tip != "blunt")
+    throw std::invalid_argument("fem: the 3d reference models a flat (blunt) punch only; needle tip '" +
+                                scene.needle.tip + "' needs geometry axisymmetric");
+  for (const Layer& l : scene.layers)
+    if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy)
+      throw std::invalid_argument("fem: the 3d reference has no fracture_energy criterion (layer '" + l.name +
+                                  "'); use geometry axisymmetric");
+  return run_needle_insertion_3d(scene, options, comm);
+}
+
+namespace {
+FemRunSummary run_needle_insertion_3d(const Scene& scene, const FemRunOptions& options, MPI_Comm comm) {
   const auto wall_start = std::chrono::steady_clock::now();
   const bool root = Utilities::MPI::this_mpi_process(comm) == 0;
   auto log = [&](const std::string& s) {
@@ -580,5 +599,7 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
       format_double(summary.peak_force_N, 5) + " N");
   return summary;
 }
+
+}  // namespace
 
 }  // namespace puncture::fem

@@ -33,6 +33,7 @@ inline Scene small_three_layer_scene() {
   s.fem.load_step_m = 0.25e-3;
   s.fem.refinement = 0;
   s.fem.element_degree = 1;
+  s.fem.geometry = "3d";
   return s;
 }
 

@@ -155,7 +155,11 @@ struct FemMeshSettings {
 
 /// Settings of the FEM reference.
 struct FemSettings {
-  std::string geometry = "axisymmetric";  ///< "axisymmetric" (r-z, the default) or "3d" (flat punch, older criteria)
+  /// "axisymmetric" (meridian plane: the cutting needle, fracture-energy
+  /// puncture, friction, the whole trajectory), "3d" (flat punch, older
+  /// criteria, insertion only) or "auto": axisymmetric for a cutting tip
+  /// (bevel, hollow), 3d for a blunt one.
+  std::string geometry = "auto";
   int refinement = 0;             ///< global refinements of the base mesh
   int element_degree = 1;         ///< 1 (Q1) or 2 (Q2)
   double load_step_m = 0.25e-3;   ///< needle travel per quasi-static load step

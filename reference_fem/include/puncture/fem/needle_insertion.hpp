@@ -114,6 +114,16 @@ struct FemRunSummary {
   int degree = 1;
   int refinement = 0;
   std::vector<double> time_s, depth_m, force_N;  ///< the rows of the force-depth CSV
+  /// Parts of force_N per row (axisymmetric geometry; 0 in 3D): friction on
+  /// the shaft and flank, cutting (cohesive energy dissipated per unit tip
+  /// advance), tip (the rest: pressing and spreading the tissue).
+  std::vector<double> tip_force_N, cutting_force_N, friction_force_N;
+  std::vector<std::string> phase;  ///< per row: approach|insertion|dwell|withdrawal
+  std::string geometry = "3d";
+  double cohesive_dissipation_J = 0.0;  ///< energy dissipated by the crack (J)
+  double tip_element_size_m = 0.0;
+  std::vector<int> elements_through_layer;
+  std::vector<std::string> warnings;   ///< e.g. a mesh too coarse for the accuracy target
   std::vector<std::string> files_written;
 };
 
@@ -123,6 +133,13 @@ struct FemRunSummary {
 /// refinements (lateral faces follow the cylinder).
 void build_slab_triangulation(const Scene& scene, const meshing::SlabMeshOptions& options,
                               int refinement, dealii::parallel::distributed::Triangulation<3>& tria);
+
+/// The axisymmetric reference (scene.fem.geometry == "axisymmetric"; see
+/// reference_fem/README.md): the same outputs, the whole trajectory
+/// (insertion, dwell, withdrawal), fracture-energy puncture by a cohesive
+/// crack that advances with the tip, shaft friction. Runs on rank 0 (a 2D
+/// problem); the other ranks wait and receive the summary.
+FemRunSummary run_axisymmetric_insertion(const Scene& scene, const FemRunOptions& options, MPI_Comm comm);
 
 /// Runs the insertion (see the file comment). Throws std::runtime_error with a
 /// clear message if the solver cannot continue (after writing the rows

@@ -1,0 +1,220 @@
+#include <puncture/meshing/axisymmetric_slab_mesh.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <puncture/meshing/graded_divisions.hpp>
+
+namespace puncture::meshing {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+[[noreturn]] void fail(const std::string& field, const std::string& what) {
+  throw std::invalid_argument("axisymmetric slab mesh: " + field + " " + what);
+}
+
+/// Sizes covering `length` that start at `first` and grow by `ratio` per
+/// element up to `largest`; the rest is split into equal elements no larger
+/// than `largest`.
+std::vector<double> growing_sizes(double length, double first, double ratio, double largest) {
+  std::vector<double> sizes;
+  double sum = 0.0, s = std::min(first, largest);
+  while (s < largest && sum + s < length) {
+    sizes.push_back(s);
+    sum += s;
+    s = std::min(s * ratio, largest);
+  }
+  const double rest = length - sum;
+  if (rest > 1e-12 * length) {
+    const int n = std::max(1, static_cast<int>(std::ceil(rest / largest - 1e-9)));
+    sizes.insert(sizes.end(), static_cast<std::size_t>(n), rest / n);
+  }
+  return sizes;
+}
+
+/// Appends the lines start - cumulative sizes (downward) or start + sizes.
+void append_lines(std::vector<double>& lines, const std::vector<double>& sizes, double sign) {
+  double x = lines.back();
+  for (double s : sizes) {
+    x += sign * s;
+    lines.push_back(x);
+  }
+}
+
+/// Inserts 2^refinement - 1 equally spaced lines into every interval.
+std::vector<double> refine_lines(const std::vector<double>& lines, int refinement) {
+  const int parts = 1 << refinement;
+  std::vector<double> out{lines.front()};
+  for (std::size_t i = 1; i < lines.size(); ++i)
+    for (int p = 1; p <= parts; ++p)
+      out.push_back(p == parts ? lines[i] : lines[i - 1] + (lines[i] - lines[i - 1]) * p / parts);
+  return out;
+}
+
+std::size_t index_of(const std::vector<double>& lines, double x) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < lines.size(); ++i)
+    if (std::abs(lines[i] - x) < std::abs(lines[best] - x)) best = i;
+  return best;
+}
+
+}  // namespace
+
+double crack_radius_for_tip(const Needle& needle) {
+  if (needle.tip == "bevel") return 2.0 * needle.radius_m / kPi;
+  if (needle.tip == "hollow") return needle.inner_radius_m;
+  return needle.radius_m;
+}
+
+double crack_path_depth(const Scene& scene) {
+  const double a = scene.needle.radius_m;
+  const double H = scene.total_thickness_m();
+  const double h_tip = a / std::max(2, scene.fem.mesh.elements_per_needle_radius);
+  return std::min(scene.insertion.target_depth_m + std::max(2e-3, 4.0 * a), H - h_tip);
+}
+
+AxisymmetricSlabMesh build_axisymmetric_slab_mesh(const Scene& scene, int refinement) {
+  if (scene.layers.empty()) fail("layers", "must not be empty");
+  for (std::size_t i = 0; i < scene.layers.size(); ++i)
+    if (!(scene.layers[i].thickness_m > 0.0))
+      fail("layers[" + std::to_string(i) + "].thickness_m", "must be > 0");
+  const double a = scene.needle.radius_m;
+  const double R_s = 0.5 * scene.sample.diameter_m;
+  if (!(a > 0.0) || !(a < 0.5 * R_s)) fail("needle.radius_m", "must lie in (0, sample radius / 2)");
+  const FemMeshSettings& ms = scene.fem.mesh;
+  if (ms.elements_per_needle_radius < 2) fail("fem.mesh.elements_per_needle_radius", "must be >= 2");
+  if (ms.min_elements_per_layer < 1) fail("fem.mesh.min_elements_per_layer", "must be >= 1");
+  if (!(ms.radial_growth >= 1.0)) fail("fem.mesh.radial_growth", "must be >= 1");
+  if (!(ms.path_element_size_mm > 0.0)) fail("fem.mesh.path_element_size_mm", "must be > 0");
+  if (refinement < 0 || refinement > 4) fail("refinement", "must lie in [0, 4]");
+
+  AxisymmetricSlabMesh mesh;
+  const double r_c = crack_radius_for_tip(scene.needle);
+  if (!(r_c > 0.0 && r_c <= a)) fail("needle.inner_radius_m", "must lie in (0, needle radius]");
+  const double h_tip = a / ms.elements_per_needle_radius;
+  const double D_p = crack_path_depth(scene);
+  if (!(D_p > 0.0)) fail("insertion.target_depth_m", "leaves no room for the needle path");
+  mesh.crack_radius_m = r_c;
+  mesh.path_depth_m = D_p;
+  mesh.tip_element_size_m = h_tip / (1 << refinement);
+
+  // Radial lines: core, needle wall, then graded to the sample radius.
+  std::vector<double> R{0.0};
+  const int n_core = std::max(2, static_cast<int>(std::lround(r_c / h_tip)));
+  append_lines(R, std::vector<double>(n_core, r_c / n_core), +1.0);
+  if (a - r_c > 1e-3 * a) {
+    const int n_wall = std::max(2, static_cast<int>(std::lround((a - r_c) / h_tip)));
+    append_lines(R, std::vector<double>(n_wall, (a - r_c) / n_wall), +1.0);
+  }
+  append_lines(R, graded_divisions(R_s - a, h_tip, ms.radial_growth), +1.0);
+
+  // Axial lines, layer by layer (Z decreasing from 0).
+  std::vector<double> Z{0.0};
+  const double path_size = ms.path_element_size_mm * 1e-3;
+  double below_path_size = h_tip;
+  for (std::size_t i = 0; i < scene.layers.size(); ++i) {
+    const double top = scene.layer_top_depth_m(i), t = scene.layers[i].thickness_m, bottom = top + t;
+    const double largest = std::min(path_size, t / ms.min_elements_per_layer);
+    std::vector<double> sizes;
+    if (top < D_p) {
+      const double path_part = std::min(bottom, D_p) - top;
+      sizes = growing_sizes(path_part, std::min(h_tip, largest), 1.2, largest);
+      const double below_part = bottom - std::min(bottom, D_p);
+      if (below_part > 1e-12) {
+        // The crack line ends inside this layer: a line at the path depth,
+        // sizes graded below it; both parts keep the layer's minimum count.
+        const int n_min_below =
+            std::max(1, ms.min_elements_per_layer - static_cast<int>(sizes.size()));
+        const auto below = graded_divisions(below_part, sizes.back(), ms.radial_growth, n_min_below);
+        sizes.insert(sizes.end(), below.begin(), below.end());
+      }
+    } else {
+      sizes = graded_divisions(t, below_path_size, ms.radial_growth, ms.min_elements_per_layer);
+    }
+    below_path_size = sizes.back();
+    append_lines(Z, sizes, -1.0);
+    Z.back() = -bottom;  // exact interface
+  }
+
+  R = refine_lines(R, refinement);
+  Z = refine_lines(Z, refinement);
+  mesh.radial_lines_m = R;
+  mesh.axial_lines_m = Z;
+
+  // Per layer statistics on the needle path.
+  for (std::size_t i = 0; i < scene.layers.size(); ++i) {
+    const double top = -scene.layer_top_depth_m(i), bottom = top - scene.layers[i].thickness_m;
+    int n = 0;
+    double largest = 0.0;
+    for (std::size_t j = 0; j + 1 < Z.size(); ++j)
+      if (Z[j] <= top + 1e-12 && Z[j + 1] >= bottom - 1e-12) {
+        ++n;
+        if (-Z[j + 1] <= D_p + 1e-12) largest = std::max(largest, Z[j] - Z[j + 1]);
+      }
+    mesh.elements_through_layer.push_back(n);
+    mesh.largest_path_element_m.push_back(largest);
+  }
+
+  // Vertices: grid (k, j), plus the outer copies of the crack vertices (blunt).
+  const std::size_t nR = R.size(), nZ = Z.size();
+  const std::size_t k_c = index_of(R, r_c);
+  const std::size_t j_p = index_of(Z, -D_p);
+  const bool open_channel = scene.needle.tip == "bevel" || scene.needle.tip == "hollow";
+  mesh.open_channel = open_channel;
+  auto grid = [nR](std::size_t k, std::size_t j) { return static_cast<unsigned>(j * nR + k); };
+  std::vector<Eigen::Vector2d> vertices;
+  vertices.reserve(nR * nZ + j_p);
+  for (std::size_t j = 0; j < nZ; ++j)
+    for (std::size_t k = 0; k < nR; ++k) vertices.emplace_back(R[k], Z[j]);
+  std::vector<unsigned> outer_copy(nZ, 0);
+  std::vector<std::pair<unsigned, unsigned>> pairs;
+  if (!open_channel)
+    for (std::size_t j = 0; j < j_p; ++j) {
+      outer_copy[j] = static_cast<unsigned>(vertices.size());
+      vertices.emplace_back(R[k_c], Z[j]);
+      pairs.emplace_back(grid(k_c, j), outer_copy[j]);
+    }
+  auto vertex = [&](std::size_t k, std::size_t j, bool outer_side) {
+    return (!open_channel && outer_side && k == k_c && j < j_p) ? outer_copy[j] : grid(k, j);
+  };
+
+  // Cells, with the layer of their centre; none inside the open channel.
+  std::vector<std::array<unsigned, 4>> cells;
+  for (std::size_t j = 0; j + 1 < nZ; ++j) {
+    const double zc = 0.5 * (Z[j] + Z[j + 1]);
+    int layer = static_cast<int>(scene.layers.size()) - 1;
+    for (std::size_t i = 0; i < scene.layers.size(); ++i)
+      if (-zc < scene.layer_top_depth_m(i) + scene.layers[i].thickness_m) {
+        layer = static_cast<int>(i);
+        break;
+      }
+    for (std::size_t k = 0; k + 1 < nR; ++k) {
+      const bool outer_side = k >= k_c;
+      if (open_channel && !outer_side && j < j_p) continue;
+      cells.push_back({vertex(k, j + 1, outer_side), vertex(k + 1, j + 1, outer_side), vertex(k, j, outer_side),
+                       vertex(k + 1, j, outer_side)});
+      mesh.material_id.push_back(layer);
+    }
+  }
+
+  // Keep only the vertices cells use (the channel's interior has none).
+  std::vector<long> new_index(vertices.size(), -1);
+  for (auto& c : cells)
+    for (unsigned& v : c) {
+      if (new_index[v] < 0) {
+        new_index[v] = static_cast<long>(mesh.vertices.size());
+        mesh.vertices.push_back(vertices[v]);
+      }
+      v = static_cast<unsigned>(new_index[v]);
+    }
+  mesh.cells = std::move(cells);
+  for (const auto& [c, o] : pairs) mesh.crack_vertex_pairs.emplace_back(new_index[c], new_index[o]);
+  if (open_channel)
+    for (std::size_t j = 0; j < j_p; ++j) mesh.crack_face_vertices.push_back(static_cast<unsigned>(new_index[grid(k_c, j)]));
+  return mesh;
+}
+
+}  // namespace puncture::meshing

@@ -1,0 +1,246 @@
+// axisymmetric_solver.hpp: quasi-static finite-strain solver of the layered
+// slab in the meridian (r-z) plane, with the needle's cutting crack, the rigid
+// needle in frictional contact, and the flat punch (deal.II, serial, sparse
+// direct solves).
+//
+// In:  an AxisymmetricSlabMesh (meshing/: vertices (R, Z) in m, cells with a
+//      layer index, the crack line R = r_c whose vertices exist twice), one
+//      LayerMaterial per layer, one cohesive law and one friction pair per
+//      layer, the needle (RigidNeedle for a cutting tip, or a flat punch of
+//      radius a), AxisymmetricSettings.
+// Out: the displacement (u_R, u_Z) (m) of every node; the axial needle force
+//      (N, > 0 when the tissue resists insertion) split into its normal and
+//      friction parts; the cohesive energy dissipated (J); the damage along
+//      the crack; per-cell fields; VTU files of the meridian plane.
+//
+// Kinematics (Holzapfel 2000, Sec. 2; components ordered R, Z, theta):
+//   F = [[1 + u_R,R, u_R,Z, 0], [u_Z,R, 1 + u_Z,Z, 0], [0, 0, 1 + u_R/R]],
+//   dV = 2 pi R dA, so nodal forces are those of the whole ring (N).
+// Material: any LayerMaterial (hyperelastic_materials.hpp) in the three-field
+// Hu-Washizu form of the 3D solver (Q1-P0 or Q2-P1, condensed per cell), so
+// the nearly incompressible layers do not lock.
+// Boundary conditions: base Z = -H fixed, lateral R = R_s fixed (the sample
+// held in a ring), axis u_R = 0, top free except where the needle touches it.
+// Crack: every pair of crack nodes is joined by the layer's cohesive law
+// (cohesive_law.hpp) with the lumped (Newton-Cotes) area of the node, or, for
+// layers that break by the older force/stretch criteria, tied by a
+// constraint until break_layer() releases them.
+// Needle: a cutting tip is a RigidNeedle (needle_contact.hpp) pushing on the
+// top-surface and crack-face nodes by penalty contact with Coulomb friction
+// on the outer side; the penalty stiffness of a node is contact_penalty x the
+// diagonal of the bulk tangent at that node (at the start of the step), so it
+// follows the stiffening of the tissue. A blunt tip is a flat punch: the top
+// nodes it reaches get u_Z prescribed, and u_R held (no slip) or free
+// (frictionless); its force is the sum of their reactions.
+// Newton with backtracking line search on the free residual; histories
+// (damage, stick points) are committed only when a step converges; on failure
+// the last converged state is restored (the caller cuts the step). Nothing
+// non-finite is kept.
+#pragma once
+
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/grid/tria.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/vector.h>
+
+#include <string>
+#include <vector>
+
+#include <puncture/fem/cohesive_law.hpp>
+#include <puncture/fem/hyperelastic_materials.hpp>
+#include <puncture/fem/needle_contact.hpp>
+#include <puncture/meshing/axisymmetric_slab_mesh.hpp>
+
+namespace puncture::fem {
+
+/// Numerical settings of the axisymmetric solver.
+struct AxisymmetricSettings {
+  unsigned int degree = 1;        ///< displacement element degree: 1 (Q1-P0) or 2 (Q2-P1)
+  int max_newton_iterations = 25;
+  /// Converged when the free residual <= tolerance x force scale (largest of
+  /// the needle force, the reactions and the largest free residual of the
+  /// step) or below absolute_residual_floor_N.
+  double newton_tolerance = 1e-6;
+  double absolute_residual_floor_N = 1e-10;
+  int max_line_search_halvings = 6;
+  double contact_penalty = 1e2;   ///< k_n / (diagonal of the bulk tangent at the node)
+  double friction_penalty = 0.5;  ///< k_t / k_n
+  double contact_rounding = 0.02; ///< eps of the C1 penalty, in tip element sizes
+  double edge_rounding = 0.25;    ///< shoulder rounding radius and inner-wall ramp height, in tip element sizes
+  /// Hold the crack line at r <= r_c below the edge too (the ring crack stands
+  /// for a slit through the axis, whose material cannot drift away from the tip).
+  bool hold_crack_line = true;
+  bool blunt_tip_no_slip = true;  ///< flat punch: hold u_R of touching nodes (else frictionless)
+  bool verbose = false;
+};
+
+/// One layer's crack behaviour.
+///
+/// For a bevel needle the ring crack of radius r_c = 2a/pi stands for the
+/// planar crack of width 2a that the bevel opens (same face perimeter, 4a):
+///   * area: one unit of ring area carries area_scale = 2a / (2 pi r_c) = 1/2
+///     units of slit area, so the ring dissipates G_c x 2a per unit depth;
+///   * opening: the ring face opens radially from r_c to a while the slit's
+///     faces open to the needle width 2a, so the law's normal separation is
+///     opening_scale = 2a / (a - r_c) times the radial opening of the ring.
+/// The nodal forces are area x area_scale x (opening_scale t_n, t_t) and the
+/// law (sigma_c, G_c) is the tissue's own. For a hollow needle both scales
+/// are 1 (the lumen edge cuts a real ring).
+struct LayerCrack {
+  enum class Kind { Cohesive, TiedUntilBroken };
+  Kind kind = Kind::Cohesive;
+  CohesiveLawParameters law;  ///< Cohesive: the law (the tissue's sigma_c, G_c)
+  double area_scale = 1.0;
+  double opening_scale = 1.0;
+};
+
+/// Convergence record of one step.
+struct AxisymmetricNewtonReport {
+  bool converged = false;
+  int iterations = 0;
+  double residual_N = 0.0;
+  double force_scale_N = 0.0;
+  std::string failure;
+  std::vector<std::string> table;
+};
+
+/// Axial force on the needle (N, > 0 when the tissue pushes it back up).
+struct NeedleForce {
+  double total_N = 0.0;
+  double normal_N = 0.0;    ///< from the normal contact pressure (tip flank, punch face)
+  double friction_N = 0.0;  ///< from the tangential (friction) tractions
+  int nodes_in_contact = 0;
+};
+
+class AxisymmetricSolver {
+ public:
+  /// core_materials: optional, one per layer, used instead of `materials` for
+  /// the cells inside the crack radius along the needle path (the bevel's
+  /// stand-in core is a compliant filler; see LayerCrack).
+  AxisymmetricSolver(const meshing::AxisymmetricSlabMesh& mesh, std::vector<LayerMaterial> materials,
+                     std::vector<LayerCrack> cracks, std::vector<FrictionCoefficients> friction,
+                     const AxisymmetricSettings& settings, std::vector<LayerMaterial> core_materials = {});
+
+  /// Distributes the dofs, finds the crack pairs and the contact nodes, u = 0.
+  void setup(double sample_radius_m, double total_thickness_m);
+
+  std::size_t n_dofs() const { return dof_handler_.n_dofs(); }
+  std::size_t n_cells() const { return triangulation_.n_active_cells(); }
+  const dealii::DoFHandler<2>& dof_handler() const { return dof_handler_; }
+
+  // --- the needle -----------------------------------------------------------
+  /// Cutting tip (bevel / hollow): the rigid needle and its position.
+  void set_cutting_needle(const RigidNeedle& needle);
+  /// Flat punch of radius a whose face is at height z_face_m (blunt tip).
+  void set_flat_punch(double radius_m, double z_face_m);
+  /// Time step of the coming solve (s), for the cohesive viscosity.
+  void set_time_step(double dt_s) { dt_s_ = dt_s; }
+
+  // --- solving ----------------------------------------------------------------
+  /// Newton solve of the current step from u + predictor_scale x (last
+  /// increment) when admissible. Commits the histories on success; restores
+  /// the last converged state on failure.
+  AxisymmetricNewtonReport solve_step(double predictor_scale = 0.0);
+
+  struct Snapshot {
+    dealii::Vector<double> solution, last_increment;
+    std::vector<CohesiveHistory> cohesive;
+    std::vector<FrictionHistory> friction;
+    std::vector<char> punch_contact;
+    std::vector<double> punch_lateral_hold;
+    std::vector<char> broken_layers;
+    double dissipated_J = 0.0;
+  };
+  Snapshot snapshot() const;
+  void restore(const Snapshot& s);
+
+  /// Releases the ties of a TiedUntilBroken layer's crack at once (older
+  /// criteria) and marks its cohesive points fully damaged.
+  void break_layer(int layer);
+
+  // --- results ----------------------------------------------------------------
+  NeedleForce needle_force() const { return force_; }
+  double cohesive_dissipation_J() const { return dissipated_J_; }
+  /// Deepest crack point (depth below the surface, m) whose damage >= threshold
+  /// in the given layer (-1: none).
+  double crack_front_depth_m(int layer, double damage_threshold = 0.999) const;
+  /// Largest damage of the crack points of a layer.
+  double max_damage(int layer) const;
+  /// u_Z (m) along the horizontal line Z = z_line_m (nodes with both
+  /// components), sorted by R: (R, u_Z). Both sides of the crack are listed.
+  std::vector<std::pair<double, double>> vertical_displacement_along(double z_line_m) const;
+  /// Maximum principal stretch over the quadrature points of the cells of a
+  /// layer within radius r_max of the axis and depth range [z_lo, z_hi].
+  double max_principal_stretch(int layer, double r_max_m, double z_lo_m, double z_hi_m) const;
+  /// Displacement of the node nearest to (R, Z) (m).
+  std::array<double, 2> displacement_at(double R_m, double Z_m) const;
+
+  /// Writes the meridian plane (x = R, y = Z, m) with displacement, layer,
+  /// J, von Mises stress (Pa), maximum principal stretch and crack damage.
+  void write_vtu(const std::string& path) const;
+
+  const dealii::Vector<double>& solution() const { return solution_; }
+
+ private:
+  struct ContactNode {
+    unsigned dof_r, dof_z;
+    double R, Z;           ///< reference position
+    double area_m2;        ///< lumped boundary area (2 pi R x tributary length)
+    bool core_side;
+    int layer;
+    bool on_top;           ///< on the top surface (flat punch candidates)
+    int partner = -1;      ///< the other copy of a crack node at the same place (-1: none)
+  };
+  /// True if this contact node's z dof is tied to its partner's (unbroken tied layer).
+  bool tied_slave(std::size_t node) const;
+  struct CohesivePoint {
+    bool to_plane = false;  ///< tied to the rigid crack plane R = r_c (open channel) instead of a core node
+    unsigned core_r, core_z, outer_r, outer_z;
+    double Z;
+    double area_m2;
+    int layer;
+  };
+  bool assemble(const dealii::Vector<double>& u, bool with_matrix);
+  void make_constraints(const dealii::Vector<double>& u, dealii::AffineConstraints<double>& c) const;
+  double free_residual_norm(const dealii::AffineConstraints<double>& c) const;
+  void update_penalties();
+  void commit();
+
+  const meshing::AxisymmetricSlabMesh& mesh_;
+  std::vector<LayerMaterial> materials_, core_materials_;
+  std::vector<char> core_cell_;  ///< per active cell: inside the crack radius on the needle path
+  const LayerMaterial& material_of(const dealii::DoFHandler<2>::active_cell_iterator& cell) const;
+  std::vector<LayerCrack> cracks_;
+  std::vector<FrictionCoefficients> friction_;
+  AxisymmetricSettings settings_;
+  dealii::Triangulation<2> triangulation_;
+  dealii::FESystem<2> fe_;
+  dealii::DoFHandler<2> dof_handler_;
+  dealii::AffineConstraints<double> dirichlet_;  ///< homogeneous: base, lateral, axis
+  dealii::SparsityPattern sparsity_;
+  dealii::SparseMatrix<double> tangent_, system_matrix_;
+  dealii::Vector<double> residual_, rhs_, solution_, last_increment_, bulk_diagonal_;
+
+  std::vector<ContactNode> contact_nodes_;
+  std::vector<CohesivePoint> cohesive_points_;
+  std::vector<CohesiveHistory> cohesive_committed_, cohesive_trial_;
+  std::vector<FrictionHistory> friction_committed_, friction_trial_;
+  std::vector<double> penalty_;  ///< k_n per contact node (N/m)
+  std::vector<char> broken_layers_;
+  double dissipated_J_ = 0.0, dissipated_trial_J_ = 0.0;
+
+  // needle
+  bool cutting_ = true;
+  RigidNeedle needle_;
+  double punch_radius_m_ = 0.0, punch_z_m_ = 0.0;
+  std::vector<char> punch_contact_;         ///< per contact node: touching the punch face
+  std::vector<double> punch_lateral_hold_;  ///< u_R held while touching (no slip)
+  double dt_s_ = 0.0;
+  NeedleForce force_, force_trial_;
+  bool debug_contacts_ = false;
+};
+
+}  // namespace puncture::fem

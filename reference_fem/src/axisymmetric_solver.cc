@@ -1,0 +1,1008 @@
+// axisymmetric_solver.cc: see axisymmetric_solver.hpp for the formulation.
+#include <puncture/fem/axisymmetric_solver.hpp>
+
+#include <deal.II/base/function.h>
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/sparse_direct.h>
+#include <deal.II/numerics/data_out.h>
+#include <deal.II/numerics/vector_tools.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace puncture::fem {
+
+using namespace dealii;
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+
+enum BoundaryId : types::boundary_id {
+  kTop = 0, kBase = 1, kLateral = 2, kAxis = 3, kCrackCore = 4, kCrackOuter = 5, kChannelFloor = 6
+};
+
+unsigned n_pressure_modes(unsigned degree) { return degree == 1 ? 1 : 3; }
+double pressure_mode(unsigned a, const Point<2>& p) { return a == 0 ? 1.0 : p[a - 1] - 0.5; }
+
+SymTensor2 right_cauchy_green(const Tensor<2, 3>& F) {
+  SymTensor2 C;
+  for (unsigned a = 0; a < 3; ++a)
+    for (unsigned b = a; b < 3; ++b) {
+      double s = 0.0;
+      for (unsigned i = 0; i < 3; ++i) s += F[i][a] * F[i][b];
+      C[a][b] = s;
+    }
+  return C;
+}
+
+SymTensor2 strain_variation(const Tensor<2, 3>& F, const Tensor<2, 3>& G) {
+  SymTensor2 dE;
+  for (unsigned a = 0; a < 3; ++a)
+    for (unsigned b = a; b < 3; ++b) {
+      double s = 0.0;
+      for (unsigned i = 0; i < 3; ++i) s += F[i][a] * G[i][b] + G[i][a] * F[i][b];
+      dE[a][b] = 0.5 * s;
+    }
+  return dE;
+}
+
+/// 3x3 gradient (R, Z, theta) of a vector shape function of component c
+/// with value N and 2D gradient g at radius R: the hoop entry N/R for c = R.
+Tensor<2, 3> shape_gradient(unsigned c, double N, const Tensor<1, 2>& g, double R) {
+  Tensor<2, 3> G;
+  G[c][0] = g[0];
+  G[c][1] = g[1];
+  if (c == 0) G[2][2] = N / R;
+  return G;
+}
+
+/// Displacement gradient (3x3) at a quadrature point from the 2D gradients
+/// of u_R, u_Z and the value of u_R.
+Tensor<2, 3> displacement_gradient(const Tensor<1, 2>& grad_ur, const Tensor<1, 2>& grad_uz, double ur, double R) {
+  Tensor<2, 3> H;
+  H[0][0] = grad_ur[0];
+  H[0][1] = grad_ur[1];
+  H[1][0] = grad_uz[0];
+  H[1][1] = grad_uz[1];
+  H[2][2] = ur / R;
+  return H;
+}
+
+bool finite(const SymTensor2& t) {
+  for (unsigned a = 0; a < 3; ++a)
+    for (unsigned b = a; b < 3; ++b)
+      if (!std::isfinite(t[a][b])) return false;
+  return true;
+}
+
+/// Constitutive state of one cell at its quadrature points (three-field,
+/// condensed; see finite_strain_solver.hpp).
+struct CellState {
+  std::vector<Tensor<2, 3>> F;
+  std::vector<double> J, dV;
+  std::vector<SymTensor2> S;
+  std::vector<SymTensor4> CC;
+  FullMatrix<double> M_inv, K_JJ;
+  std::vector<std::vector<double>> Np;
+};
+
+bool evaluate_cell(const LayerMaterial& material, unsigned degree, const FEValues<2>& fev,
+                   const std::vector<Tensor<2, 3>>& H, CellState& st) {
+  const unsigned nq = fev.n_quadrature_points, np = n_pressure_modes(degree);
+  st.F.resize(nq);
+  st.J.resize(nq);
+  st.dV.resize(nq);
+  st.S.resize(nq);
+  st.CC.resize(nq);
+  st.M_inv.reinit(np, np);
+  st.K_JJ.reinit(np, np);
+  st.Np.assign(nq, std::vector<double>(np, 0.0));
+  const Tensor<2, 3> I = unit_symmetric_tensor<3>();
+  const auto& unit_points = fev.get_quadrature().get_points();
+  FullMatrix<double> M(np, np);
+  std::vector<double> bJ(np, 0.0), bp(np, 0.0), cJ(np, 0.0), cp(np, 0.0);
+  for (unsigned q = 0; q < nq; ++q) {
+    st.F[q] = I + H[q];
+    st.J[q] = determinant(st.F[q]);
+    if (!(st.J[q] > 0.0) || !std::isfinite(st.J[q])) return false;
+    st.dV[q] = kTwoPi * fev.quadrature_point(q)[0] * fev.JxW(q);
+    for (unsigned a = 0; a < np; ++a) st.Np[q][a] = pressure_mode(a, unit_points[q]);
+    for (unsigned a = 0; a < np; ++a) {
+      bJ[a] += st.Np[q][a] * st.J[q] * st.dV[q];
+      for (unsigned b = 0; b < np; ++b) M(a, b) += st.Np[q][a] * st.Np[q][b] * st.dV[q];
+    }
+  }
+  st.M_inv.invert(M);
+  for (unsigned a = 0; a < np; ++a)
+    for (unsigned b = 0; b < np; ++b) cJ[a] += st.M_inv(a, b) * bJ[b];
+  const VolumetricLaw& vol = material.volumetric();
+  std::vector<double> J_tilde(nq, 0.0), pressure(nq, 0.0);
+  for (unsigned q = 0; q < nq; ++q) {
+    for (unsigned a = 0; a < np; ++a) J_tilde[q] += cJ[a] * st.Np[q][a];
+    if (!(J_tilde[q] > 0.0) || !std::isfinite(J_tilde[q])) return false;
+    const double dp = vol.dpressure_dJ(J_tilde[q]);
+    for (unsigned a = 0; a < np; ++a) {
+      bp[a] += st.Np[q][a] * vol.pressure(J_tilde[q]) * st.dV[q];
+      for (unsigned b = 0; b < np; ++b) st.K_JJ(a, b) += dp * st.Np[q][a] * st.Np[q][b] * st.dV[q];
+    }
+  }
+  for (unsigned a = 0; a < np; ++a)
+    for (unsigned b = 0; b < np; ++b) cp[a] += st.M_inv(a, b) * bp[b];
+  for (unsigned q = 0; q < nq; ++q) {
+    for (unsigned a = 0; a < np; ++a) pressure[q] += cp[a] * st.Np[q][a];
+    const SymTensor2 C = right_cauchy_green(st.F[q]);
+    material.isochoric_stress_and_tangent(C, st.S[q], st.CC[q]);
+    add_volumetric_at_fixed_pressure(invert(C), st.J[q], pressure[q], st.S[q], st.CC[q]);
+    if (!finite(st.S[q])) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+AxisymmetricSolver::AxisymmetricSolver(const meshing::AxisymmetricSlabMesh& mesh,
+                                       std::vector<LayerMaterial> materials, std::vector<LayerCrack> cracks,
+                                       std::vector<FrictionCoefficients> friction,
+                                       const AxisymmetricSettings& settings,
+                                       std::vector<LayerMaterial> core_materials)
+    : mesh_(mesh),
+      materials_(std::move(materials)),
+      core_materials_(std::move(core_materials)),
+      cracks_(std::move(cracks)),
+      friction_(std::move(friction)),
+      settings_(settings),
+      fe_(FE_Q<2>(settings.degree), 2),
+      dof_handler_(triangulation_) {
+  if (settings_.degree != 1 && settings_.degree != 2)
+    throw std::invalid_argument("AxisymmetricSolver: element degree must be 1 or 2");
+  if (materials_.empty() || cracks_.size() != materials_.size() || friction_.size() != materials_.size())
+    throw std::invalid_argument("AxisymmetricSolver: one material, crack law and friction pair per layer");
+  if (!core_materials_.empty() && core_materials_.size() != materials_.size())
+    throw std::invalid_argument("AxisymmetricSolver: core materials must be given for every layer or none");
+  for (const LayerCrack& c : cracks_)
+    if (!(c.area_scale > 0.0) || !(c.opening_scale > 0.0))
+      throw std::invalid_argument("AxisymmetricSolver: crack area and opening scales must be > 0");
+  for (const LayerCrack& c : cracks_)
+    if (c.kind == LayerCrack::Kind::Cohesive) c.law.check();
+  if (!(settings_.contact_penalty > 0.0) || !(settings_.friction_penalty > 0.0))
+    throw std::invalid_argument("AxisymmetricSolver: penalty factors must be > 0");
+}
+
+void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m) {
+  // Triangulation from the plain mesh (crack vertices duplicated: the two
+  // sides share no face and their faces are boundary faces).
+  std::vector<Point<2>> vertices;
+  vertices.reserve(mesh_.vertices.size());
+  for (const auto& v : mesh_.vertices) vertices.emplace_back(v[0], v[1]);
+  std::vector<CellData<2>> cells(mesh_.cells.size());
+  for (std::size_t c = 0; c < mesh_.cells.size(); ++c) {
+    for (unsigned i = 0; i < 4; ++i) cells[c].vertices[i] = mesh_.cells[c][i];
+    cells[c].material_id = static_cast<types::material_id>(mesh_.material_id[c]);
+    if (mesh_.material_id[c] < 0 || static_cast<std::size_t>(mesh_.material_id[c]) >= materials_.size())
+      throw std::invalid_argument("AxisymmetricSolver: cell layer index without a material");
+  }
+  triangulation_.clear();
+  triangulation_.create_triangulation(vertices, cells, SubCellData());
+  const double r_c = mesh_.crack_radius_m;
+  const double tol = 1e-9 * sample_radius_m;
+  for (const auto& cell : triangulation_.active_cell_iterators())
+    for (const unsigned f : cell->face_indices()) {
+      if (!cell->face(f)->at_boundary()) continue;
+      const Point<2> p = cell->face(f)->center();
+      types::boundary_id id = kTop;
+      if (std::abs(p[1]) < tol)
+        id = kTop;
+      else if (std::abs(p[1] + total_thickness_m) < tol)
+        id = kBase;
+      else if (std::abs(p[0] - sample_radius_m) < tol)
+        id = kLateral;
+      else if (std::abs(p[0]) < tol)
+        id = kAxis;
+      else if (std::abs(p[0] - r_c) < tol)
+        id = cell->center()[0] < r_c ? kCrackCore : kCrackOuter;
+      else if (mesh_.open_channel && std::abs(p[1] + mesh_.path_depth_m) < tol && p[0] < r_c)
+        id = kChannelFloor;
+      else
+        throw std::logic_error("AxisymmetricSolver: unexpected boundary face");
+      cell->face(f)->set_boundary_id(id);
+    }
+
+  core_cell_.assign(triangulation_.n_active_cells(), 0);
+  if (!core_materials_.empty())
+    for (const auto& cell : triangulation_.active_cell_iterators())
+      core_cell_[cell->active_cell_index()] =
+          cell->center()[0] < r_c && cell->center()[1] > -mesh_.path_depth_m ? 1 : 0;
+
+  dof_handler_.distribute_dofs(fe_);
+  const unsigned n = dof_handler_.n_dofs();
+  std::vector<Point<2>> support(n);
+  DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
+
+  // Homogeneous Dirichlet conditions.
+  dirichlet_.clear();
+  VectorTools::interpolate_boundary_values(dof_handler_, kBase, Functions::ZeroFunction<2>(2), dirichlet_);
+  VectorTools::interpolate_boundary_values(dof_handler_, kLateral, Functions::ZeroFunction<2>(2), dirichlet_);
+  VectorTools::interpolate_boundary_values(dof_handler_, kAxis, Functions::ZeroFunction<2>(2), dirichlet_,
+                                           fe_.component_mask(FEValuesExtractors::Scalar(0)));
+  dirichlet_.close();
+
+  // Contact nodes and cohesive points from the boundary faces.
+  contact_nodes_.clear();
+  cohesive_points_.clear();
+  std::map<unsigned, std::size_t> node_of_rdof;  // R-dof -> contact node
+  const unsigned dpf = fe_.n_dofs_per_face();
+  std::vector<types::global_dof_index> face_dofs(dpf);
+  // Crack faces of the outer side by the centre of the face, to pair with the core side.
+  std::map<std::pair<long, long>, std::pair<DoFHandler<2>::active_cell_iterator, unsigned>> outer_faces;
+  auto key = [&](const Point<2>& p) {
+    return std::make_pair(std::lround(p[0] / tol * 1e-3), std::lround(p[1] / tol * 1e-3));
+  };
+  for (const auto& cell : dof_handler_.active_cell_iterators())
+    for (const unsigned f : cell->face_indices())
+      if (cell->face(f)->at_boundary() && cell->face(f)->boundary_id() == kCrackOuter)
+        outer_faces[key(cell->face(f)->center())] = {cell, f};
+
+  auto newton_cotes_weight = [&](const Point<2>& p, const Point<2>& v0, double length) {
+    const double s = (p - v0).norm() / length;
+    if (settings_.degree == 1) return 0.5;
+    return (s < 0.25 || s > 0.75) ? 1.0 / 6.0 : 4.0 / 6.0;
+  };
+
+  for (const auto& cell : dof_handler_.active_cell_iterators())
+    for (const unsigned f : cell->face_indices()) {
+      const auto face = cell->face(f);
+      if (!face->at_boundary()) continue;
+      const auto id = face->boundary_id();
+      if (id != kTop && id != kCrackCore && id != kCrackOuter) continue;
+      face->get_dof_indices(face_dofs);
+      const double length = face->measure();
+      const Point<2> v0 = face->vertex(0);
+      const bool core = id == kCrackCore || (id == kTop && cell->center()[0] < r_c);
+      const int layer = static_cast<int>(cell->material_id());
+      for (unsigned i = 0; i < dpf; ++i) {
+        if (fe_.face_system_to_component_index(i).first != 0) continue;
+        const unsigned dr = face_dofs[i];
+        unsigned dz = 0;
+        for (unsigned j = 0; j < dpf; ++j)
+          if (fe_.face_system_to_component_index(j).first == 1 &&
+              support[face_dofs[j]].distance(support[dr]) < tol)
+            dz = face_dofs[j];
+        const Point<2> p = support[dr];
+        const double area = kTwoPi * std::max(p[0], 0.0) * newton_cotes_weight(p, v0, length) * length;
+        auto it = node_of_rdof.find(dr);
+        if (it == node_of_rdof.end()) {
+          node_of_rdof[dr] = contact_nodes_.size();
+          contact_nodes_.push_back({dr, dz, p[0], p[1], area, core, layer, id == kTop});
+        } else {
+          ContactNode& node = contact_nodes_[it->second];
+          node.area_m2 += area;
+          node.on_top = node.on_top || id == kTop;
+        }
+      }
+      if (id == kCrackOuter && mesh_.open_channel) {
+        // Open channel: each wall node is tied to the rigid crack plane.
+        for (unsigned i = 0; i < dpf; ++i) {
+          if (fe_.face_system_to_component_index(i).first != 0) continue;
+          const Point<2> p = support[face_dofs[i]];
+          CohesivePoint cp{};
+          cp.to_plane = true;
+          cp.outer_r = cp.core_r = face_dofs[i];
+          for (unsigned j = 0; j < dpf; ++j)
+            if (fe_.face_system_to_component_index(j).first == 1 && support[face_dofs[j]].distance(p) < tol)
+              cp.outer_z = cp.core_z = face_dofs[j];
+          cp.Z = p[1];
+          cp.area_m2 = kTwoPi * r_c * newton_cotes_weight(p, face->vertex(0), length) * length;
+          cp.layer = layer;
+          cohesive_points_.push_back(cp);
+        }
+        continue;
+      }
+      if (id != kCrackCore) continue;
+      // Cohesive points: pair the core face's dofs with the outer face's.
+      const auto match = outer_faces.find(key(face->center()));
+      if (match == outer_faces.end()) throw std::logic_error("AxisymmetricSolver: unmatched crack face");
+      std::vector<types::global_dof_index> outer_dofs(dpf);
+      match->second.first->face(match->second.second)->get_dof_indices(outer_dofs);
+      for (unsigned i = 0; i < dpf; ++i) {
+        if (fe_.face_system_to_component_index(i).first != 0) continue;
+        const Point<2> p = support[face_dofs[i]];
+        CohesivePoint cp{};
+        cp.core_r = face_dofs[i];
+        for (unsigned j = 0; j < dpf; ++j)
+          if (fe_.face_system_to_component_index(j).first == 1 && support[face_dofs[j]].distance(p) < tol)
+            cp.core_z = face_dofs[j];
+        bool found_r = false, found_z = false;
+        for (unsigned j = 0; j < dpf; ++j) {
+          if (support[outer_dofs[j]].distance(p) >= tol) continue;
+          if (fe_.face_system_to_component_index(j).first == 0) {
+            cp.outer_r = outer_dofs[j];
+            found_r = true;
+          } else {
+            cp.outer_z = outer_dofs[j];
+            found_z = true;
+          }
+        }
+        if (!found_r || !found_z) throw std::logic_error("AxisymmetricSolver: crack dofs do not pair up");
+        if (cp.outer_r == cp.core_r) continue;  // shared node at the path depth
+        cp.Z = p[1];
+        cp.area_m2 = kTwoPi * r_c * newton_cotes_weight(p, face->vertex(0), length) * length;
+        cp.layer = layer;
+        cohesive_points_.push_back(cp);
+      }
+    }
+
+  // Partners: the two copies of a crack node.
+  for (std::size_t i = 0; i < contact_nodes_.size(); ++i)
+    for (std::size_t j = i + 1; j < contact_nodes_.size(); ++j)
+      if (std::abs(contact_nodes_[i].R - contact_nodes_[j].R) < tol &&
+          std::abs(contact_nodes_[i].Z - contact_nodes_[j].Z) < tol) {
+        contact_nodes_[i].partner = static_cast<int>(j);
+        contact_nodes_[j].partner = static_cast<int>(i);
+      }
+
+  // Sparsity: cells, plus the couplings of each cohesive point.
+  // (condensed with every possible crack tie, so that any set of tie
+  // constraints can be condensed into the matrix later).
+  AffineConstraints<double> all_ties;
+  for (const CohesivePoint& cp : cohesive_points_) {
+    if (cp.to_plane) continue;
+    for (const auto& [slave, master] : {std::make_pair(cp.outer_r, cp.core_r), std::make_pair(cp.outer_z, cp.core_z)})
+      if (!all_ties.is_constrained(slave)) {
+        all_ties.add_line(slave);
+        all_ties.add_entry(slave, master, 1.0);
+      }
+  }
+  all_ties.close();
+  DynamicSparsityPattern dsp(n, n);
+  DoFTools::make_sparsity_pattern(dof_handler_, dsp, all_ties, true);
+  for (const CohesivePoint& cp : cohesive_points_) {
+    if (cp.to_plane) continue;
+    const unsigned d[4] = {cp.core_r, cp.core_z, cp.outer_r, cp.outer_z};
+    for (unsigned a : d)
+      for (unsigned b : d) dsp.add(a, b);
+  }
+  sparsity_.copy_from(dsp);
+  tangent_.reinit(sparsity_);
+  system_matrix_.reinit(sparsity_);
+  residual_.reinit(n);
+  rhs_.reinit(n);
+  solution_.reinit(n);
+  last_increment_.reinit(n);
+  bulk_diagonal_.reinit(n);
+  cohesive_committed_.assign(cohesive_points_.size(), CohesiveHistory{});
+  cohesive_trial_ = cohesive_committed_;
+  friction_committed_.assign(contact_nodes_.size(), FrictionHistory{});
+  friction_trial_ = friction_committed_;
+  punch_contact_.assign(contact_nodes_.size(), 0);
+  punch_lateral_hold_.assign(contact_nodes_.size(), 0.0);
+  penalty_.assign(contact_nodes_.size(), 0.0);
+  broken_layers_.assign(materials_.size(), 0);
+  dissipated_J_ = dissipated_trial_J_ = 0.0;
+  assemble(solution_, true);
+  update_penalties();
+}
+
+const LayerMaterial& AxisymmetricSolver::material_of(const DoFHandler<2>::active_cell_iterator& cell) const {
+  return core_cell_[cell->active_cell_index()] ? core_materials_[cell->material_id()] : materials_[cell->material_id()];
+}
+
+void AxisymmetricSolver::set_cutting_needle(const RigidNeedle& needle) {
+  needle.check();
+  cutting_ = true;
+  needle_ = needle;
+}
+
+void AxisymmetricSolver::set_flat_punch(double radius_m, double z_face_m) {
+  if (!(radius_m > 0.0) || !std::isfinite(z_face_m))
+    throw std::invalid_argument("AxisymmetricSolver: flat punch needs a positive radius and a finite face height");
+  cutting_ = false;
+  punch_radius_m_ = radius_m;
+  punch_z_m_ = z_face_m;
+}
+
+void AxisymmetricSolver::break_layer(int layer) {
+  if (layer < 0 || layer >= static_cast<int>(materials_.size())) throw std::out_of_range("break_layer: no such layer");
+  broken_layers_[layer] = 1;
+  for (std::size_t i = 0; i < cohesive_points_.size(); ++i)
+    if (cohesive_points_[i].layer == layer) cohesive_committed_[i].damage = 1.0;
+  cohesive_trial_ = cohesive_committed_;
+}
+
+bool AxisymmetricSolver::tied_slave(std::size_t node) const {
+  const ContactNode& nd = contact_nodes_[node];
+  if (nd.partner < 0 || nd.core_side) return false;
+  for (const CohesivePoint& cp : cohesive_points_)
+    if (cp.outer_z == nd.dof_z)
+      return cracks_[cp.layer].kind == LayerCrack::Kind::TiedUntilBroken && !broken_layers_[cp.layer];
+  return false;
+}
+
+void AxisymmetricSolver::make_constraints(const Vector<double>& u, AffineConstraints<double>& c) const {
+  // Newton-increment constraints: Dirichlet (homogeneous), ties of unbroken
+  // tied layers, and the flat punch (du = target - u).
+  c.clear();
+  for (const CohesivePoint& cp : cohesive_points_)
+    if (!cp.to_plane && cracks_[cp.layer].kind == LayerCrack::Kind::TiedUntilBroken && !broken_layers_[cp.layer]) {
+      c.add_line(cp.outer_r);
+      c.add_entry(cp.outer_r, cp.core_r, 1.0);
+      c.set_inhomogeneity(cp.outer_r, u[cp.core_r] - u[cp.outer_r]);
+      c.add_line(cp.outer_z);
+      c.add_entry(cp.outer_z, cp.core_z, 1.0);
+      c.set_inhomogeneity(cp.outer_z, u[cp.core_z] - u[cp.outer_z]);
+    }
+  if (!cutting_)
+    for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
+      if (!punch_contact_[i]) continue;
+      const ContactNode& nd = contact_nodes_[i];
+      if (c.is_constrained(nd.dof_z) || dirichlet_.is_constrained(nd.dof_z)) continue;
+      c.add_line(nd.dof_z);
+      c.set_inhomogeneity(nd.dof_z, (punch_z_m_ - nd.Z) - u[nd.dof_z]);
+      if (settings_.blunt_tip_no_slip && !dirichlet_.is_constrained(nd.dof_r) && !c.is_constrained(nd.dof_r)) {
+        c.add_line(nd.dof_r);
+        c.set_inhomogeneity(nd.dof_r, punch_lateral_hold_[i] - u[nd.dof_r]);
+      }
+    }
+  c.merge(dirichlet_, AffineConstraints<double>::MergeConflictBehavior::left_object_wins);
+  c.close();
+}
+
+bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
+  const unsigned degree = settings_.degree;
+  const QGauss<2> quadrature(degree + 1);
+  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_JxW_values | update_quadrature_points);
+  const unsigned dpc = fe_.n_dofs_per_cell(), nq = quadrature.size(), np = n_pressure_modes(degree);
+  FullMatrix<double> Ke(dpc, dpc), B(np, dpc), G(np, np), tmp(np, np), GB(np, dpc);
+  Vector<double> Re(dpc);
+  std::vector<types::global_dof_index> dofs(dpc);
+  std::vector<Tensor<2, 3>> H(nq), gradN(dpc);
+  std::vector<SymTensor2> dE(dpc), CC_dE(dpc);
+  std::vector<unsigned> comp(dpc);
+  for (unsigned i = 0; i < dpc; ++i) comp[i] = fe_.system_to_component_index(i).first;
+  const FEValuesExtractors::Scalar ur(0), uz(1);
+  std::vector<Tensor<1, 2>> g_ur(nq), g_uz(nq);
+  std::vector<double> v_ur(nq);
+  CellState st;
+
+  if (with_matrix) {
+    tangent_ = 0.0;
+    bulk_diagonal_ = 0.0;
+  }
+  residual_ = 0.0;
+  for (const auto& cell : dof_handler_.active_cell_iterators()) {
+    fev.reinit(cell);
+    fev[ur].get_function_gradients(u, g_ur);
+    fev[uz].get_function_gradients(u, g_uz);
+    fev[ur].get_function_values(u, v_ur);
+    for (unsigned q = 0; q < nq; ++q)
+      H[q] = displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+    if (!evaluate_cell(material_of(cell), degree, fev, H, st)) return false;
+    Ke = 0.0;
+    Re = 0.0;
+    B = 0.0;
+    for (unsigned q = 0; q < nq; ++q) {
+      const double R = fev.quadrature_point(q)[0];
+      const Tensor<2, 3> S_full(st.S[q]);
+      const Tensor<2, 3> F_inv_T = transpose(invert(st.F[q]));
+      for (unsigned i = 0; i < dpc; ++i) {
+        gradN[i] = shape_gradient(comp[i], fev.shape_value(i, q), fev.shape_grad(i, q), R);
+        dE[i] = strain_variation(st.F[q], gradN[i]);
+        Re(i) += scalar_product(st.S[q], dE[i]) * st.dV[q];
+      }
+      if (!with_matrix) continue;
+      for (unsigned i = 0; i < dpc; ++i) {
+        CC_dE[i] = st.CC[q] * dE[i];
+        const Tensor<2, 3> gNi_S = gradN[i] * S_full;
+        for (unsigned j = 0; j <= i; ++j)
+          Ke(i, j) += (scalar_product(CC_dE[i], dE[j]) + scalar_product(gNi_S, gradN[j])) * st.dV[q];
+        const double dJ_i = st.J[q] * scalar_product(gradN[i], F_inv_T);
+        for (unsigned a = 0; a < np; ++a) B(a, i) += st.Np[q][a] * dJ_i * st.dV[q];
+      }
+    }
+    if (with_matrix) {
+      st.M_inv.mmult(tmp, st.K_JJ);
+      tmp.mmult(G, st.M_inv);
+      G.mmult(GB, B);
+      for (unsigned i = 0; i < dpc; ++i)
+        for (unsigned j = 0; j <= i; ++j) {
+          double s = 0.0;
+          for (unsigned a = 0; a < np; ++a) s += B(a, i) * GB(a, j);
+          Ke(i, j) += s;
+        }
+      for (unsigned i = 0; i < dpc; ++i)
+        for (unsigned j = i + 1; j < dpc; ++j) Ke(i, j) = Ke(j, i);
+    }
+    cell->get_dof_indices(dofs);
+    for (unsigned i = 0; i < dpc; ++i) {
+      residual_(dofs[i]) += Re(i);
+      if (with_matrix) {
+        bulk_diagonal_(dofs[i]) += Ke(i, i);
+        for (unsigned j = 0; j < dpc; ++j) tangent_.add(dofs[i], dofs[j], Ke(i, j));
+      }
+    }
+  }
+
+  // Cohesive points: R_outer += A t, R_core -= A t.
+  dissipated_trial_J_ = dissipated_J_;
+  for (std::size_t k = 0; k < cohesive_points_.size(); ++k) {
+    const CohesivePoint& cp = cohesive_points_[k];
+    const LayerCrack& crack = cracks_[cp.layer];
+    if (crack.kind == LayerCrack::Kind::TiedUntilBroken) {
+      // Tied by constraints until broken; afterwards only the faces'
+      // no-interpenetration penalty of a fully damaged law remains.
+      if (!broken_layers_[cp.layer]) continue;
+    }
+    CohesiveLawParameters law = crack.law;
+    double area_scale = crack.area_scale, kn = crack.opening_scale;
+    if (crack.kind == LayerCrack::Kind::TiedUntilBroken) {
+      // A broken tied layer keeps a stiff closure penalty only (D = 1).
+      law.strength_Pa = 1e3 * materials_[cp.layer].youngs_modulus_Pa();
+      law.toughness_J_per_m2 = 1e-3 * law.strength_Pa;
+      area_scale = kn = 1.0;
+    }
+    // Law in the slit's separation (kn x radial opening, sliding); forces on
+    // the ring nodes A area_scale (kn t_n, t_t) (see LayerCrack).
+    // A wall tied to the crack plane opens by its radial displacement and
+    // does not slide on it (the plane is one of symmetry of the cut).
+    const double dn = cp.to_plane ? u[cp.outer_r] : u[cp.outer_r] - u[cp.core_r];
+    const double dt = cp.to_plane ? 0.0 : u[cp.outer_z] - u[cp.core_z];
+    const CohesiveResponse r = cohesive_response(law, cohesive_committed_[k], kn * dn, dt, dt_s_);
+    if (!std::isfinite(r.traction[0]) || !std::isfinite(r.traction[1])) return false;
+    cohesive_trial_[k] = r.history;
+    const double A = cp.area_m2 * area_scale;
+    dissipated_trial_J_ += A * (r.history.dissipated_J_per_m2 - cohesive_committed_[k].dissipated_J_per_m2);
+    if (cp.to_plane) {
+      residual_(cp.outer_r) += A * kn * r.traction[0];
+      if (with_matrix) tangent_.add(cp.outer_r, cp.outer_r, A * kn * kn * r.tangent[0][0]);
+      continue;
+    }
+    const double scale[2] = {kn, 1.0};
+    const unsigned d[4] = {cp.core_r, cp.core_z, cp.outer_r, cp.outer_z};
+    const double sgn[4] = {-1.0, -1.0, 1.0, 1.0};
+    for (unsigned i = 0; i < 4; ++i) residual_(d[i]) += sgn[i] * A * scale[i % 2] * r.traction[i % 2];
+    if (with_matrix)
+      for (unsigned i = 0; i < 4; ++i)
+        for (unsigned j = 0; j < 4; ++j)
+          tangent_.add(d[i], d[j], sgn[i] * sgn[j] * A * scale[i % 2] * scale[j % 2] * r.tangent[i % 2][j % 2]);
+  }
+
+  // Needle: penalty contact with friction (cutting tip) or flat punch reactions.
+  force_trial_ = NeedleForce{};
+  if (cutting_) {
+    const Vec2 edge{needle_.edge_radius_m, needle_.z_tip_m};
+    for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
+      const ContactNode& nd = contact_nodes_[i];
+      const Vec2 x{nd.R + u[nd.dof_r], nd.Z + u[nd.dof_z]};
+      const ContactPenalty penalty{penalty_[i], settings_.contact_rounding * mesh_.tip_element_size_m};
+      NodalContactResponse resp;
+      ContactPoint c;
+      if (nd.core_side) {
+        resp = core_wall_contact(needle_, x, penalty,
+                                 settings_.hold_crack_line ? -1.0 : settings_.edge_rounding * mesh_.tip_element_size_m);
+        c.penetration_m = std::max(x[0] - needle_.edge_radius_m, 0.0);
+      } else {
+        c = outer_contact(needle_, x, settings_.edge_rounding * mesh_.tip_element_size_m);
+        resp = nodal_contact(c, x, edge, friction_committed_[i], friction_[nd.layer], penalty,
+                             settings_.friction_penalty * penalty_[i]);
+      }
+      friction_trial_[i] = resp.history;
+      if (!resp.history.in_contact) continue;
+      if (debug_contacts_)
+        std::cout << "        node R " << nd.R * 1e3 << " Z " << nd.Z * 1e3 << (nd.core_side ? " core" : " outer")
+                  << " x (" << x[0] * 1e3 << ", " << x[1] * 1e3 << ") pen " << c.penetration_m * 1e6 << " um n ("
+                  << c.normal[0] << "," << c.normal[1] << ") k " << penalty_[i] << " f " << resp.normal_force[0] << ","
+                  << resp.normal_force[1] << " ft " << resp.friction_force[1] << std::endl;
+      const unsigned d[2] = {nd.dof_r, nd.dof_z};
+      for (unsigned a = 0; a < 2; ++a) {
+        residual_(d[a]) -= resp.normal_force[a] + resp.friction_force[a];
+        if (with_matrix)
+          for (unsigned b = 0; b < 2; ++b) tangent_.add(d[a], d[b], -resp.dforce_dx[a][b]);
+      }
+      force_trial_.normal_N -= resp.normal_force[1];
+      force_trial_.friction_N -= resp.friction_force[1];
+      ++force_trial_.nodes_in_contact;
+    }
+  } else {
+    for (std::size_t i = 0; i < contact_nodes_.size(); ++i)
+      if (punch_contact_[i]) {
+        force_trial_.normal_N -= residual_(contact_nodes_[i].dof_z);  // R_z < 0 where the punch presses
+        ++force_trial_.nodes_in_contact;
+      }
+  }
+  force_trial_.total_N = force_trial_.normal_N + force_trial_.friction_N;
+  for (std::size_t i = 0; i < residual_.size(); ++i)
+    if (!std::isfinite(residual_(i))) return false;
+  return true;
+}
+
+double AxisymmetricSolver::free_residual_norm(const AffineConstraints<double>& c) const {
+  // Residual of the unknowns left free by the constraints: a constrained dof
+  // hands its residual to its masters (a tied crack node to its partner).
+  Vector<double> r(residual_);
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    if (!c.is_constrained(i)) continue;
+    if (const auto* entries = c.get_constraint_entries(i))
+      for (const auto& [j, w] : *entries) r(j) += w * residual_(i);
+  }
+  double s = 0.0;
+  for (std::size_t i = 0; i < r.size(); ++i)
+    if (!c.is_constrained(i)) s += r(i) * r(i);
+  return std::sqrt(s);
+}
+
+void AxisymmetricSolver::update_penalties() {
+  // k_n = contact_penalty x the bulk stiffness at the node (mean of its two
+  // diagonal entries; the bulk tangent of the last converged state).
+  for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
+    const ContactNode& nd = contact_nodes_[i];
+    const double k = 0.5 * (bulk_diagonal_(nd.dof_r) + bulk_diagonal_(nd.dof_z));
+    penalty_[i] = settings_.contact_penalty * std::max(k, 1e-12);
+  }
+}
+
+void AxisymmetricSolver::commit() {
+  cohesive_committed_ = cohesive_trial_;
+  friction_committed_ = friction_trial_;
+  dissipated_J_ = dissipated_trial_J_;
+  force_ = force_trial_;
+}
+
+AxisymmetricSolver::Snapshot AxisymmetricSolver::snapshot() const {
+  return {solution_,          last_increment_,     cohesive_committed_, friction_committed_,
+          punch_contact_,     punch_lateral_hold_, broken_layers_,      dissipated_J_};
+}
+
+void AxisymmetricSolver::restore(const Snapshot& s) {
+  solution_ = s.solution;
+  last_increment_ = s.last_increment;
+  cohesive_committed_ = cohesive_trial_ = s.cohesive;
+  friction_committed_ = friction_trial_ = s.friction;
+  punch_contact_ = s.punch_contact;
+  punch_lateral_hold_ = s.punch_lateral_hold;
+  broken_layers_ = s.broken_layers;
+  dissipated_J_ = dissipated_trial_J_ = s.dissipated_J;
+  assemble(solution_, true);
+  force_ = force_trial_;
+  update_penalties();
+}
+
+AxisymmetricNewtonReport AxisymmetricSolver::solve_step(double predictor_scale) {
+  AxisymmetricNewtonReport report;
+  const Vector<double> u_start(solution_);
+  const auto punch_contact_start = punch_contact_;
+  const auto punch_hold_start = punch_lateral_hold_;
+  auto fail = [&](const std::string& why) {
+    solution_ = u_start;
+    punch_contact_ = punch_contact_start;
+    punch_lateral_hold_ = punch_hold_start;
+    cohesive_trial_ = cohesive_committed_;
+    friction_trial_ = friction_committed_;
+    assemble(solution_, true);
+    report.converged = false;
+    report.failure = why;
+    if (settings_.verbose) std::cout << "      newton failed: " << why << std::endl;
+    return report;
+  };
+  if (predictor_scale > 0.0 && last_increment_.linfty_norm() > 0.0) {
+    solution_.add(predictor_scale, last_increment_);
+    if (!assemble(solution_, false)) solution_ = u_start;
+  }
+  // Flat punch: top nodes within the punch radius that the face has reached
+  // join; a node released for a tensile reaction stays free for this step.
+  std::vector<char> released_in_step(contact_nodes_.size(), 0);
+  auto update_punch_contact = [&]() {
+    bool changed = false;
+    if (cutting_) return changed;
+    for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
+      const ContactNode& nd = contact_nodes_[i];
+      if (punch_contact_[i] || released_in_step[i] || !nd.on_top || nd.R > punch_radius_m_ * (1 + 1e-9) ||
+          tied_slave(i))
+        continue;
+      if (nd.Z + solution_(nd.dof_z) >= punch_z_m_) {
+        punch_contact_[i] = 1;
+        punch_lateral_hold_[i] = solution_(nd.dof_r);
+        if (nd.partner >= 0 && tied_slave(static_cast<std::size_t>(nd.partner))) punch_contact_[nd.partner] = 1;
+        changed = true;
+      }
+    }
+    return changed;
+  };
+  update_punch_contact();
+
+  AffineConstraints<double> constraints;
+  SparseDirectUMFPACK direct;
+  Vector<double> du(solution_.size()), trial(solution_.size());
+  double max_free = 0.0;
+  int contact_changes = 0;
+  for (int it = 0;; ++it) {
+    debug_contacts_ = settings_.verbose && std::getenv("PUNCTURE_FEM_DEBUG_CONTACT") != nullptr;
+    make_constraints(solution_, constraints);
+    const auto t_assemble = std::chrono::steady_clock::now();
+    if (!assemble(solution_, true)) return fail("inverted or non-finite state");
+    debug_contacts_ = false;
+    const double assemble_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_assemble).count();
+    const double free = free_residual_norm(constraints);
+    double gap = 0.0;
+    for (std::size_t i = 0; i < solution_.size(); ++i)
+      if (constraints.is_inhomogeneously_constrained(i)) gap = std::max(gap, std::abs(constraints.get_inhomogeneity(i)));
+    max_free = std::max(max_free, free);
+    double reaction = std::abs(force_trial_.total_N);
+    for (std::size_t i = 0; i < solution_.size(); ++i)
+      if (constraints.is_constrained(i)) reaction = std::max(reaction, std::abs(residual_(i)));
+    const double scale = std::max({reaction, max_free, 1e-300});
+    report.residual_N = free;
+    report.force_scale_N = scale;
+    if (!std::isfinite(free)) return fail("non-finite residual");
+    const bool converged = gap <= 1e-12 * std::max(1e-3, punch_radius_m_) &&
+                           (free <= settings_.newton_tolerance * scale || free <= settings_.absolute_residual_floor_N);
+    std::ostringstream line;
+    int sliding = 0, damaged = 0, broken = 0, closed = 0;
+    for (const auto& h : friction_trial_) sliding += h.sliding ? 1 : 0;
+    for (std::size_t k = 0; k < cohesive_points_.size(); ++k) {
+      damaged += cohesive_trial_[k].damage > 0.0 ? 1 : 0;
+      broken += cohesive_trial_[k].damage >= 1.0 ? 1 : 0;
+      closed += (cohesive_trial_[k].damage > 0.0 &&
+                 solution_(cohesive_points_[k].outer_r) < solution_(cohesive_points_[k].core_r)) ? 1 : 0;
+    }
+    line << std::setw(4) << it << "  |R_free| " << std::scientific << std::setprecision(3) << free << " N  scale "
+         << scale << " N  F_needle " << force_trial_.total_N << " N  contact " << force_trial_.nodes_in_contact
+         << " sliding " << sliding << " damaged " << damaged << " broken " << broken << " closed " << closed;
+    if (converged) {
+      // Flat punch: release nodes pulled by the face (tensile reaction), then go on.
+      bool released = false;
+      if (!cutting_)
+        for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
+          if (!punch_contact_[i] || tied_slave(i)) continue;
+          // A tied pair of crack nodes carries its reaction together.
+          const int p = contact_nodes_[i].partner;
+          double reaction = residual_(contact_nodes_[i].dof_z);
+          if (p >= 0 && tied_slave(static_cast<std::size_t>(p))) reaction += residual_(contact_nodes_[p].dof_z);
+          if (reaction > 1e-6 * scale) {  // R_z > 0: the face would pull the node
+            if (settings_.verbose)
+              std::cout << "      punch releases node R=" << contact_nodes_[i].R << " reaction " << reaction << std::endl;
+            punch_contact_[i] = 0;
+            released_in_step[i] = 1;
+            if (p >= 0 && tied_slave(static_cast<std::size_t>(p))) punch_contact_[p] = 0;
+            released = true;
+          }
+        }
+      if (update_punch_contact()) released = true;
+      if (released && ++contact_changes > 50) return fail("flat punch contact set does not settle");
+      if (!released) {
+        report.table.push_back(line.str() + "  converged");
+        if (settings_.verbose) std::cout << "      " << report.table.back() << std::endl;
+        report.converged = true;
+        report.iterations = it;
+        last_increment_ = solution_;
+        last_increment_ -= u_start;
+        commit();
+        update_penalties();
+        return report;
+      }
+      line << "  (punch contact set changed)";
+      report.table.push_back(line.str());
+      continue;
+    }
+    if (it >= settings_.max_newton_iterations) {
+      report.table.push_back(line.str());
+      report.iterations = it;
+      return fail("no convergence in " + std::to_string(it) + " Newton iterations");
+    }
+    // Linear system K du = -R with the increment constraints condensed in
+    // (UMFPACK takes the nonsymmetric tangent of sliding friction).
+    rhs_ = residual_;
+    rhs_ *= -1.0;
+    const auto t_solve = std::chrono::steady_clock::now();
+    system_matrix_.copy_from(tangent_);
+    constraints.condense(system_matrix_, rhs_);
+    try {
+      direct.initialize(system_matrix_);
+      direct.vmult(du, rhs_);
+    } catch (const std::exception& e) {
+      return fail(std::string("sparse direct solve failed: ") + e.what());
+    }
+    const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_solve).count();
+    constraints.distribute(du);
+    if (!std::isfinite(du.l2_norm())) return fail("non-finite Newton update");
+
+    double alpha = 1.0, best_alpha = -1.0, best_free = std::numeric_limits<double>::infinity();
+    bool accepted = false;
+    for (int h = 0; h <= settings_.max_line_search_halvings; ++h, alpha *= 0.5) {
+      trial = solution_;
+      trial.add(alpha, du);
+      if (!assemble(trial, false)) continue;
+      AffineConstraints<double> tc;
+      make_constraints(trial, tc);
+      const double trial_free = free_residual_norm(tc);
+      if (!std::isfinite(trial_free)) continue;
+      if (gap > 0.0 || trial_free < (1.0 - 1e-4 * alpha) * free || trial_free <= settings_.absolute_residual_floor_N) {
+        accepted = true;
+        break;
+      }
+      if (trial_free < best_free) {
+        best_free = trial_free;
+        best_alpha = alpha;
+      }
+    }
+    if (!accepted) {
+      if (best_alpha < 0.0) return fail("line search: every trial state is inverted or non-finite");
+      alpha = best_alpha;
+      trial = solution_;
+      trial.add(alpha, du);
+    }
+    line << "  alpha " << std::defaultfloat << alpha << "  t_assemble " << std::setprecision(3) << assemble_s
+         << " s  t_solve " << solve_s << " s";
+    report.table.push_back(line.str());
+    if (settings_.verbose) std::cout << "      " << report.table.back() << std::endl;
+    solution_ = trial;
+  }
+}
+
+double AxisymmetricSolver::crack_front_depth_m(int layer, double damage_threshold) const {
+  double depth = -1.0;
+  for (std::size_t k = 0; k < cohesive_points_.size(); ++k)
+    if (cohesive_points_[k].layer == layer && cohesive_committed_[k].damage >= damage_threshold)
+      depth = std::max(depth, -cohesive_points_[k].Z);
+  return depth;
+}
+
+double AxisymmetricSolver::max_damage(int layer) const {
+  double d = 0.0;
+  for (std::size_t k = 0; k < cohesive_points_.size(); ++k)
+    if (cohesive_points_[k].layer == layer) d = std::max(d, cohesive_committed_[k].damage);
+  return d;
+}
+
+std::vector<std::pair<double, double>> AxisymmetricSolver::vertical_displacement_along(double z_line_m) const {
+  std::vector<Point<2>> support(dof_handler_.n_dofs());
+  DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
+  std::vector<std::pair<double, double>> out;
+  const double tol = 1e-9;
+  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
+  std::vector<char> seen(dof_handler_.n_dofs(), 0);
+  for (const auto& cell : dof_handler_.active_cell_iterators()) {
+    cell->get_dof_indices(dofs);
+    for (unsigned i = 0; i < dofs.size(); ++i) {
+      if (fe_.system_to_component_index(i).first != 1 || seen[dofs[i]]) continue;
+      seen[dofs[i]] = 1;
+      if (std::abs(support[dofs[i]][1] - z_line_m) < tol) out.emplace_back(support[dofs[i]][0], solution_(dofs[i]));
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+double AxisymmetricSolver::max_principal_stretch(int layer, double r_max_m, double z_lo_m, double z_hi_m) const {
+  const QGauss<2> quadrature(settings_.degree + 1);
+  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points);
+  const FEValuesExtractors::Scalar ur(0), uz(1);
+  std::vector<Tensor<1, 2>> g_ur(quadrature.size()), g_uz(quadrature.size());
+  std::vector<double> v_ur(quadrature.size());
+  double stretch = 1.0;
+  for (const auto& cell : dof_handler_.active_cell_iterators()) {
+    if (static_cast<int>(cell->material_id()) != layer) continue;
+    const Point<2> c = cell->center();
+    if (c[0] > r_max_m || c[1] < z_lo_m || c[1] > z_hi_m) continue;
+    fev.reinit(cell);
+    fev[ur].get_function_gradients(solution_, g_ur);
+    fev[uz].get_function_gradients(solution_, g_uz);
+    fev[ur].get_function_values(solution_, v_ur);
+    for (unsigned q = 0; q < quadrature.size(); ++q) {
+      const Tensor<2, 3> F =
+          Tensor<2, 3>(unit_symmetric_tensor<3>()) + displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+      const auto ev = eigenvalues(right_cauchy_green(F));
+      stretch = std::max(stretch, std::sqrt(std::max(ev[0], 0.0)));
+    }
+  }
+  return stretch;
+}
+
+std::array<double, 2> AxisymmetricSolver::displacement_at(double R_m, double Z_m) const {
+  std::vector<Point<2>> support(dof_handler_.n_dofs());
+  DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
+  const Point<2> p(R_m, Z_m);
+  double best[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  std::array<double, 2> u{0.0, 0.0};
+  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
+  for (const auto& cell : dof_handler_.active_cell_iterators()) {
+    cell->get_dof_indices(dofs);
+    for (unsigned i = 0; i < dofs.size(); ++i) {
+      const unsigned c = fe_.system_to_component_index(i).first;
+      const double d = support[dofs[i]].distance(p);
+      if (d < best[c]) {
+        best[c] = d;
+        u[c] = solution_(dofs[i]);
+      }
+    }
+  }
+  return u;
+}
+
+void AxisymmetricSolver::write_vtu(const std::string& path) const {
+  const unsigned n = triangulation_.n_active_cells();
+  Vector<double> layer(n), J(n), von_mises(n), stretch(n), damage(n);
+  const QGauss<2> quadrature(settings_.degree + 1);
+  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points | update_JxW_values);
+  const FEValuesExtractors::Scalar ur(0), uz(1);
+  const unsigned nq = quadrature.size();
+  std::vector<Tensor<1, 2>> g_ur(nq), g_uz(nq);
+  std::vector<double> v_ur(nq);
+  std::vector<Tensor<2, 3>> H(nq);
+  CellState st;
+  for (const auto& cell : dof_handler_.active_cell_iterators()) {
+    const unsigned c = cell->active_cell_index();
+    fev.reinit(cell);
+    fev[ur].get_function_gradients(solution_, g_ur);
+    fev[uz].get_function_gradients(solution_, g_uz);
+    fev[ur].get_function_values(solution_, v_ur);
+    for (unsigned q = 0; q < nq; ++q) H[q] = displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+    layer(c) = cell->material_id();
+    const bool ok = evaluate_cell(material_of(cell), settings_.degree, fev, H, st);
+    double j_sum = 0.0, vm_sum = 0.0, s_max = 1.0;
+    for (unsigned q = 0; q < nq; ++q) {
+      const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) + H[q];
+      const double Jq = determinant(F);
+      j_sum += Jq;
+      const auto ev = eigenvalues(right_cauchy_green(F));
+      s_max = std::max(s_max, std::sqrt(std::max(ev[0], 0.0)));
+      if (ok) {
+        const Tensor<2, 3> sigma = (1.0 / Jq) * F * Tensor<2, 3>(st.S[q]) * transpose(F);
+        const SymTensor2 s = deviator(symmetrize(sigma));
+        vm_sum += std::sqrt(1.5 * scalar_product(s, s));
+      }
+    }
+    J(c) = j_sum / nq;
+    von_mises(c) = vm_sum / nq;
+    stretch(c) = s_max;
+  }
+  // Crack damage on the cells along the crack (largest of their points).
+  std::map<unsigned, double> damage_of_dof;
+  for (std::size_t k = 0; k < cohesive_points_.size(); ++k) {
+    damage_of_dof[cohesive_points_[k].core_r] = std::max(damage_of_dof[cohesive_points_[k].core_r], cohesive_committed_[k].damage);
+    damage_of_dof[cohesive_points_[k].outer_r] = std::max(damage_of_dof[cohesive_points_[k].outer_r], cohesive_committed_[k].damage);
+  }
+  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
+  for (const auto& cell : dof_handler_.active_cell_iterators()) {
+    cell->get_dof_indices(dofs);
+    double d = 0.0;
+    for (auto dof : dofs) {
+      const auto it = damage_of_dof.find(dof);
+      if (it != damage_of_dof.end()) d = std::max(d, it->second);
+    }
+    damage(cell->active_cell_index()) = d;
+  }
+  DataOut<2> out;
+  out.attach_dof_handler(dof_handler_);
+  std::vector<std::string> names{"displacement_m", "displacement_m"};
+  std::vector<DataComponentInterpretation::DataComponentInterpretation> interp(
+      2, DataComponentInterpretation::component_is_part_of_vector);
+  out.add_data_vector(solution_, names, DataOut<2>::type_dof_data, interp);
+  out.add_data_vector(layer, "layer_id");
+  out.add_data_vector(J, "J");
+  out.add_data_vector(von_mises, "von_mises_Pa");
+  out.add_data_vector(stretch, "max_principal_stretch");
+  out.add_data_vector(damage, "crack_damage");
+  out.build_patches(settings_.degree);
+  std::ofstream file(path);
+  if (!file) throw std::runtime_error("cannot write " + path);
+  out.write_vtu(file);
+  if (!file) throw std::runtime_error("error while writing " + path);
+}
+
+}  // namespace puncture::fem
