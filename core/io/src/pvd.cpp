@@ -25,9 +25,18 @@ std::string xml_escape(const std::string& s) {
 }
 }  // namespace
 
-std::string pvd_document(const std::vector<PvdEntry>& entries) {
-  std::string out =
-      "<?xml version=\"1.0\"?>\n"
+std::string pvd_document(const std::vector<PvdEntry>& entries, const Provenance* provenance) {
+  std::string out = "<?xml version=\"1.0\"?>\n";
+  if (provenance) {
+    std::string text;
+    for (const auto& [key, value] : provenance_fields(*provenance))
+      text += (text.empty() ? "" : " | ") + key + ": " + value;
+    // "--" may not appear inside an XML comment.
+    for (std::size_t p = text.find("--"); p != std::string::npos; p = text.find("--", p)) text.replace(p, 2, "- -");
+    if (!text.empty() && text.back() == '-') text += ' ';
+    out += "<!-- provenance: " + text + " -->\n";
+  }
+  out +=
       "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
       "  <Collection>\n";
   char buffer[64];
@@ -45,9 +54,9 @@ std::string pvd_document(const std::vector<PvdEntry>& entries) {
   return out;
 }
 
-void write_pvd(OutputSession& session, const std::string& relative_name,
-               const std::vector<PvdEntry>& entries) {
-  session.write_text(relative_name, pvd_document(entries));
+void write_pvd(OutputSession& session, const std::string& relative_name, const std::vector<PvdEntry>& entries,
+               const Provenance* provenance) {
+  session.write_text(relative_name, pvd_document(entries, provenance));
 }
 
 }  // namespace puncture::io
