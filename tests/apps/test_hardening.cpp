@@ -27,6 +27,7 @@
 #include "puncture/apps/commands.hpp"
 #include "puncture/io/csv_reader.hpp"
 #include "puncture/io/provenance.hpp"
+#include "puncture/validation/calibration.hpp"
 
 extern char** environ;
 
@@ -324,6 +325,22 @@ TEST(ProgramContract, ANewRunRemovesStagedFilesOfADeadRun) {
   EXPECT_TRUE(staging_files(dir).empty());
   fs::remove_all(dir);
   fs::remove(scene);
+}
+
+}  // namespace
+}  // namespace puncture::apps
+
+namespace puncture::apps {
+namespace {
+
+TEST(DocumentedDefaults, CalibrationBoundFactorOfTheCommandAndTheLibrary) {
+  // validation/README.md and apps/README.md: the library keeps each parameter
+  // within [p0 / 3, 3 p0]; `puncture calibrate` widens it to 1000.
+  EXPECT_EQ(CalibrateOptions{}.bound_factor, 1000.0);
+  EXPECT_EQ(validation::CalibrationOptions{}.bound_factor, 3.0);
+  const Result help = run_program("calibrate --help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("default 1000"), std::string::npos) << help.out;
 }
 
 }  // namespace
