@@ -32,7 +32,7 @@ std::string string_field(vtkFieldData* fd, const char* name) {
 }
 
 TEST(VtkProvenance, PolyDataCarriesItAsFieldData) {
-  testing::ScratchDir scratch;
+  puncture::io::testing::ScratchDir scratch;
   const Provenance p{"puncture run x.json -o out", "0.1.0", "abc1234-dirty", "2026-01-01T00:00:00Z", "host (cpu, 2 cores)"};
   {
     OutputSession session(scratch.path());
