@@ -27,6 +27,7 @@
 #include "puncture/apps/commands.hpp"
 #include "puncture/io/csv_reader.hpp"
 #include "puncture/io/provenance.hpp"
+#include "puncture/scene_io.hpp"
 #include "puncture/validation/calibration.hpp"
 
 extern char** environ;
@@ -341,6 +342,27 @@ TEST(DocumentedDefaults, CalibrationBoundFactorOfTheCommandAndTheLibrary) {
   const Result help = run_program("calibrate --help");
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_NE(help.out.find("default 1000"), std::string::npos) << help.out;
+}
+
+}  // namespace
+}  // namespace puncture::apps
+
+namespace puncture::apps {
+namespace {
+
+TEST(CommittedResults, DefaultRunWasMadeFromTheCurrentDefaultScene) {
+  // results/default_run/summary.json records the scene it ran; when
+  // scenes/default.json changes, the committed result is stale: rerun
+  // `bash scripts/results_default_run.sh`.
+  std::ifstream in(kSourceDir / "results" / "default_run" / "summary.json");
+  ASSERT_TRUE(in) << "results/default_run/summary.json is missing";
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  const Scene current = load_scene(kSourceDir / "scenes" / "default.json");
+  const Scene recorded = parse_scene(summary.at("settings").dump(), "results/default_run/summary.json:/settings");
+  EXPECT_EQ(scene_to_json_text(recorded), scene_to_json_text(current))
+      << "results/default_run is stale: run bash scripts/results_default_run.sh";
+  EXPECT_TRUE(summary.contains("provenance"));
+  EXPECT_TRUE(summary.contains("warnings"));
 }
 
 }  // namespace
