@@ -36,6 +36,7 @@
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/fem_reference.hpp"
 #include "puncture/io/atomic_file.hpp"
+#include "puncture/io/vtk_xml_field_data.hpp"
 #include "puncture/io/provenance_json.hpp"
 #include "puncture/io/output_session.hpp"
 #include "puncture/io/pvd.hpp"
@@ -149,13 +150,20 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
 
     // 6. Report files.
     session.write_text("realtime_curve.csv", insertion_curve_csv(realtime_curve, &provenance));
-    // The FEM's own files, copied with the provenance of the FEM run they carry.
-    session.write_text("fem_force_depth.csv", io::read_text_file(reference.dir / "fem_force_depth.csv"));
+    // The FEM's own files, copied; a copy without provenance of its own gets
+    // this command's (with the cache entry it came from).
+    auto with_csv_provenance = [&](const std::string& name) {
+      const std::string text = io::read_text_file(reference.dir / name);
+      if (text.rfind("# command:", 0) == 0) return text;
+      return io::provenance_comment_lines(provenance) + "# copied_from: " + (reference.dir / name).string() + "\n" +
+             text;
+    };
+    session.write_text("fem_force_depth.csv", with_csv_provenance("fem_force_depth.csv"));
     session.write_text("fem_curve.csv", insertion_curve_csv(fem.curve, &provenance));
     session.write_text("force_depth_aligned.csv", aligned_curves_csv(realtime_curve, fem.curve, provenance));
     session.write_text("layer_metrics.csv", layer_metrics_csv(scene, cmp, defl, provenance));
     session.write_text("deflection_profiles.csv", deflection_profiles_csv(scene, defl, provenance));
-    session.write_text("fem_recovery_profile.csv", io::read_text_file(reference.dir / "fem_recovery_profile.csv"));
+    session.write_text("fem_recovery_profile.csv", with_csv_provenance("fem_recovery_profile.csv"));
 
     nlohmann::json metrics;
     metrics["provenance"] = io::provenance_json(provenance);
@@ -178,7 +186,18 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
       std::vector<io::PvdEntry> entries;
       for (const FemFrame& f : fem.frames) {
         for (const std::string& file : f.files)
-          session.write_text("fem/" + file, io::read_text_file(reference.dir / file));
+        {
+          // Copies of FEM frames without provenance of their own get this
+          // command's: field data in a .vtu, a comment in a .pvtu.
+          std::string text = io::read_text_file(reference.dir / file);
+          if (text.find("provenance") == std::string::npos) {
+            if (std::filesystem::path(file).extension() == ".vtu")
+              text = io::add_provenance_field_data(text, provenance, "m");
+            else if (std::filesystem::path(file).extension() == ".pvtu")
+              text = io::add_provenance_comment(text, provenance);
+          }
+          session.write_text("fem/" + file, text);
+        }
         entries.push_back({f.time_s, 0, "fem/" + f.pvtu});
       }
 #ifdef PUNCTURE_HAVE_VTK

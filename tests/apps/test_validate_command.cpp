@@ -258,6 +258,27 @@ TEST(ValidateCommand, ReportOfASmallSceneAndSecondRunFromCache) {
   EXPECT_NE(pvd.str().find("part=\"0\" file=\"fem/"), std::string::npos);
   EXPECT_NE(pvd.str().find("file=\"realtime/skin_surface_"), std::string::npos);
 
+  // Provenance in every file of the report, also in the copies of the FEM's files.
+  std::size_t with_provenance = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (!e.is_regular_file()) continue;
+    std::ifstream in(e.path(), std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string ext = e.path().extension().string();
+    if (ext == ".csv")
+      EXPECT_EQ(text.rfind("# command: puncture", 0), 0u) << e.path();
+    else if (ext == ".vtu" || ext == ".vtp")
+      EXPECT_NE(text.find("provenance_command"), std::string::npos) << e.path();
+    else if (ext == ".pvd" || ext == ".pvtu")
+      EXPECT_NE(text.find("<!-- provenance: command: puncture"), std::string::npos) << e.path();
+    else if (ext == ".json" || ext == ".md")
+      EXPECT_NE(text.find("git"), std::string::npos) << e.path();
+    else if (ext != ".png")
+      ADD_FAILURE() << "unexpected report file " << e.path();
+    ++with_provenance;
+  }
+  EXPECT_GT(with_provenance, 10u);
+
   // Summary: provenance and links.
   std::ifstream md_in(dir / "validation_summary.md");
   std::stringstream md;

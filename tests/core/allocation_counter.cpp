@@ -19,7 +19,10 @@ std::atomic<long> allocations{0};
 }  // namespace
 
 #ifdef PUNCTURE_ASAN
-#include <sanitizer/allocator_interface.h>
+// The sanitizer runtime's hook (sanitizer/allocator_interface.h, which GCC
+// does not install; libasan exports the function).
+extern "C" int __sanitizer_install_malloc_and_free_hooks(void (*malloc_hook)(const volatile void*, std::size_t),
+                                                         void (*free_hook)(const volatile void*));
 
 namespace {
 void on_malloc(const volatile void*, std::size_t) {

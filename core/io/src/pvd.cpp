@@ -1,6 +1,7 @@
 #include <puncture/io/pvd.hpp>
 
 #include <puncture/io/output_session.hpp>
+#include <puncture/io/vtk_xml_field_data.hpp>
 
 #include <charconv>
 #include <cmath>
@@ -27,15 +28,7 @@ std::string xml_escape(const std::string& s) {
 
 std::string pvd_document(const std::vector<PvdEntry>& entries, const Provenance* provenance) {
   std::string out = "<?xml version=\"1.0\"?>\n";
-  if (provenance) {
-    std::string text;
-    for (const auto& [key, value] : provenance_fields(*provenance))
-      text += (text.empty() ? "" : " | ") + key + ": " + value;
-    // "--" may not appear inside an XML comment.
-    for (std::size_t p = text.find("--"); p != std::string::npos; p = text.find("--", p)) text.replace(p, 2, "- -");
-    if (!text.empty() && text.back() == '-') text += ' ';
-    out += "<!-- provenance: " + text + " -->\n";
-  }
+  if (provenance) out += provenance_xml_comment(*provenance) + "\n";
   out +=
       "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
       "  <Collection>\n";

@@ -54,6 +54,25 @@ std::string add_vtk_xml_field_data(const std::string& text,
   return out;
 }
 
+std::string provenance_xml_comment(const Provenance& provenance) {
+  std::string text;
+  for (const auto& [key, value] : provenance_fields(provenance)) text += (text.empty() ? "" : " | ") + key + ": " + value;
+  for (std::size_t p = text.find("--"); p != std::string::npos; p = text.find("--", p)) text.replace(p, 2, "- -");
+  if (!text.empty() && text.back() == '-') text += ' ';
+  return "<!-- provenance: " + text + " -->";
+}
+
+std::string add_provenance_comment(const std::string& xml, const Provenance& provenance) {
+  std::size_t at = 0;
+  if (xml.compare(0, 5, "<?xml") == 0) {
+    const std::size_t end = xml.find("?>");
+    if (end != std::string::npos) at = end + 2;
+  }
+  std::string out = xml;
+  out.insert(at, (at ? "\n" : "") + provenance_xml_comment(provenance) + (at ? "" : "\n"));
+  return out;
+}
+
 std::vector<std::pair<std::string, std::string>> provenance_field_data(const Provenance& provenance,
                                                                         const std::string& coordinate_unit) {
   std::vector<std::pair<std::string, std::string>> fields;

@@ -31,6 +31,14 @@ std::string add_vtk_xml_field_data(const std::string& vtk_xml,
 std::string add_provenance_field_data(const std::string& vtk_xml, const Provenance& provenance,
                                       const std::string& coordinate_unit = "m");
 
+/// "<!-- provenance: command: ... | program_version: ... | ... -->" ("--"
+/// inside values written "- -", as XML requires).
+std::string provenance_xml_comment(const Provenance& provenance);
+
+/// The comment inserted after the XML declaration (at the start without one):
+/// for XML files without field data of their own (.pvd, .pvtu).
+std::string add_provenance_comment(const std::string& xml, const Provenance& provenance);
+
 /// The (name, value) pairs add_provenance_field_data writes; the VTK writers of
 /// validation/io store the same names.
 std::vector<std::pair<std::string, std::string>> provenance_field_data(const Provenance& provenance,
