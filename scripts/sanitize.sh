@@ -36,6 +36,8 @@ cmake --build "$build" -j2
 (( build_only )) && exit 0
 
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+# OpenMPI's memory patcher hooks mmap/munmap, which AddressSanitizer owns.
+export OMPI_MCA_memory=^patcher
 # detect_leaks: LeakSanitizer at exit; the ODR check is off because deal.II's
 # and Trilinos' shared libraries define the same symbols (not our code).
 export ASAN_OPTIONS="detect_leaks=1:detect_odr_violation=0:check_initialization_order=1:strict_init_order=1:abort_on_error=0"
