@@ -17,6 +17,10 @@
 # The allocation test (tests/core/test_no_allocation.cpp) counts through
 # ASan's allocation hook in this build instead of interposing malloc.
 #
+# Tests that start MPI run without leak detection (reasons below, at the
+# ctest calls); under ASan the reference_fem label takes several times its
+# usual ~5 minutes.
+#
 # Usage: bash scripts/sanitize.sh [--build-only] [extra ctest arguments]
 # Env:   PUNCTURE_SANITIZE_BUILD_DIR  build directory (default ./build-sanitize)
 set -euo pipefail
@@ -47,4 +51,17 @@ export ASAN_OPTIONS="detect_leaks=1:detect_odr_violation=0:check_initialization_
 export LSAN_OPTIONS="suppressions=$root/scripts/sanitizers/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/scripts/sanitizers/ubsan.supp"
 cd "$build"
-ctest --output-on-failure -j2 --timeout 3000 "$@"
+# Tests that initialise MPI (the FEM: label reference_fem, and the apps tests
+# that run the FEM in process) end with a LeakSanitizer report of about
+# 117 kB in ~3350 allocations made by modules that were unloaded before the
+# check (OpenMPI/PMIx plugins; the report shows "<unknown module>", so no
+# suppression can name them). They run with leak detection off; AddressSanitizer
+# (heap, stack, use-after-free) and UBSan stay on for them, and every other
+# test, which does not start MPI, runs with leak detection on.
+mpi_tests='FemReferenceCache|ValidateCommand.Report|SweepCommand'
+status=0
+ctest --output-on-failure -j2 --timeout 3000 -LE reference_fem -E "$mpi_tests" "$@" || status=1
+no_leaks="${ASAN_OPTIONS/detect_leaks=1/detect_leaks=0}"
+ASAN_OPTIONS="$no_leaks" ctest --output-on-failure -j2 --timeout 3000 -R "$mpi_tests" "$@" || status=1
+ASAN_OPTIONS="$no_leaks" ctest --output-on-failure -j1 --timeout 3000 -L reference_fem "$@" || status=1
+exit $status
