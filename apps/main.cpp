@@ -5,16 +5,27 @@
 //   puncture calibrate [SCENE] [--reference CSV] [-o DIR]   tuned preset
 //   puncture sweep     [SCENE] [-o DIR]   accuracy versus time of every fidelity knob
 //   puncture grade SCORES.csv [-o DIR]    comprehensive weighted grading (paper Sec. 3.3)
+//   puncture --version
+// Exit codes: 0 success, 1 the run failed, 2 bad input (scene, CSV, command
+// line), 3 output not writable, 128 + n ended by signal n (apps/README.md).
 #include <CLI/CLI.hpp>
 #include <iostream>
 
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/fem_reference.hpp"
+#include "puncture/io/interrupt_cleanup.hpp"
+#include "puncture/io/provenance.hpp"
 
 int main(int argc, char** argv) {
   using namespace puncture::apps;
+  // Before any other thread exists: SIGINT/SIGTERM/SIGHUP remove staged files.
+  puncture::io::install_interrupt_cleanup();
   CLI::App app{"puncture: virtual needle-puncture simulation (real-time SHF + MSM model, FEM reference)"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("puncture ") + puncture::io::program_version() + " (git " +
+                                        puncture::io::git_revision() + ")");
+  app.footer("Exit codes: 0 success, 1 the run failed, 2 bad input (scene file, CSV, command line), "
+             "3 output not writable, 128+n ended by signal n. -q: nothing on stdout (warnings and errors on stderr).");
   std::string scene, output, cache;
 
   RunOptions run;
@@ -22,7 +33,7 @@ int main(int argc, char** argv) {
   run_cmd->add_option("scene", scene, "Scene file (JSON); default: scenes/default.json");
   run_cmd->add_option("-o,--output", output, "Output directory; default: out/<scene name>");
   run_cmd->add_flag("--no-frames", [&](std::int64_t) { run.write_frames = false; }, "Do not write VTK frames");
-  run_cmd->add_flag("-q,--quiet", run.quiet, "No progress output");
+  run_cmd->add_flag("-q,--quiet", run.quiet, "Nothing on stdout (warnings and errors still on stderr)");
 
   FemOptions fem;
   auto* fem_cmd = app.add_subcommand("fem", "Run the deal.II FEM reference along the same insertion (MPI-aware)");
@@ -31,6 +42,7 @@ int main(int argc, char** argv) {
   fem_cmd->add_option("--refinement", fem.refinement, "Global refinements (overrides the scene)")->check(CLI::Range(0, 4));
   fem_cmd->add_option("--degree", fem.degree, "Element degree 1 (Q1) or 2 (Q2) (overrides the scene)")->check(CLI::Range(1, 2));
   fem_cmd->add_flag("--no-vtu", [&](std::int64_t) { fem.write_vtu = false; }, "Do not write .vtu field output");
+  fem_cmd->add_flag("-q,--quiet", fem.quiet, "Nothing on stdout");
 
   ValidateOptions validate;
   auto* validate_cmd = app.add_subcommand("validate", "Real-time model against the FEM reference on the same insertion");
@@ -39,7 +51,7 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("--cache", cache, "FEM cache directory; default: out/.fem_cache");
   validate_cmd->add_option("--refinement", validate.refinement, "FEM refinement (overrides the scene)")->check(CLI::Range(0, 4));
   validate_cmd->add_option("--degree", validate.degree, "FEM element degree (overrides the scene)")->check(CLI::Range(1, 2));
-  validate_cmd->add_flag("-q,--quiet", validate.quiet, "No progress output");
+  validate_cmd->add_flag("-q,--quiet", validate.quiet, "Nothing on stdout (warnings and errors still on stderr)");
 
   CalibrateOptions calibrate;
   std::string reference;
@@ -63,7 +75,7 @@ int main(int argc, char** argv) {
                             "Weight of the puncture-depth term (error in units of min(L, thickness)); default 0.1");
   calibrate_cmd->add_option("--bound-factor", calibrate.bound_factor,
                             "Each tuned parameter stays within [start / f, start * f]; default 1000");
-  calibrate_cmd->add_flag("-q,--quiet", calibrate.quiet, "No progress output");
+  calibrate_cmd->add_flag("-q,--quiet", calibrate.quiet, "Nothing on stdout (warnings and errors still on stderr)");
 
   SweepOptions sweep;
   auto* sweep_cmd = app.add_subcommand("sweep", "What accuracy costs in time: every fidelity knob against the finest FEM");
@@ -72,7 +84,7 @@ int main(int argc, char** argv) {
   sweep_cmd->add_option("--cache", cache, "FEM cache directory; default: out/.fem_cache");
   sweep_cmd->add_flag("--no-fem-knobs", [&](std::int64_t) { sweep.include_fem_knobs = false; },
                       "Do not sweep FEM refinement and degree");
-  sweep_cmd->add_flag("-q,--quiet", sweep.quiet, "No progress output");
+  sweep_cmd->add_flag("-q,--quiet", sweep.quiet, "Nothing on stdout (warnings and errors still on stderr)");
 
   GradeOptions grade;
   std::string scores;
@@ -80,8 +92,16 @@ int main(int argc, char** argv) {
   grade_cmd->add_option("scores", scores, "CSV: model, resident, then one column per indicator")->required();
   grade_cmd->add_option("-o,--output", output, "Output directory; default: out/grading");
   grade_cmd->add_option("--mu", grade.mu, "Preference coefficient (share of the subjective weights), default 0.4");
+  grade_cmd->add_flag("-q,--quiet", grade.quiet, "Nothing on stdout");
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version exit 0; every usage error exits 2 (CLI11's own
+    // codes, 100-120, are not documented and would vary by error).
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitBadInput;
+  }
 
   const auto dispatch = [&]() -> int {
     if (*run_cmd) {
@@ -108,7 +128,7 @@ int main(int argc, char** argv) {
       grade.scores = scores, grade.output_dir = output;
       return grade_command(grade, std::cout, std::cerr);
     }
-    return 1;
+    return kExitFailure;
   };
   const int exit_code = dispatch();
   finalize_mpi();  // before static destruction (see fem_reference.hpp)

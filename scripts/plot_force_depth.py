@@ -20,7 +20,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 def read_csv(path):
     with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
+        # Skip the provenance lines ("# key: value") before the header.
+        rows = list(csv.DictReader(l for l in f if not l.startswith("#")))
     if not rows:
         raise SystemExit(f"{path}: no rows")
     return rows

@@ -29,7 +29,8 @@ def main():
         sys.exit("usage: plot_sweep.py SWEEP_DIR")
     d = sys.argv[1]
     with open(os.path.join(d, "accuracy_cost.csv"), newline="") as f:
-        rows = [r for r in csv.DictReader(f) if r["status"] == "ok"]
+        # Skip the provenance lines ("# key: value") before the header.
+        rows = [r for r in csv.DictReader(l for l in f if not l.startswith("#")) if r["status"] == "ok"]
     points = []
     for r in rows:
         t, e = num(r["time_per_step_s"]), num(r["force_rmse_N"])

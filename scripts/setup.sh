@@ -18,6 +18,7 @@ PACKAGES=(
   openmpi-bin libopenmpi-dev        # MPI runs of the FEM
   python3 python3-matplotlib python3-numpy   # plots in results/
   xvfb                              # offscreen rendering in CI
+  clang libclang-rt-14-dev          # libFuzzer target of the scene reader (tests/fuzz/)
 )
 
 missing=()

@@ -12,44 +12,16 @@
 #include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/fem_reference.hpp"
-#include "puncture/apps/provenance.hpp"
+#include "puncture/io/provenance.hpp"
+#include "puncture/validation/calibration_report.hpp"
 #include "puncture/io/output_session.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/calibration.hpp"
 #include "puncture/validation/metrics.hpp"
-#include "validation_support.hpp"
+#include "puncture/validation/fem_comparison.hpp"
 
 namespace puncture::apps {
 namespace {
-
-std::string metrics_table(const validation::CalibrationResult& r) {
-  std::ostringstream s;
-  s << "| layer | force RMSE before (N) | after (N) | after (% of reference peak) | puncture depth error before (mm) "
-       "| after (mm) |\n"
-       "|---|---|---|---|---|---|\n";
-  if (r.before.empty() || r.after.empty()) return s.str();
-  for (const auto& before : r.before.front().layers) {
-    const validation::LayerMetrics* after = r.after.front().layer(before.layer);
-    s << "| " << before.layer << " | " << std::setprecision(4) << before.force_rmse_N << " | "
-      << (after ? after->force_rmse_N : 0.0) << " | " << std::setprecision(3)
-      << (after ? 100.0 * after->force_rmse_relative : 0.0) << " | " << std::setprecision(4)
-      << before.puncture_depth_error_m * 1e3 << " | " << (after ? after->puncture_depth_error_m * 1e3 : 0.0)
-      << " |\n";
-  }
-  return s.str();
-}
-
-/// curve,time_s,depth_mm,force_N rows of the insertion phase of each curve.
-std::string curves_csv(const std::vector<std::pair<std::string, const validation::InsertionCurve*>>& curves) {
-  std::ostringstream s;
-  s << std::setprecision(9) << "curve,time_s,depth_mm,force_N\n";
-  for (const auto& [name, c] : curves)
-    for (std::size_t i = 0; i < c->size(); ++i) {
-      if (i > 0 && c->velocity_m_per_s[i] < 0.0) break;  // withdrawal: not compared
-      s << name << ',' << c->time_s[i] << ',' << c->depth_m[i] * 1e3 << ',' << c->force_N[i] << '\n';
-    }
-  return s.str();
-}
 
 /// The command line that reproduces this calibration, every setting spelled out.
 std::string command_line(const CalibrateOptions& options, const std::filesystem::path& scene_path,
@@ -67,7 +39,9 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
 
 }  // namespace
 
-int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::ostream& err) {
+int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stream, std::ostream& err) {
+  NullStream quiet;
+  std::ostream& out = options.quiet ? quiet : stdout_stream;
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
   return report_errors(err, "", [&]() -> int {
     const Scene scene = load_scene(scene_path);
@@ -93,11 +67,14 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
     calibration.method = validation::parse_calibration_method(options.method);
     calibration.layers = options.layers;
     if (!(options.bound_factor > 1.0) || !std::isfinite(options.bound_factor))
-      throw std::invalid_argument("--bound-factor must be a finite number > 1");
+      throw UsageError("--bound-factor must be a finite number > 1");
     calibration.bound_factor = options.bound_factor;
     calibration.integrator = options.integrator.empty() ? scene.realtime.integrator : options.integrator;
+    if (calibration.integrator != "quasi_static" && calibration.integrator != "explicit" &&
+        calibration.integrator != "implicit")
+      throw UsageError("--integrator must be quasi_static, explicit or implicit (got '" + calibration.integrator + "')");
     if (!(options.depth_weight >= 0.0) || !std::isfinite(options.depth_weight))
-      throw std::invalid_argument("--depth-weight must be a finite number >= 0");
+      throw UsageError("--depth-weight must be a finite number >= 0");
     calibration.weights.puncture_depth = options.depth_weight;
     for (const std::string& name : options.also_tune) {
       if (name == "surface_stiffness")
@@ -107,7 +84,7 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
       else if (name == "spacing")
         calibration.parameters.spacing = true;
       else
-        throw std::invalid_argument("--also-tune: unknown parameter '" + name +
+        throw UsageError("--also-tune: unknown parameter '" + name +
                                     "' (surface_stiffness, rings or spacing)");
     }
     validation::CalibrationProgressCallback progress;
@@ -125,30 +102,32 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
     io::OutputSession session(dir);
     const std::string name = options.preset_name.empty() ? scene.name + "_tuned" : options.preset_name;
     const std::string command = command_line(options, scene_path, dir, name, calibration.integrator);
+    const io::Provenance provenance = io::make_provenance(command);
     validation::write_tuned_preset(session, name, result, {reference}, calibration);
     // The model curves the objective compared, before and after, for the report.
     session.write_text("calibration_curves.csv",
-                       "# made by: " + command + " on " + machine_summary() + ", " + utc_timestamp() + "\n" +
-                           curves_csv({{reference.kind, &reference.curve},
-                                       {"before", &result.model_before.front()},
-                                       {"after", &result.model_after.front()}}));
+                       validation::calibration_curves_csv({{reference.kind, &reference.curve},
+                                                           {"before", &result.model_before.front()},
+                                                           {"after", &result.model_after.front()}},
+                                                          provenance));
     std::ostringstream md;
-    md << "# Calibration of " << scene.name << "\n\nMade by `" << command << "` on " << machine_summary() << ", " << utc_timestamp() << ".\n\nReference: " << reference.kind << " ("
+    md << "# Calibration of " << scene.name << "\n\nMade by `" << command << "` on " << provenance.machine << ", " << provenance.date_utc << " (program " << provenance.program_version
+       << ", git " << provenance.git_revision << ").\n\nReference: " << reference.kind << " ("
        << reference.curve.source << "). Method: " << options.method << ", " << result.evaluations
        << " model runs in " << std::setprecision(4) << calibration_s
        << " s (wall, reference already available). Objective " << result.objective_before << " -> "
        << result.objective_after << ".\n\n"
-       << metrics_table(result) << "\nTuned preset: `" << name << ".json` (a scene `puncture run` accepts), provenance: `"
+       << validation::calibration_metrics_table(result) << "\nTuned preset: `" << name << ".json` (a scene `puncture run` accepts), provenance: `"
        << name << ".provenance.json`.\n";
     if (!result.damping_note.empty()) md << "\nDamping d: " << result.damping_note << "\n";
     session.commit();
-    const std::vector<std::string> plots = run_plot_script("plot_calibration.py", dir, out, err);
+    const std::vector<std::string> plots = validation::run_plot_script("plot_calibration.py", dir, out, err);
     for (const std::string& p : plots) md << "\n![" << p << "](" << p << ")\n";
     io::OutputSession md_session(dir);
     md_session.write_text("calibration_summary.md", md.str());
     md_session.commit();
 
-    out << "\n" << metrics_table(result) << "\nTuned preset: " << (dir / (name + ".json")).string()
+    out << "\n" << validation::calibration_metrics_table(result) << "\nTuned preset: " << (dir / (name + ".json")).string()
         << "\n  run it with: puncture run " << (dir / (name + ".json")).string() << '\n';
     return 0;
   });

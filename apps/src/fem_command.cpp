@@ -2,6 +2,7 @@
 // unchanged under `mpirun -np N puncture fem ...`; rank 0 prints.
 #include <iostream>
 
+#include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/fem_reference.hpp"
 #include "puncture/scene_io.hpp"
@@ -14,12 +15,15 @@
 
 namespace puncture::apps {
 
-int fem_command(const FemOptions& options, std::ostream& out, std::ostream& err) {
+int fem_command(const FemOptions& options, std::ostream& stdout_stream, std::ostream& err) {
+  NullStream quiet;
+  std::ostream& out = options.quiet ? quiet : stdout_stream;
 #ifdef PUNCTURE_HAVE_FEM
   ensure_mpi();
   const bool root = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
-  try {
+  NullStream silent;
+  return report_errors(root ? err : silent, scene_path.string(), [&]() -> int {
     const Scene scene = load_scene(scene_path);
     fem::FemRunOptions fem_options;
     fem_options.output_dir =
@@ -27,6 +31,7 @@ int fem_command(const FemOptions& options, std::ostream& out, std::ostream& err)
     fem_options.refinement_override = options.refinement;
     fem_options.degree_override = options.degree;
     fem_options.write_vtu = options.write_vtu;
+    fem_options.verbose = !options.quiet;
     const fem::FemRunSummary summary = fem::run_needle_insertion(scene, fem_options, MPI_COMM_WORLD);
     if (root) {
       out << "\nFEM puncture events (" << summary.punctures.size() << "):\n";
@@ -37,18 +42,12 @@ int fem_command(const FemOptions& options, std::ostream& out, std::ostream& err)
           << " s\nOutputs in " << fem_options.output_dir << "/ (fem_force_depth.csv, fem_summary.json, fem_fields.pvd)\n";
     }
     return 0;
-  } catch (const SceneError& e) {
-    if (root) err << "error: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    if (root) err << "error: " << scene_path.string() << ": " << e.what() << '\n';
-    return 1;
-  }
+  });
 #else
   (void)options;
   (void)out;
   err << "error: this build has no FEM reference (configure with -DPUNCTURE_WITH_FEM=ON)\n";
-  return 1;
+  return kExitFailure;
 #endif
 }
 

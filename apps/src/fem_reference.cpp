@@ -27,6 +27,8 @@
 #include <nlohmann/json.hpp>
 
 #include "puncture/io/content_hash.hpp"
+#include "puncture/io/interrupt_cleanup.hpp"
+#include "puncture/io/provenance.hpp"
 
 #ifdef PUNCTURE_HAVE_FEM
 #include <deal.II/base/mpi.h>
@@ -36,9 +38,6 @@
 
 #ifndef PUNCTURE_FEM_SOURCE_DIGEST
 #define PUNCTURE_FEM_SOURCE_DIGEST "none"
-#endif
-#ifndef PUNCTURE_VERSION
-#define PUNCTURE_VERSION "unknown"
 #endif
 
 namespace puncture::apps {
@@ -59,7 +58,7 @@ const char* criterion_name(PunctureCriterion::Kind kind) {
 /// The text that is hashed (JSON, numbers in SI units printed exactly).
 std::string fem_reference_key_text(const Scene& scene, const FemReferenceOptions& options) {
   nlohmann::ordered_json key;
-  key["program_version"] = PUNCTURE_VERSION;
+  key["program_version"] = io::program_version();
   key["fem_source_digest"] = PUNCTURE_FEM_SOURCE_DIGEST;
   key["sample_diameter_m"] = exact(scene.sample.diameter_m);
   key["needle"] = {{"radius_m", exact(scene.needle.radius_m)}, {"tip", scene.needle.tip}};
@@ -183,7 +182,8 @@ FemReference obtain_fem_reference(const Scene& scene, const FemReferenceOptions&
   const std::filesystem::path staging = options.cache_dir / (".tmp-" + ref.hash);
   if (root) {
     std::filesystem::create_directories(options.cache_dir);
-    std::filesystem::remove_all(staging);
+    std::filesystem::remove_all(staging);  // left by an earlier run of the same key that died
+    io::register_cleanup(staging, io::CleanupKind::Tree);  // an interrupted run leaves nothing
   }
   MPI_Barrier(MPI_COMM_WORLD);
   if (options.verbose && root)
@@ -207,6 +207,7 @@ FemReference obtain_fem_reference(const Scene& scene, const FemReferenceOptions&
     if (root) {
       std::error_code ignored;
       std::filesystem::remove_all(staging, ignored);
+      io::unregister_cleanup(staging);
     }
     throw;
   }
@@ -215,6 +216,7 @@ FemReference obtain_fem_reference(const Scene& scene, const FemReferenceOptions&
     // Replace an incomplete or vtu-less reference of the same key.
     std::filesystem::remove_all(ref.dir);
     std::filesystem::rename(staging, ref.dir);
+    io::unregister_cleanup(staging);
   }
   MPI_Barrier(MPI_COMM_WORLD);
   if (options.verbose && root) out << "[fem] reference cached in " << ref.dir.string() << "\n";

@@ -5,20 +5,21 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
-#include "puncture/apps/provenance.hpp"
-#include "run_outputs.hpp"
+#include "puncture/io/csv_writer.hpp"
 #include "puncture/io/output_session.hpp"
-#include "puncture/io/pvd.hpp"
-#include "puncture/io/vtk_polydata.hpp"
-#include "puncture/model/force_mesh_field.hpp"
+#include "puncture/io/provenance_json.hpp"
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/scene_io.hpp"
+#include "puncture/scene_limits.hpp"
+#include "puncture/validation/plausibility.hpp"
+#include "run_outputs.hpp"
 
 namespace puncture::apps {
 
@@ -44,46 +45,47 @@ double quantile(std::vector<double> v, double q) {
   return v[k];
 }
 
-std::string fmt(double x, int precision = 17) {
-  std::ostringstream s;
-  s << std::setprecision(precision) << x;
-  return s.str();
-}
-
-/// realtime_curve.csv: one row per haptic tick.
-std::string curve_csv(const Scene& scene, const ScriptedRunResult& run) {
-  std::ostringstream csv;
-  csv << "time_s,depth_mm,velocity_mm_per_s,force_N";
+/// realtime_curve.csv: one row per kept haptic tick (every tick unless the
+/// run is longer than scene_limits::kMaxCurveRows ticks).
+std::string curve_csv(const Scene& scene, const ScriptedRunResult& run, const std::vector<std::size_t>& kept,
+                      std::size_t stride, const io::Provenance& provenance) {
+  std::vector<std::string> columns{"time_s", "depth_mm", "velocity_mm_per_s", "force_N"};
   for (const Layer& l : scene.layers)
-    csv << ',' << l.name << "_state," << l.name << "_surface_force_N," << l.name << "_damping_force_N," << l.name
-        << "_deformed_rings";
-  csv << '\n';
-  for (const TickResult& t : run.ticks) {
-    csv << fmt(t.time_s) << ',' << fmt(t.depth_m / kMm) << ',' << fmt(t.velocity_m_per_s / kMm) << ','
-        << fmt(t.total_force_N);
+    for (const char* c : {"_state", "_surface_force_N", "_damping_force_N", "_deformed_rings"}) columns.push_back(l.name + c);
+  io::CsvWriter csv(columns);
+  csv.add_provenance(provenance);
+  if (stride > 1)
+    csv.add_metadata("decimation", "every " + std::to_string(stride) + "-th of " + std::to_string(run.ticks.size()) +
+                                       " ticks, plus every tick at which a layer changes state");
+  for (std::size_t i : kept) {
+    const TickResult& t = run.ticks[i];
+    csv.number(t.time_s).number(t.depth_m / kMm).number(t.velocity_m_per_s / kMm).number(t.total_force_N);
     for (const LayerTickResult& l : t.layers)
-      csv << ',' << to_string(l.state) << ',' << fmt(l.surface_force_N) << ',' << fmt(l.damping_force_N) << ','
-          << l.deformed_rings;
-    csv << '\n';
+      csv.text(to_string(l.state)).number(l.surface_force_N).number(l.damping_force_N).integer(l.deformed_rings);
+    csv.end_row();
   }
   return csv.str();
 }
 
 /// sh_fit_error.csv: the SH degree accuracy knob, per layer.
-std::string fit_error_csv(const std::vector<LayerFitErrorEntry>& rows) {
-  std::ostringstream csv;
-  csv << "layer,degree,top_face_max_error_mm,top_face_rms_error_mm,whole_surface_rms_error_mm,condition_number\n";
+std::string fit_error_csv(const std::vector<LayerFitErrorEntry>& rows, const io::Provenance& provenance) {
+  io::CsvWriter csv({"layer", "degree", "top_face_max_error_mm", "top_face_rms_error_mm", "whole_surface_rms_error_mm",
+                     "condition_number"});
+  csv.add_provenance(provenance);
   for (const auto& e : rows)
-    csv << e.layer << ',' << e.row.degree << ',' << fmt(e.row.top_face_max_error_m / kMm, 6) << ','
-        << fmt(e.row.top_face_rms_error_m / kMm, 6) << ',' << fmt(e.row.whole_surface_rms_error_m / kMm, 6) << ','
-        << fmt(e.row.condition_number, 6) << '\n';
+    csv.text(e.layer).integer(e.row.degree).number(e.row.top_face_max_error_m / kMm, 6)
+        .number(e.row.top_face_rms_error_m / kMm, 6).number(e.row.whole_surface_rms_error_m / kMm, 6)
+        .number(e.row.condition_number, 6).end_row();
   return csv.str();
 }
 
 nlohmann::json summary_json(const Scene& scene, const RealtimeModel& model, const ScriptedRunResult& run,
-                            const std::string& command_line) {
+                            const io::Provenance& provenance, const std::vector<std::string>& warnings,
+                            std::size_t curve_rows, std::size_t stride) {
   nlohmann::json j;
-  j["provenance"] = provenance_json(command_line);
+  j["provenance"] = io::provenance_json(provenance);
+  j["warnings"] = warnings;
+  j["realtime_curve"] = {{"ticks", run.ticks.size()}, {"rows", curve_rows}, {"decimation_stride", stride}};
   j["scene"] = {{"name", scene.name}, {"file", scene.source_path}};
   j["settings"] = nlohmann::json::parse(scene_to_json_text(scene));
   nlohmann::json events = nlohmann::json::array();
@@ -124,14 +126,19 @@ nlohmann::json summary_json(const Scene& scene, const RealtimeModel& model, cons
 
 }  // namespace
 
-int run_command(const RunOptions& options, std::ostream& out, std::ostream& err) {
+int run_command(const RunOptions& options, std::ostream& stdout_stream, std::ostream& err) {
+  NullStream quiet;
+  std::ostream& out = options.quiet ? quiet : stdout_stream;
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
   return report_errors(err, scene_path.string(), [&]() -> int {
     const Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / scene.name : options.output_dir;
-    if (!options.quiet) out << "[run] scene " << scene_path.string() << " (" << scene.layers.size() << " layers, SH degree "
-                            << scene.realtime.sh_degree << ", integrator " << scene.realtime.integrator << ")\n";
+    out << "[run] scene " << scene_path.string() << " (" << scene.layers.size() << " layers, SH degree "
+        << scene.realtime.sh_degree << ", integrator " << scene.realtime.integrator << ")\n";
+    const std::string command_line = "puncture run " + scene_path.string() + " -o " + dir.string() +
+                                     (options.write_frames ? "" : " --no-frames");
+    const io::Provenance provenance = io::make_provenance(command_line);
 
     RealtimeModel model = build_realtime_model(scene);
     io::OutputSession session(dir);
@@ -140,23 +147,45 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     if (std::find(degrees.begin(), degrees.end(), scene.realtime.sh_degree) == degrees.end())
       degrees.push_back(scene.realtime.sh_degree);
     std::sort(degrees.begin(), degrees.end());
-    session.write_text("sh_fit_error.csv", fit_error_csv(scene_fit_error_sweep(scene, degrees)));
+    session.write_text("sh_fit_error.csv", fit_error_csv(scene_fit_error_sweep(scene, degrees), provenance));
 
+    FrameCallback on_frame;
+#ifdef PUNCTURE_HAVE_VTK
     const bool frames = options.write_frames && scene.effects.surface_output;
     std::optional<FrameWriter> writer;
-    if (frames) writer.emplace(session, model, scene);
-    FrameCallback on_frame;
+    if (frames) {
+      FrameWriterOptions frame_options;
+      frame_options.provenance = &provenance;
+      writer.emplace(session, model, scene, frame_options);
+    }
     if (writer) on_frame = [&](const PunctureSimulator& sim, const TickResult& t, int f) { writer->write(sim, t, f); };
+#else
+    if (options.write_frames && scene.effects.surface_output)
+      err << "warning: this build has no VTK (PUNCTURE_WITH_VTK=OFF): no surface frames are written\n";
+#endif
     ProgressCallback on_progress;
     if (!options.quiet)
       on_progress = [&](double f) { out << "[run] " << std::setw(3) << static_cast<int>(std::lround(100 * f)) << " %\n" << std::flush; };
 
     const ScriptedRunResult run = run_scripted_insertion(model, scene, on_frame, on_progress);
+#ifdef PUNCTURE_HAVE_VTK
     if (writer) writer->finish();
+#endif
 
-    session.write_text("realtime_curve.csv", curve_csv(scene, run));
-    const std::string command_line = "puncture run " + scene_path.string() + " -o " + dir.string();
-    session.write_text("summary.json", summary_json(scene, model, run, command_line).dump(2) + "\n");
+    std::vector<std::string> warnings = validation::plausibility_warnings(scene, run);
+    std::size_t stride = 1;
+    const std::vector<std::size_t> kept =
+        validation::decimated_tick_indices(run, scene_limits::kMaxCurveRows, stride);
+    if (stride > 1)
+      warnings.push_back("realtime_curve.csv: " + std::to_string(run.ticks.size()) + " ticks are more than " +
+                         std::to_string(scene_limits::kMaxCurveRows) + " rows; written every " +
+                         std::to_string(stride) + "-th tick plus every tick at which a layer changes state (" +
+                         std::to_string(kept.size()) + " rows)");
+    for (const std::string& w : warnings) err << "warning: " << w << '\n';
+
+    session.write_text("realtime_curve.csv", curve_csv(scene, run, kept, stride, provenance));
+    session.write_text("summary.json",
+                       summary_json(scene, model, run, provenance, warnings, kept.size(), stride).dump(2) + "\n");
     session.commit();
 
     out << "\nPuncture events (" << run.events.size() << "):\n";
@@ -168,10 +197,12 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     out.unsetf(std::ios::floatfield);
     out << "\nOutputs in " << dir.string() << "/:\n"
         << "  realtime_curve.csv  force, depth, per-layer states and forces per haptic tick\n"
-        << "  summary.json        puncture events, peak forces, SH fit, tick timing, settings\n"
+        << "  summary.json        puncture events, peak forces, SH fit, tick timing, settings, warnings\n"
         << "  sh_fit_error.csv    SH surface fit error versus degree l\n";
+#ifdef PUNCTURE_HAVE_VTK
     if (writer)
       out << "  realtime.pvd        " << writer->frames() << " frames of layer surfaces and force meshes (open in ParaView)\n";
+#endif
     return 0;
   });
 }

@@ -10,8 +10,10 @@
 //   Out: staged files in the session; entries() for a combined .pvd.
 // Part indices: surface of layer k = first_part + k, its force mesh =
 // first_part + n_layers + k. Coordinates in m (scene frame), shifted by
-// x_offset_m along x (validate puts the real-time model beside the FEM slab).
+// x_offset_m along x (validate puts the real-time model beside the FEM slab);
+// point arrays in the unit their name says (deflection_mm in mm).
 #pragma once
+#ifdef PUNCTURE_HAVE_VTK  // the frames are VTK files: only in builds with VTK
 
 #include <cmath>
 #include <cstdio>
@@ -37,6 +39,8 @@ struct FrameWriterOptions {
   int first_part = 0;                 ///< .pvd part index of the first layer surface
   int surface_bands_theta = 48;       ///< tessellation of the SH surfaces
   int surface_azimuths = 72;
+  /// Provenance stored as field data of every .vtp and as a comment in the .pvd.
+  const io::Provenance* provenance = nullptr;
   /// Optional reference deflection (mm, > 0 into the tissue) of layer k at
   /// radius r_m from the needle axis at time t_s; NaN where there is none.
   /// When set, the surfaces carry deflection_error_mm = model - reference (0
@@ -99,7 +103,7 @@ class FrameWriter {
       }
       vertices.rowwise() += offset;
       const std::string surface_file = options_.directory + "/" + name + "_surface_" + index + ".vtp";
-      io::write_polydata(session_, surface_file, vertices, triangles_[k], fields, {});
+      io::write_polydata(session_, surface_file, vertices, triangles_[k], fields, {}, options_.provenance);
       entries_.push_back({tick.time_s, options_.first_part + static_cast<int>(k), surface_file});
 
       if (mesh && mesh->node_count() > 0) {
@@ -116,7 +120,7 @@ class FrameWriter {
         if (lattice_tris_[k].rows() == 0) lattice_tris_[k] = lattice_triangles(mesh->lattice());
         const std::string mesh_file = options_.directory + "/" + name + "_force_mesh_" + index + ".vtp";
         io::write_polydata(session_, mesh_file, nodes, lattice_tris_[k],
-                           {{"ring", ring}, {"deflection_mm", node_deflection}}, {});
+                           {{"ring", ring}, {"deflection_mm", node_deflection}}, {}, options_.provenance);
         entries_.push_back({tick.time_s, options_.first_part + static_cast<int>(n_layers + k), mesh_file});
       }
     }
@@ -124,7 +128,7 @@ class FrameWriter {
   }
 
   void finish() {
-    if (!entries_.empty() && !options_.pvd_name.empty()) io::write_pvd(session_, options_.pvd_name, entries_);
+    if (!entries_.empty() && !options_.pvd_name.empty()) io::write_pvd(session_, options_.pvd_name, entries_, options_.provenance);
   }
   int frames() const { return frames_; }
   const std::vector<io::PvdEntry>& entries() const { return entries_; }
@@ -142,3 +146,5 @@ class FrameWriter {
 };
 
 }  // namespace puncture::apps
+
+#endif  // PUNCTURE_HAVE_VTK

@@ -32,19 +32,29 @@
 #include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/fem_reference.hpp"
-#include "puncture/apps/provenance.hpp"
+#include "puncture/io/provenance.hpp"
+#include "puncture/io/provenance_json.hpp"
 #include "puncture/io/output_session.hpp"
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/metrics.hpp"
-#include "validation_support.hpp"
+#include "puncture/io/atomic_file.hpp"
+#include "puncture/validation/fem_comparison.hpp"
+#include "puncture/validation/sweep.hpp"
 
 namespace puncture::apps {
 
 namespace {
 
-constexpr double kMm = 1e-3;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using validation::SweepRow;
+
+std::string fmt(double x, int precision) {
+  if (!std::isfinite(x)) return "nan";
+  std::ostringstream s;
+  s << std::setprecision(precision) << x;
+  return s.str();
+}
 
 struct FemKnob {
   int refinement;
@@ -53,139 +63,18 @@ struct FemKnob {
 /// The default FEM part: what finishes in about a quarter of an hour on 2 cores.
 const std::vector<FemKnob> kFemKnobs{{0, 1}, {0, 2}, {1, 1}};
 
-struct SweepRow {
-  std::string model;    ///< "realtime" or "fem"
-  std::string knob;     ///< e.g. "sh_degree"
-  std::string value;    ///< the knob's value as text
-  bool baseline = false;
-  std::string status = "ok";
-  double force_rmse_N = kNaN;
-  double force_rmse_relative = kNaN;
-  double puncture_depth_error_mm = kNaN;
-  int punctures_compared = 0;
-  int missed_punctures = 0;
-  double time_per_step_s = kNaN;
-  std::string time_kind;
-  double n_dofs = kNaN;
-};
-
-std::string fmt(double x, int precision = 8) {
-  if (!std::isfinite(x)) return "nan";
-  std::ostringstream s;
-  s << std::setprecision(precision) << x;
-  return s.str();
-}
-
-void fill_errors(SweepRow& row, const validation::InsertionCurve& model, const validation::InsertionCurve& reference) {
-  const validation::CurveComparison cmp = validation::compare_curves(model, reference);
-  row.force_rmse_N = cmp.force_rmse_N;
-  row.force_rmse_relative = cmp.force_rmse_relative;
-  double sum_sq = 0.0;
-  for (const validation::LayerMetrics& m : cmp.layers) {
-    if (m.reference_puncture.found && m.model_puncture.found) {
-      sum_sq += m.puncture_depth_error_m * m.puncture_depth_error_m;
-      ++row.punctures_compared;
-    } else if (m.reference_puncture.found != m.model_puncture.found) {
-      ++row.missed_punctures;
-    }
-  }
-  row.puncture_depth_error_mm = row.punctures_compared > 0 ? std::sqrt(sum_sq / row.punctures_compared) / kMm : kNaN;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
-
-SweepRow realtime_variant(const Scene& scene, const std::string& knob, const std::string& value, bool baseline,
-                          const validation::InsertionCurve& reference) {
-  SweepRow row;
-  row.model = "realtime";
-  row.knob = knob;
-  row.value = value;
-  row.baseline = baseline;
-  row.time_kind = "median haptic tick wall time";
-  try {
-    validate_scene(scene, "sweep variant " + knob + " = " + value);
-  } catch (const SceneError& e) {
-    // E.g. a spacing L that puts the force mesh outside the sample.
-    row.status = std::string("invalid: ") + e.what();
-    return row;
-  }
-  try {
-    RealtimeModel model = build_realtime_model(scene);
-    const ScriptedRunResult run = run_scripted_insertion(model, scene);
-    row.time_per_step_s = median(run.tick_wall_time_s);
-    // Against the quasi-static, frictionless FEM: without the damping force.
-    fill_errors(row, validation::curve_from_run(scene, run, "realtime", /*include_damping=*/false), reference);
-  } catch (const std::exception& e) {
-    row.status = std::string("failed: ") + e.what();
-  }
-  return row;
-}
-
-std::string table_csv(const std::vector<SweepRow>& rows) {
-  std::ostringstream csv;
-  csv << "model,knob,value,baseline,status,force_rmse_N,force_rmse_relative,puncture_depth_error_mm,"
-         "punctures_compared,missed_punctures,time_per_step_s,n_dofs\n";
-  for (const SweepRow& r : rows) {
-    std::string status = r.status;
-    std::replace(status.begin(), status.end(), ',', ';');
-    std::replace(status.begin(), status.end(), '\n', ' ');
-    csv << r.model << ',' << r.knob << ',' << r.value << ',' << (r.baseline ? 1 : 0) << ',' << status << ','
-        << fmt(r.force_rmse_N) << ',' << fmt(r.force_rmse_relative) << ',' << fmt(r.puncture_depth_error_mm) << ','
-        << r.punctures_compared << ',' << r.missed_punctures << ',' << fmt(r.time_per_step_s) << ',' << fmt(r.n_dofs)
-        << '\n';
-  }
-  return csv.str();
-}
-
-std::string table_markdown(const Scene& scene, const std::vector<SweepRow>& rows, const std::string& finest,
-                           const nlohmann::json& provenance, const std::vector<std::string>& plots) {
-  std::ostringstream md;
-  md << "# Accuracy against cost: " << scene.name << "\n\n";
-  md << "Every fidelity knob varied one at a time around the scene's values (baseline rows marked). Error "
-        "against the finest FEM reference (" << finest << "): force RMSE over the insertion phase and the RMS "
-        "puncture-depth error over the layers both models puncture (missed = punctured by one model only). "
-        "Cost: real-time = median wall time of one haptic tick; FEM = wall time per quasi-static load step.\n\n";
-  md << "- command: `" << provenance.value("command", "") << "`\n";
-  md << "- program " << provenance.value("program_version", "") << ", git revision "
-     << provenance.value("git_revision", "") << "; machine: " << provenance.value("machine", "")
-     << "; date (UTC): " << provenance.value("date_utc", "") << "\n\n";
-  for (const std::string& p : plots) md << "![" << p << "](" << p << ")\n\n";
-  md << "| model | knob | value | force RMSE (N) | RMSE / peak | puncture depth error (mm) | missed punctures | "
-        "time per step | DoFs | status |\n";
-  md << "|---|---|---|---|---|---|---|---|---|---|\n";
-  for (const SweepRow& r : rows) {
-    std::string time = "–";
-    if (std::isfinite(r.time_per_step_s)) {
-      std::ostringstream t;
-      if (r.model == "fem")
-        t << std::setprecision(3) << r.time_per_step_s << " s";
-      else
-        t << std::setprecision(3) << r.time_per_step_s * 1e6 << " µs";
-      time = t.str();
-    }
-    md << "| " << r.model << " | " << r.knob << " | " << r.value << (r.baseline ? " (baseline)" : "") << " | "
-       << fmt(r.force_rmse_N, 4) << " | " << fmt(r.force_rmse_relative, 3) << " | "
-       << fmt(r.puncture_depth_error_mm, 4) << " | " << r.missed_punctures << " | " << time << " | "
-       << (std::isfinite(r.n_dofs) ? fmt(r.n_dofs, 10) : "–") << " | " << r.status << " |\n";
-  }
-  md << "\nFiles: [accuracy_cost.csv](accuracy_cost.csv), [accuracy_cost.json](accuracy_cost.json).\n";
-  return md.str();
-}
-
 }  // namespace
 
-int sweep_command(const SweepOptions& options, std::ostream& out, std::ostream& err) {
+int sweep_command(const SweepOptions& options, std::ostream& stdout_stream, std::ostream& err) {
+  NullStream quiet;
+  std::ostream& out = options.quiet ? quiet : stdout_stream;
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
   return report_errors(err, scene_path.string(), [&]() -> int {
     const Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_accuracy_cost") : options.output_dir;
     auto progress = [&](const std::string& line) {
-      if (!options.quiet) out << "[sweep] " << line << '\n' << std::flush;
+      out << "[sweep] " << line << '\n' << std::flush;
     };
     std::vector<SweepRow> rows;
 
@@ -210,7 +99,7 @@ int sweep_command(const SweepOptions& options, std::ostream& out, std::ostream& 
       fo.verbose = !options.quiet;
       FemResult r{k, obtain_fem_reference(scene, fo, out), {}, {}};
       r.curve = validation::read_insertion_curve(r.ref.dir / "fem_force_depth.csv");
-      r.summary = nlohmann::json::parse(read_text(r.ref.dir / "fem_summary.json"));
+      r.summary = nlohmann::json::parse(io::read_text_file(r.ref.dir / "fem_summary.json"));
       fem_results.push_back(std::move(r));
     }
     if (!is_mpi_root()) return 0;  // the other ranks only help with the FEM
@@ -232,59 +121,27 @@ int sweep_command(const SweepOptions& options, std::ostream& out, std::ostream& 
       row.n_dofs = r.summary.value("n_dofs", 0.0);
       const double steps = r.summary.value("load_steps", 0.0);
       row.time_per_step_s = steps > 0 ? r.summary.value("wall_time_s", 0.0) / steps : kNaN;
-      fill_errors(row, r.curve, finest.curve);
+      validation::fill_sweep_errors(row, r.curve, finest.curve);
       rows.push_back(row);
     }
 
     // 3. Real-time knobs, one at a time.
     const validation::InsertionCurve& reference = finest.curve;
-    auto run_variant = [&](const Scene& variant, const std::string& knob, const std::string& value, bool baseline) {
-      progress("real-time " + knob + " = " + value);
-      rows.push_back(realtime_variant(variant, knob, value, baseline, reference));
-      if (!options.quiet && rows.back().status != "ok") out << "[sweep]   " << rows.back().status << '\n';
-    };
-    std::vector<int> degrees{4, 8, 12, 16, 24, 32};
-    if (std::find(degrees.begin(), degrees.end(), scene.realtime.sh_degree) == degrees.end())
-      degrees.push_back(scene.realtime.sh_degree), std::sort(degrees.begin(), degrees.end());
-    for (int l : degrees) {
-      Scene v = scene;
-      v.realtime.sh_degree = l;
-      run_variant(v, "sh_degree", std::to_string(l), l == scene.realtime.sh_degree);
-    }
-    for (int delta : {-2, -1, 0, 1, 2, 4}) {
-      Scene v = scene;
-      bool valid = true;
-      for (Layer& layer : v.layers) {
-        layer.force_mesh.rings_w += delta;
-        valid = valid && layer.force_mesh.rings_w >= 2;
-      }
-      if (!valid) continue;
-      run_variant(v, "rings_w_delta", (delta > 0 ? "+" : "") + std::to_string(delta), delta == 0);
-    }
-    for (double factor : {0.5, 0.75, 1.0, 1.5, 2.0}) {
-      Scene v = scene;
-      for (Layer& layer : v.layers) layer.force_mesh.spacing_L_m *= factor;
-      run_variant(v, "spacing_L_factor", fmt(factor, 3), factor == 1.0);
-    }
-    for (const char* integrator : {"explicit", "implicit", "quasi_static"}) {
-      Scene v = scene;
-      v.realtime.integrator = integrator;
-      run_variant(v, "integrator", integrator, v.realtime.integrator == scene.realtime.integrator);
-    }
-    for (double rate : {250.0, 500.0, 1000.0, 2000.0, 4000.0}) {
-      Scene v = scene;
-      v.realtime.haptic_rate_Hz = rate;
-      run_variant(v, "haptic_rate_Hz", fmt(rate, 6), rate == scene.realtime.haptic_rate_Hz);
+    for (SweepRow& row : validation::sweep_realtime_knobs(scene, reference, [&](const std::string& knob, const std::string& value) {
+           progress("real-time " + knob + " = " + value);
+         })) {
+      if (row.status != "ok") out << "[sweep]   " << row.status << '\n';
+      rows.push_back(std::move(row));
     }
 
     // 5. Outputs.
     std::string command_line = "puncture sweep " + scene_path.string() + " -o " + dir.string();
     if (!options.include_fem_knobs) command_line += " --no-fem-knobs";
-    const nlohmann::json provenance = provenance_json(command_line);
+    const io::Provenance provenance = io::make_provenance(command_line);
     io::OutputSession session(dir);
-    session.write_text("accuracy_cost.csv", table_csv(rows));
+    session.write_text("accuracy_cost.csv", validation::sweep_table_csv(rows, provenance));
     nlohmann::json j;
-    j["provenance"] = provenance;
+    j["provenance"] = io::provenance_json(provenance);
     j["scene"] = {{"name", scene.name}, {"file", scene_path.string()}};
     j["reference"] = {{"description", finest_name}, {"hash", finest.ref.hash}};
     nlohmann::json fem_json = nlohmann::json::array();
@@ -292,9 +149,9 @@ int sweep_command(const SweepOptions& options, std::ostream& out, std::ostream& 
     j["fem_runs"] = fem_json;
     session.write_text("accuracy_cost.json", j.dump(2) + "\n");
     session.commit();
-    const std::vector<std::string> plots = run_plot_script("plot_sweep.py", dir, out, err);
+    const std::vector<std::string> plots = validation::run_plot_script("plot_sweep.py", dir, out, err);
     io::OutputSession md_session(dir);
-    md_session.write_text("accuracy_cost.md", table_markdown(scene, rows, finest_name, provenance, plots));
+    md_session.write_text("accuracy_cost.md", validation::sweep_table_markdown(scene, rows, finest_name, provenance, plots));
     md_session.commit();
 
     out << "\nAccuracy against cost (" << rows.size() << " variants; reference " << finest_name << ")\n";

@@ -35,21 +35,22 @@
 #include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/fem_reference.hpp"
-#include "puncture/apps/provenance.hpp"
+#include "puncture/io/atomic_file.hpp"
+#include "puncture/io/vtk_xml_field_data.hpp"
+#include "puncture/io/provenance_json.hpp"
 #include "puncture/io/output_session.hpp"
 #include "puncture/io/pvd.hpp"
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/metrics.hpp"
 #include "run_outputs.hpp"
-#include "validation_support.hpp"
+#include "puncture/validation/fem_comparison.hpp"
 
 namespace puncture::apps {
 
 namespace {
 
 constexpr double kMm = 1e-3;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string fmt(double x, int precision = 10) {
   if (!std::isfinite(x)) return "nan";
@@ -58,105 +59,27 @@ std::string fmt(double x, int precision = 10) {
   return s.str();
 }
 
-using LayerDeflection = LayerDeflectionComparison;
-
-std::string layer_metrics_csv(const Scene& scene, const validation::CurveComparison& cmp,
-                              const std::vector<LayerDeflection>& defl) {
-  std::ostringstream csv;
-  csv << "layer,pressed_from_mm,pressed_to_mm,n_samples,force_rmse_N,force_rmse_relative,"
-         "fem_puncture_depth_mm,realtime_puncture_depth_mm,puncture_depth_error_mm,"
-         "fem_puncture_force_N,realtime_puncture_force_N,puncture_force_error_N,"
-         "deflection_realtime_depth_mm,deflection_fem_depth_mm,deflection_rings,deflection_rmse_mm,"
-         "deflection_max_error_mm,deflection_relative_rmse,recovery_delay_s,recovery_rings,recovery_rmse_mm,"
-         "recovery_max_error_mm\n";
-  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
-    const validation::LayerMetrics* m = cmp.layer(scene.layers[k].name);
-    const LayerDeflection& d = defl[k];
-    csv << scene.layers[k].name << ',';
-    if (m) {
-      const bool both = m->reference_puncture.found && m->model_puncture.found;
-      csv << (m->has_pressed_interval ? fmt(m->pressed_from_depth_m / kMm) : "nan") << ','
-          << (m->has_pressed_interval ? fmt(m->pressed_to_depth_m / kMm) : "nan") << ',' << m->n_samples << ','
-          << fmt(m->force_rmse_N) << ',' << fmt(m->force_rmse_relative) << ','
-          << (m->reference_puncture.found ? fmt(m->reference_puncture.depth_m / kMm) : "nan") << ','
-          << (m->model_puncture.found ? fmt(m->model_puncture.depth_m / kMm) : "nan") << ','
-          << (both ? fmt(m->puncture_depth_error_m / kMm) : "nan") << ','
-          << (m->reference_puncture.found ? fmt(m->reference_puncture.force_N) : "nan") << ','
-          << (m->model_puncture.found ? fmt(m->model_puncture.force_N) : "nan") << ','
-          << (both ? fmt(m->puncture_force_error_N) : "nan") << ',';
-    } else {
-      csv << "nan,nan,0,nan,nan,nan,nan,nan,nan,nan,nan,";
-    }
-    csv << fmt(d.realtime_depth_m / kMm) << ',' << fmt(d.fem_depth_m / kMm) << ',' << d.error.n_rings << ','
-        << (d.compared ? fmt(d.error.rmse_m / kMm) : "nan") << ','
-        << (d.compared ? fmt(d.error.max_abs_error_m / kMm) : "nan") << ','
-        << (d.compared ? fmt(d.error.relative_rmse) : "nan") << ',' << fmt(d.recovery_delay_s) << ','
-        << d.recovery_error.n_rings << ',' << (d.recovery_compared ? fmt(d.recovery_error.rmse_m / kMm) : "nan")
-        << ',' << (d.recovery_compared ? fmt(d.recovery_error.max_abs_error_m / kMm) : "nan") << '\n';
-  }
-  return csv.str();
-}
-
-/// deflection_profiles.csv: deflection (mm, > 0 into the tissue) against the
-/// distance from the needle axis, both models, before and after breakthrough.
-std::string deflection_profiles_csv(const Scene& scene, const std::vector<LayerDeflection>& defl) {
-  std::ostringstream csv;
-  csv << "layer,phase,model,depth_mm,r_mm,deflection_mm\n";
-  auto rings = [&](const std::string& layer, const char* phase, double depth, const std::vector<double>& dz,
-                   double L) {
-    for (std::size_t j = 0; j < dz.size(); ++j)
-      csv << layer << ',' << phase << ",realtime," << fmt(depth / kMm) << ',' << fmt(static_cast<double>(j) * L / kMm)
-          << ',' << fmt(dz[j] / kMm) << '\n';
-  };
-  auto fem = [&](const std::string& layer, const char* phase, const validation::RadialProfile& p) {
-    for (std::size_t i = 0; i < p.r_m.size(); ++i)
-      csv << layer << ',' << phase << ",fem," << fmt(p.depth_m / kMm) << ',' << fmt(p.r_m[i] / kMm) << ','
-          << fmt(-p.uz_m[i] / kMm) << '\n';
-  };
-  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
-    const std::string& name = scene.layers[k].name;
-    const double L = scene.layers[k].force_mesh.spacing_L_m;
-    const LayerDeflection& d = defl[k];
-    if (d.compared) {
-      rings(name, "before_breakthrough", d.realtime_depth_m, d.realtime_rings_m, L);
-      fem(name, "before_breakthrough", d.fem);
-    }
-    if (d.recovery_compared) {
-      rings(name, "after_breakthrough", d.recovery_realtime_depth_m, d.realtime_recovered_rings_m, L);
-      fem(name, "after_breakthrough", d.fem_after);
-    }
-  }
-  return csv.str();
-}
-
-/// force_depth_aligned.csv: the FEM's insertion samples with the real-time
-/// force interpolated at the same depths.
-std::string aligned_curves_csv(const validation::InsertionCurve& realtime, const validation::InsertionCurve& fem) {
-  std::ostringstream csv;
-  csv << "depth_mm,fem_force_N,realtime_force_N,difference_N\n";
-  const std::vector<std::size_t> rt_idx = validation::insertion_phase(realtime);
-  std::vector<double> rt_depth, rt_force;
-  for (std::size_t i : rt_idx) rt_depth.push_back(realtime.depth_m[i]), rt_force.push_back(realtime.force_N[i]);
-  for (std::size_t i : validation::insertion_phase(fem)) {
-    double f = kNaN;
-    const bool inside = validation::interpolate_linear(rt_depth, rt_force, fem.depth_m[i], f);
-    csv << fmt(fem.depth_m[i] / kMm) << ',' << fmt(fem.force_N[i]) << ',' << (inside ? fmt(f) : "nan") << ','
-        << (inside ? fmt(f - fem.force_N[i]) : "nan") << '\n';
-  }
-  return csv.str();
-}
-
 }  // namespace
 
-int validate_command(const ValidateOptions& options, std::ostream& out, std::ostream& err) {
+int validate_command(const ValidateOptions& options, std::ostream& stdout_stream, std::ostream& err) {
+  using namespace validation;
+  NullStream quiet;
+  std::ostream& out = options.quiet ? quiet : stdout_stream;
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
   return report_errors(err, scene_path.string(), [&]() -> int {
     const Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_validation") : options.output_dir;
+#ifdef PUNCTURE_HAVE_VTK
     const bool vtk = options.write_vtk;
+#else
+    const bool vtk = false;  // this build has no VTK: CSV, PNG and markdown only
+#endif
+    const std::string command_line = "puncture validate " + scene_path.string() + " -o " + dir.string() +
+                                     (vtk ? "" : " --no-vtk");
+    const io::Provenance provenance = io::make_provenance(command_line);
     auto progress = [&](const std::string& line) {
-      if (!options.quiet) out << "[validate] " << line << '\n' << std::flush;
+      out << "[validate] " << line << '\n' << std::flush;
     };
     progress("scene " + scene_path.string());
 
@@ -176,10 +99,12 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
              scene.realtime.integrator);
     RealtimeModel model = build_realtime_model(scene);
     io::OutputSession session(dir);
-    std::optional<FrameWriter> writer;
     std::vector<double> frame_times = vtk ? fem.frame_times_s : std::vector<double>{};
+#ifdef PUNCTURE_HAVE_VTK
+    std::optional<FrameWriter> writer;
     if (!frame_times.empty()) {
       FrameWriterOptions fw;
+      fw.provenance = &provenance;
       fw.directory = "realtime";
       fw.pvd_name.clear();
       fw.x_offset_m = scene.sample.diameter_m;
@@ -189,6 +114,7 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
       };
       writer.emplace(session, model, scene, fw);
     }
+#endif
     RingRecorder recorder(scene);
     std::size_t next_frame = 0;
     const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
@@ -196,10 +122,14 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
     every_tick.realtime.frame_rate_Hz = scene.realtime.haptic_rate_Hz;
     FrameCallback on_tick = [&](const PunctureSimulator& sim, const TickResult& t, int) {
       recorder.record(sim);
+#ifdef PUNCTURE_HAVE_VTK
       while (writer && next_frame < frame_times.size() && t.time_s + 0.5 * dt >= frame_times[next_frame]) {
         writer->write(sim, t, static_cast<int>(next_frame));
         ++next_frame;
       }
+#else
+      (void)t, (void)next_frame, (void)dt;
+#endif
     };
     ProgressCallback on_progress;
     if (!options.quiet)
@@ -214,24 +144,29 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
     const validation::CurveComparison cmp = validation::compare_curves(realtime_curve, fem.curve);
 
     // 4-5. Deflection before breakthrough and recovery after it.
-    std::vector<LayerDeflection> defl(scene.layers.size());
+    std::vector<LayerDeflectionComparison> defl(scene.layers.size());
     for (std::size_t k = 0; k < scene.layers.size(); ++k)
       defl[k] = compare_layer_deflection(scene, k, run, recorder, fem);
 
     // 6. Report files.
-    const std::string command_line = "puncture validate " + scene_path.string() + " -o " + dir.string() +
-                                     (vtk ? "" : " --no-vtk");
-    const nlohmann::json provenance = provenance_json(command_line);
-    session.write_text("realtime_curve.csv", validation::insertion_curve_csv(realtime_curve));
-    session.write_text("fem_force_depth.csv", read_text(reference.dir / "fem_force_depth.csv"));
-    session.write_text("fem_curve.csv", validation::insertion_curve_csv(fem.curve));
-    session.write_text("force_depth_aligned.csv", aligned_curves_csv(realtime_curve, fem.curve));
-    session.write_text("layer_metrics.csv", layer_metrics_csv(scene, cmp, defl));
-    session.write_text("deflection_profiles.csv", deflection_profiles_csv(scene, defl));
-    session.write_text("fem_recovery_profile.csv", read_text(reference.dir / "fem_recovery_profile.csv"));
+    session.write_text("realtime_curve.csv", insertion_curve_csv(realtime_curve, &provenance));
+    // The FEM's own files, copied; a copy without provenance of its own gets
+    // this command's (with the cache entry it came from).
+    auto with_csv_provenance = [&](const std::string& name) {
+      const std::string text = io::read_text_file(reference.dir / name);
+      if (text.rfind("# command:", 0) == 0) return text;
+      return io::provenance_comment_lines(provenance) + "# copied_from: " + (reference.dir / name).string() + "\n" +
+             text;
+    };
+    session.write_text("fem_force_depth.csv", with_csv_provenance("fem_force_depth.csv"));
+    session.write_text("fem_curve.csv", insertion_curve_csv(fem.curve, &provenance));
+    session.write_text("force_depth_aligned.csv", aligned_curves_csv(realtime_curve, fem.curve, provenance));
+    session.write_text("layer_metrics.csv", layer_metrics_csv(scene, cmp, defl, provenance));
+    session.write_text("deflection_profiles.csv", deflection_profiles_csv(scene, defl, provenance));
+    session.write_text("fem_recovery_profile.csv", with_csv_provenance("fem_recovery_profile.csv"));
 
     nlohmann::json metrics;
-    metrics["provenance"] = provenance;
+    metrics["provenance"] = io::provenance_json(provenance);
     metrics["scene"] = {{"name", scene.name}, {"file", scene_path.string()}};
     metrics["fem_reference"] = {{"hash", reference.hash},
                                 {"cache_dir", reference.dir.string()},
@@ -243,35 +178,7 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
                           {"force_rmse_relative", cmp.force_rmse_relative},
                           {"compared_from_depth_mm", cmp.compared_from_depth_m / kMm},
                           {"compared_to_depth_mm", cmp.compared_to_depth_m / kMm}};
-    nlohmann::json layers = nlohmann::json::array();
-    for (std::size_t k = 0; k < scene.layers.size(); ++k) {
-      nlohmann::json j;
-      j["layer"] = scene.layers[k].name;
-      if (const validation::LayerMetrics* m = cmp.layer(scene.layers[k].name)) {
-        j["force_rmse_N"] = m->force_rmse_N;
-        j["force_rmse_relative"] = m->force_rmse_relative;
-        j["n_samples"] = m->n_samples;
-        j["fem_punctured"] = m->reference_puncture.found;
-        j["realtime_punctured"] = m->model_puncture.found;
-        if (m->reference_puncture.found && m->model_puncture.found) {
-          j["puncture_depth_error_mm"] = m->puncture_depth_error_m / kMm;
-          j["puncture_force_error_N"] = m->puncture_force_error_N;
-        }
-      }
-      if (defl[k].compared)
-        j["deflection"] = {{"realtime_depth_mm", defl[k].realtime_depth_m / kMm},
-                           {"fem_depth_mm", defl[k].fem_depth_m / kMm},
-                           {"rings", defl[k].error.n_rings},
-                           {"rmse_mm", defl[k].error.rmse_m / kMm},
-                           {"max_abs_error_mm", defl[k].error.max_abs_error_m / kMm},
-                           {"relative_rmse", defl[k].error.relative_rmse}};
-      if (defl[k].recovery_compared)
-        j["recovery"] = {{"delay_s", defl[k].recovery_delay_s},
-                         {"rings", defl[k].recovery_error.n_rings},
-                         {"rmse_mm", defl[k].recovery_error.rmse_m / kMm},
-                         {"max_abs_error_mm", defl[k].recovery_error.max_abs_error_m / kMm}};
-      layers.push_back(j);
-    }
+    const nlohmann::json layers = layer_metrics_json(scene, cmp, defl);
     metrics["layers"] = layers;
     session.write_text("validation_metrics.json", metrics.dump(2) + "\n");
 
@@ -279,12 +186,25 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
       std::vector<io::PvdEntry> entries;
       for (const FemFrame& f : fem.frames) {
         for (const std::string& file : f.files)
-          session.write_text("fem/" + file, read_text(reference.dir / file));
+        {
+          // Copies of FEM frames without provenance of their own get this
+          // command's: field data in a .vtu, a comment in a .pvtu.
+          std::string text = io::read_text_file(reference.dir / file);
+          if (text.find("provenance") == std::string::npos) {
+            if (std::filesystem::path(file).extension() == ".vtu")
+              text = io::add_provenance_field_data(text, provenance, "m");
+            else if (std::filesystem::path(file).extension() == ".pvtu")
+              text = io::add_provenance_comment(text, provenance);
+          }
+          session.write_text("fem/" + file, text);
+        }
         entries.push_back({f.time_s, 0, "fem/" + f.pvtu});
       }
+#ifdef PUNCTURE_HAVE_VTK
       if (writer)
         for (const io::PvdEntry& e : writer->entries()) entries.push_back(e);
-      if (!entries.empty()) io::write_pvd(session, "validation.pvd", entries);
+#endif
+      if (!entries.empty()) io::write_pvd(session, "validation.pvd", entries, &provenance);
     }
     session.commit();
     progress("data written to " + dir.string());
@@ -293,8 +213,8 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
     const std::vector<std::string> plots = run_plot_script("plot_validation.py", dir, out, err);
     io::OutputSession summary_session(dir);
     summary_session.write_text("validation_summary.md",
-                               validation_summary_markdown(scene, command_line, provenance, reference, fem, cmp,
-                                                           layers, plots, vtk && !fem.frames.empty()));
+                               validation_summary_markdown(scene, provenance, {reference.hash, reference.from_cache},
+                                                           fem, cmp, layers, plots, vtk && !fem.frames.empty()));
     summary_session.commit();
 
     out << "\nValidation of " << scene.name << " (FEM reference " << reference.hash.substr(0, 12)

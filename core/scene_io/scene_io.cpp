@@ -5,12 +5,18 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
 #include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
+
+#include "json_reader.hpp"
+#include "puncture/scene_limits.hpp"
 
 namespace puncture {
 namespace {
@@ -37,7 +43,7 @@ class ObjectReader {
   [[noreturn]] void fail(const std::string& path, const std::string& what) const {
     throw SceneError(file_, path, what);
   }
-  std::string child(const std::string& key) const { return path_ + "/" + key; }
+  std::string child(const std::string& key) const { return path_ + "/" + detail::json_pointer_token(key); }
   bool has(const std::string& key) const { return object_.contains(key); }
 
   const json& raw(const std::string& key) {
@@ -58,6 +64,9 @@ class ObjectReader {
   int integer(const std::string& key) {
     const json& v = raw(key);
     if (!v.is_number_integer()) fail(child(key), "must be an integer (got " + describe(v) + ")");
+    if (v.is_number_unsigned() ? v.get<std::uint64_t>() > 1000000000ULL
+                               : (v.get<std::int64_t>() > 1000000000LL || v.get<std::int64_t>() < -1000000000LL))
+      fail(child(key), "integer out of range (got " + describe(v) + ")");
     return v.get<int>();
   }
   int integer(const std::string& key, int fallback) { return has(key) ? integer(key) : fallback; }
@@ -288,6 +297,11 @@ void require(bool ok, const std::string& file, const std::string& path, const st
 
 }  // namespace
 
+const std::vector<std::string>& known_effects() {
+  static const std::vector<std::string> names(kEffects.begin(), kEffects.end());
+  return names;
+}
+
 void validate_scene(const Scene& s, const std::string& file) {
   require(s.sample.diameter_m > 0, file, "/sample/diameter_mm", "> 0", s.sample.diameter_m / kMm);
   const double sample_radius = 0.5 * s.sample.diameter_m;
@@ -385,7 +399,8 @@ void validate_scene(const Scene& s, const std::string& file) {
 
   const Insertion& in = s.insertion;
   require(in.start_height_m >= 0, file, "/insertion/start_height_mm", ">= 0", in.start_height_m / kMm);
-  require(in.speed_m_per_s >= 0, file, "/insertion/speed_mm_per_s", ">= 0", in.speed_m_per_s / kMm);
+  require(in.speed_m_per_s > 0, file, "/insertion/speed_mm_per_s", "> 0 (the scripted insertion must reach the target)",
+          in.speed_m_per_s / kMm);
   require(in.speed_m_per_s <= 10.0, file, "/insertion/speed_mm_per_s", "<= 10000 (10 m/s)", in.speed_m_per_s / kMm);
   require(in.target_depth_m > 0, file, "/insertion/target_depth_mm", "> 0", in.target_depth_m / kMm);
   require(in.target_depth_m < s.total_thickness_m(), file, "/insertion/target_depth_mm",
@@ -438,26 +453,31 @@ void validate_scene(const Scene& s, const std::string& file) {
   require(f.mesh.path_element_size_mm > 0 && f.mesh.path_element_size_mm <= 10, file,
           "/fem/mesh/path_element_size_mm", "in (0, 10] mm", f.mesh.path_element_size_mm);
   if (s.models.empty()) throw SceneError(file, "/models", "must name at least one model (realtime, fem)");
+  scene_limits::check_scene_limits(s, file);
 }
 
 Scene parse_scene(const std::string& text, const std::string& source_name) {
-  json root;
-  try {
-    root = json::parse(text);
-  } catch (const json::out_of_range& e) {
-    throw SceneError(source_name, "", std::string("number out of range: ") + e.what());
-  } catch (const json::parse_error& e) {
-    // e.what() names the byte position; keep it, drop nlohmann's prefix.
-    std::string what = e.what();
-    const auto pos = what.find("parse error");
-    throw SceneError(source_name, "", "malformed JSON: " + (pos == std::string::npos ? what : what.substr(pos)));
-  }
-  return read_scene(root, source_name);
+  if (text.size() > scene_limits::kMaxSceneFileBytes)
+    throw SceneError(source_name, "", "scene text of " + std::to_string(text.size()) + " bytes; the limit is " +
+                                          std::to_string(scene_limits::kMaxSceneFileBytes) + " bytes");
+  return read_scene(detail::parse_json_with_paths(text, source_name), source_name);
 }
 
 Scene load_scene(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw SceneError(path.string(), "", "cannot open scene file");
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status))
+    throw SceneError(path.string(), "", "cannot open scene file: " +
+                                            (ec ? ec.message() : std::string("No such file or directory")));
+  if (std::filesystem::is_directory(status))
+    throw SceneError(path.string(), "", "is a directory, not a scene file");
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > scene_limits::kMaxSceneFileBytes)
+    throw SceneError(path.string(), "", "file of " + std::to_string(size) + " bytes; a scene file is at most " +
+                                            std::to_string(scene_limits::kMaxSceneFileBytes) + " bytes");
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path.string(), "", std::string("cannot open scene file: ") + std::strerror(errno ? errno : EACCES));
   std::stringstream buffer;
   buffer << in.rdbuf();
   return parse_scene(buffer.str(), path.string());

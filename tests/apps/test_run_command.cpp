@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "csv_header.hpp"
 #include "puncture/apps/commands.hpp"
 
 namespace fs = std::filesystem;
@@ -37,7 +38,7 @@ TEST(RunCommand, DefaultSceneWritesCurveSummaryAndFrames) {
   RunOptions options;
   options.scene = kSourceDir / "scenes" / "default.json";
   options.output_dir = dir;
-  options.quiet = true;
+  options.quiet = false;
   std::ostringstream out, err;
   ASSERT_EQ(run_command(options, out, err), 0) << err.str();
 
@@ -58,8 +59,7 @@ TEST(RunCommand, DefaultSceneWritesCurveSummaryAndFrames) {
 
   // Curve CSV: header with per-layer columns and one row per tick.
   std::ifstream csv(dir / "realtime_curve.csv");
-  std::string header;
-  std::getline(csv, header);
+  const std::string header = test::header_after_provenance(csv);
   EXPECT_EQ(header.rfind("time_s,depth_mm,velocity_mm_per_s,force_N,skin_state,", 0), 0u) << header;
   std::size_t rows = 0;
   for (std::string line; std::getline(csv, line);) ++rows;

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "csv_header.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/apps/fem_reference.hpp"
 #include "puncture/scene_io.hpp"
@@ -170,7 +171,8 @@ TEST(FemReferenceCache, SecondCallComesFromTheCacheWithoutRunning) {
   // The cached curve is the FEM's insertion: it reaches the target depth with the skin punctured.
   std::ifstream csv(first.dir / "fem_force_depth.csv");
   std::string line, last;
-  std::getline(csv, line);
+  while (std::getline(csv, line) && !line.empty() && line[0] == '#') {
+  }  // the FEM's provenance lines, if any
   EXPECT_EQ(line.rfind("time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch,skin_state", 0), 0u) << line;
   while (std::getline(csv, line))
     if (!line.empty()) last = line;
@@ -222,8 +224,7 @@ TEST(ValidateCommand, ReportOfASmallSceneAndSecondRunFromCache) {
   std::vector<double> rt_depth, rt_force;
   for (std::size_t i : validation::insertion_phase(rt)) rt_depth.push_back(rt.depth_m[i]), rt_force.push_back(rt.force_N[i]);
   std::ifstream aligned(dir / "force_depth_aligned.csv");
-  std::string line;
-  std::getline(aligned, line);
+  std::string line = test::header_after_provenance(aligned);
   EXPECT_EQ(line, "depth_mm,fem_force_N,realtime_force_N,difference_N");
   std::size_t rows = 0, checked = 0;
   const std::vector<std::size_t> fem_phase = validation::insertion_phase(fem);
@@ -256,6 +257,27 @@ TEST(ValidateCommand, ReportOfASmallSceneAndSecondRunFromCache) {
   pvd << pvd_in.rdbuf();
   EXPECT_NE(pvd.str().find("part=\"0\" file=\"fem/"), std::string::npos);
   EXPECT_NE(pvd.str().find("file=\"realtime/skin_surface_"), std::string::npos);
+
+  // Provenance in every file of the report, also in the copies of the FEM's files.
+  std::size_t with_provenance = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (!e.is_regular_file()) continue;
+    std::ifstream in(e.path(), std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string ext = e.path().extension().string();
+    if (ext == ".csv")
+      EXPECT_EQ(text.rfind("# command: puncture", 0), 0u) << e.path();
+    else if (ext == ".vtu" || ext == ".vtp")
+      EXPECT_NE(text.find("provenance_command"), std::string::npos) << e.path();
+    else if (ext == ".pvd" || ext == ".pvtu")
+      EXPECT_NE(text.find("<!-- provenance: command: puncture"), std::string::npos) << e.path();
+    else if (ext == ".json" || ext == ".md")
+      EXPECT_NE(text.find("git"), std::string::npos) << e.path();
+    else if (ext != ".png")
+      ADD_FAILURE() << "unexpected report file " << e.path();
+    ++with_provenance;
+  }
+  EXPECT_GT(with_provenance, 10u);
 
   // Summary: provenance and links.
   std::ifstream md_in(dir / "validation_summary.md");
@@ -302,8 +324,7 @@ TEST(SweepCommand, TableOfEveryRealtimeKnobAgainstTheFem) {
   for (const char* f : {"accuracy_cost.csv", "accuracy_cost.md", "accuracy_cost.json"})
     EXPECT_TRUE(fs::is_regular_file(options.output_dir / f)) << f;
   std::ifstream csv(options.output_dir / "accuracy_cost.csv");
-  std::string line;
-  std::getline(csv, line);
+  std::string line = test::header_after_provenance(csv);
   EXPECT_EQ(line.rfind("model,knob,value,baseline,status,force_rmse_N", 0), 0u) << line;
   std::map<std::string, int> variants;
   int baselines = 0;

@@ -1,70 +1,32 @@
-// The haptic tick does no heap allocation. Global operator new/delete are
-// replaced by counting versions, and malloc/calloc/realloc are interposed
-// (Eigen allocates with malloc, not new); both counters must stay at zero
-// over many ticks of the Table 2 scene with every effect on, for each
+// The haptic tick does no heap allocation: every allocation of the process
+// is counted (allocation_counter.hpp: counting operator new and malloc, or
+// AddressSanitizer's allocation hook in a sanitizer build) and must stay at
+// zero over many ticks of the Table 2 scene with every effect on, for each
 // integrator.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
+#include <cmath>
+#include <vector>
 
+#include "allocation_counter.hpp"
 #include "puncture/simulator.hpp"
 #include "table2_scene.hpp"
 
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void __libc_free(void*);
-}
-
-namespace {
-std::atomic<bool> counting{false};
-std::atomic<long> new_calls{0};
-std::atomic<long> malloc_calls{0};
-}  // namespace
-
-extern "C" {
-void* malloc(std::size_t n) {
-  if (counting.load(std::memory_order_relaxed)) ++malloc_calls;
-  return __libc_malloc(n);
-}
-void* calloc(std::size_t n, std::size_t m) {
-  if (counting.load(std::memory_order_relaxed)) ++malloc_calls;
-  return __libc_calloc(n, m);
-}
-void* realloc(void* p, std::size_t n) {
-  if (counting.load(std::memory_order_relaxed)) ++malloc_calls;
-  return __libc_realloc(p, n);
-}
-void free(void* p) { __libc_free(p); }
-}
-
-void* operator new(std::size_t n) {
-  if (counting.load(std::memory_order_relaxed)) ++new_calls;
-  if (void* p = __libc_malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { __libc_free(p); }
-void operator delete[](void* p) noexcept { __libc_free(p); }
-void operator delete(void* p, std::size_t) noexcept { __libc_free(p); }
-void operator delete[](void* p, std::size_t) noexcept { __libc_free(p); }
-
 using namespace puncture;
 
-TEST(NoAllocation, CountersSeeAnAllocation) {
-  // The instrument works: a vector and an Eigen vector are both counted.
-  counting = true;
+TEST(NoAllocation, CounterSeesAnAllocation) {
+  // The instrument works (with and without AddressSanitizer): operator new
+  // (the vector object and its buffer) and malloc (Eigen's buffer) are counted.
+  test::start_counting_allocations();
   auto* v = new std::vector<int>(10);
+  const long after_new = test::stop_counting_allocations();
+  test::start_counting_allocations();
   Eigen::VectorXd e(100);
-  counting = false;
+  const long after_eigen = test::stop_counting_allocations();
   delete v;
-  EXPECT_GE(new_calls.load(), 2);     // the vector object and its buffer
-  EXPECT_GE(malloc_calls.load(), 1);  // Eigen's buffer
-  new_calls = 0;
-  malloc_calls = 0;
+  EXPECT_EQ(after_new, 2) << (test::allocation_count_from_sanitizer() ? "ASan hook" : "interposed malloc/new");
+  EXPECT_GE(after_eigen, 1);
+  e.setZero();
 }
 
 class NoAllocationTick : public ::testing::TestWithParam<const char*> {};
@@ -80,14 +42,10 @@ TEST_P(NoAllocationTick, FullInsertionAllocatesNothing) {
   states.reserve(ticks);
   for (int i = 0; i < ticks; ++i) states.push_back(tr.sample(i * 1e-3));
 
-  new_calls = 0;
-  malloc_calls = 0;
   double sum = 0.0;
-  counting = true;
+  test::start_counting_allocations();
   for (const NeedleState& s : states) sum += sim.tick(s).total_force_N;
-  counting = false;
-  EXPECT_EQ(new_calls.load(), 0) << GetParam();
-  EXPECT_EQ(malloc_calls.load(), 0) << GetParam();
+  EXPECT_EQ(test::stop_counting_allocations(), 0) << GetParam();
   EXPECT_TRUE(std::isfinite(sum));
   EXPECT_EQ(sim.puncture_events().size(), 3u);  // the counted ticks did the whole job
 }

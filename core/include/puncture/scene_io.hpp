@@ -9,11 +9,16 @@
 // SceneError whose message names the file and the JSON path of the offending
 // field, e.g.
 //   scenes/bad.json: /layers/1/thickness_mm: must be > 0 (got -2)
+// Problems of the file itself (missing, a directory, too large) have no JSON
+// path: "scenes/x.json: cannot open scene file: No such file or directory".
+// A UTF-8 byte-order mark at the start is accepted; a key repeated within one
+// object is an error; limits in puncture/scene_limits.hpp.
 #pragma once
 
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "puncture/scene.hpp"
 
@@ -22,7 +27,7 @@ namespace puncture {
 class SceneError : public std::runtime_error {
  public:
   SceneError(const std::string& file, const std::string& json_path, const std::string& what)
-      : std::runtime_error(file + ": " + (json_path.empty() ? std::string("/") : json_path) + ": " + what),
+      : std::runtime_error(file + ": " + (json_path.empty() ? std::string() : json_path + ": ") + what),
         file_(file),
         json_path_(json_path) {}
   const std::string& file() const { return file_; }
@@ -32,6 +37,9 @@ class SceneError : public std::runtime_error {
   std::string file_;
   std::string json_path_;
 };
+
+/// The effect names a scene's "effects" list may hold (the soak turns them all on).
+const std::vector<std::string>& known_effects();
 
 /// Loads and validates a scene file.
 Scene load_scene(const std::filesystem::path& path);

@@ -12,14 +12,9 @@
 #include <stdexcept>
 
 #include "puncture/io/output_session.hpp"
+#include "puncture/io/provenance.hpp"
 #include "puncture/scene_io.hpp"
 
-#ifndef PUNCTURE_VERSION
-#define PUNCTURE_VERSION "unknown"
-#endif
-#ifndef PUNCTURE_GIT_REVISION
-#define PUNCTURE_GIT_REVISION "unknown"
-#endif
 
 namespace puncture::validation {
 
@@ -677,15 +672,6 @@ nlohmann::json parameters_json(const std::vector<LayerParameters>& ps) {
   return a;
 }
 
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
 }  // namespace
 
 std::string tuned_preset_provenance_json(const std::string& name, const CalibrationResult& result,
@@ -759,9 +745,10 @@ std::string tuned_preset_provenance_json(const std::string& name, const Calibrat
                       {"optimiser_result", s.nlopt_result}});
   opt["stages"] = stages;
   j["optimiser"] = opt;
-  j["date_utc"] = utc_now();
-  j["project_version"] = PUNCTURE_VERSION;
-  j["git_revision"] = PUNCTURE_GIT_REVISION;
+  j["date_utc"] = io::utc_timestamp();
+  j["project_version"] = io::program_version();
+  j["git_revision"] = io::git_revision();
+  j["machine"] = io::machine_summary();
   return j.dump(2) + "\n";
 }
 

@@ -8,7 +8,9 @@
 #include <stdexcept>
 
 #include "puncture/io/output_session.hpp"
-#include "text_fields.hpp"
+#include "puncture/io/atomic_file.hpp"
+#include "puncture/io/csv_reader.hpp"
+#include "puncture/io/csv_writer.hpp"
 
 namespace puncture::validation {
 
@@ -152,33 +154,29 @@ DelphiResult run_delphi(const ScoreMatrix& expert_weights, const DelphiSettings&
 
 GradingResult grade_scores_csv_text(const std::string& text, const std::string& source_name, std::vector<double> alpha,
                                     double mu) {
-  std::istringstream in(text);
-  std::string line;
-  int line_no = 0;
-  std::vector<std::string> header;
   std::vector<std::string> order;
   std::vector<ScoreMatrix> matrices;
   std::vector<std::vector<std::string>> labels;
+  io::CsvDocument doc;
+  try {
+    doc = io::parse_csv(text, source_name);
+  } catch (const io::CsvFormatError& e) {
+    throw std::runtime_error(e.what());
+  }
+  const std::vector<std::string>& header = doc.header;
+  int line_no = doc.header_line;
   auto fail = [&](const std::string& what) {
     throw std::runtime_error(source_name + ":" + std::to_string(line_no) + ": " + what);
   };
-  while (std::getline(in, line)) {
-    ++line_no;
-    const std::string t = detail::trim(line);
-    if (t.empty() || t[0] == '#') continue;
-    const std::vector<std::string> fields = detail::split_csv_line(t);
-    if (header.empty()) {
-      if (fields.size() < 3 || fields[0] != "model" || fields[1] != "resident")
-        fail("header must be `model,resident,<indicator>,...` with at least one indicator");
-      header = fields;
-      continue;
-    }
-    if (fields.size() != header.size())
-      fail("expected " + std::to_string(header.size()) + " fields, got " + std::to_string(fields.size()));
+  if (header.size() < 3 || header[0] != "model" || header[1] != "resident")
+    fail("header must be `model,resident,<indicator>,...` with at least one indicator");
+  for (const io::CsvRecord& record : doc.records) {
+    line_no = record.line;
+    const std::vector<std::string>& fields = record.fields;
     if (fields[0].empty()) fail("column 1 (model): empty model name");
     std::vector<double> row(header.size() - 2);
     for (std::size_t j = 2; j < fields.size(); ++j)
-      if (!detail::parse_finite(fields[j], row[j - 2]))
+      if (!io::parse_finite_number(fields[j], row[j - 2]))
         fail("column " + std::to_string(j + 1) + " (" + header[j] + "): not a finite number: '" + fields[j] + "'");
     auto it = std::find(order.begin(), order.end(), fields[0]);
     std::size_t k = static_cast<std::size_t>(it - order.begin());
@@ -190,7 +188,6 @@ GradingResult grade_scores_csv_text(const std::string& text, const std::string& 
     matrices[k].push_back(std::move(row));
     labels[k].push_back(fields[1]);
   }
-  if (header.empty()) throw std::runtime_error(source_name + ": no header line");
   if (order.empty()) throw std::runtime_error(source_name + ": no score rows");
 
   GradingResult result;
@@ -219,57 +216,42 @@ GradingResult grade_scores_csv_text(const std::string& text, const std::string& 
 }
 
 GradingResult grade_scores_csv(const std::filesystem::path& path, std::vector<double> alpha, double mu) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path.string() + ": cannot open scores file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return grade_scores_csv_text(text.str(), path.string(), std::move(alpha), mu);
+  return grade_scores_csv_text(io::read_text_file(path), path.string(), std::move(alpha), mu);
 }
 
-namespace {
-std::string num(double x) {
-  std::ostringstream s;
-  s << std::setprecision(12) << x;
-  return s.str();
-}
-std::string quoted(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += (c == '"') ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
-}  // namespace
-
-std::string grading_summary_csv(const GradingResult& result) {
-  std::ostringstream csv;
-  csv << "model,n_schemes,mean_score,min_score,max_score";
-  for (const auto& ind : result.indicators) csv << ",omega_" << ind;
-  for (const auto& ind : result.indicators) csv << ",beta_" << ind;
-  csv << '\n';
+std::string grading_summary_csv(const GradingResult& result, const io::Provenance* provenance) {
+  std::vector<std::string> columns{"model", "n_schemes", "mean_score", "min_score", "max_score"};
+  for (const auto& ind : result.indicators) columns.push_back("omega_" + ind);
+  for (const auto& ind : result.indicators) columns.push_back("beta_" + ind);
+  io::CsvWriter csv(columns);
+  if (provenance) csv.add_provenance(*provenance);
   for (const ModelGrade& g : result.models) {
     const auto [lo, hi] = std::minmax_element(g.scheme_scores.begin(), g.scheme_scores.end());
-    csv << quoted(g.model) << ',' << g.scheme_scores.size() << ',' << num(g.mean_score) << ',' << num(*lo) << ','
-        << num(*hi);
-    for (double w : g.omega) csv << ',' << num(w);
-    for (double b : g.objective.beta) csv << ',' << num(b);
-    csv << '\n';
+    csv.text(g.model).integer(static_cast<long long>(g.scheme_scores.size()));
+    csv.number(g.mean_score, 12).number(*lo, 12).number(*hi, 12);
+    for (double w : g.omega) csv.number(w, 12);
+    for (double b : g.objective.beta) csv.number(b, 12);
+    csv.end_row();
   }
   return csv.str();
 }
 
-std::string grading_scheme_scores_csv(const GradingResult& result) {
-  std::ostringstream csv;
-  csv << "model,resident,comprehensive_score\n";
+std::string grading_scheme_scores_csv(const GradingResult& result, const io::Provenance* provenance) {
+  io::CsvWriter csv({"model", "resident", "comprehensive_score"});
+  if (provenance) csv.add_provenance(*provenance);
   for (const ModelGrade& g : result.models)
     for (std::size_t i = 0; i < g.scheme_scores.size(); ++i)
-      csv << quoted(g.model) << ',' << quoted(i < g.scheme_labels.size() ? g.scheme_labels[i] : std::to_string(i + 1))
-          << ',' << num(g.scheme_scores[i]) << '\n';
+      csv.text(g.model)
+          .text(i < g.scheme_labels.size() ? g.scheme_labels[i] : std::to_string(i + 1))
+          .number(g.scheme_scores[i], 12)
+          .end_row();
   return csv.str();
 }
 
-void write_grading_csv(io::OutputSession& session, const std::string& prefix, const GradingResult& result) {
-  session.write_text(prefix + "_summary.csv", grading_summary_csv(result));
-  session.write_text(prefix + "_schemes.csv", grading_scheme_scores_csv(result));
+void write_grading_csv(io::OutputSession& session, const std::string& prefix, const GradingResult& result,
+                       const io::Provenance* provenance) {
+  session.write_text(prefix + "_summary.csv", grading_summary_csv(result, provenance));
+  session.write_text(prefix + "_schemes.csv", grading_scheme_scores_csv(result, provenance));
 }
 
 }  // namespace puncture::validation

@@ -7,7 +7,9 @@
 #include <sstream>
 
 #include "puncture/io/content_hash.hpp"
-#include "text_fields.hpp"
+#include "puncture/io/atomic_file.hpp"
+#include "puncture/io/csv_reader.hpp"
+#include "puncture/io/csv_writer.hpp"
 
 namespace puncture::validation {
 
@@ -16,11 +18,19 @@ namespace {
 constexpr double kMm = 1e-3;
 
 std::string read_file_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw CurveFormatError(path.string(), 0, "", "cannot open file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  try {
+    return io::read_text_file(path);
+  } catch (const std::runtime_error& e) {
+    throw CurveFormatError(path.string(), 0, "", e.what());
+  }
+}
+
+io::CsvDocument parse_document(const std::string& text, const std::string& source_name) {
+  try {
+    return io::parse_csv(text, source_name);
+  } catch (const io::CsvFormatError& e) {
+    throw CurveFormatError(e.source(), e.line(), e.column(), e.reason());
+  }
 }
 
 bool parse_state(const std::string& text, LayerState& state) {
@@ -29,12 +39,6 @@ bool parse_state(const std::string& text, LayerState& state) {
   else if (text == "punctured") state = LayerState::Punctured;
   else return false;
   return true;
-}
-
-std::string fmt(double x) {
-  std::ostringstream s;
-  s << std::setprecision(17) << x;
-  return s.str();
 }
 
 std::string describe_time(const InsertionCurve& c, std::size_t i) {
@@ -61,7 +65,7 @@ int InsertionCurve::layer_index(const std::string& name) const {
 bool InsertionCurve::metadata_number(const std::string& key, double& value) const {
   const auto it = metadata.find(key);
   if (it == metadata.end()) return false;
-  if (!detail::parse_finite(it->second, value))
+  if (!io::parse_finite_number(it->second, value))
     throw CurveFormatError(source, 0, "", "metadata '" + key + "' is not a finite number: '" + it->second + "'");
   return true;
 }
@@ -69,61 +73,34 @@ bool InsertionCurve::metadata_number(const std::string& key, double& value) cons
 InsertionCurve parse_insertion_curve(const std::string& text, const std::string& source_name) {
   InsertionCurve curve;
   curve.source = source_name;
-  std::istringstream in(text);
-  std::string raw;
-  int line_no = 0;
-  std::vector<std::string> header;
+  const io::CsvDocument doc = parse_document(text, source_name);
+  curve.metadata = doc.metadata_map();
   int col_time = -1, col_depth = -1, col_vel = -1, col_force = -1;
   std::vector<int> state_cols;
-  bool in_preamble = true;
-  while (std::getline(in, raw)) {
-    ++line_no;
-    const std::string line = detail::trim(raw);
-    if (line.empty()) continue;
-    if (line[0] == '#') {
-      if (in_preamble) {
-        const std::string body = detail::trim(line.substr(1));
-        const auto colon = body.find(':');
-        if (colon != std::string::npos && colon > 0) {
-          const std::string key = detail::trim(body.substr(0, colon));
-          if (key.find(' ') == std::string::npos) curve.metadata[key] = detail::trim(body.substr(colon + 1));
-        }
-      }
-      continue;
+  for (std::size_t j = 0; j < doc.header.size(); ++j) {
+    const std::string& h = doc.header[j];
+    const int jj = static_cast<int>(j);
+    if (h == "time_s") col_time = jj;
+    else if (h == "depth_mm") col_depth = jj;
+    else if (h == "velocity_mm_per_s") col_vel = jj;
+    else if (h == "force_N") col_force = jj;
+    else if (h.size() > 6 && h.compare(h.size() - 6, 6, "_state") == 0) {
+      state_cols.push_back(jj);
+      curve.layer_names.push_back(h.substr(0, h.size() - 6));
     }
-    in_preamble = false;
-    const std::vector<std::string> fields = detail::split_csv_line(line);
-    if (header.empty()) {
-      header = fields;
-      for (std::size_t j = 0; j < header.size(); ++j) {
-        const std::string& h = header[j];
-        if (h.empty()) throw CurveFormatError(source_name, line_no, "", "empty column name in header (column " + std::to_string(j + 1) + ")");
-        for (std::size_t k = 0; k < j; ++k)
-          if (header[k] == h) throw CurveFormatError(source_name, line_no, h, "duplicate column name");
-        const int jj = static_cast<int>(j);
-        if (h == "time_s") col_time = jj;
-        else if (h == "depth_mm") col_depth = jj;
-        else if (h == "velocity_mm_per_s") col_vel = jj;
-        else if (h == "force_N") col_force = jj;
-        else if (h.size() > 6 && h.compare(h.size() - 6, 6, "_state") == 0) {
-          state_cols.push_back(jj);
-          curve.layer_names.push_back(h.substr(0, h.size() - 6));
-        }
-      }
-      const std::pair<int, const char*> required[] = {
-          {col_time, "time_s"}, {col_depth, "depth_mm"}, {col_vel, "velocity_mm_per_s"}, {col_force, "force_N"}};
-      for (const auto& [col, name] : required)
-        if (col < 0) throw CurveFormatError(source_name, line_no, name, "required column missing from the header");
-      curve.layer_states.resize(state_cols.size());
-      continue;
-    }
-    if (fields.size() != header.size())
-      throw CurveFormatError(source_name, line_no, "",
-                             "expected " + std::to_string(header.size()) + " fields, got " + std::to_string(fields.size()));
+  }
+  const std::pair<int, const char*> required[] = {
+      {col_time, "time_s"}, {col_depth, "depth_mm"}, {col_vel, "velocity_mm_per_s"}, {col_force, "force_N"}};
+  for (const auto& [col, name] : required)
+    if (col < 0) throw CurveFormatError(source_name, doc.header_line, name, "required column missing from the header");
+  curve.layer_states.resize(state_cols.size());
+  for (const io::CsvRecord& record : doc.records) {
+    const int line_no = record.line;
+    const std::vector<std::string>& fields = record.fields;
     auto number = [&](int col, double scale) {
       double v = 0.0;
-      if (!detail::parse_finite(fields[static_cast<std::size_t>(col)], v))
-        throw CurveFormatError(source_name, line_no, header[static_cast<std::size_t>(col)],
+      if (!io::parse_finite_number(fields[static_cast<std::size_t>(col)], v))
+        throw CurveFormatError(source_name, line_no, doc.header[static_cast<std::size_t>(col)],
                                "not a finite number: '" + fields[static_cast<std::size_t>(col)] + "'");
       return v * scale;
     };
@@ -135,7 +112,7 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
       LayerState s;
       const std::string& f = fields[static_cast<std::size_t>(state_cols[k])];
       if (!parse_state(f, s))
-        throw CurveFormatError(source_name, line_no, header[static_cast<std::size_t>(state_cols[k])],
+        throw CurveFormatError(source_name, line_no, doc.header[static_cast<std::size_t>(state_cols[k])],
                                "layer state must be untouched, pressed or punctured (got '" + f + "')");
       curve.layer_states[k].push_back(s);
     }
@@ -151,7 +128,6 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
                                "time must increase (a repeated time is allowed only at the same depth)");
     }
   }
-  if (header.empty()) throw CurveFormatError(source_name, 0, "", "no header line");
   if (curve.size() == 0) throw CurveFormatError(source_name, 0, "", "no data rows");
   return curve;
 }
@@ -187,17 +163,19 @@ InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, 
   return c;
 }
 
-std::string insertion_curve_csv(const InsertionCurve& curve) {
-  std::ostringstream csv;
-  for (const auto& [k, v] : curve.metadata) csv << "# " << k << ": " << v << '\n';
-  csv << "time_s,depth_mm,velocity_mm_per_s,force_N";
-  for (const auto& name : curve.layer_names) csv << ',' << name << "_state";
-  csv << '\n';
+std::string insertion_curve_csv(const InsertionCurve& curve, const io::Provenance* provenance) {
+  std::vector<std::string> columns{"time_s", "depth_mm", "velocity_mm_per_s", "force_N"};
+  for (const auto& name : curve.layer_names) columns.push_back(name + "_state");
+  io::CsvWriter csv(columns);
+  if (provenance) csv.add_provenance(*provenance);
+  for (const auto& [k, v] : curve.metadata)
+    if (!provenance || (k != "command" && k != "program_version" && k != "git_revision" && k != "date_utc" &&
+                        k != "machine"))
+      csv.add_metadata(k, v);
   for (std::size_t i = 0; i < curve.size(); ++i) {
-    csv << fmt(curve.time_s[i]) << ',' << fmt(curve.depth_m[i] / kMm) << ',' << fmt(curve.velocity_m_per_s[i] / kMm)
-        << ',' << fmt(curve.force_N[i]);
-    for (const auto& states : curve.layer_states) csv << ',' << to_string(states[i]);
-    csv << '\n';
+    csv.number(curve.time_s[i]).number(curve.depth_m[i] / kMm).number(curve.velocity_m_per_s[i] / kMm).number(curve.force_N[i]);
+    for (const auto& states : curve.layer_states) csv.text(to_string(states[i]));
+    csv.end_row();
   }
   return csv.str();
 }
@@ -373,39 +351,16 @@ DeflectionProfileError deflection_profile_error(const std::vector<double>& ring_
 }
 
 std::vector<RadialProfile> parse_surface_profiles(const std::string& text, const std::string& source_name) {
-  std::istringstream in(text);
-  std::string raw;
-  int line_no = 0;
-  std::vector<std::string> header;
-  int c_step = -1, c_depth = -1, c_r = -1, c_uz = -1;
+  const io::CsvDocument doc = parse_document(text, source_name);
+  const std::size_t c_step = doc.require_column("step"), c_depth = doc.require_column("depth_mm"),
+                    c_r = doc.require_column("r_mm"), c_uz = doc.require_column("uz_mm");
   std::vector<RadialProfile> out;
-  while (std::getline(in, raw)) {
-    ++line_no;
-    const std::string line = detail::trim(raw);
-    if (line.empty() || line[0] == '#') continue;
-    const auto fields = detail::split_csv_line(line);
-    if (header.empty()) {
-      header = fields;
-      for (std::size_t j = 0; j < header.size(); ++j) {
-        const int jj = static_cast<int>(j);
-        if (header[j] == "step") c_step = jj;
-        else if (header[j] == "depth_mm") c_depth = jj;
-        else if (header[j] == "r_mm") c_r = jj;
-        else if (header[j] == "uz_mm") c_uz = jj;
-      }
-      const std::pair<int, const char*> required[] = {{c_step, "step"}, {c_depth, "depth_mm"}, {c_r, "r_mm"}, {c_uz, "uz_mm"}};
-      for (const auto& [col, name] : required)
-        if (col < 0) throw CurveFormatError(source_name, line_no, name, "required column missing from the header");
-      continue;
-    }
-    if (fields.size() != header.size())
-      throw CurveFormatError(source_name, line_no, "",
-                             "expected " + std::to_string(header.size()) + " fields, got " + std::to_string(fields.size()));
-    auto number = [&](int col) {
+  for (const io::CsvRecord& record : doc.records) {
+    const int line_no = record.line;
+    auto number = [&](std::size_t col) {
       double v = 0.0;
-      if (!detail::parse_finite(fields[static_cast<std::size_t>(col)], v))
-        throw CurveFormatError(source_name, line_no, header[static_cast<std::size_t>(col)],
-                               "not a finite number: '" + fields[static_cast<std::size_t>(col)] + "'");
+      if (!io::parse_finite_number(record.fields[col], v))
+        throw CurveFormatError(source_name, line_no, doc.header[col], "not a finite number: '" + record.fields[col] + "'");
       return v;
     };
     const double step = number(c_step);

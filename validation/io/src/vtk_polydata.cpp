@@ -1,12 +1,15 @@
 #include <puncture/io/vtk_polydata.hpp>
 
 #include <puncture/io/output_session.hpp>
+#include <puncture/io/vtk_xml_field_data.hpp>
 
 #include <set>
 #include <stdexcept>
 
 #include <vtkCellArray.h>
 #include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkStringArray.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
@@ -26,7 +29,8 @@ void check_name(std::set<std::string>& names, const std::string& name) {
 void write_polydata(OutputSession& session, const std::string& relative_name,
                     const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& triangles,
                     const std::vector<std::pair<std::string, Eigen::VectorXd>>& point_scalars,
-                    const std::vector<std::pair<std::string, Eigen::MatrixX3d>>& point_vectors) {
+                    const std::vector<std::pair<std::string, Eigen::MatrixX3d>>& point_vectors,
+                    const Provenance* provenance) {
   const Eigen::Index n = vertices.rows();
   const std::string where = "write_polydata('" + relative_name + "')";
   if (!vertices.allFinite()) throw std::invalid_argument(where + ": non-finite vertex coordinate");
@@ -83,6 +87,16 @@ void write_polydata(OutputSession& session, const std::string& relative_name,
     for (Eigen::Index i = 0; i < n; ++i) array->SetTuple3(i, values(i, 0), values(i, 1), values(i, 2));
     poly->GetPointData()->AddArray(array);
     if (k == 0) poly->GetPointData()->SetActiveVectors(name.c_str());
+  }
+
+  if (provenance) {
+    for (const auto& [name, value] : provenance_field_data(*provenance, "m")) {
+      vtkNew<vtkStringArray> array;
+      array->SetName(name.c_str());
+      array->SetNumberOfValues(1);
+      array->SetValue(0, value);
+      poly->GetFieldData()->AddArray(array);
+    }
   }
 
   const std::filesystem::path path = session.stage(relative_name);

@@ -1,7 +1,9 @@
 // commands.hpp: the subcommands of the `puncture` program as functions.
-// Each returns the process exit code (0 on success) and prints progress and
-// a short report to `out`, errors to `err`. Outputs are written through an
-// io::OutputSession: on any error nothing half-written is left behind.
+// Each returns the process exit code (0 success, 1 the run failed, 2 bad
+// input: scene, CSV or option, 3 the output cannot be written) and prints
+// progress and a short report to `out` (nothing with quiet), warnings and
+// errors to `err`. Outputs are written through an io::OutputSession: on any
+// error nothing half-written is left behind.
 #pragma once
 
 #include <filesystem>
@@ -11,6 +13,9 @@
 
 namespace puncture::apps {
 
+/// Exit codes of the `puncture` program (apps/README.md); 128 + n when ended by signal n.
+enum ExitCode : int { kExitOk = 0, kExitFailure = 1, kExitBadInput = 2, kExitOutput = 3 };
+
 /// The scene `puncture run` uses without arguments: scenes/default.json in the
 /// working directory if present, else the one in the source tree.
 std::filesystem::path default_scene_path();
@@ -19,7 +24,7 @@ struct RunOptions {
   std::filesystem::path scene;        ///< empty: default_scene_path()
   std::filesystem::path output_dir;   ///< empty: out/<scene name>
   bool write_frames = true;           ///< VTK surface frames (also needs Effects::surface_output)
-  bool quiet = false;                 ///< no progress lines
+  bool quiet = false;                 ///< nothing on `out` (warnings and errors still go to `err`)
 };
 
 /// `puncture run`: real-time model along the scene's scripted insertion.
@@ -33,6 +38,7 @@ struct FemOptions {
   int refinement = -1;                ///< -1: from the scene
   int degree = -1;                    ///< -1: from the scene
   bool write_vtu = true;
+  bool quiet = false;                 ///< nothing on `out`
 };
 
 /// `puncture fem`: the deal.II reference along the same insertion (MPI-aware).
@@ -85,6 +91,7 @@ struct GradeOptions {
   std::filesystem::path scores;       ///< CSV: model,resident,<one column per indicator>
   std::filesystem::path output_dir;   ///< empty: out/grading
   double mu = 0.4;                    ///< preference coefficient (subjective share)
+  bool quiet = false;                 ///< nothing on `out`
 };
 
 /// `puncture grade`: comprehensive weighted grading (seed paper Sec. 3.3).

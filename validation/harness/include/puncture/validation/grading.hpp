@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include "puncture/io/provenance.hpp"
+
 namespace puncture::io {
 class OutputSession;
 }
@@ -109,10 +111,12 @@ GradingResult grade_scores_csv_text(const std::string& text, const std::string& 
 
 /// Per-model comprehensive scores: columns model, n_schemes, mean_score,
 /// min_score, max_score, then omega_<indicator> and beta_<indicator>.
-std::string grading_summary_csv(const GradingResult& result);
+std::string grading_summary_csv(const GradingResult& result, const io::Provenance* provenance = nullptr);
 /// Per-scheme scores: columns model, resident, comprehensive_score.
-std::string grading_scheme_scores_csv(const GradingResult& result);
+std::string grading_scheme_scores_csv(const GradingResult& result, const io::Provenance* provenance = nullptr);
 /// Writes <prefix>_summary.csv and <prefix>_schemes.csv into the session.
-void write_grading_csv(io::OutputSession& session, const std::string& prefix, const GradingResult& result);
+/// Both tables, each with the provenance header when given.
+void write_grading_csv(io::OutputSession& session, const std::string& prefix, const GradingResult& result,
+                       const io::Provenance* provenance = nullptr);
 
 }  // namespace puncture::validation

@@ -37,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include "puncture/io/provenance.hpp"
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/puncture_force.hpp"
 #include "puncture/scene.hpp"
@@ -83,8 +84,9 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
 /// with); the curve's metadata then says "force: without damping".
 InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, const std::string& source = "realtime",
                               bool include_damping = true);
-/// CSV text in the reader's schema (depth and velocity in mm, states), metadata first.
-std::string insertion_curve_csv(const InsertionCurve& curve);
+/// CSV text in the reader's schema (depth and velocity in mm, states): the
+/// provenance lines (when given), the curve's metadata, then the table.
+std::string insertion_curve_csv(const InsertionCurve& curve, const io::Provenance* provenance = nullptr);
 
 /// Indices of the insertion-phase samples (velocity > 0, up to the deepest
 /// sample). Throws CurveFormatError (with the sample's time) if depth

@@ -1,5 +1,5 @@
-// validation_support.hpp (internal to apps/src): pieces shared by `puncture
-// validate` and `puncture sweep`.
+// fem_comparison.hpp: the real-time model against the FEM reference's files
+// (used by `puncture validate` and `puncture sweep`).
 //
 //   read_fem_result(dir, scene)      the FEM reference files of one cache entry:
 //                                    curve, summary, surface profiles per layer,
@@ -12,6 +12,8 @@
 //                                    radius r and time t (for error fields)
 //   run_plot_script(name, dir, ...)  /usr/bin/python3 scripts/<name> <dir>
 //   validation_summary_markdown(...) validation_summary.md
+//   layer_metrics_csv, deflection_profiles_csv, aligned_curves_csv,
+//   validation_metrics_json          the report files of `puncture validate`
 #pragma once
 
 #include <filesystem>
@@ -23,15 +25,18 @@
 
 #include <nlohmann/json.hpp>
 
-#include "puncture/apps/fem_reference.hpp"
+#include "puncture/io/provenance.hpp"
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/scene.hpp"
 #include "puncture/validation/metrics.hpp"
 
-namespace puncture::apps {
+namespace puncture::validation {
 
-/// Whole file as text; throws std::runtime_error naming the file.
-std::string read_text(const std::filesystem::path& path);
+/// Which FEM reference a report compares with.
+struct FemReferenceInfo {
+  std::string hash;         ///< cache key
+  bool from_cache = false;  ///< read from the cache (true) or computed by this run
+};
 
 
 struct FemFrame {
@@ -41,13 +46,13 @@ struct FemFrame {
 };
 
 struct FemResultFiles {
-  validation::InsertionCurve curve;  ///< fem_force_depth.csv
+  InsertionCurve curve;  ///< fem_force_depth.csv
   nlohmann::json summary;            ///< fem_summary.json
   /// fem_surface_profile.csv split by the surface (layer name) column, depth order.
-  std::map<std::string, std::vector<validation::RadialProfile>> profiles;
+  std::map<std::string, std::vector<RadialProfile>> profiles;
   /// fem_recovery_profile.csv: the layer's top surface just before and just
   /// after its breakthrough (same depth), by layer name.
-  std::map<std::string, validation::RadialProfile> before_breakthrough, after_breakthrough;
+  std::map<std::string, RadialProfile> before_breakthrough, after_breakthrough;
   std::map<std::string, double> puncture_depth_m;  ///< from fem_summary.json
   std::vector<FemFrame> frames;                    ///< from fem_fields.pvd (empty without VTU)
   std::vector<double> frame_times_s;
@@ -83,15 +88,15 @@ struct LayerDeflectionComparison {
   double realtime_depth_m = std::numeric_limits<double>::quiet_NaN();  ///< tip depth of the tick used
   double fem_depth_m = std::numeric_limits<double>::quiet_NaN();       ///< depth of the FEM profile used
   std::vector<double> realtime_rings_m;
-  validation::RadialProfile fem;
-  validation::DeflectionProfileError error;
+  RadialProfile fem;
+  DeflectionProfileError error;
 
   bool recovery_compared = false;
   double recovery_delay_s = std::numeric_limits<double>::quiet_NaN();  ///< time after the real-time breakthrough
   double recovery_realtime_depth_m = std::numeric_limits<double>::quiet_NaN();  ///< tip depth then
   std::vector<double> realtime_recovered_rings_m;
-  validation::RadialProfile fem_after;
-  validation::DeflectionProfileError recovery_error;
+  RadialProfile fem_after;
+  DeflectionProfileError recovery_error;
 };
 
 /// Before breakthrough: the last insertion depth at which layer k is intact in
@@ -108,10 +113,24 @@ LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size
 std::vector<std::string> run_plot_script(const std::string& script, const std::filesystem::path& dir,
                                          std::ostream& out, std::ostream& err);
 
-std::string validation_summary_markdown(const Scene& scene, const std::string& command_line,
-                                        const nlohmann::json& provenance, const FemReference& reference,
-                                        const FemResultFiles& fem, const validation::CurveComparison& cmp,
-                                        const nlohmann::json& layers, const std::vector<std::string>& plots,
-                                        bool has_vtk);
+std::string validation_summary_markdown(const Scene& scene, const io::Provenance& provenance,
+                                        const FemReferenceInfo& reference, const FemResultFiles& fem,
+                                        const CurveComparison& cmp, const nlohmann::json& layers,
+                                        const std::vector<std::string>& plots, bool has_vtk);
 
-}  // namespace puncture::apps
+/// layer_metrics.csv: per-layer force, puncture and deflection metrics.
+std::string layer_metrics_csv(const Scene& scene, const CurveComparison& cmp,
+                              const std::vector<LayerDeflectionComparison>& deflection, const io::Provenance& provenance);
+/// deflection_profiles.csv: deflection (mm, > 0 into the tissue) against the
+/// distance from the needle axis, both models, before and after breakthrough.
+std::string deflection_profiles_csv(const Scene& scene, const std::vector<LayerDeflectionComparison>& deflection,
+                                    const io::Provenance& provenance);
+/// force_depth_aligned.csv: the FEM's insertion samples with the real-time
+/// force interpolated at the same depths.
+std::string aligned_curves_csv(const InsertionCurve& realtime, const InsertionCurve& fem,
+                               const io::Provenance& provenance);
+/// Per-layer metrics as JSON (the "layers" array of validation_metrics.json).
+nlohmann::json layer_metrics_json(const Scene& scene, const CurveComparison& cmp,
+                                  const std::vector<LayerDeflectionComparison>& deflection);
+
+}  // namespace puncture::validation

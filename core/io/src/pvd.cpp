@@ -1,6 +1,7 @@
 #include <puncture/io/pvd.hpp>
 
 #include <puncture/io/output_session.hpp>
+#include <puncture/io/vtk_xml_field_data.hpp>
 
 #include <charconv>
 #include <cmath>
@@ -25,9 +26,10 @@ std::string xml_escape(const std::string& s) {
 }
 }  // namespace
 
-std::string pvd_document(const std::vector<PvdEntry>& entries) {
-  std::string out =
-      "<?xml version=\"1.0\"?>\n"
+std::string pvd_document(const std::vector<PvdEntry>& entries, const Provenance* provenance) {
+  std::string out = "<?xml version=\"1.0\"?>\n";
+  if (provenance) out += provenance_xml_comment(*provenance) + "\n";
+  out +=
       "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
       "  <Collection>\n";
   char buffer[64];
@@ -45,9 +47,9 @@ std::string pvd_document(const std::vector<PvdEntry>& entries) {
   return out;
 }
 
-void write_pvd(OutputSession& session, const std::string& relative_name,
-               const std::vector<PvdEntry>& entries) {
-  session.write_text(relative_name, pvd_document(entries));
+void write_pvd(OutputSession& session, const std::string& relative_name, const std::vector<PvdEntry>& entries,
+               const Provenance* provenance) {
+  session.write_text(relative_name, pvd_document(entries, provenance));
 }
 
 }  // namespace puncture::io

@@ -3,6 +3,8 @@
 //
 // In:  entries (time_s in s, part index >= 0, file name relative to the .pvd).
 // Out: the staged file <relative_name> in the session:
+//   <?xml version="1.0"?>
+//   <!-- provenance: command: ... | program_version: ... | ... -->   (when given)
 //   <VTKFile type="Collection" version="0.1" byte_order="LittleEndian">
 //     <Collection> <DataSet timestep=".." group="" part=".." file=".."/> ...
 // Times are printed in the shortest round-trip form; file names are XML-escaped.
@@ -12,6 +14,8 @@
 
 #include <string>
 #include <vector>
+
+#include "puncture/io/provenance.hpp"
 
 namespace puncture::io {
 
@@ -23,10 +27,10 @@ struct PvdEntry {
   std::string file;     ///< dataset file, relative to the .pvd
 };
 
-/// The .pvd document as text.
-std::string pvd_document(const std::vector<PvdEntry>& entries);
+/// The .pvd document as text; with a provenance, an XML comment carries it.
+std::string pvd_document(const std::vector<PvdEntry>& entries, const Provenance* provenance = nullptr);
 
-void write_pvd(OutputSession& session, const std::string& relative_name,
-               const std::vector<PvdEntry>& entries);
+void write_pvd(OutputSession& session, const std::string& relative_name, const std::vector<PvdEntry>& entries,
+               const Provenance* provenance = nullptr);
 
 }  // namespace puncture::io

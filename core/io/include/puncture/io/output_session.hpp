@@ -1,13 +1,22 @@
 // output_session.hpp: all-or-nothing writing of the output files of one command.
 //
 // Every file of a run is first written under a hidden temporary name in the
-// directory where it belongs ("<dir>/.<name>.staging-<token>"); commit()
+// directory where it belongs ("<dir>/.<name>.staging-<pid>-<n>@<host>",
+// atomic_file.hpp); commit()
 // renames each staged file onto its final name (std::filesystem::rename, an
 // atomic replace on POSIX within one file system). If the session is
 // destroyed without commit() (an exception unwound the run), every staged
 // file is deleted, and so is every directory the session created, so a failed
 // run leaves nothing half-written and files from earlier runs stay untouched
-// (they are only replaced by commit()).
+// (they are only replaced by commit()). The output directory itself is removed
+// again if the session created it and it is empty.
+//
+// Interrupted runs: every staged file and created directory is registered
+// with interrupt_cleanup.hpp, so SIGINT/SIGTERM remove them too (once main()
+// called install_interrupt_cleanup()). Runs killed without a chance to clean
+// up (SIGKILL) are handled by the next session in the same directory: the
+// constructor removes staged files of processes of this host that no longer
+// run (remove_stale_staging).
 //
 // In:  relative names ("summary.csv", "frames/skin_0001.vtp"): relative, no
 //      "..", not empty. Out: paths to write to now (stage), the final paths
@@ -18,15 +27,24 @@
 #pragma once
 
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace puncture::io {
 
+/// The output cannot be written (directory not creatable, disk full, ...):
+/// the message names the path and the OS reason.
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class OutputSession {
  public:
-  /// Creates output_dir (and parents) if missing. Throws std::runtime_error if
-  /// it cannot be created or is not a directory.
+  /// Creates output_dir (and parents) if missing and removes stale staged
+  /// files of dead runs in it. Throws OutputError (path and OS reason) if it
+  /// cannot be created or is not a directory.
   explicit OutputSession(std::filesystem::path output_dir);
   OutputSession(const OutputSession&) = delete;
   OutputSession& operator=(const OutputSession&) = delete;
@@ -39,8 +57,8 @@ class OutputSession {
   /// with "..", or an empty name; std::logic_error after commit().
   std::filesystem::path stage(const std::string& relative_name);
 
-  /// stage() + write `content` (bytes as given). Throws std::runtime_error on
-  /// an I/O error.
+  /// stage() + write `content` (bytes as given). Throws OutputError on an I/O
+  /// error.
   void write_text(const std::string& relative_name, const std::string& content);
 
   /// Renames every staged file into place, in staging order. Throws
@@ -62,9 +80,8 @@ class OutputSession {
   void rollback() noexcept;
 
   std::filesystem::path output_dir_;
-  std::string token_;  ///< unique per session: process id + counter + address
   std::vector<Staged> staged_;
-  std::vector<std::filesystem::path> created_dirs_;  ///< created by this session, parents first
+  std::vector<std::filesystem::path> created_dirs_;  ///< created by this session, parents first (output dir included)
   std::vector<std::filesystem::path> committed_;
   bool is_committed_ = false;
 };

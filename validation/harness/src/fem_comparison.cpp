@@ -1,5 +1,5 @@
-// validation_support.cpp: see validation_support.hpp.
-#include "validation_support.hpp"
+// fem_comparison.cpp: see fem_comparison.hpp.
+#include "puncture/validation/fem_comparison.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,56 +12,19 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "puncture/apps/commands.hpp"
+#include "puncture/io/atomic_file.hpp"
+#include "puncture/io/csv_reader.hpp"
+#include "puncture/io/csv_writer.hpp"
 
-namespace puncture::apps {
+namespace puncture::validation {
 
 namespace {
 
 constexpr double kMm = 1e-3;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::vector<std::string> split_csv_line(const std::string& line) {
-  std::vector<std::string> fields;
-  std::string field;
-  std::istringstream s(line);
-  while (std::getline(s, field, ',')) fields.push_back(field);
-  if (!line.empty() && line.back() == ',') fields.emplace_back();
-  return fields;
-}
-
-double to_double(const std::string& text, const std::string& file, int line) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
-    throw std::runtime_error(file + ":" + std::to_string(line) + ": not a finite number: '" + text + "'");
-  return v;
-}
-
-/// Rows of a CSV as maps column -> text.
-std::vector<std::map<std::string, std::string>> read_csv_rows(const std::filesystem::path& path) {
-  std::istringstream in(read_text(path));
-  std::string line;
-  if (!std::getline(in, line)) throw std::runtime_error(path.string() + ": empty file");
-  const std::vector<std::string> header = split_csv_line(line);
-  std::vector<std::map<std::string, std::string>> rows;
-  int n = 1;
-  while (std::getline(in, line)) {
-    ++n;
-    if (line.empty()) continue;
-    const std::vector<std::string> f = split_csv_line(line);
-    if (f.size() != header.size())
-      throw std::runtime_error(path.string() + ":" + std::to_string(n) + ": " + std::to_string(f.size()) +
-                               " fields, header has " + std::to_string(header.size()));
-    std::map<std::string, std::string> row;
-    for (std::size_t i = 0; i < f.size(); ++i) row[header[i]] = f[i];
-    rows.push_back(std::move(row));
-  }
-  return rows;
-}
-
 /// Appends (r, uz) to the profile, keeping r strictly increasing.
-void append_point(validation::RadialProfile& p, double r_m, double uz_m) {
+void append_point(RadialProfile& p, double r_m, double uz_m) {
   if (!p.r_m.empty() && r_m <= p.r_m.back()) return;
   p.r_m.push_back(r_m);
   p.uz_m.push_back(uz_m);
@@ -70,85 +33,79 @@ void append_point(validation::RadialProfile& p, double r_m, double uz_m) {
 /// The FEM profile at `depth`: linear in depth between the two recorded
 /// profiles that bracket it when they share their radii (the same surface
 /// nodes), else the nearest one.
-validation::RadialProfile fem_profile_at_depth(std::vector<validation::RadialProfile> profiles, double depth) {
+RadialProfile fem_profile_at_depth(std::vector<RadialProfile> profiles, double depth) {
   std::sort(profiles.begin(), profiles.end(), [](const auto& a, const auto& b) { return a.depth_m < b.depth_m; });
   for (std::size_t i = 0; i + 1 < profiles.size(); ++i) {
-    const validation::RadialProfile& a = profiles[i];
-    const validation::RadialProfile& b = profiles[i + 1];
+    const RadialProfile& a = profiles[i];
+    const RadialProfile& b = profiles[i + 1];
     if (a.depth_m <= depth && depth <= b.depth_m && b.depth_m > a.depth_m && a.r_m == b.r_m) {
       const double t = (depth - a.depth_m) / (b.depth_m - a.depth_m);
-      validation::RadialProfile p = a;
+      RadialProfile p = a;
       p.depth_m = depth;
       for (std::size_t j = 0; j < p.uz_m.size(); ++j) p.uz_m[j] = (1 - t) * a.uz_m[j] + t * b.uz_m[j];
       return p;
     }
   }
-  return validation::profile_nearest_depth(profiles, depth);
+  return profile_nearest_depth(profiles, depth);
 }
 
 }  // namespace
 
-std::string read_text(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + path.string());
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 FemResultFiles read_fem_result(const std::filesystem::path& dir, const Scene& scene) {
   FemResultFiles fem;
-  fem.curve = validation::read_insertion_curve(dir / "fem_force_depth.csv");
-  fem.summary = nlohmann::json::parse(read_text(dir / "fem_summary.json"));
+  fem.curve = read_insertion_curve(dir / "fem_force_depth.csv");
+  fem.summary = nlohmann::json::parse(io::read_text_file(dir / "fem_summary.json"));
   if (fem.summary.contains("punctures"))
     for (const auto& p : fem.summary["punctures"])
       fem.puncture_depth_m[p.at("name").get<std::string>()] = p.at("depth_mm").get<double>() * kMm;
 
   {  // surface profiles, one per (step, surface)
-    const auto path = dir / "fem_surface_profile.csv";
-    int line = 1;
-    for (const auto& row : read_csv_rows(path)) {
-      ++line;
-      const std::string surface = row.at("surface");
-      const int step = static_cast<int>(to_double(row.at("step"), path.string(), line));
+    const io::CsvDocument doc = io::read_csv_file(dir / "fem_surface_profile.csv");
+    const std::size_t c_surface = doc.require_column("surface"), c_step = doc.require_column("step"),
+                      c_depth = doc.require_column("depth_mm"), c_r = doc.require_column("r_mm"),
+                      c_uz = doc.require_column("uz_mm");
+    for (const io::CsvRecord& row : doc.records) {
+      const std::string& surface = row.fields[c_surface];
+      const int step = static_cast<int>(doc.number(row, c_step));
       auto& list = fem.profiles[surface];
       if (list.empty() || list.back().step != step) {
-        validation::RadialProfile p;
+        RadialProfile p;
         p.step = step;
-        p.depth_m = to_double(row.at("depth_mm"), path.string(), line) * kMm;
+        p.depth_m = doc.number(row, c_depth) * kMm;
         list.push_back(p);
       }
-      append_point(list.back(), to_double(row.at("r_mm"), path.string(), line) * kMm,
-                   to_double(row.at("uz_mm"), path.string(), line) * kMm);
+      append_point(list.back(), doc.number(row, c_r) * kMm, doc.number(row, c_uz) * kMm);
     }
   }
   {  // spring-back profiles
-    const auto path = dir / "fem_recovery_profile.csv";
-    int line = 1;
-    for (const auto& row : read_csv_rows(path)) {
-      ++line;
-      const int layer = static_cast<int>(to_double(row.at("layer"), path.string(), line));
-      if (layer < 0 || layer >= static_cast<int>(scene.layers.size()))
-        throw std::runtime_error(path.string() + ":" + std::to_string(line) + ": layer index out of range");
+    const io::CsvDocument doc = io::read_csv_file(dir / "fem_recovery_profile.csv");
+    const std::size_t c_layer = doc.require_column("layer"), c_phase = doc.require_column("phase"),
+                      c_depth = doc.require_column("depth_mm"), c_r = doc.require_column("r_mm"),
+                      c_uz = doc.require_column("uz_mm");
+    for (const io::CsvRecord& row : doc.records) {
+      const double layer_value = doc.number(row, c_layer);
+      const int layer = static_cast<int>(layer_value);
+      if (layer < 0 || layer >= static_cast<int>(scene.layers.size()) || layer != layer_value)
+        throw io::CsvFormatError(doc.source, row.line, "layer", "layer index out of range");
       const std::string& name = scene.layers[static_cast<std::size_t>(layer)].name;
-      auto& target = row.at("phase") == "before" ? fem.before_breakthrough[name] : fem.after_breakthrough[name];
-      target.depth_m = to_double(row.at("depth_mm"), path.string(), line) * kMm;
-      append_point(target, to_double(row.at("r_mm"), path.string(), line) * kMm,
-                   to_double(row.at("uz_mm"), path.string(), line) * kMm);
+      auto& target = row.fields[c_phase] == "before" ? fem.before_breakthrough[name] : fem.after_breakthrough[name];
+      target.depth_m = doc.number(row, c_depth) * kMm;
+      append_point(target, doc.number(row, c_r) * kMm, doc.number(row, c_uz) * kMm);
     }
   }
   const auto pvd = dir / "fem_fields.pvd";
   if (std::filesystem::is_regular_file(pvd)) {
-    const std::string text = read_text(pvd);
+    const std::string text = io::read_text_file(pvd);
     const std::regex dataset(R"re(<DataSet[^>]*timestep="([^"]+)"[^>]*file="([^"]+)")re");
     const std::regex source(R"re(Source="([^"]+)")re");
     for (auto it = std::sregex_iterator(text.begin(), text.end(), dataset); it != std::sregex_iterator(); ++it) {
       FemFrame f;
-      f.time_s = to_double((*it)[1], pvd.string(), 0);
+      if (!io::parse_finite_number((*it)[1], f.time_s))
+        throw std::runtime_error(pvd.string() + ": timestep is not a finite number: '" + std::string((*it)[1]) + "'");
       f.pvtu = (*it)[2];
       f.files.push_back(f.pvtu);
       const std::filesystem::path pvtu_dir = std::filesystem::path(f.pvtu).parent_path();
-      const std::string pvtu_text = read_text(dir / f.pvtu);
+      const std::string pvtu_text = io::read_text_file(dir / f.pvtu);
       for (auto s = std::sregex_iterator(pvtu_text.begin(), pvtu_text.end(), source); s != std::sregex_iterator(); ++s)
         f.files.push_back((pvtu_dir / std::string((*s)[1])).string());
       fem.frame_times_s.push_back(f.time_s);
@@ -163,10 +120,10 @@ double fem_deflection_at_mm(const FemResultFiles& fem, const Scene& scene, std::
   const auto it = fem.profiles.find(scene.layers[layer].name);
   if (it == fem.profiles.end() || it->second.empty()) return kNaN;
   const double depth = scene.insertion.speed_m_per_s * time_s - scene.insertion.start_height_m;
-  const validation::RadialProfile& p = validation::profile_nearest_depth(it->second, depth);
+  const RadialProfile& p = profile_nearest_depth(it->second, depth);
   if (std::abs(p.depth_m - depth) > 0.5 * scene.fem.load_step_m + 1e-9) return kNaN;
   double uz = kNaN;
-  if (!validation::interpolate_linear(p.r_m, p.uz_m, r_m, uz)) return kNaN;
+  if (!interpolate_linear(p.r_m, p.uz_m, r_m, uz)) return kNaN;
   return -uz / kMm;
 }
 
@@ -229,7 +186,7 @@ LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size
   const double realtime_pre_depth =
       broke < run.ticks.size() && broke > 0 ? run.ticks[broke - 1].depth_m : run.ticks[deepest].depth_m;
 
-  std::vector<validation::RadialProfile> candidates;
+  std::vector<RadialProfile> candidates;
   if (const auto it = fem.profiles.find(layer.name); it != fem.profiles.end()) candidates = it->second;
   if (const auto it = fem.before_breakthrough.find(layer.name); it != fem.before_breakthrough.end())
     candidates.push_back(it->second);
@@ -247,7 +204,7 @@ LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size
       c.realtime_rings_m = recorder.rings(tick, k);
       c.fem = fem_profile_at_depth(candidates, c.realtime_depth_m);
       c.fem_depth_m = c.fem.depth_m;
-      c.error = validation::deflection_profile_error(c.realtime_rings_m, L, c.fem);
+      c.error = deflection_profile_error(c.realtime_rings_m, L, c.fem);
       c.compared = c.error.n_rings > 0;
     }
   }
@@ -260,7 +217,7 @@ LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size
     c.recovery_realtime_depth_m = run.ticks[tick].depth_m;
     c.realtime_recovered_rings_m = recorder.rings(tick, k);
     c.fem_after = after->second;
-    c.recovery_error = validation::deflection_profile_error(c.realtime_recovered_rings_m, L, c.fem_after);
+    c.recovery_error = deflection_profile_error(c.realtime_recovered_rings_m, L, c.fem_after);
     c.recovery_compared = c.recovery_error.n_rings > 0;
   }
   return c;
@@ -307,11 +264,10 @@ std::string num(const nlohmann::json& j, const char* key, double scale = 1.0, in
 }
 }  // namespace
 
-std::string validation_summary_markdown(const Scene& scene, const std::string& command_line,
-                                        const nlohmann::json& provenance, const FemReference& reference,
-                                        const FemResultFiles& fem, const validation::CurveComparison& cmp,
-                                        const nlohmann::json& layers, const std::vector<std::string>& plots,
-                                        bool has_vtk) {
+std::string validation_summary_markdown(const Scene& scene, const io::Provenance& provenance,
+                                        const FemReferenceInfo& reference, const FemResultFiles& fem,
+                                        const CurveComparison& cmp, const nlohmann::json& layers,
+                                        const std::vector<std::string>& plots, bool has_vtk) {
   std::ostringstream md;
   md << "# Validation: " << scene.name << "\n\n";
   md << "Real-time SHF + MSM model against the deal.II FEM reference on the identical insertion ("
@@ -319,11 +275,10 @@ std::string validation_summary_markdown(const Scene& scene, const std::string& c
      << " mm), aligned on depth. Only the insertion phase is compared (the FEM is quasi-static and stops at the "
         "target depth).\n\n";
   md << "## Provenance\n\n";
-  md << "- command: `" << command_line << "`\n";
-  md << "- program " << provenance.value("program_version", "") << ", git revision "
-     << provenance.value("git_revision", "") << "\n";
-  md << "- machine: " << provenance.value("machine", "") << "\n";
-  md << "- date (UTC): " << provenance.value("date_utc", "") << "\n";
+  md << "- command: `" << provenance.command << "`\n";
+  md << "- program " << provenance.program_version << ", git revision " << provenance.git_revision << "\n";
+  md << "- machine: " << provenance.machine << "\n";
+  md << "- date (UTC): " << provenance.date_utc << "\n";
   md << "- scene: `" << scene.source_path << "`\n";
   md << "- FEM reference: key `" << reference.hash << "` (" << (reference.from_cache ? "from the cache" : "computed")
      << "), " << fem.summary.value("n_dofs", 0) << " DoFs, Q" << fem.summary.value("element_degree", 0)
@@ -345,7 +300,7 @@ std::string validation_summary_markdown(const Scene& scene, const std::string& c
   md << "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& j : layers) {
     const std::string name = j["layer"].get<std::string>();
-    const validation::LayerMetrics* m = cmp.layer(name);
+    const LayerMetrics* m = cmp.layer(name);
     md << "| " << name << " | " << num(j, "force_rmse_N") << " | " << num(j, "force_rmse_relative") << " | "
        << (m && m->reference_puncture.found ? num(m->reference_puncture.depth_m / kMm) : "not punctured") << " | "
        << (m && m->model_puncture.found ? num(m->model_puncture.depth_m / kMm) : "not punctured") << " | "
@@ -383,4 +338,132 @@ std::string validation_summary_markdown(const Scene& scene, const std::string& c
   return md.str();
 }
 
-}  // namespace puncture::apps
+std::string layer_metrics_csv(const Scene& scene, const CurveComparison& cmp,
+                              const std::vector<LayerDeflectionComparison>& defl, const io::Provenance& provenance) {
+  io::CsvWriter csv({"layer", "pressed_from_mm", "pressed_to_mm", "n_samples", "force_rmse_N", "force_rmse_relative",
+                     "fem_puncture_depth_mm", "realtime_puncture_depth_mm", "puncture_depth_error_mm",
+                     "fem_puncture_force_N", "realtime_puncture_force_N", "puncture_force_error_N",
+                     "deflection_realtime_depth_mm", "deflection_fem_depth_mm", "deflection_rings", "deflection_rmse_mm",
+                     "deflection_max_error_mm", "deflection_relative_rmse", "recovery_delay_s", "recovery_rings",
+                     "recovery_rmse_mm", "recovery_max_error_mm"});
+  csv.add_provenance(provenance);
+  auto value = [&](bool ok, double x) { csv.number(ok ? x : kNaN, 10); };
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    const LayerMetrics* m = cmp.layer(scene.layers[k].name);
+    const LayerDeflectionComparison& d = defl[k];
+    csv.text(scene.layers[k].name);
+    if (m) {
+      const bool both = m->reference_puncture.found && m->model_puncture.found;
+      value(m->has_pressed_interval, m->pressed_from_depth_m / kMm);
+      value(m->has_pressed_interval, m->pressed_to_depth_m / kMm);
+      csv.integer(static_cast<long long>(m->n_samples));
+      value(true, m->force_rmse_N);
+      value(true, m->force_rmse_relative);
+      value(m->reference_puncture.found, m->reference_puncture.depth_m / kMm);
+      value(m->model_puncture.found, m->model_puncture.depth_m / kMm);
+      value(both, m->puncture_depth_error_m / kMm);
+      value(m->reference_puncture.found, m->reference_puncture.force_N);
+      value(m->model_puncture.found, m->model_puncture.force_N);
+      value(both, m->puncture_force_error_N);
+    } else {
+      value(false, 0), value(false, 0);
+      csv.integer(0);
+      for (int i = 0; i < 8; ++i) value(false, 0);
+    }
+    value(true, d.realtime_depth_m / kMm);
+    value(true, d.fem_depth_m / kMm);
+    csv.integer(static_cast<long long>(d.error.n_rings));
+    value(d.compared, d.error.rmse_m / kMm);
+    value(d.compared, d.error.max_abs_error_m / kMm);
+    value(d.compared, d.error.relative_rmse);
+    value(true, d.recovery_delay_s);
+    csv.integer(static_cast<long long>(d.recovery_error.n_rings));
+    value(d.recovery_compared, d.recovery_error.rmse_m / kMm);
+    value(d.recovery_compared, d.recovery_error.max_abs_error_m / kMm);
+    csv.end_row();
+  }
+  return csv.str();
+}
+
+std::string deflection_profiles_csv(const Scene& scene, const std::vector<LayerDeflectionComparison>& defl,
+                                    const io::Provenance& provenance) {
+  io::CsvWriter csv({"layer", "phase", "model", "depth_mm", "r_mm", "deflection_mm"});
+  csv.add_provenance(provenance);
+  auto rings = [&](const std::string& layer, const char* phase, double depth, const std::vector<double>& dz,
+                   double L) {
+    for (std::size_t j = 0; j < dz.size(); ++j)
+      csv.text(layer).text(phase).text("realtime").number(depth / kMm, 10)
+          .number(static_cast<double>(j) * L / kMm, 10).number(dz[j] / kMm, 10).end_row();
+  };
+  auto fem = [&](const std::string& layer, const char* phase, const RadialProfile& p) {
+    for (std::size_t i = 0; i < p.r_m.size(); ++i)
+      csv.text(layer).text(phase).text("fem").number(p.depth_m / kMm, 10).number(p.r_m[i] / kMm, 10)
+          .number(-p.uz_m[i] / kMm, 10).end_row();
+  };
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    const std::string& name = scene.layers[k].name;
+    const double L = scene.layers[k].force_mesh.spacing_L_m;
+    const LayerDeflectionComparison& d = defl[k];
+    if (d.compared) {
+      rings(name, "before_breakthrough", d.realtime_depth_m, d.realtime_rings_m, L);
+      fem(name, "before_breakthrough", d.fem);
+    }
+    if (d.recovery_compared) {
+      rings(name, "after_breakthrough", d.recovery_realtime_depth_m, d.realtime_recovered_rings_m, L);
+      fem(name, "after_breakthrough", d.fem_after);
+    }
+  }
+  return csv.str();
+}
+
+std::string aligned_curves_csv(const InsertionCurve& realtime, const InsertionCurve& fem,
+                               const io::Provenance& provenance) {
+  io::CsvWriter csv({"depth_mm", "fem_force_N", "realtime_force_N", "difference_N"});
+  csv.add_provenance(provenance);
+  const std::vector<std::size_t> rt_idx = insertion_phase(realtime);
+  std::vector<double> rt_depth, rt_force;
+  for (std::size_t i : rt_idx) rt_depth.push_back(realtime.depth_m[i]), rt_force.push_back(realtime.force_N[i]);
+  for (std::size_t i : insertion_phase(fem)) {
+    double f = kNaN;
+    const bool inside = interpolate_linear(rt_depth, rt_force, fem.depth_m[i], f);
+    csv.number(fem.depth_m[i] / kMm, 10).number(fem.force_N[i], 10).number(inside ? f : kNaN, 10)
+        .number(inside ? f - fem.force_N[i] : kNaN, 10).end_row();
+  }
+  return csv.str();
+}
+
+nlohmann::json layer_metrics_json(const Scene& scene, const CurveComparison& cmp,
+                                  const std::vector<LayerDeflectionComparison>& defl) {
+  nlohmann::json layers = nlohmann::json::array();
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    nlohmann::json j;
+    j["layer"] = scene.layers[k].name;
+    if (const LayerMetrics* m = cmp.layer(scene.layers[k].name)) {
+      j["force_rmse_N"] = m->force_rmse_N;
+      j["force_rmse_relative"] = m->force_rmse_relative;
+      j["n_samples"] = m->n_samples;
+      j["fem_punctured"] = m->reference_puncture.found;
+      j["realtime_punctured"] = m->model_puncture.found;
+      if (m->reference_puncture.found && m->model_puncture.found) {
+        j["puncture_depth_error_mm"] = m->puncture_depth_error_m / kMm;
+        j["puncture_force_error_N"] = m->puncture_force_error_N;
+      }
+    }
+    if (defl[k].compared)
+      j["deflection"] = {{"realtime_depth_mm", defl[k].realtime_depth_m / kMm},
+                         {"fem_depth_mm", defl[k].fem_depth_m / kMm},
+                         {"rings", defl[k].error.n_rings},
+                         {"rmse_mm", defl[k].error.rmse_m / kMm},
+                         {"max_abs_error_mm", defl[k].error.max_abs_error_m / kMm},
+                         {"relative_rmse", defl[k].error.relative_rmse}};
+    if (defl[k].recovery_compared)
+      j["recovery"] = {{"delay_s", defl[k].recovery_delay_s},
+                       {"rings", defl[k].recovery_error.n_rings},
+                       {"rmse_mm", defl[k].recovery_error.rmse_m / kMm},
+                       {"max_abs_error_mm", defl[k].recovery_error.max_abs_error_m / kMm}};
+    layers.push_back(j);
+  }
+  return layers;
+}
+
+}  // namespace puncture::validation

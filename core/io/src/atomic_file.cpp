@@ -1,0 +1,79 @@
+#include "puncture/io/atomic_file.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "puncture/io/interrupt_cleanup.hpp"
+
+namespace puncture::io {
+namespace fs = std::filesystem;
+
+namespace {
+std::atomic<unsigned long> staging_counter{0};
+
+std::string host_tag() {
+  char host[256] = "unknown";
+  gethostname(host, sizeof host - 1);
+  host[sizeof host - 1] = '\0';
+  std::string h = host;
+  for (char& c : h)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' || c == '_')) c = '_';
+  return h;
+}
+}  // namespace
+
+fs::path staging_path_for(const fs::path& final_path) {
+  static const std::string host = host_tag();
+  return final_path.parent_path() / ("." + final_path.filename().string() + ".staging-" +
+                                     std::to_string(static_cast<long>(::getpid())) + "-" +
+                                     std::to_string(++staging_counter) + "@" + host);
+}
+
+void write_file_atomically(const fs::path& path, const std::string& contents) {
+  const fs::path tmp = staging_path_for(path);
+  register_cleanup(tmp, CleanupKind::File);
+  auto fail = [&](const std::string& what, int error) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    unregister_cleanup(tmp);
+    throw std::runtime_error("cannot write '" + path.string() + "': " + what +
+                             (error ? std::string(": ") + std::strerror(error) : std::string()));
+  };
+  {
+    errno = 0;
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) fail("cannot create a file in '" + path.parent_path().string() + "'", errno);
+    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
+    out.flush();
+    if (!out) fail("write failed", errno);
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) fail("rename failed (" + ec.message() + ")", 0);
+  unregister_cleanup(tmp);
+}
+
+std::string read_text_file(const fs::path& path) {
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (ec || !fs::exists(status))
+    throw std::runtime_error("cannot read '" + path.string() + "': " +
+                             (ec ? ec.message() : std::string(std::strerror(ENOENT))));
+  if (fs::is_directory(status)) throw std::runtime_error("cannot read '" + path.string() + "': it is a directory");
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read '" + path.string() + "': " + std::strerror(errno ? errno : EACCES));
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) throw std::runtime_error("cannot read '" + path.string() + "': read error");
+  return s.str();
+}
+
+}  // namespace puncture::io

@@ -1,0 +1,176 @@
+#include "puncture/io/interrupt_cleanup.hpp"
+
+#include <pthread.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace puncture::io {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::mutex& registry_mutex() {
+  static std::mutex m;
+  return m;
+}
+std::map<fs::path, CleanupKind>& registry() {
+  static std::map<fs::path, CleanupKind> r;
+  return r;
+}
+std::atomic<bool> installed{false};
+
+sigset_t watched_signals() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGHUP);
+  return set;
+}
+
+std::string this_host() {
+  char host[256] = "unknown";
+  gethostname(host, sizeof host - 1);
+  host[sizeof host - 1] = '\0';
+  std::string h = host;
+  for (char& c : h)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' || c == '_')) c = '_';
+  return h;
+}
+
+bool process_alive(long pid) {
+  if (pid <= 0) return true;  // not a pid we can judge: keep the file
+  if (::kill(static_cast<pid_t>(pid), 0) == 0) return true;
+  return errno != ESRCH;  // EPERM: it exists, owned by someone else
+}
+
+void watcher() {
+  const sigset_t set = watched_signals();
+  int sig = 0;
+  while (sigwait(&set, &sig) != 0) {
+  }
+  const std::size_t removed = run_cleanup_now();
+  char message[160];
+  std::snprintf(message, sizeof message, "\ninterrupted by signal %d (%s): removed %zu staged file(s); nothing was committed\n",
+                sig, sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "SIGHUP", removed);
+  (void)!::write(STDERR_FILENO, message, std::char_traits<char>::length(message));
+  // End the process by the same signal (default action), so the parent sees
+  // a death by signal.
+  ::signal(sig, SIG_DFL);
+  sigset_t one;
+  sigemptyset(&one);
+  sigaddset(&one, sig);
+  pthread_sigmask(SIG_UNBLOCK, &one, nullptr);
+  ::raise(sig);
+  ::_exit(128 + sig);
+}
+
+}  // namespace
+
+void install_interrupt_cleanup() {
+  if (installed.exchange(true)) return;
+  const sigset_t set = watched_signals();
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  std::thread(watcher).detach();
+}
+
+bool interrupt_cleanup_installed() { return installed.load(); }
+
+void register_cleanup(const fs::path& path, CleanupKind kind) {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  registry()[path] = kind;
+}
+
+void unregister_cleanup(const fs::path& path) {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  registry().erase(path);
+}
+
+std::size_t run_cleanup_now() {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  std::size_t removed = 0;
+  std::vector<fs::path> dirs;
+  for (const auto& [path, kind] : registry()) {
+    std::error_code ec;
+    if (kind == CleanupKind::File) {
+      if (fs::remove(path, ec)) ++removed;
+    } else if (kind == CleanupKind::Tree) {
+      const auto n = fs::remove_all(path, ec);
+      if (n != static_cast<std::uintmax_t>(-1) && n > 0) ++removed;
+    } else {
+      dirs.push_back(path);
+    }
+  }
+  // Deepest directories first; a directory that still holds files stays.
+  std::sort(dirs.begin(), dirs.end(), [](const fs::path& a, const fs::path& b) {
+    return a.string().size() > b.string().size();
+  });
+  for (const fs::path& d : dirs) {
+    std::error_code ec;
+    fs::remove(d, ec);
+  }
+  registry().clear();
+  return removed;
+}
+
+bool is_stale_staging_name(const std::string& name) {
+  const std::string tag = ".staging-";
+  if (name.empty() || name[0] != '.') return false;
+  const auto at = name.rfind(tag);
+  if (at == std::string::npos) return false;
+  std::size_t i = at + tag.size();
+  auto read_number = [&](long& value) {
+    const std::size_t start = i;
+    while (i < name.size() && std::isdigit(static_cast<unsigned char>(name[i]))) ++i;
+    if (i == start || i - start > 12) return false;
+    value = std::stol(name.substr(start, i - start));
+    return true;
+  };
+  long pid = 0, counter = 0;
+  if (!read_number(pid) || i >= name.size() || name[i] != '-') return false;
+  ++i;
+  if (!read_number(counter)) return false;
+  if (i < name.size()) {
+    // "@<host>": only processes of this host can be checked.
+    if (name[i] != '@' || name.substr(i + 1) != this_host()) return false;
+  }
+  return !process_alive(pid);
+}
+
+std::size_t remove_stale_staging(const fs::path& dir, int depth) {
+  std::error_code ec;
+  if (depth < 0 || !fs::is_directory(dir, ec)) return 0;
+  std::size_t removed = 0;
+  std::vector<fs::path> subdirs;
+  bool removed_here = false;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const fs::path p = it->path();
+    const std::string name = p.filename().string();
+    std::error_code e2;
+    if (it->is_directory(e2)) {
+      if (!name.empty() && name[0] != '.') subdirs.push_back(p);
+    } else if (is_stale_staging_name(name)) {
+      if (fs::remove(p, e2)) ++removed, removed_here = true;
+    }
+  }
+  for (const fs::path& s : subdirs) {
+    const std::size_t n = remove_stale_staging(s, depth - 1);
+    removed += n;
+    if (n > 0 && fs::is_empty(s, ec)) fs::remove(s, ec);  // a directory only the dead run used
+  }
+  (void)removed_here;
+  return removed;
+}
+
+}  // namespace puncture::io
