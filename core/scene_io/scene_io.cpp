@@ -262,6 +262,7 @@ Scene read_scene(const json& root, const std::string& file) {
     f.max_newton_iterations = o.integer("max_newton_iterations", f.max_newton_iterations);
     f.newton_tolerance = o.number("newton_tolerance", f.newton_tolerance);
     f.cohesive_viscosity_s = o.number("cohesive_viscosity_s", f.cohesive_viscosity_s);
+    f.stabilization_time_s = o.number("stabilization_time_s", f.stabilization_time_s);
     if (o.has("mesh")) {
       ObjectReader m(o.raw("mesh"), "/fem/mesh", file);
       FemMeshSettings& ms = f.mesh;
@@ -444,6 +445,8 @@ void validate_scene(const Scene& s, const std::string& file) {
           f.newton_tolerance);
   require(f.cohesive_viscosity_s >= 0 && f.cohesive_viscosity_s <= 1, file, "/fem/cohesive_viscosity_s",
           "in [0, 1] s", f.cohesive_viscosity_s);
+  require(f.stabilization_time_s >= 0 && f.stabilization_time_s <= 1, file, "/fem/stabilization_time_s",
+          "in [0, 1] s", f.stabilization_time_s);
   require(f.mesh.elements_per_needle_radius >= 2 && f.mesh.elements_per_needle_radius <= 64, file,
           "/fem/mesh/elements_per_needle_radius", "in [2, 64]", f.mesh.elements_per_needle_radius);
   require(f.mesh.min_elements_per_layer >= 1 && f.mesh.min_elements_per_layer <= 200, file,
@@ -552,6 +555,7 @@ std::string scene_to_json_text(const Scene& s) {
                  {"max_newton_iterations", s.fem.max_newton_iterations},
                  {"newton_tolerance", s.fem.newton_tolerance},
                  {"cohesive_viscosity_s", s.fem.cohesive_viscosity_s},
+                 {"stabilization_time_s", s.fem.stabilization_time_s},
                  {"mesh",
                   {{"elements_per_needle_radius", s.fem.mesh.elements_per_needle_radius},
                    {"min_elements_per_layer", s.fem.mesh.min_elements_per_layer},

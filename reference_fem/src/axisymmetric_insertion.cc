@@ -156,6 +156,7 @@ FemRunSummary run_axisymmetric_insertion(const Scene& scene, const FemRunOptions
       settings.max_newton_iterations = scene.fem.max_newton_iterations;
       settings.newton_tolerance = scene.fem.newton_tolerance;
       settings.verbose = std::getenv("PUNCTURE_FEM_DEBUG") != nullptr;
+      settings.stabilization_time_s = scene.fem.stabilization_time_s;
       AxisymmetricSolver solver(mesh, laws.materials, laws.cracks, laws.friction, settings);
       solver.setup(0.5 * scene.sample.diameter_m, scene.total_thickness_m());
       summary.geometry = "axisymmetric";

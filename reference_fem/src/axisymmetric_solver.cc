@@ -395,6 +395,7 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
   penalty_.assign(contact_nodes_.size(), 0.0);
   broken_layers_.assign(materials_.size(), 0);
   dissipated_J_ = dissipated_trial_J_ = 0.0;
+  stabilization_J_ = stabilization_trial_J_ = 0.0;
   assemble(solution_, true);
   update_penalties();
 }
@@ -478,7 +479,15 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
   const FEValuesExtractors::Scalar ur(0), uz(1);
   std::vector<Tensor<1, 2>> g_ur(nq), g_uz(nq);
   std::vector<double> v_ur(nq);
+  std::vector<Tensor<1, 2>> g0_ur(nq), g0_uz(nq);
+  std::vector<double> v0_ur(nq);
   CellState st;
+  // Viscous stabilisation (Kelvin-Voigt on the step's strain increment):
+  // sigma_v = (tau / dt) 2 mu_0 sym(H - H_step_start), mu_0 the layer's
+  // initial shear modulus.
+  const bool stabilize = settings_.stabilization_time_s > 0.0 && dt_s_ > 0.0 && step_start_.size() == u.size();
+  const double stab_ratio = stabilize ? settings_.stabilization_time_s / dt_s_ : 0.0;
+  stabilization_trial_J_ = stabilization_J_;
 
   if (with_matrix) {
     tangent_ = 0.0;
@@ -496,6 +505,29 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
     Ke = 0.0;
     Re = 0.0;
     B = 0.0;
+    if (stabilize) {
+      fev[ur].get_function_gradients(step_start_, g0_ur);
+      fev[uz].get_function_gradients(step_start_, g0_uz);
+      fev[ur].get_function_values(step_start_, v0_ur);
+      const LayerMaterial& m = material_of(cell);
+      const double two_mu_v = stab_ratio * m.youngs_modulus_Pa() / (1.0 + m.poisson_ratio());
+      for (unsigned q = 0; q < nq; ++q) {
+        const double R = fev.quadrature_point(q)[0];
+        const Tensor<2, 3> dH = H[q] - displacement_gradient(g0_ur[q], g0_uz[q], v0_ur[q], R);
+        const Tensor<2, 3> eps = 0.5 * (dH + transpose(dH));
+        stabilization_trial_J_ += two_mu_v * scalar_product(eps, eps) * st.dV[q];
+        for (unsigned i = 0; i < dpc; ++i) {
+          const Tensor<2, 3> gi = shape_gradient(comp[i], fev.shape_value(i, q), fev.shape_grad(i, q), R);
+          const Tensor<2, 3> ei = 0.5 * (gi + transpose(gi));
+          Re(i) += two_mu_v * scalar_product(ei, eps) * st.dV[q];
+          if (!with_matrix) continue;
+          for (unsigned j = 0; j <= i; ++j) {
+            const Tensor<2, 3> gj = shape_gradient(comp[j], fev.shape_value(j, q), fev.shape_grad(j, q), R);
+            Ke(i, j) += two_mu_v * 0.5 * scalar_product(ei, gj + transpose(gj)) * st.dV[q];
+          }
+        }
+      }
+    }
     for (unsigned q = 0; q < nq; ++q) {
       const double R = fev.quadrature_point(q)[0];
       const Tensor<2, 3> S_full(st.S[q]);
@@ -660,12 +692,14 @@ void AxisymmetricSolver::commit() {
   cohesive_committed_ = cohesive_trial_;
   friction_committed_ = friction_trial_;
   dissipated_J_ = dissipated_trial_J_;
+  stabilization_J_ = stabilization_trial_J_;
   force_ = force_trial_;
 }
 
 AxisymmetricSolver::Snapshot AxisymmetricSolver::snapshot() const {
   return {solution_,          last_increment_,     cohesive_committed_, friction_committed_,
-          punch_contact_,     punch_lateral_hold_, broken_layers_,      dissipated_J_};
+          punch_contact_,     punch_lateral_hold_, broken_layers_,      dissipated_J_,
+          stabilization_J_};
 }
 
 void AxisymmetricSolver::restore(const Snapshot& s) {
@@ -677,6 +711,8 @@ void AxisymmetricSolver::restore(const Snapshot& s) {
   punch_lateral_hold_ = s.punch_lateral_hold;
   broken_layers_ = s.broken_layers;
   dissipated_J_ = dissipated_trial_J_ = s.dissipated_J;
+  stabilization_J_ = stabilization_trial_J_ = s.stabilization_J;
+  step_start_ = solution_;
   assemble(solution_, true);
   force_ = force_trial_;
   update_penalties();
@@ -685,6 +721,7 @@ void AxisymmetricSolver::restore(const Snapshot& s) {
 AxisymmetricNewtonReport AxisymmetricSolver::solve_step(double predictor_scale) {
   AxisymmetricNewtonReport report;
   const Vector<double> u_start(solution_);
+  step_start_ = u_start;
   const auto punch_contact_start = punch_contact_;
   const auto punch_hold_start = punch_lateral_hold_;
   auto fail = [&](const std::string& why) {

@@ -170,6 +170,9 @@ struct FemSettings {
   /// its rate-independent value with this delay, so that an unstable crack
   /// jump is traced over a few steps instead of defeating Newton.
   double cohesive_viscosity_s = 2e-3;
+  /// Axisymmetric FEM: Kelvin-Voigt stabilisation time (s) on each step's
+  /// strain increment, which carries the solution through snaps (0: off).
+  double stabilization_time_s = 1e-3;
 };
 
 /// Effects a scene can switch on. An effect that is off is not constructed.

@@ -74,6 +74,15 @@ struct AxisymmetricSettings {
   /// for a slit through the axis, whose material cannot drift away from the tip).
   bool hold_crack_line = true;
   bool blunt_tip_no_slip = true;  ///< flat punch: hold u_R of touching nodes (else frictionless)
+  /// Viscous stabilisation time tau (s): a Kelvin-Voigt stress
+  /// (tau/dt) 2 mu_0 sym(H - H_step_start) on the step's strain increment
+  /// (mu_0: the layer's initial shear modulus; rigid motion costs nothing).
+  /// It carries the solution through a snap (the skin slipping over the tip,
+  /// a crack running) where the quasi-static path has a limit point; it is
+  /// small at full steps (tau/dt = 0.01 at 0.1 mm steps at 10 mm/s, against
+  /// tissue that has stiffened far beyond mu_0) and grows when a step is cut,
+  /// so a cut step converges. Its dissipated energy is reported.
+  double stabilization_time_s = 1e-4;
   bool verbose = false;
 };
 
@@ -153,6 +162,7 @@ class AxisymmetricSolver {
     std::vector<double> punch_lateral_hold;
     std::vector<char> broken_layers;
     double dissipated_J = 0.0;
+    double stabilization_J = 0.0;
   };
   Snapshot snapshot() const;
   void restore(const Snapshot& s);
@@ -164,6 +174,8 @@ class AxisymmetricSolver {
   // --- results ----------------------------------------------------------------
   NeedleForce needle_force() const { return force_; }
   double cohesive_dissipation_J() const { return dissipated_J_; }
+  /// Energy dissipated by the viscous stabilisation so far (J).
+  double stabilization_dissipation_J() const { return stabilization_J_; }
   /// Deepest crack point (depth below the surface, m) whose damage >= threshold
   /// in the given layer (-1: none).
   double crack_front_depth_m(int layer, double damage_threshold = 0.999) const;
@@ -231,6 +243,8 @@ class AxisymmetricSolver {
   std::vector<double> penalty_;  ///< k_n per contact node (N/m)
   std::vector<char> broken_layers_;
   double dissipated_J_ = 0.0, dissipated_trial_J_ = 0.0;
+  double stabilization_J_ = 0.0, stabilization_trial_J_ = 0.0;
+  dealii::Vector<double> step_start_;  ///< u at the start of the step (viscous stabilisation)
 
   // needle
   bool cutting_ = true;

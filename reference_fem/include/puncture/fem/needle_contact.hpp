@@ -19,13 +19,15 @@
 //   N(p) = k_n p^2 / (2 eps) for p < eps,  k_n (p - eps / 2) beyond
 // (ContactPenalty), so a node entering contact does not see a jump in
 // stiffness. The inner wall acts on core-side nodes only above the edge,
-// switched on by a smooth ramp over a height h_edge below... above the edge
-// (the edge is rounded), which keeps the energy C1 as the edge passes a node. Friction (outer side only) is Coulomb with a static and a
-// dynamic coefficient (Karnopp-like stick-slip), regularised by a tangential
-// penalty k_t: the stick point is remembered in the needle's frame and the
-// elastic slip xi = (x - x_edge - anchor) . t gives the trial force -k_t xi t;
-// beyond the limit the node slides: at mu_s N in the step it breaks free, at
-// mu_d N while it keeps sliding (see nodal_contact).
+// switched on by a smooth ramp over a height h_edge above the edge (the edge
+// is rounded), which keeps the energy C1 as the edge passes a node. Friction
+// (shaft side only) is Coulomb with a static and a dynamic coefficient,
+// regularised by a tangential penalty k_t: the stick point is remembered in
+// the needle's frame, the elastic slip xi = (x - x_edge - anchor) . t gives
+// the force -mu N tanh(k_t xi / (mu N)) t (stick for small slips, slide at
+// mu N for large ones, smooth in between so Newton converges through
+// stick-slip and through the reversal at withdrawal); plastic slip is
+// committed between steps (see nodal_contact).
 //
 // Units: m, N, N/m.
 #pragma once
@@ -88,6 +90,11 @@ struct ContactPoint {
   Vec2 normal{1.0, 0.0};
   Vec2 tangent{0.0, 1.0};
   bool frictional = false;
+  /// Share of Coulomb friction in [0, 1]: 0 on the flank (the cutting bevel),
+  /// 1 on the shaft, a smooth step over the rounded shoulder (so a node sliding
+  /// round the shoulder sees no jump), and its gradient (1/m).
+  double friction_weight = 0.0;
+  Vec2 dfriction_weight_dx{0.0, 0.0};
 };
 
 /// Contact of a tissue node at x = (r, z) on the outer side of the crack,
@@ -111,6 +118,7 @@ inline ContactPoint outer_contact(const RigidNeedle& needle, const Vec2& x, doub
   const double z_corner = needle.z_tip_m + (r_corner - needle.edge_radius_m - (-rho) * n1[0]) / t1[0] * t1[1] + (-rho) * n1[1];
   double d = 0.0;
   Vec2 n = n1;
+  bool on_corner = false;
   if (g1 <= 0.0 && g2 <= 0.0) {  // inside the shrunk body (penetration beyond the rounding)
     d = std::max(g1, g2);
     n = g1 >= g2 ? n1 : n2;
@@ -130,6 +138,7 @@ inline ContactPoint outer_contact(const RigidNeedle& needle, const Vec2& x, doub
       const Vec2 v{x[0] - r_corner, x[1] - z_corner};
       d = std::sqrt(dot(v, v));
       n = d > 0.0 ? Vec2{v[0] / d, v[1] / d} : n1;
+      on_corner = d > 0.0;
     }
   }
   const double penetration = rho - d;
@@ -137,9 +146,19 @@ inline ContactPoint outer_contact(const RigidNeedle& needle, const Vec2& x, doub
   c.penetration_m = penetration;
   c.normal = n;
   c.tangent = {-n[1], n[0]};
-  // Friction acts on the shaft (and the upper half of the rounded shoulder);
-  // the tip's flank is the cutting bevel, whose force is its normal pressure.
-  c.frictional = n[0] >= std::cos(0.5 * beta) - 1e-12;
+  // Friction acts on the shaft, fading out over the rounded shoulder; the
+  // tip's flank is the cutting bevel, whose force is its normal pressure.
+  // w = smoothstep(s), s = (n_r - cos beta) / (1 - cos beta).
+  const double span = 1.0 - std::cos(beta);
+  const double s = span > 0.0 ? std::clamp((n[0] - std::cos(beta)) / span, 0.0, 1.0) : 1.0;
+  c.friction_weight = s * s * (3.0 - 2.0 * s);
+  if (on_corner && s > 0.0 && s < 1.0) {
+    // d n_r / dx = (e_r - n_r n) / d on the rounded corner (n = v / |v|).
+    const double dw_ds = 6.0 * s * (1.0 - s) / span;
+    const double d_inv = 1.0 / d;
+    c.dfriction_weight_dx = {dw_ds * (1.0 - n[0] * n[0]) * d_inv, dw_ds * (-n[0] * n[1]) * d_inv};
+  }
+  c.frictional = c.friction_weight > 0.0;
   return c;
 }
 
@@ -194,6 +213,11 @@ inline NodalContactResponse core_wall_contact(const RigidNeedle& needle, const V
   return out;
 }
 
+/// Elastic slip (in units of mu N / k_t) a sliding node keeps from one step to
+/// the next: tanh(2) = 0.96, so a node that slides starts its next step at 96 %
+/// of the Coulomb force.
+inline constexpr double kCommittedSlipRatio = 2.0;
+
 /// Penalty contact and friction of an outer-side node touching the face c.
 /// edge = (r_c, z_tip): position of the cutting edge; k_t: tangential penalty (N/m).
 inline NodalContactResponse nodal_contact(const ContactPoint& c, const Vec2& x, const Vec2& edge,
@@ -215,32 +239,37 @@ inline NodalContactResponse nodal_contact(const ContactPoint& c, const Vec2& x, 
   if (!committed.in_contact) return out;
   const Vec2 anchor = committed.anchor;
   const double xi = dot(Vec2{rel[0] - anchor[0], rel[1] - anchor[1]}, c.tangent);
-  const double trial = -k_t * xi;  // tangential force along t
-  // Karnopp-like stick-slip, continuous within a step: a node that stuck in
-  // the last step breaks free at mu_s N and slides at mu_s N in this step; a
-  // sliding node slides at mu_d N (the drop from static to dynamic friction
-  // happens between steps, so Newton never sees a jump).
+  // Regularised Coulomb friction, smooth within a step so that Newton sees no
+  // switch: f = -mu N tanh(k_t xi / (mu N)) along t. Small slips stick
+  // elastically (f = -k_t xi), large ones slide at mu N. Plastic slip is
+  // committed between steps: a node whose elastic slip exceeds
+  // kCommittedSlipRatio mu N / k_t keeps that much and moves its stick
+  // point. A node that stuck in the last step resists with mu_s, a sliding one
+  // with mu_d (the drop from static to dynamic happens between steps).
   const double mu_now = committed.sliding ? mu.dynamic : mu.static_;
-  const double limit = mu_now * N;
-  if (std::abs(trial) <= limit) {
-    for (int i = 0; i < 2; ++i) {
-      out.friction_force[i] = trial * c.tangent[i];
-      for (int j = 0; j < 2; ++j) out.dforce_dx[i][j] += -k_t * c.tangent[i] * c.tangent[j];
-    }
+  const double cap = mu_now * N;
+  if (!(cap > 0.0)) return out;
+  const double u = k_t * xi / cap;
+  const double th = std::tanh(u), sech2 = 1.0 - th * th;
+  const double f = -cap * th;
+  const double df_dxi = -k_t * sech2;
+  const double df_dN = -mu_now * (th - u * sech2);
+  // d xi / dx = t; d N / dx = dN (-n) (the penetration falls along n).
+  const double w = c.friction_weight;
+  for (int i = 0; i < 2; ++i) {
+    out.friction_force[i] = w * f * c.tangent[i];
+    for (int j = 0; j < 2; ++j)
+      out.dforce_dx[i][j] += c.tangent[i] * (w * (df_dxi * c.tangent[j] - df_dN * dN * c.normal[j]) +
+                                             f * c.dfriction_weight_dx[j]);
+  }
+  const double xi_max = kCommittedSlipRatio * cap / k_t;
+  if (std::abs(xi) > xi_max) {
+    out.history.sliding = true;
+    const double xi_e = xi > 0.0 ? xi_max : -xi_max;
+    for (int i = 0; i < 2; ++i) out.history.anchor[i] = rel[i] - xi_e * c.tangent[i];
+  } else {
     out.history.sliding = false;
     out.history.anchor = anchor;
-  } else {
-    const double sign = trial > 0.0 ? 1.0 : -1.0;
-    const double f = sign * mu_now * N;
-    // d f / dx = sign mu dN/dp dp/dx = sign mu dN (-n) (penetration falls along n).
-    for (int i = 0; i < 2; ++i) {
-      out.friction_force[i] = f * c.tangent[i];
-      for (int j = 0; j < 2; ++j) out.dforce_dx[i][j] += -sign * mu_now * dN * c.tangent[i] * c.normal[j];
-    }
-    out.history.sliding = true;
-    // New stick point: the elastic slip that carries exactly the sliding force.
-    const double xi_new = -f / k_t;
-    for (int i = 0; i < 2; ++i) out.history.anchor[i] = rel[i] - xi_new * c.tangent[i];
   }
   return out;
 }
