@@ -397,6 +397,11 @@ FemRunSummary run_axisymmetric_insertion(const Scene& scene, const FemRunOptions
         }
       }
       summary.cohesive_dissipation_J = solver.cohesive_dissipation_J();
+      summary.stabilization_dissipation_J = solver.stabilization_dissipation_J();
+      // Needle work over the insertion (trapezoid rule on force x depth).
+      for (std::size_t k = 1; k < rows.size(); ++k)
+        if (rows[k].phase == "insertion")
+          summary.needle_work_J += 0.5 * (rows[k].force_N + rows[k - 1].force_N) * (rows[k].depth_m - rows[k - 1].depth_m);
 
       // ---- 5. Write ---------------------------------------------------------------------
       summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
@@ -444,6 +449,8 @@ FemRunSummary run_axisymmetric_insertion(const Scene& scene, const FemRunOptions
         j["peak_force_N"] = summary.peak_force_N;
         j["peak_force_depth_mm"] = summary.peak_force_depth_m * 1e3;
         j["cohesive_dissipation_J"] = summary.cohesive_dissipation_J;
+        j["stabilization_dissipation_J"] = summary.stabilization_dissipation_J;
+        j["needle_work_insertion_J"] = summary.needle_work_J;
         j["load_steps"] = summary.load_steps;
         j["step_cuts"] = summary.step_cuts;
         j["newton_iterations"] = summary.newton_iterations;

@@ -1,3 +1,4 @@
+#include <algorithm>
 // Axisymmetric slab mesh: the layer volumes of revolution are those of the
 // cylinders, cells carry the layer at their depth, every layer gets its
 // minimum number of elements and starts with the tip element size on the
@@ -39,19 +40,29 @@ double cell_area(const AxisymmetricSlabMesh& m, std::size_t c, double* centroid_
 
 }  // namespace
 
-TEST(AxisymmetricSlabMesh, LayerVolumesOfRevolutionAreTheCylinders) {
-  const Scene s = three_layers("bevel");
-  const auto m = build_axisymmetric_slab_mesh(s, 0);
-  std::vector<double> volume(3, 0.0);
-  for (std::size_t c = 0; c < m.cells.size(); ++c) {
-    double rc = 0.0;
-    const double area = cell_area(m, c, &rc);
-    ASSERT_GT(area, 0.0) << "cell " << c << " has a non-positive orientation";
-    volume[m.material_id[c]] += 2.0 * M_PI * rc * area;  // Pappus, exact for a rectangle
+TEST(AxisymmetricSlabMesh, LayerVolumesOfRevolutionAreTheCylindersLessTheChannel) {
+  // Cutting tips: the channel R < r_c above the path depth has no cells, so a
+  // layer's volume is its cylinder less pi r_c^2 times the part of the layer
+  // above the path; a blunt tip's mesh is the full cylinder.
+  for (const std::string tip : {"bevel", "blunt"}) {
+    const Scene s = three_layers(tip);
+    const auto m = build_axisymmetric_slab_mesh(s, 0);
+    EXPECT_EQ(m.open_channel, tip == "bevel") << tip;
+    std::vector<double> volume(3, 0.0);
+    for (std::size_t c = 0; c < m.cells.size(); ++c) {
+      double rc = 0.0;
+      const double area = cell_area(m, c, &rc);
+      ASSERT_GT(area, 0.0) << "cell " << c << " has a non-positive orientation";
+      volume[m.material_id[c]] += 2.0 * M_PI * rc * area;  // Pappus, exact for a rectangle
+    }
+    const double R = 0.5 * s.sample.diameter_m;
+    for (int i = 0; i < 3; ++i) {
+      const double top = s.layer_top_depth_m(i), bottom = top + s.layers[i].thickness_m;
+      const double cut = m.open_channel ? std::clamp(m.path_depth_m, top, bottom) - top : 0.0;
+      const double expected = M_PI * R * R * s.layers[i].thickness_m - M_PI * m.crack_radius_m * m.crack_radius_m * cut;
+      EXPECT_NEAR(volume[i], expected, 1e-9 * volume[i]) << tip << " " << s.layers[i].name;
+    }
   }
-  const double R = 0.5 * s.sample.diameter_m;
-  for (int i = 0; i < 3; ++i)
-    EXPECT_NEAR(volume[i], M_PI * R * R * s.layers[i].thickness_m, 1e-9 * volume[i]) << s.layers[i].name;
 }
 
 TEST(AxisymmetricSlabMesh, CellsCarryTheLayerAtTheirDepth) {
@@ -89,35 +100,65 @@ TEST(AxisymmetricSlabMesh, ResolutionFollowsNeedleRadiusAndLayerThickness) {
   EXPECT_GE(build_axisymmetric_slab_mesh(s, 0).elements_through_layer[0], 20);
 }
 
-TEST(AxisymmetricSlabMesh, CrackLineIsDoubledAlongTheNeedlePath) {
-  for (const std::string tip : {"bevel", "hollow", "blunt"}) {
+TEST(AxisymmetricSlabMesh, BluntTipCrackLineIsDoubledAlongTheNeedlePath) {
+  const Scene s = three_layers("blunt");
+  const auto m = build_axisymmetric_slab_mesh(s, 0);
+  EXPECT_NEAR(m.crack_radius_m, s.needle.radius_m, 1e-15);
+  ASSERT_FALSE(m.crack_vertex_pairs.empty());
+  double deepest = 0.0;
+  std::set<unsigned> core, outer;
+  for (const auto& [c, o] : m.crack_vertex_pairs) {
+    EXPECT_NE(c, o);
+    EXPECT_EQ(m.vertices[c], m.vertices[o]);
+    EXPECT_NEAR(m.vertices[c][0], m.crack_radius_m, 1e-15);
+    deepest = std::max(deepest, -m.vertices[c][1]);
+    core.insert(c);
+    outer.insert(o);
+  }
+  EXPECT_NEAR(m.vertices[m.crack_vertex_pairs.front().first][1], 0.0, 1e-15) << "crack starts at the surface";
+  EXPECT_GE(deepest, s.insertion.target_depth_m) << "crack line reaches the target depth";
+  EXPECT_LT(deepest, m.path_depth_m) << "the vertex at the path depth is shared";
+  // Cells left of the crack use the core copies only, cells right of it the outer copies only.
+  for (std::size_t c = 0; c < m.cells.size(); ++c) {
+    const double rc = 0.5 * (m.vertices[m.cells[c][0]][0] + m.vertices[m.cells[c][3]][0]);
+    for (unsigned v : m.cells[c]) {
+      if (rc < m.crack_radius_m) EXPECT_EQ(outer.count(v), 0u);
+      if (rc > m.crack_radius_m) EXPECT_EQ(core.count(v), 0u);
+    }
+  }
+}
+
+TEST(AxisymmetricSlabMesh, CuttingTipsOpenAChannelWhoseWallIsTheCrackFace) {
+  for (const std::string tip : {"bevel", "hollow"}) {
     const Scene s = three_layers(tip);
     const auto m = build_axisymmetric_slab_mesh(s, 0);
-    const double expected = tip == "bevel" ? 2 * s.needle.radius_m / M_PI
-                                           : (tip == "hollow" ? s.needle.inner_radius_m : s.needle.radius_m);
+    // Crack radius: the bevel's slit of width 2a has the perimeter of a ring of
+    // radius 2a/pi; a hollow needle cores at its inner radius.
+    const double expected = tip == "bevel" ? 2 * s.needle.radius_m / M_PI : s.needle.inner_radius_m;
     EXPECT_NEAR(m.crack_radius_m, expected, 1e-15) << tip;
-    ASSERT_FALSE(m.crack_vertex_pairs.empty());
-    double deepest = 0.0;
-    std::set<unsigned> core, outer;
-    for (const auto& [c, o] : m.crack_vertex_pairs) {
-      EXPECT_NE(c, o);
-      EXPECT_EQ(m.vertices[c], m.vertices[o]);
-      EXPECT_NEAR(m.vertices[c][0], m.crack_radius_m, 1e-15);
-      deepest = std::max(deepest, -m.vertices[c][1]);
-      core.insert(c);
-      outer.insert(o);
+    ASSERT_TRUE(m.open_channel);
+    EXPECT_TRUE(m.crack_vertex_pairs.empty()) << tip;
+    ASSERT_FALSE(m.crack_face_vertices.empty());
+    double deepest = 0.0, shallowest = 1.0;
+    for (unsigned v : m.crack_face_vertices) {
+      EXPECT_NEAR(m.vertices[v][0], m.crack_radius_m, 1e-15) << tip;
+      deepest = std::max(deepest, -m.vertices[v][1]);
+      shallowest = std::min(shallowest, -m.vertices[v][1]);
     }
-    EXPECT_NEAR(m.vertices[m.crack_vertex_pairs.front().first][1], 0.0, 1e-15) << "crack starts at the surface";
-    EXPECT_GE(deepest, s.insertion.target_depth_m) << "crack line reaches the target depth";
-    EXPECT_LT(deepest, m.path_depth_m) << "the vertex at the path depth is shared";
-    // Cells left of the crack use the core copies only, cells right of it the outer copies only.
+    EXPECT_NEAR(shallowest, 0.0, 1e-15) << "the face starts at the surface";
+    EXPECT_GE(deepest, s.insertion.target_depth_m) << "the face reaches the target depth";
+    EXPECT_LE(deepest, m.path_depth_m + 1e-15);
+    // No cell inside the channel; below the path the axis is material again.
+    bool below = false;
     for (std::size_t c = 0; c < m.cells.size(); ++c) {
       const double rc = 0.5 * (m.vertices[m.cells[c][0]][0] + m.vertices[m.cells[c][3]][0]);
-      for (unsigned v : m.cells[c]) {
-        if (rc < m.crack_radius_m) EXPECT_EQ(outer.count(v), 0u);
-        if (rc > m.crack_radius_m) EXPECT_EQ(core.count(v), 0u);
+      const double zc = 0.5 * (m.vertices[m.cells[c][0]][1] + m.vertices[m.cells[c][3]][1]);
+      if (rc < m.crack_radius_m) {
+        EXPECT_GT(-zc, m.path_depth_m) << tip << ": cell " << c << " inside the channel";
+        below = true;
       }
     }
+    EXPECT_TRUE(below) << tip;
   }
 }
 

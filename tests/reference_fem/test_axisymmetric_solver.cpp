@@ -89,7 +89,6 @@ TEST(AxisymmetricSolver, ThickBlockMatchesSneddonFlatPunch) {
   for (unsigned degree : {1u, 2u}) {
     const Indentation q = indent(s, depth, 1, degree, 0);
     EXPECT_NEAR(q.force_N / exact, 1.0, 0.03) << "Q" << degree << " with " << q.dofs << " dofs";
-    std::cout << "Q" << degree << " ratio " << q.force_N / exact << " dofs " << q.dofs << std::endl;
   }
 }
 
@@ -102,5 +101,4 @@ TEST(AxisymmetricSolver, ThinBondedLayerMatchesBottomEffectCorrection) {
   const Indentation q = indent(s, depth, 1, 2, 0);
   const double sneddon = 2 * E * a * depth / (1 - nu * nu);
   EXPECT_NEAR(q.force_N / sneddon, 1.95, 0.05 * 1.95) << q.dofs << " dofs";
-  std::cout << "thin ratio " << q.force_N / sneddon << std::endl;
 }

@@ -121,6 +121,10 @@ struct FemRunSummary {
   std::vector<std::string> phase;  ///< per row: approach|insertion|dwell|withdrawal
   std::string geometry = "3d";
   double cohesive_dissipation_J = 0.0;  ///< energy dissipated by the crack (J)
+  /// Energy dissipated by the numerical (Kelvin-Voigt) stabilisation (J); to
+  /// be compared with the needle's work, of which it should be a small share.
+  double stabilization_dissipation_J = 0.0;
+  double needle_work_J = 0.0;  ///< work of the needle force over the insertion phase (J)
   double tip_element_size_m = 0.0;
   std::vector<int> elements_through_layer;
   std::vector<std::string> warnings;   ///< e.g. a mesh too coarse for the accuracy target
