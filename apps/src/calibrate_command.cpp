@@ -22,32 +22,74 @@
 namespace puncture::apps {
 namespace {
 
-std::string metrics_table(const validation::CalibrationResult& r) {
+std::string num(double x, int precision = 4) {
   std::ostringstream s;
-  s << "| layer | force RMSE before (N) | after (N) | after (% of reference peak) | puncture depth error before (mm) "
-       "| after (mm) |\n"
-       "|---|---|---|---|---|---|\n";
-  if (r.before.empty() || r.after.empty()) return s.str();
-  for (const auto& before : r.before.front().layers) {
-    const validation::LayerMetrics* after = r.after.front().layer(before.layer);
-    s << "| " << before.layer << " | " << std::setprecision(4) << before.force_rmse_N << " | "
-      << (after ? after->force_rmse_N : 0.0) << " | " << std::setprecision(3)
-      << (after ? 100.0 * after->force_rmse_relative : 0.0) << " | " << std::setprecision(4)
-      << before.puncture_depth_error_m * 1e3 << " | " << (after ? after->puncture_depth_error_m * 1e3 : 0.0)
-      << " |\n";
+  s << std::setprecision(precision) << x;
+  return s.str();
+}
+
+/// Every objective term before and after; "n/a" (with the reason) where a
+/// term could not be computed.
+std::string terms_table(const validation::CalibrationResult& r) {
+  std::ostringstream s;
+  if (r.trajectory_before.empty() || r.trajectory_after.empty()) return s.str();
+  const validation::TrajectoryComparison& before = r.trajectory_before.front();
+  const validation::TrajectoryComparison& after = r.trajectory_after.front();
+  s << "| term | before | after | error after | weight | reference samples | note |\n|---|---|---|---|---|---|---|\n";
+  auto value = [](const validation::ObjectiveTerm* t) { return t && t->available ? num(t->value, 3) : std::string("n/a"); };
+  for (const validation::ObjectiveTerm& t : after.terms) {
+    const validation::ObjectiveTerm* b = before.term(t.name, t.layer);
+    std::string error = "n/a";
+    if (t.available) error = t.name == "puncture_depth" ? num(t.raw * 1e3, 3) + " mm"
+                             : t.name == "missing_puncture" ? num(t.value, 1)
+                                                            : num(t.raw, 3) + " N";
+    s << "| " << t.label() << " | " << value(b) << " | " << value(&t) << " | " << error << " | " << num(t.weight, 3)
+      << " | " << t.samples << " | " << t.note << " |\n";
+  }
+  s << "\nValues are dimensionless: force RMSEs over the reference's peak force ("
+    << num(after.reference_peak_force_N, 4) << " N), puncture force errors over the reference's puncture force, "
+       "depth errors over min(L, layer thickness); the objective is the sum of weight x value^2 over the available "
+       "terms: "
+    << num(before.objective, 4) << " before, " << num(after.objective, 4) << " after.\n";
+  return s.str();
+}
+
+std::string parameters_table(const validation::CalibrationResult& r) {
+  std::ostringstream s;
+  s << "| layer | parameter | start | tuned | physical bounds | at a bound |\n|---|---|---|---|---|---|\n";
+  for (const validation::TunedParameterRecord& p : r.parameters)
+    s << "| " << p.layer << " | " << p.name << " (" << p.unit << ") | " << num(p.start) << (p.start_moved_inside ? " (outside: moved in)" : "")
+      << " | " << num(p.tuned) << " | [" << num(p.lower) << ", " << num(p.upper) << "] | "
+      << (p.at_bound.empty() ? "no" : "**" + p.at_bound + "**") << " |\n";
+  return s.str();
+}
+
+std::string punctures_table(const validation::CalibrationResult& r, const Scene& scene) {
+  std::ostringstream s;
+  if (r.reference_events.empty() || r.trajectory_after.empty()) return s.str();
+  const validation::ReferenceEvents& ev = r.reference_events.front();
+  s << "Reference punctures: " << ev.note << ".\n\n| layer | reference depth (mm) | reference force (N) | model depth after (mm) | model force after (N) |\n|---|---|---|---|---|\n";
+  for (std::size_t k = 0; k < scene.layers.size() && k < ev.punctures.size(); ++k) {
+    const auto& p = ev.punctures[k];
+    const auto& m = r.trajectory_after.front().model_punctures[k];
+    s << "| " << scene.layers[k].name << " | " << (p.found ? num(p.depth_m * 1e3) : "n/a") << " | "
+      << (p.found ? num(p.force_N) : "n/a") << " | " << (m.found ? num(m.depth_m * 1e3) : "n/a") << " | "
+      << (m.found ? num(m.force_N) : "n/a") << " |\n";
   }
   return s.str();
 }
 
-/// curve,time_s,depth_mm,force_N rows of the insertion phase of each curve.
+/// curve,time_s,depth_mm,force_N,phase rows of each curve (the whole trajectory).
 std::string curves_csv(const std::vector<std::pair<std::string, const validation::InsertionCurve*>>& curves) {
   std::ostringstream s;
-  s << std::setprecision(9) << "curve,time_s,depth_mm,force_N\n";
-  for (const auto& [name, c] : curves)
-    for (std::size_t i = 0; i < c->size(); ++i) {
-      if (i > 0 && c->velocity_m_per_s[i] < 0.0) break;  // withdrawal: not compared
-      s << name << ',' << c->time_s[i] << ',' << c->depth_m[i] * 1e3 << ',' << c->force_N[i] << '\n';
-    }
+  s << std::setprecision(9) << "curve,time_s,depth_mm,force_N,phase\n";
+  for (const auto& [name, c] : curves) {
+    const std::vector<validation::CurvePhase> phase =
+        c->phase.size() == c->size() ? c->phase : std::vector<validation::CurvePhase>(c->size(), validation::CurvePhase::Insertion);
+    for (std::size_t i = 0; i < c->size(); ++i)
+      s << name << ',' << c->time_s[i] << ',' << c->depth_m[i] * 1e3 << ',' << c->force_N[i] << ','
+        << validation::to_string(phase[i]) << '\n';
+  }
   return s.str();
 }
 
@@ -62,6 +104,9 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
   for (const std::string& layer : options.layers) c << " --layers " << layer;
   c << " --bound-factor " << options.bound_factor << " --depth-weight " << options.depth_weight << " --integrator "
     << integrator;
+  for (std::size_t i = 0; i < options.puncture_depths_mm.size(); ++i)
+    c << (i ? "," : " --puncture-depths ") << options.puncture_depths_mm[i];
+  for (std::size_t i = 0; i < options.keep.size(); ++i) c << (i ? "," : " --keep ") << options.keep[i];
   return c.str();
 }
 
@@ -110,6 +155,20 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
         throw std::invalid_argument("--also-tune: unknown parameter '" + name +
                                     "' (surface_stiffness, rings or spacing)");
     }
+    for (const std::string& name : options.keep) {
+      if (name == "K") calibration.parameters.virtual_stiffness = false;
+      else if (name == "breakthrough") calibration.parameters.deformed_threshold = false;
+      else if (name == "cutting") calibration.parameters.cutting = false;
+      else if (name == "friction") calibration.parameters.friction = false;
+      else if (name == "stiffening") calibration.parameters.stiffening = false;
+      else
+        throw std::invalid_argument("--keep: unknown parameter '" + name +
+                                    "' (K, breakthrough, cutting, friction or stiffening)");
+    }
+    for (double d : options.puncture_depths_mm) {
+      if (!(d > 0.0) || !std::isfinite(d)) throw std::invalid_argument("--puncture-depths: depths must be finite and > 0 (mm)");
+      calibration.puncture_depths_m.push_back(d * 1e-3);
+    }
     validation::CalibrationProgressCallback progress;
     if (!options.quiet)
       progress = [&](const validation::CalibrationProgress& p) {
@@ -138,9 +197,15 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
        << " model runs in " << std::setprecision(4) << calibration_s
        << " s (wall, reference already available). Objective " << result.objective_before << " -> "
        << result.objective_after << ".\n\n"
-       << metrics_table(result) << "\nTuned preset: `" << name << ".json` (a scene `puncture run` accepts), provenance: `"
-       << name << ".provenance.json`.\n";
+       << "## Objective, term by term\n\n" << terms_table(result) << "\n## Punctures\n\n"
+       << punctures_table(result, scene) << "\n## Tuned parameters\n\n" << parameters_table(result)
+       << "\nTuned preset: `" << name << ".json` (a scene `puncture run` accepts), provenance: `" << name
+       << ".provenance.json`.\n";
     if (!result.damping_note.empty()) md << "\nDamping d: " << result.damping_note << "\n";
+    if (!result.warnings.empty()) {
+      md << "\n## Warnings\n\n";
+      for (const std::string& w : result.warnings) md << "- " << w << "\n";
+    }
     session.commit();
     const std::vector<std::string> plots = run_plot_script("plot_calibration.py", dir, out, err);
     for (const std::string& p : plots) md << "\n![" << p << "](" << p << ")\n";
@@ -148,7 +213,9 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::o
     md_session.write_text("calibration_summary.md", md.str());
     md_session.commit();
 
-    out << "\n" << metrics_table(result) << "\nTuned preset: " << (dir / (name + ".json")).string()
+    out << "\n" << terms_table(result) << "\n" << parameters_table(result);
+    for (const std::string& w : result.warnings) out << "warning: " << w << "\n";
+    out << "\nTuned preset: " << (dir / (name + ".json")).string()
         << "\n  run it with: puncture run " << (dir / (name + ".json")).string() << '\n';
     return 0;
   });

@@ -49,6 +49,13 @@ std::vector<std::size_t> without_drops(const InsertionCurve& c, const std::vecto
   return out;
 }
 
+ObjectiveTerm make_term(const std::string& name, const std::string& layer) {
+  ObjectiveTerm t;
+  t.name = name;
+  t.layer = layer;
+  return t;
+}
+
 struct Rmse {
   double sum_sq = 0.0;
   std::size_t n = 0;
@@ -95,7 +102,7 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
   };
   auto force_term = [&](const std::string& name, const std::string& layer, double weight, const Rmse& r,
                         const std::string& where) {
-    ObjectiveTerm t{name, layer};
+    ObjectiveTerm t = make_term(name, layer);
     t.weight = weight;
     t.samples = r.n;
     t.available = r.n > 0;
@@ -115,7 +122,7 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
     const std::vector<double>* mod_parts[] = {&model.tip_force_N, &model.cutting_force_N, &model.friction_force_N};
     for (int p = 0; p < 3; ++p) {
       if (!reference.has_parts() || !model.has_parts()) {
-        ObjectiveTerm t{part_names[p], ""};
+        ObjectiveTerm t = make_term(part_names[p], "");
         t.weight = w.parts;
         t.note = reference.has_parts() ? "the model curve has no part columns" : "the reference has no part columns";
         add_term(t);
@@ -168,7 +175,7 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
                           insertion_rmse(s.pressing_from_m, s.pressing_to_m, !ev.punctures[k].found, reference.force_N, model_in),
                           "over " + mm(s.pressing_from_m) + " - " + mm(s.pressing_to_m)));
     } else {
-      ObjectiveTerm t{"pressing", name};
+      ObjectiveTerm t = make_term("pressing", name);
       t.weight = w.pressing;
       t.note = ev.has_contact_onset ? "the reference does not reach this layer" : "the reference has no contact onset";
       add_term(t);
@@ -176,7 +183,8 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
     const PunctureEventMetrics& rp = ev.punctures[k];
     const PunctureEventMetrics& mp = out.model_punctures[k];
     const double depth_scale = std::min(layers[k].thickness_m, layers[k].spacing_L_m > 0 ? layers[k].spacing_L_m : layers[k].thickness_m);
-    ObjectiveTerm force{"puncture_force", name}, depth{"puncture_depth", name}, missing{"missing_puncture", name};
+    ObjectiveTerm force = make_term("puncture_force", name), depth = make_term("puncture_depth", name),
+                  missing = make_term("missing_puncture", name);
     force.weight = w.puncture_force;
     depth.weight = w.puncture_depth;
     missing.weight = w.missing_puncture;
@@ -215,7 +223,7 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
                           insertion_rmse(s.after_from_m, s.after_to_m, false, reference.force_N, model_in),
                           "over " + mm(s.after_from_m) + " - " + mm(s.after_to_m)));
     } else {
-      ObjectiveTerm t{"after_puncture", name};
+      ObjectiveTerm t = make_term("after_puncture", name);
       t.weight = w.after_puncture;
       t.note = rp.found ? "the reference ends at the puncture" : "the reference does not puncture this layer";
       add_term(t);
@@ -224,7 +232,7 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
 
   // --- withdrawal (depth-aligned) ---
   if (sel.withdrawal) {
-    ObjectiveTerm t{"withdrawal", ""};
+    ObjectiveTerm t = make_term("withdrawal", "");
     t.weight = w.withdrawal;
     const std::vector<std::size_t> ref_out = without_drops(reference, withdrawal_phase(reference));
     const std::vector<std::size_t> mod_out = withdrawal_phase(model);
@@ -249,7 +257,7 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
 
   // --- dwell (time-aligned from its start) ---
   if (sel.dwell) {
-    ObjectiveTerm t{"dwell", ""};
+    ObjectiveTerm t = make_term("dwell", "");
     t.weight = w.dwell;
     const std::vector<std::size_t> ref_dwell = dwell_phase(reference), mod_dwell = dwell_phase(model);
     if (ref_dwell.empty()) {
