@@ -1,0 +1,89 @@
+// The haptic tick on the SH layer surfaces allocates nothing, also when an
+// off-axis needle makes the simulator lay the force meshes again at the
+// contact point (LayerSurface::project and intersect_ray inside the tick)
+// and with every force-law effect on. Same counting operator new / malloc
+// as tests/core/test_no_allocation.cpp (this suite is its own executable).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "puncture/model/realtime_model.hpp"
+#include "puncture/needle.hpp"
+#include "puncture/scene_io.hpp"
+
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void __libc_free(void*);
+}
+
+namespace {
+std::atomic<bool> counting{false};
+std::atomic<long> new_calls{0};
+std::atomic<long> malloc_calls{0};
+}  // namespace
+
+extern "C" {
+void* malloc(std::size_t n) {
+  if (counting.load(std::memory_order_relaxed)) ++malloc_calls;
+  return __libc_malloc(n);
+}
+void* calloc(std::size_t n, std::size_t m) {
+  if (counting.load(std::memory_order_relaxed)) ++malloc_calls;
+  return __libc_calloc(n, m);
+}
+void* realloc(void* p, std::size_t n) {
+  if (counting.load(std::memory_order_relaxed)) ++malloc_calls;
+  return __libc_realloc(p, n);
+}
+void free(void* p) { __libc_free(p); }
+}
+
+void* operator new(std::size_t n) {
+  if (counting.load(std::memory_order_relaxed)) ++new_calls;
+  if (void* p = __libc_malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { __libc_free(p); }
+void operator delete[](void* p) noexcept { __libc_free(p); }
+void operator delete(void* p, std::size_t) noexcept { __libc_free(p); }
+void operator delete[](void* p, std::size_t) noexcept { __libc_free(p); }
+
+using namespace puncture;
+
+TEST(NoAllocationSh, OffAxisInsertionOnShSurfacesWithEveryEffectAllocatesNothing) {
+  Scene scene = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json");
+  scene.realtime.sh_degree = 8;
+  scene.effects.stiffening = scene.effects.layer_interaction = true;
+  for (Layer& l : scene.layers) {
+    l.force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+    l.force_law.breakthrough.critical_force_N = 1.0;
+    l.force_law.stiffening.quadratic_N_per_m2 = 2e4;
+  }
+  scene.layers[0].force_mesh.virtual_stiffness_N_per_m = 2000.0;
+  RealtimeModel model = build_realtime_model(scene);
+  const ScriptedTrajectory tr(scene.insertion);
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  std::vector<NeedleState> states;
+  for (int i = 0; i * dt <= tr.duration(); ++i) {
+    states.push_back(tr.sample(i * dt));
+    states.back().tip_position_m.x() += 3e-3;  // off the scene axis
+  }
+  new_calls = 0;
+  malloc_calls = 0;
+  double sum = 0.0;
+  counting = true;
+  for (const NeedleState& s : states) sum += model.simulator->tick(s).total_force_N;
+  counting = false;
+  EXPECT_EQ(new_calls.load(), 0);
+  EXPECT_EQ(malloc_calls.load(), 0);
+  EXPECT_TRUE(std::isfinite(sum));
+  EXPECT_GE(model.simulator->puncture_events().size(), 2u);
+  // The meshes were laid where the off-axis needle met each surface.
+  for (std::size_t k = 0; k < model.simulator->puncture_events().size(); ++k)
+    EXPECT_NEAR(model.simulator->force_mesh(k)->rest_positions()(0, 0), 3e-3, 1e-9) << k;
+}
