@@ -84,9 +84,9 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   rest_.resize(3, n);
   normals_.resize(3, n);
   positions_.resize(3, n);
+  z_.setZero(n);
   layout(surface, contact);
 
-  z_.setZero(n);
   v_.setZero(n);
   pz_.setZero(n);
   pv_.setZero(n);
@@ -157,33 +157,60 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   update_derived();
 }
 
-void ForceMesh::layout(const ContactSurface& surface, const SurfacePoint& contact) {
-  // Tangent plane of the contact point; nodes projected on the surface.
+void ForceMesh::set_frame(const SurfacePoint& contact) {
+  // Tangent plane of the contact point.
   Eigen::Vector3d nrm = contact.normal;
   if (!(nrm.norm() > 0.0) || !nrm.allFinite() || !contact.position.allFinite())
     throw std::invalid_argument("force mesh: contact point or normal is not finite");
   nrm.normalize();
   const Eigen::Vector3d helper = std::abs(nrm.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d e1 = (helper - helper.dot(nrm) * nrm).normalized();
-  const Eigen::Vector3d e2 = nrm.cross(e1);
-  const double L = params_.spacing_L_m;
+  frame_origin_ = contact.position;
+  frame_normal_ = nrm;
+  frame_e1_ = (helper - helper.dot(nrm) * nrm).normalized();
+  frame_e2_ = nrm.cross(frame_e1_);
+}
+
+void ForceMesh::project_node(int i) {
+  const Eigen::Vector2d p = lattice_.planar_position(i, params_.spacing_L_m);
+  const SurfacePoint sp = layout_surface_->project(frame_origin_ + p.x() * frame_e1_ + p.y() * frame_e2_);
+  if (!sp.position.allFinite() || !sp.normal.allFinite() || !(sp.normal.norm() > 0.0))
+    throw std::invalid_argument("force mesh: projecting node " + std::to_string(i) +
+                                " onto the layer surface gave a non-finite point");
+  rest_.col(i) = sp.position;
+  normals_.col(i) = sp.normal.normalized();
+  positions_.col(i) = rest_.col(i) - z_[i] * normals_.col(i);
+}
+
+void ForceMesh::layout(const ContactSurface& surface, const SurfacePoint& contact) {
+  // Every node projected onto the surface at once (construction).
+  set_frame(contact);
+  layout_surface_ = &surface;
   rest_.col(0) = contact.position;
-  normals_.col(0) = nrm;
-  for (int i = 1; i < lattice_.node_count(); ++i) {
-    const Eigen::Vector2d p = lattice_.planar_position(i, L);
-    const SurfacePoint sp = surface.project(contact.position + p.x() * e1 + p.y() * e2);
-    if (!sp.position.allFinite() || !sp.normal.allFinite() || !(sp.normal.norm() > 0.0))
-      throw std::invalid_argument("force mesh: projecting node " + std::to_string(i) +
-                                  " onto the layer surface gave a non-finite point");
-    rest_.col(i) = sp.position;
-    normals_.col(i) = sp.normal.normalized();
-  }
+  normals_.col(0) = frame_normal_;
+  positions_.col(0) = rest_.col(0);
+  for (int i = 1; i < lattice_.node_count(); ++i) project_node(i);
+  next_projection_ = lattice_.node_count();
   positions_ = rest_;
 }
 
 void ForceMesh::relayout(const ContactSurface& surface, const SurfacePoint& contact) {
-  layout(surface, contact);
+  set_frame(contact);
+  layout_surface_ = &surface;
+  rest_.col(0) = contact.position;
+  normals_.col(0) = frame_normal_;
+  for (int i = 1; i < lattice_.node_count(); ++i) {
+    const Eigen::Vector2d p = lattice_.planar_position(i, params_.spacing_L_m);
+    rest_.col(i) = frame_origin_ + p.x() * frame_e1_ + p.y() * frame_e2_;
+    normals_.col(i) = frame_normal_;
+  }
+  next_projection_ = 1;
   reset();
+}
+
+int ForceMesh::refine_layout(int max_nodes) {
+  const int n = lattice_.node_count();
+  for (int k = 0; k < max_nodes && next_projection_ < n; ++k) project_node(next_projection_++);
+  return n - next_projection_;
 }
 
 bool ForceMesh::laid_at(const SurfacePoint& contact, double tolerance_m) const {

@@ -239,6 +239,12 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   event.surface_force_N = surface_force_N;
   event.total_force_N = surface_force_N;  // tick() adds the friction of the layers above
   events_.push_back(event);               // capacity reserved at construction
+  if (layer.mesh && layer.mesh->layout_pending()) {
+    // The drawn surface must be complete before it recovers (a break within
+    // a few ticks of the contact: rare).
+    layer.mesh->refine_layout(layer.mesh->node_count());
+    if (layer.resumption) layer.resumption->set_rest_positions(layer.mesh->rest_positions());
+  }
   if (layer.resumption) layer.resumption->start(layer.mesh->positions(), needle.time_s);
   const double tip_axial = needle.tip_position_m.dot(needle.direction);
   layer.front_m = tip_axial;
@@ -350,6 +356,19 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
       if (e.time_s == needle.time_s)
         for (int k = 0; k < e.layer; ++k)
           e.total_force_N += result_.layers[k].damping_force_N + result_.layers[k].friction_force_N;
+
+  // 6. Meshes laid at a new contact point get their nodes projected onto the
+  // surface a few per tick (only the drawn surface depends on it).
+  int budget = kLayoutNodesPerTick;
+  for (LayerModel& layer : layers_) {
+    if (budget <= 0) break;
+    if (!layer.mesh || !layer.mesh->layout_pending()) continue;
+    const int nodes = std::min(budget, layer.mesh->pending_nodes());
+    layer.mesh->refine_layout(nodes);
+    budget -= nodes;
+    if (!layer.mesh->layout_pending() && layer.resumption && !layer.resumption->active())
+      layer.resumption->set_rest_positions(layer.mesh->rest_positions());
+  }
 
   if (!std::isfinite(result_.total_force_N))
     throw std::runtime_error("PunctureSimulator::tick: the needle force became non-finite at t = " +

@@ -21,8 +21,11 @@
 //       (mean and p99 there: where the work is; the haptic loop cares about
 //       the slow ticks, which a mean per phase hides)
 //   BM_force_mesh_relayout/<layer>      ForceMesh::relayout on the layer's SH
-//       surface (l = 16) at an off-axis point: the extra work of the one tick
-//       in which an off-axis needle first touches a layer
+//       surface (l = 16) at an off-axis point (tangent-plane layout): the
+//       extra work of the tick in which an off-axis needle first touches it
+//   BM_force_mesh_refine/<layer>        the projection of kLayoutNodesPerTick
+//       nodes onto the SH surface: the extra work of each of the following
+//       ticks until the mesh lies on the surface
 //   BM_build_realtime_model/<l>         SH fit + simulator construction
 //       (outside the haptic loop; ms)
 // Run through scripts/benchmarks.sh, which writes results/benchmarks/.
@@ -187,6 +190,32 @@ void register_all() {
         benchmark::DoNotOptimize(mesh.rest_positions().data());
       }
       st.counters["mesh_nodes"] = mesh.node_count();
+    });
+    benchmark::RegisterBenchmark(("BM_force_mesh_refine/" + std::to_string(k)).c_str(), [k](benchmark::State& st) {
+      const Setup& s = setup_for("default", default_scene());
+      const Layer& layer = s.scene.layers[k];
+      const LayerSurface& surface = *s.model.surfaces[k];
+      MeshIntegrationSettings integration;
+      integration.integrator = parse_mesh_integrator(s.scene.realtime.integrator);
+      integration.time_step_s = 1.0 / s.scene.realtime.haptic_rate_Hz;
+      SurfacePoint a, b;
+      double t = 0.0;
+      surface.intersect_ray(Eigen::Vector3d(3e-3, -2e-3, 1.0), -Eigen::Vector3d::UnitZ(), t, a);
+      surface.intersect_ray(Eigen::Vector3d(-4e-3, 1e-3, 1.0), -Eigen::Vector3d::UnitZ(), t, b);
+      ForceMesh mesh(surface, a, layer.force_mesh, layer.thickness_m, layer.density_kg_per_m3, integration);
+      bool flip = false;
+      for (auto _ : st) {
+        if (!mesh.layout_pending()) {
+          st.PauseTiming();
+          mesh.relayout(surface, flip ? a : b);
+          flip = !flip;
+          st.ResumeTiming();
+        }
+        mesh.refine_layout(kLayoutNodesPerTick);  // the work one tick adds after an off-axis contact
+        benchmark::DoNotOptimize(mesh.rest_positions().data());
+      }
+      st.counters["mesh_nodes"] = mesh.node_count();
+      st.counters["ticks_to_complete"] = (mesh.node_count() - 1 + kLayoutNodesPerTick - 1) / kLayoutNodesPerTick;
     });
   }
 

@@ -123,10 +123,21 @@ class ForceMesh {
   void commit(double contact_deflection_m);
   /// Back to the undeformed state at rest.
   void reset();
-  /// Lays the mesh out again at `contact` on `surface` (at rest). No
-  /// allocation (ContactSurface::project must not allocate). Throws
-  /// std::invalid_argument if a projection is not finite.
+  /// Lays the mesh out again at `contact` on `surface` (at rest), at once in
+  /// the tangent plane of the contact point with the contact normal at every
+  /// node (exact for a flat surface); the projections of the nodes onto the
+  /// surface follow in refine_layout(). The mechanics do not depend on the
+  /// node positions (scalar deflections along the normals), so the force is
+  /// exact from the first tick; only the drawn surface is refined. No
+  /// allocation (ContactSurface::project must not allocate).
   void relayout(const ContactSurface& surface, const SurfacePoint& contact);
+  /// Projects up to max_nodes pending nodes onto the surface (a few us each
+  /// on an SH surface: the simulator spreads them over ticks). Returns the
+  /// number still pending. Throws std::invalid_argument if a projection is
+  /// not finite. `surface` must be the one given to relayout().
+  int refine_layout(int max_nodes);
+  bool layout_pending() const { return next_projection_ < lattice_.node_count(); }
+  int pending_nodes() const { return lattice_.node_count() - next_projection_; }
   /// True if the mesh is laid out at `contact` (position within tolerance_m,
   /// normal within 1e-9).
   bool laid_at(const SurfacePoint& contact, double tolerance_m) const;
@@ -184,6 +195,8 @@ class ForceMesh {
   void implicit_solve();
   void update_derived();
   void layout(const ContactSurface& surface, const SurfacePoint& contact);
+  void set_frame(const SurfacePoint& contact);
+  void project_node(int i);
   /// Free-node state after one step from (z_, v_) with contact deflection
   /// z0_old -> z0_new, written to (z_, v_) (used at construction for the unit response).
   void step_free_nodes(double z0_old, double z0_new);
@@ -200,6 +213,12 @@ class ForceMesh {
   bool use_implicit_ = false;
 
   Eigen::Matrix3Xd rest_, normals_, positions_;
+  // Layout frame: contact point, normal and in-plane axes; nodes >= next_projection_ are
+  // still in the tangent plane (relayout) and wait for their projection onto *layout_surface_.
+  const ContactSurface* layout_surface_ = nullptr;
+  Eigen::Vector3d frame_origin_ = Eigen::Vector3d::Zero(), frame_normal_ = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d frame_e1_ = Eigen::Vector3d::UnitX(), frame_e2_ = Eigen::Vector3d::UnitY();
+  int next_projection_ = 0;
   Eigen::VectorXd z_, v_, influence_, rhs_, work_;
   Eigen::VectorXd pz_, pv_;  ///< predicted free-node state for z0 = 0 (index 0 unused)
   Eigen::VectorXd qz_, qv_;  ///< unit response of the free nodes to z0 = 1 at the end of a step

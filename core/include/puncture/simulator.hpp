@@ -55,7 +55,12 @@
 //      next layer has no contact yet), adds the cutting force (cutting.hpp);
 //   6. every punctured layer adds its shaft friction phi h (shaft_friction.hpp)
 //      and the damping force d h v (Table 1), with h the shaft length inside
-//      the layer's depth range [top, top + thickness] of the scene.
+//      the layer's depth range [top, top + thickness] of the scene;
+//   7. a mesh laid out anew (step 2) starts in the tangent plane of the
+//      contact point (exact force at once: the mechanics are deflections
+//      along the normals) and gets its nodes projected onto the curved
+//      surface kLayoutNodesPerTick per tick (a few us each on an SH surface),
+//      so an off-axis contact costs no spike in one tick.
 // The force meshes are laid out at construction around the point where the
 // scene's insertion axis (x = y = 0, direction -z) crosses each surface; the
 // mesh step is the fixed haptic step 1 / RealtimeSettings::haptic_rate_Hz.
@@ -102,6 +107,9 @@ struct TickResult {
   double friction_force_N = 0.0;  ///< sum of shaft friction and damping d h v
   std::vector<LayerTickResult> layers;  ///< one per layer, sized at construction
 };
+
+/// Node projections per tick after a mesh was laid at a new contact point.
+constexpr int kLayoutNodesPerTick = 4;
 
 class PunctureSimulator {
  public:
