@@ -107,7 +107,8 @@ for name in ("bench_tick", "bench_effects"):
             r["median_us"] = t_us
             r["median_cpu_us"] = b["cpu_time"] * TO_US[b.get("time_unit", "ns")]
             for key, value in b.items():
-                if key in ("phase_ticks", "punctures", "mesh_nodes_all_layers", "ticks_per_insertion") or \
+                if key in ("phase_ticks", "punctures", "mesh_nodes_all_layers", "ticks_per_insertion", "contact_ticks",
+                           "mesh_nodes", "ticks_to_complete") or \
                         (key.endswith("_us") and isinstance(value, (int, float))):
                     r["counter:" + key] = value
         elif agg == "mean":
@@ -231,7 +232,7 @@ if len(same) > 1:
 md.append("## Tick by phase of the insertion (default scene)")
 md.append("")
 md.append("press_skin: the skin is pressed (force mesh active) until it breaks; after_skin_break: the "
-          "ceil(1/eta_r) ticks after the skin broke (skin resumption running, fat pressed); "
+          "ticks of the skin's recovery time (resumption_time_s) after it broke (skin resumption running, fat pressed); "
           "inside_punctured: after the last puncture until the target depth (damping, friction and "
           "cutting of the punctured layers, resumption in its first ticks); in_tissue: every tick with "
           "the tip below the skin surface (the ticks with contact, where the work is: the cost axis of "
