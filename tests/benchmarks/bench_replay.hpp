@@ -56,7 +56,7 @@ struct InsertionScript {
   std::size_t insertion_end_tick = 0;  ///< first tick at or after the target depth is reached
   TickRange whole;             ///< every tick of the trajectory
   TickRange press_skin;        ///< skin Pressed (tip below its contact point), before it breaks
-  TickRange after_skin_break;  ///< ceil(1 / eta_r(skin)) ticks after the skin broke
+  TickRange after_skin_break;  ///< the ticks of the skin's recovery time after it broke
   TickRange inside_punctured;  ///< after the last puncture, until the target depth is reached
   TickRange in_tissue;         ///< ticks with contact: first to last tick with the tip below the skin surface
 };
