@@ -55,11 +55,11 @@ int main(int argc, char** argv) {
 
   CalibrateOptions calibrate;
   std::string reference;
-  auto* calibrate_cmd = app.add_subcommand("calibrate", "Tune K, threshold (and optionally w, L, k_s, d) per layer; write a preset");
+  auto* calibrate_cmd = app.add_subcommand("calibrate", "Tune the force law per layer (K, breakthrough, cutting, friction, stiffening; optionally w, L, k_s, d); write a preset");
   calibrate_cmd->add_option("scene", scene, "Scene file (JSON); default: scenes/default.json");
   calibrate_cmd->add_option("--reference", reference,
-                            "Measured insertion curve (CSV: time_s, depth_mm, velocity_mm_per_s, force_N); "
-                            "default: the scene's FEM reference (cached)");
+                            "Measured insertion curve (CSV with depth_mm and force_N at least; see "
+                            "validation/README.md); default: the scene's FEM reference (cached)");
   calibrate_cmd->add_option("-o,--output", output, "Output directory; default: out/<scene name>_calibration");
   calibrate_cmd->add_option("--cache", cache, "FEM cache directory; default: out/.fem_cache");
   calibrate_cmd->add_option("--method", calibrate.method, "nelder_mead (default), bobyqa or simulated_annealing")
@@ -74,7 +74,16 @@ int main(int argc, char** argv) {
   calibrate_cmd->add_option("--depth-weight", calibrate.depth_weight,
                             "Weight of the puncture-depth term (error in units of min(L, thickness)); default 0.1");
   calibrate_cmd->add_option("--bound-factor", calibrate.bound_factor,
-                            "Each tuned parameter stays within [start / f, start * f]; default 1000");
+                            "Each tuned scale parameter stays within [start / f, start * f] (and its physical "
+                            "range); default 1000");
+  calibrate_cmd->add_option("--puncture-depths", calibrate.puncture_depths_mm,
+                            "Puncture depths of the reference in mm, one per layer from the top (comma separated); "
+                            "default: from its state columns, else from its force drops")
+      ->delimiter(',');
+  calibrate_cmd->add_option("--keep", calibrate.keep,
+                            "Keep at the scene's values: K, breakthrough, cutting, friction, stiffening (comma "
+                            "separated); default: tune each whose effect is on")
+      ->delimiter(',');
   calibrate_cmd->add_flag("-q,--quiet", calibrate.quiet, "Nothing on stdout (warnings and errors still on stderr)");
 
   SweepOptions sweep;

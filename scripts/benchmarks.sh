@@ -107,7 +107,8 @@ for name in ("bench_tick", "bench_effects"):
             r["median_us"] = t_us
             r["median_cpu_us"] = b["cpu_time"] * TO_US[b.get("time_unit", "ns")]
             for key, value in b.items():
-                if key in ("phase_ticks", "punctures", "mesh_nodes_all_layers", "ticks_per_insertion") or \
+                if key in ("phase_ticks", "punctures", "mesh_nodes_all_layers", "ticks_per_insertion", "contact_ticks",
+                           "mesh_nodes", "ticks_to_complete") or \
                         (key.endswith("_us") and isinstance(value, (int, float))):
                     r["counter:" + key] = value
         elif agg == "mean":
@@ -201,11 +202,13 @@ if p50_all is not None and p50_press is not None:
     md.append(f"**Target: median tick <= 10 us (default scene, all effects on, l = 16): {verdict}.** "
               f"Median single tick over the whole insertion {fmt_time(p50_all)} us; over the ticks that press "
               f"the skin (the most expensive phase) {fmt_time(p50_press)} us, p99 "
-              f"{fmt_time(dist.get('counter:press_p99_us'))} us (table 'Single-tick distribution').")
+              f"{fmt_time(dist.get('counter:press_p99_us'))} us; over the ticks with contact mean "
+              f"{fmt_time(dist.get('counter:contact_mean_us'))} us, p99 {fmt_time(dist.get('counter:contact_p99_us'))} us "
+              "(table 'Single-tick distribution').")
     md.append("")
 if whole is not None:
     phase_means = [(p, get(f"BM_tick_phase/{p}")) for p in
-                   ("press_skin", "after_skin_break", "inside_punctured", "whole_insertion")]
+                   ("press_skin", "after_skin_break", "inside_punctured", "in_tissue", "whole_insertion")]
     worst_name, worst = max(((p, r) for p, r in phase_means if r.get("median_us") is not None),
                             key=lambda pr: pr[1]["median_us"])
     md.append(f"Mean tick per phase (median of 5 repetitions): whole insertion {fmt_time(whole)} us wall / "
@@ -229,14 +232,17 @@ if len(same) > 1:
 md.append("## Tick by phase of the insertion (default scene)")
 md.append("")
 md.append("press_skin: the skin is pressed (force mesh active) until it breaks; after_skin_break: the "
-          "ceil(1/eta_r) ticks after the skin broke (skin resumption running, fat pressed); "
-          "inside_punctured: after the last puncture until the target depth (damping of every "
-          "punctured layer, resumption in its first ticks); whole_insertion: approach, insertion, "
-          "dwell and withdrawal. Ratio: to whole_insertion.")
+          "ticks of the skin's recovery time (resumption_time_s) after it broke (skin resumption running, fat pressed); "
+          "inside_punctured: after the last puncture until the target depth (damping, friction and "
+          "cutting of the punctured layers, resumption in its first ticks); in_tissue: every tick with "
+          "the tip below the skin surface (the ticks with contact, where the work is: the cost axis of "
+          "`puncture sweep` and `summary.json` is the mean and p99 over these); whole_insertion: "
+          "approach, insertion, dwell and withdrawal (its median is a tick without contact). "
+          "Ratio: to whole_insertion.")
 md.append("")
 md.append(table(["phase", "ticks in phase", "median us / tick", "CPU us / tick", "ratio", "spread %"],
                 [time_row(p, f"BM_tick_phase/{p}", "BM_tick_phase/whole_insertion", ("phase_ticks",))
-                 for p in ("press_skin", "after_skin_break", "inside_punctured", "whole_insertion")]))
+                 for p in ("press_skin", "after_skin_break", "inside_punctured", "in_tissue", "whole_insertion")]))
 md.append("")
 
 md.append("## Single-tick distribution (default scene)")
@@ -254,7 +260,9 @@ md.append(table(["ticks", "p50 us", "p90 us", "p99 us", "max us"],
                 [["all ticks of the insertion", counter("p50_us"), counter("p90_us"), counter("p99_us"),
                   counter("max_us")],
                  ["press_skin ticks", counter("press_p50_us"), "", counter("press_p99_us"),
-                  counter("press_max_us")]]))
+                  counter("press_max_us")],
+                 [f"ticks with contact ({fmt_count(r, 'contact_ticks')}; mean {counter('contact_mean_us')} us)",
+                  counter("contact_p50_us"), "", counter("contact_p99_us"), ""]]))
 md.append("")
 
 md.append("## Force-mesh integrator")
@@ -328,16 +336,37 @@ for l in (4, 8, 16, 24, 32):
 md.append(table(["l", "median ms / build", "ratio", "spread %"], lines))
 md.append("")
 
+md.append("## Force mesh laid at an off-axis contact point")
+md.append("")
+md.append("`ForceMesh::relayout` on the layer's SH surface (l = 16) at a new contact point: the lattice is laid "
+          "in the tangent plane at once (the force is exact from this tick: the mechanics are deflections along "
+          "the normals), then `refine_layout` projects 4 nodes per tick onto the curved surface (a few us each) "
+          "until the drawn mesh lies on it. An on-axis needle never pays either (the meshes are laid on the axis "
+          "at construction).")
+md.append("")
+lines = []
+for k, name in ((0, "skin (w = 8)"), (2, "muscle (w = 10)")):
+    r, q = get(f"BM_force_mesh_relayout/{k}"), get(f"BM_force_mesh_refine/{k}")
+    lines.append([name, fmt_count(r, "mesh_nodes") if "counter:mesh_nodes" in r else "n/a",
+                  fmt_time(r.get("median_us")), fmt_time(q.get("median_us")),
+                  fmt_count(q, "ticks_to_complete") if "counter:ticks_to_complete" in q else "n/a"])
+md.append(table(["layer", "mesh nodes", "us in the contact tick", "us in each later tick", "later ticks"], lines))
+md.append("")
+
 md.append("## Effects on / off")
 md.append("")
 md.append("An effect that is off is not constructed (tests/core/model/test_effects_off.cpp checks the "
-          "objects are absent and the forces exactly 0). surface_force_off also removes resumption "
-          "(it needs the force mesh) and every layer then breaks as soon as the tip passes its "
-          "surface; surface_output does not enter the tick. Ratio: to all_on for the same phase.")
+          "objects are absent and the forces exactly 0). all_on is the default scene (surface force, "
+          "damping, resumption, cutting, friction); paper: Table 1 and Eq. 8 only; surface_force_off also "
+          "removes resumption (it needs the force mesh) and every layer then breaks as soon as the tip "
+          "passes its surface; stiffening_on and interaction_on add the tip stiffening and the layers in "
+          "series (tests/benchmarks/bench_effects.cpp gives their parameters); surface_output does not "
+          "enter the tick. Ratio: to all_on for the same phase.")
 md.append("")
 lines = []
-for cfg in ("all_on", "surface_force_off", "damping_off", "resumption_off", "all_off"):
-    for phase in ("whole_insertion", "inside_punctured"):
+for cfg in ("all_on", "paper", "surface_force_off", "damping_off", "resumption_off", "cutting_off", "friction_off",
+            "stiffening_on", "interaction_on", "all_off"):
+    for phase in ("whole_insertion", "in_tissue", "inside_punctured"):
         lines.append(time_row(f"{cfg} / {phase}", f"BM_effects/{cfg}/{phase}", f"BM_effects/all_on/{phase}",
                               ("phase_ticks", "punctures")))
 md.append(table(["effects / phase", "ticks in phase", "punctures", "median us / tick", "CPU us / tick", "ratio", "spread %"],

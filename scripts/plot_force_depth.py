@@ -57,7 +57,11 @@ def main():
         frows = read_csv(os.path.join(a.fem, "fem_force_depth.csv"))
         ax1.plot([float(r["depth_mm"]) for r in frows], [float(r["force_N"]) for r in frows],
                  color="C2", lw=1.6, label="FEM reference (quasi-static)")
-    ax1.set_ylim(min(0.0, min(force)) * 1.15, max(force) * 1.25)
+    shown = list(force)
+    if a.fem:
+        shown += [float(r["force_N"]) for r in frows]
+    span = max(shown) - min(0.0, min(shown))
+    ax1.set_ylim(min(0.0, min(shown)) - 0.05 * span, max(shown) + 0.2 * span)
     cum = 0.0
     for name, layer in zip(layers, summary["settings"]["layers"]):
         ax1.axvline(cum, color="0.8", lw=0.8)
@@ -71,14 +75,20 @@ def main():
 
     t = [float(r["time_s"]) for r in rows]
     ax2.plot(t, force, color="C0", lw=1.4, label="total")
-    for k, name in enumerate(layers):
-        sf = [float(r[f"{name}_surface_force_N"]) for r in rows]
-        df = [float(r[f"{name}_damping_force_N"]) for r in rows]
-        ax2.plot(t, sf, lw=0.9, color=f"C{k + 3}", label=f"{name} surface force")
-        ax2.plot(t, df, lw=0.9, ls=":", color=f"C{k + 3}", label=f"{name} damping d h v")
+    if "tip_force_N" in rows[0]:
+        # The force's parts: tip (surface force of the pressed layer), cutting, shaft friction (+ d h v).
+        for key, label, color in (("tip_force_N", "tip (surface force)", "C3"), ("cutting_force_N", "cutting", "C1"),
+                                  ("friction_force_N", "shaft friction + d h v", "C2")):
+            ax2.plot(t, [float(r[key]) for r in rows], lw=1.0, color=color, label=label)
+    else:
+        for k, name in enumerate(layers):
+            sf = [float(r[f"{name}_surface_force_N"]) for r in rows]
+            df = [float(r[f"{name}_damping_force_N"]) for r in rows]
+            ax2.plot(t, sf, lw=0.9, color=f"C{k + 3}", label=f"{name} surface force")
+            ax2.plot(t, df, lw=0.9, ls=":", color=f"C{k + 3}", label=f"{name} damping d h v")
     ax2.set_xlabel("time (s)")
     ax2.set_ylabel("force (N)")
-    ax2.set_title("Force components (Table 1)")
+    ax2.set_title("Force parts along the trajectory")
     ax2.legend(fontsize=7, ncol=2)
     ax2.grid(alpha=0.3)
     if a.note:

@@ -1,4 +1,4 @@
-// `puncture calibrate`: tunes the real-time model's force-mesh parameters
+// `puncture calibrate`: tunes the real-time model's force-law parameters
 // against a reference insertion curve (the scene's FEM reference, cached, or a
 // measured curve) and writes a tuned preset with its provenance, the curves of
 // the reference and of the model before and after (calibration_curves.csv),
@@ -34,6 +34,9 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
   for (const std::string& layer : options.layers) c << " --layers " << layer;
   c << " --bound-factor " << options.bound_factor << " --depth-weight " << options.depth_weight << " --integrator "
     << integrator;
+  for (std::size_t i = 0; i < options.puncture_depths_mm.size(); ++i)
+    c << (i ? "," : " --puncture-depths ") << options.puncture_depths_mm[i];
+  for (std::size_t i = 0; i < options.keep.size(); ++i) c << (i ? "," : " --keep ") << options.keep[i];
   return c.str();
 }
 
@@ -87,6 +90,19 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
         throw UsageError("--also-tune: unknown parameter '" + name +
                                     "' (surface_stiffness, rings or spacing)");
     }
+    for (const std::string& name : options.keep) {
+      if (name == "K") calibration.parameters.virtual_stiffness = false;
+      else if (name == "breakthrough") calibration.parameters.deformed_threshold = false;
+      else if (name == "cutting") calibration.parameters.cutting = false;
+      else if (name == "friction") calibration.parameters.friction = false;
+      else if (name == "stiffening") calibration.parameters.stiffening = false;
+      else
+        throw UsageError("--keep: unknown parameter '" + name + "' (K, breakthrough, cutting, friction or stiffening)");
+    }
+    for (double d : options.puncture_depths_mm) {
+      if (!(d > 0.0) || !std::isfinite(d)) throw UsageError("--puncture-depths: depths must be finite and > 0 (mm)");
+      calibration.puncture_depths_m.push_back(d * 1e-3);
+    }
     validation::CalibrationProgressCallback progress;
     if (!options.quiet)
       progress = [&](const validation::CalibrationProgress& p) {
@@ -117,9 +133,15 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
        << " model runs in " << std::setprecision(4) << calibration_s
        << " s (wall, reference already available). Objective " << result.objective_before << " -> "
        << result.objective_after << ".\n\n"
-       << validation::calibration_metrics_table(result) << "\nTuned preset: `" << name << ".json` (a scene `puncture run` accepts), provenance: `"
-       << name << ".provenance.json`.\n";
+       << "## Objective, term by term\n\n" << validation::calibration_terms_table(result) << "\n## Punctures\n\n"
+       << validation::calibration_punctures_table(result, scene) << "\n## Tuned parameters\n\n"
+       << validation::calibration_parameters_table(result) << "\nTuned preset: `" << name
+       << ".json` (a scene `puncture run` accepts), provenance: `" << name << ".provenance.json`.\n";
     if (!result.damping_note.empty()) md << "\nDamping d: " << result.damping_note << "\n";
+    if (!result.warnings.empty()) {
+      md << "\n## Warnings\n\n";
+      for (const std::string& w : result.warnings) md << "- " << w << "\n";
+    }
     session.commit();
     const std::vector<std::string> plots = validation::run_plot_script("plot_calibration.py", dir, out, err);
     for (const std::string& p : plots) md << "\n![" << p << "](" << p << ")\n";
@@ -127,7 +149,10 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
     md_session.write_text("calibration_summary.md", md.str());
     md_session.commit();
 
-    out << "\n" << validation::calibration_metrics_table(result) << "\nTuned preset: " << (dir / (name + ".json")).string()
+    out << "\n" << validation::calibration_terms_table(result) << "\n" << validation::calibration_parameters_table(result);
+    // Warnings go to stderr: -q silences stdout only.
+    for (const std::string& w : result.warnings) err << "warning: " << w << "\n";
+    out << "\nTuned preset: " << (dir / (name + ".json")).string()
         << "\n  run it with: puncture run " << (dir / (name + ".json")).string() << '\n';
     return 0;
   });

@@ -114,7 +114,8 @@ class ObjectReader {
   std::set<std::string> used_;
 };
 
-const std::set<std::string> kEffects{"surface_force", "damping", "resumption", "surface_output"};
+const std::set<std::string> kEffects{"surface_force", "damping",  "resumption", "surface_output",
+                                     "cutting",       "friction", "stiffening", "layer_interaction"};
 const std::set<std::string> kModels{"realtime", "fem"};
 
 ForceMeshParams read_force_mesh(ObjectReader r) {
@@ -185,7 +186,65 @@ ShaftFriction read_shaft_friction(ObjectReader r) {
   return f;
 }
 
-Layer read_layer(ObjectReader r, const std::string& file) {
+BreakthroughCriterion read_breakthrough(ObjectReader r) {
+  BreakthroughCriterion c;
+  const std::string kind = r.string("criterion");
+  if (kind == "rings") {
+    c.kind = BreakthroughCriterion::Kind::Rings;
+  } else if (kind == "critical_force") {
+    c.kind = BreakthroughCriterion::Kind::CriticalForce;
+    c.critical_force_N = r.number("critical_force_N");
+  } else if (kind == "critical_energy") {
+    c.kind = BreakthroughCriterion::Kind::CriticalEnergy;
+    c.critical_energy_J = r.number("critical_energy_mJ") * 1e-3;
+  } else {
+    r.fail(r.child("criterion"), "unknown criterion '" + kind + "' (known: rings, critical_force, critical_energy)");
+  }
+  r.reject_unknown_keys();
+  return c;
+}
+
+StiffeningLaw read_stiffening(ObjectReader r) {
+  StiffeningLaw st;
+  const std::string law = r.string("law");
+  if (law == "polynomial") {
+    st.kind = StiffeningLaw::Kind::Polynomial;
+    st.quadratic_N_per_m2 = r.number("quadratic_N_per_mm2", 0.0) / (kMm * kMm);
+    st.cubic_N_per_m3 = r.number("cubic_N_per_mm3", 0.0) / (kMm * kMm * kMm);
+  } else if (law == "exponential") {
+    st.kind = StiffeningLaw::Kind::Exponential;
+    st.exponential_stiffness_N_per_m = r.number("stiffness_N_per_mm") / kMm;
+    st.strain_scale_m = r.number("strain_scale_mm") * kMm;
+  } else {
+    r.fail(r.child("law"), "unknown stiffening law '" + law + "' (known: polynomial, exponential)");
+  }
+  r.reject_unknown_keys();
+  return st;
+}
+
+ShaftFrictionLaw read_friction(ObjectReader r) {
+  ShaftFrictionLaw f;
+  f.dynamic_N_per_m = r.number("dynamic_N_per_mm") / kMm;
+  f.static_N_per_m = r.number("static_N_per_mm", f.dynamic_N_per_m * kMm) / kMm;
+  f.velocity_band_m_per_s = r.number("velocity_band_mm_per_s", f.velocity_band_m_per_s / kMm) * kMm;
+  r.reject_unknown_keys();
+  return f;
+}
+
+ForceLaw read_force_law(ObjectReader r, const std::string& file) {
+  ForceLaw law;
+  if (r.has("breakthrough"))
+    law.breakthrough = read_breakthrough(ObjectReader(r.raw("breakthrough"), r.child("breakthrough"), file));
+  if (r.has("stiffening"))
+    law.stiffening = read_stiffening(ObjectReader(r.raw("stiffening"), r.child("stiffening"), file));
+  law.cutting_force_N = r.number("cutting_force_N", law.cutting_force_N);
+  law.cutting_release_m = r.number("cutting_release_mm", law.cutting_release_m / kMm) * kMm;
+  if (r.has("friction")) law.friction = read_friction(ObjectReader(r.raw("friction"), r.child("friction"), file));
+  r.reject_unknown_keys();
+  return law;
+}
+
+Layer read_layer(ObjectReader r, const std::string& file, bool& has_resumption_time) {
   Layer l;
   l.name = r.string("name");
   l.thickness_m = r.number("thickness_mm") * kMm;
@@ -193,6 +252,9 @@ Layer read_layer(ObjectReader r, const std::string& file) {
   l.force_mesh = read_force_mesh(ObjectReader(r.raw("force_mesh"), r.child("force_mesh"), file));
   l.damping_N_s_per_m2 = r.number("damping_d_N_s_per_m2");
   l.resumption_rate = r.number("resumption_rate", l.resumption_rate);
+  has_resumption_time = r.has("resumption_time_s");
+  l.resumption_time_s = r.number("resumption_time_s", l.resumption_time_s);
+  if (r.has("force_law")) l.force_law = read_force_law(ObjectReader(r.raw("force_law"), r.child("force_law"), file), file);
   if (r.has("material"))
     l.material = read_material(ObjectReader(r.raw("material"), r.child("material"), file), file);
   if (r.has("puncture")) l.puncture = read_puncture(ObjectReader(r.raw("puncture"), r.child("puncture"), file));
@@ -212,6 +274,7 @@ Scene read_scene(const json& root, const std::string& file) {
   s.name = r.string("name");
   s.description = r.string("description", "");
   s.source_path = file;
+  std::vector<bool> resumption_time_given;
 
   {
     ObjectReader o(r.raw("sample"), "/sample", file);
@@ -229,8 +292,11 @@ Scene read_scene(const json& root, const std::string& file) {
   {
     const json& layers = r.raw("layers");
     if (!layers.is_array()) r.fail("/layers", "must be an array of layer objects");
-    for (std::size_t i = 0; i < layers.size(); ++i)
-      s.layers.push_back(read_layer(ObjectReader(layers[i], "/layers/" + std::to_string(i), file), file));
+    for (std::size_t i = 0; i < layers.size(); ++i) {
+      bool has_time = false;
+      s.layers.push_back(read_layer(ObjectReader(layers[i], "/layers/" + std::to_string(i), file), file, has_time));
+      resumption_time_given.push_back(has_time);
+    }
   }
   {
     ObjectReader o(r.raw("insertion"), "/insertion", file);
@@ -282,8 +348,25 @@ Scene read_scene(const json& root, const std::string& file) {
     s.effects.damping = on("damping");
     s.effects.resumption = on("resumption");
     s.effects.surface_output = on("surface_output");
+    s.effects.cutting = on("cutting");
+    s.effects.friction = on("friction");
+    s.effects.stiffening = on("stiffening");
+    s.effects.layer_interaction = on("layer_interaction");
   }
   r.reject_unknown_keys();
+  // Recovery time in seconds: given, or the paper's eta_r per haptic step at
+  // this file's haptic rate (so that it no longer changes with the rate);
+  // eta_r is kept consistent for reports.
+  for (std::size_t i = 0; i < s.layers.size(); ++i) {
+    Layer& l = s.layers[i];
+    const std::string p = "/layers/" + std::to_string(i);
+    if (resumption_time_given[i]) {
+      if (!(l.resumption_time_s > 0)) r.fail(p + "/resumption_time_s", "must be > 0 (got " + describe(l.resumption_time_s) + ")");
+      if (s.realtime.haptic_rate_Hz > 0) l.resumption_rate = std::min(1.0, 1.0 / (l.resumption_time_s * s.realtime.haptic_rate_Hz));
+    } else if (l.resumption_rate > 0 && s.realtime.haptic_rate_Hz > 0) {
+      l.resumption_time_s = 1.0 / (l.resumption_rate * s.realtime.haptic_rate_Hz);
+    }
+  }
   validate_scene(s, file);
   return s;
 }
@@ -294,6 +377,34 @@ void require(bool ok, const std::string& file, const std::string& path, const st
   std::ostringstream msg;
   msg << "must be " << rule << " (got " << value << ")";
   throw SceneError(file, path, msg.str());
+}
+
+/// The layer's force_law object (every value is checked, used or not: a
+/// scene that switches an effect on later must already be valid).
+void validate_force_law(const ForceLaw& law, const std::string& file, const std::string& p, double thickness_m) {
+  const BreakthroughCriterion& b = law.breakthrough;
+  if (b.kind == BreakthroughCriterion::Kind::CriticalForce)
+    require(b.critical_force_N > 0 && b.critical_force_N <= 1e3, file, p + "/breakthrough/critical_force_N",
+            "in (0, 1000]", b.critical_force_N);
+  if (b.kind == BreakthroughCriterion::Kind::CriticalEnergy)
+    require(b.critical_energy_J > 0 && b.critical_energy_J <= 1e3, file, p + "/breakthrough/critical_energy_mJ",
+            "in (0, 1e6]", b.critical_energy_J * 1e3);
+  const StiffeningLaw& st = law.stiffening;
+  require(st.quadratic_N_per_m2 >= 0, file, p + "/stiffening/quadratic_N_per_mm2", ">= 0", st.quadratic_N_per_m2 * kMm * kMm);
+  require(st.cubic_N_per_m3 >= 0, file, p + "/stiffening/cubic_N_per_mm3", ">= 0", st.cubic_N_per_m3 * kMm * kMm * kMm);
+  require(st.exponential_stiffness_N_per_m >= 0, file, p + "/stiffening/stiffness_N_per_mm", ">= 0",
+          st.exponential_stiffness_N_per_m * kMm);
+  require(st.strain_scale_m > 0, file, p + "/stiffening/strain_scale_mm", "> 0", st.strain_scale_m / kMm);
+  require(law.cutting_force_N >= 0 && law.cutting_force_N <= 1e3, file, p + "/cutting_force_N", "in [0, 1000]",
+          law.cutting_force_N);
+  require(law.cutting_release_m > 0 && law.cutting_release_m <= thickness_m + 1e-3, file, p + "/cutting_release_mm",
+          "> 0 and at most the layer thickness + 1 mm", law.cutting_release_m / kMm);
+  const ShaftFrictionLaw& f = law.friction;
+  require(f.dynamic_N_per_m >= 0, file, p + "/friction/dynamic_N_per_mm", ">= 0", f.dynamic_N_per_m * kMm);
+  require(f.static_N_per_m >= f.dynamic_N_per_m, file, p + "/friction/static_N_per_mm",
+          ">= dynamic_N_per_mm (the shaft cannot stick with less force than it slides with)", f.static_N_per_m * kMm);
+  require(f.velocity_band_m_per_s > 0, file, p + "/friction/velocity_band_mm_per_s", "> 0",
+          f.velocity_band_m_per_s / kMm);
 }
 
 }  // namespace
@@ -347,6 +458,9 @@ void validate_scene(const Scene& s, const std::string& file) {
     require(l.damping_N_s_per_m2 >= 0, file, p + "/damping_d_N_s_per_m2", ">= 0", l.damping_N_s_per_m2);
     require(l.resumption_rate > 0 && l.resumption_rate <= 1, file, p + "/resumption_rate", "in (0, 1]",
             l.resumption_rate);
+    require(l.resumption_time_s > 0 && std::isfinite(l.resumption_time_s), file, p + "/resumption_time_s", "> 0",
+            l.resumption_time_s);
+    validate_force_law(l.force_law, file, p + "/force_law", l.thickness_m);
     const ContinuumMaterial& m = l.material;
     if (m.model != "neo_hookean" && m.model != "mooney_rivlin" && m.model != "ogden" && m.model != "veronda_westmann")
       throw SceneError(file, p + "/material/model",
@@ -457,6 +571,16 @@ void validate_scene(const Scene& s, const std::string& file) {
           "/fem/mesh/path_element_size_mm", "in (0, 10] mm", f.mesh.path_element_size_mm);
   if (s.models.empty()) throw SceneError(file, "/models", "must name at least one model (realtime, fem)");
   scene_limits::check_scene_limits(s, file);
+  if (s.effects.layer_interaction) {
+    // A layer pressed by the one above is deflected before the needle meets
+    // it: the ring rule would break it at first touch.
+    for (std::size_t i = 1; i < s.layers.size(); ++i)
+      if (s.layers[i].force_law.breakthrough.kind == BreakthroughCriterion::Kind::Rings)
+        throw SceneError(file, "/layers/" + std::to_string(i) + "/force_law/breakthrough/criterion",
+                         "with the layer_interaction effect every layer below the first needs critical_force or "
+                         "critical_energy (the ring rule counts the deflection carried from the layer above)");
+    if (s.layers.size() > 16) throw SceneError(file, "/layers", "layer_interaction supports at most 16 layers");
+  }
 }
 
 Scene parse_scene(const std::string& text, const std::string& source_name) {
@@ -486,6 +610,39 @@ Scene load_scene(const std::filesystem::path& path) {
   return parse_scene(buffer.str(), path.string());
 }
 
+namespace {
+
+json force_law_json(const ForceLaw& law) {
+  json j;
+  const BreakthroughCriterion& b = law.breakthrough;
+  switch (b.kind) {
+    case BreakthroughCriterion::Kind::Rings: j["breakthrough"] = {{"criterion", "rings"}}; break;
+    case BreakthroughCriterion::Kind::CriticalForce:
+      j["breakthrough"] = {{"criterion", "critical_force"}, {"critical_force_N", b.critical_force_N}};
+      break;
+    case BreakthroughCriterion::Kind::CriticalEnergy:
+      j["breakthrough"] = {{"criterion", "critical_energy"}, {"critical_energy_mJ", b.critical_energy_J * 1e3}};
+      break;
+  }
+  const StiffeningLaw& st = law.stiffening;
+  if (st.kind == StiffeningLaw::Kind::Polynomial)
+    j["stiffening"] = {{"law", "polynomial"},
+                       {"quadratic_N_per_mm2", st.quadratic_N_per_m2 * kMm * kMm},
+                       {"cubic_N_per_mm3", st.cubic_N_per_m3 * kMm * kMm * kMm}};
+  else
+    j["stiffening"] = {{"law", "exponential"},
+                       {"stiffness_N_per_mm", st.exponential_stiffness_N_per_m * kMm},
+                       {"strain_scale_mm", st.strain_scale_m / kMm}};
+  j["cutting_force_N"] = law.cutting_force_N;
+  j["cutting_release_mm"] = law.cutting_release_m / kMm;
+  j["friction"] = {{"static_N_per_mm", law.friction.static_N_per_m * kMm},
+                   {"dynamic_N_per_mm", law.friction.dynamic_N_per_m * kMm},
+                   {"velocity_band_mm_per_s", law.friction.velocity_band_m_per_s / kMm}};
+  return j;
+}
+
+}  // namespace
+
 std::string scene_to_json_text(const Scene& s) {
   json root;
   root["schema_version"] = kSchemaVersion;
@@ -509,7 +666,8 @@ std::string scene_to_json_text(const Scene& s) {
                        {"deformed_threshold_mm", l.force_mesh.deformed_threshold_m / kMm},
                        {"node_damping_N_s_per_m", l.force_mesh.node_damping_N_s_per_m}};
     j["damping_d_N_s_per_m2"] = l.damping_N_s_per_m2;
-    j["resumption_rate"] = l.resumption_rate;
+    j["resumption_time_s"] = l.resumption_time_s;
+    j["force_law"] = force_law_json(l.force_law);
     j["material"] = {{"model", l.material.model},
                      {"youngs_modulus_kPa", l.material.youngs_modulus_Pa / 1e3},
                      {"poisson_ratio", l.material.poisson_ratio},
@@ -567,6 +725,10 @@ std::string scene_to_json_text(const Scene& s) {
   if (s.effects.damping) effects.push_back("damping");
   if (s.effects.resumption) effects.push_back("resumption");
   if (s.effects.surface_output) effects.push_back("surface_output");
+  if (s.effects.cutting) effects.push_back("cutting");
+  if (s.effects.friction) effects.push_back("friction");
+  if (s.effects.stiffening) effects.push_back("stiffening");
+  if (s.effects.layer_interaction) effects.push_back("layer_interaction");
   root["effects"] = effects;
   return root.dump(2) + "\n";
 }

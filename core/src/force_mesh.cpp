@@ -81,30 +81,15 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   const double L = params.spacing_L_m;
   mass_kg_ = density_kg_per_m3 * layer_thickness_m * 0.5 * std::sqrt(3.0) * L * L;
 
-  // --- geometry: tangent plane of the contact point, nodes projected on the surface ---
-  Eigen::Vector3d nrm = contact.normal;
-  if (!(nrm.norm() > 0.0) || !nrm.allFinite()) throw std::invalid_argument("force mesh: contact normal is not a direction");
-  nrm.normalize();
-  const Eigen::Vector3d helper = std::abs(nrm.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d e1 = (helper - helper.dot(nrm) * nrm).normalized();
-  const Eigen::Vector3d e2 = nrm.cross(e1);
   rest_.resize(3, n);
   normals_.resize(3, n);
-  rest_.col(0) = contact.position;
-  normals_.col(0) = nrm;
-  for (int i = 1; i < n; ++i) {
-    const Eigen::Vector2d p = lattice_.planar_position(i, L);
-    const SurfacePoint sp = surface.project(contact.position + p.x() * e1 + p.y() * e2);
-    if (!sp.position.allFinite() || !sp.normal.allFinite() || !(sp.normal.norm() > 0.0))
-      throw std::invalid_argument("force mesh: projecting node " + std::to_string(i) +
-                                  " onto the layer surface gave a non-finite point");
-    rest_.col(i) = sp.position;
-    normals_.col(i) = sp.normal.normalized();
-  }
-  positions_ = rest_;
-
+  positions_.resize(3, n);
   z_.setZero(n);
+  layout(surface, contact);
+
   v_.setZero(n);
+  pz_.setZero(n);
+  pv_.setZero(n);
   rhs_.setZero(nf);
   work_.setZero(nf);
   ring_mean_m_.setZero(params.rings_w);
@@ -157,11 +142,86 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
     perm_.resize(nf);
     for (int k = 0; k < nf; ++k) perm_[k] = ldlt.permutationP().indices()[k];
   }
+
+  // --- unit response of one step: z0 = 0 -> 1 from rest (the step is affine in z0) ---
+  step_free_nodes(0.0, 1.0);
+  qz_ = z_;
+  qv_ = v_;
+  qz_[0] = 1.0;
+  qv_[0] = 0.0;
+  z_.setZero();
+  v_.setZero();
+  reaction_slope_N_per_m_ = K;
+  for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
+    reaction_slope_N_per_m_ += ks * (1.0 - qz_[lattice_.neighbours[k]]);
+  update_derived();
+}
+
+void ForceMesh::set_frame(const SurfacePoint& contact) {
+  // Tangent plane of the contact point.
+  Eigen::Vector3d nrm = contact.normal;
+  if (!(nrm.norm() > 0.0) || !nrm.allFinite() || !contact.position.allFinite())
+    throw std::invalid_argument("force mesh: contact point or normal is not finite");
+  nrm.normalize();
+  const Eigen::Vector3d helper = std::abs(nrm.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  frame_origin_ = contact.position;
+  frame_normal_ = nrm;
+  frame_e1_ = (helper - helper.dot(nrm) * nrm).normalized();
+  frame_e2_ = nrm.cross(frame_e1_);
+}
+
+void ForceMesh::project_node(int i) {
+  const Eigen::Vector2d p = lattice_.planar_position(i, params_.spacing_L_m);
+  const SurfacePoint sp = layout_surface_->project(frame_origin_ + p.x() * frame_e1_ + p.y() * frame_e2_);
+  if (!sp.position.allFinite() || !sp.normal.allFinite() || !(sp.normal.norm() > 0.0))
+    throw std::invalid_argument("force mesh: projecting node " + std::to_string(i) +
+                                " onto the layer surface gave a non-finite point");
+  rest_.col(i) = sp.position;
+  normals_.col(i) = sp.normal.normalized();
+  positions_.col(i) = rest_.col(i) - z_[i] * normals_.col(i);
+}
+
+void ForceMesh::layout(const ContactSurface& surface, const SurfacePoint& contact) {
+  // Every node projected onto the surface at once (construction).
+  set_frame(contact);
+  layout_surface_ = &surface;
+  rest_.col(0) = contact.position;
+  normals_.col(0) = frame_normal_;
+  positions_.col(0) = rest_.col(0);
+  for (int i = 1; i < lattice_.node_count(); ++i) project_node(i);
+  next_projection_ = lattice_.node_count();
+  positions_ = rest_;
+}
+
+void ForceMesh::relayout(const ContactSurface& surface, const SurfacePoint& contact) {
+  set_frame(contact);
+  layout_surface_ = &surface;
+  rest_.col(0) = contact.position;
+  normals_.col(0) = frame_normal_;
+  for (int i = 1; i < lattice_.node_count(); ++i) {
+    const Eigen::Vector2d p = lattice_.planar_position(i, params_.spacing_L_m);
+    rest_.col(i) = frame_origin_ + p.x() * frame_e1_ + p.y() * frame_e2_;
+    normals_.col(i) = frame_normal_;
+  }
+  next_projection_ = 1;
+  reset();
+}
+
+int ForceMesh::refine_layout(int max_nodes) {
+  const int n = lattice_.node_count();
+  for (int k = 0; k < max_nodes && next_projection_ < n; ++k) project_node(next_projection_++);
+  return n - next_projection_;
+}
+
+bool ForceMesh::laid_at(const SurfacePoint& contact, double tolerance_m) const {
+  return (rest_.col(0) - contact.position).norm() <= tolerance_m &&
+         (normals_.col(0) - contact.normal.normalized()).norm() <= 1e-9;
 }
 
 void ForceMesh::reset() {
   z_.setZero();
   v_.setZero();
+  predicted_ = false;
   update_derived();
 }
 
@@ -184,18 +244,9 @@ void ForceMesh::explicit_substep(double dt, double z0) {
   }
 }
 
-void ForceMesh::implicit_step(double z0) {
-  const int n = lattice_.node_count();
-  const int nf = n - 1;
-  const double dt = settings_.time_step_s;
-  const double m_dt2 = mass_kg_ / (dt * dt);
-  const double c_dt = params_.node_damping_N_s_per_m / dt;
-  const double ks = params_.surface_stiffness_N_per_m;
-  // rhs = M/dt^2 (z + dt v) + C/dt z + b z0
-  for (int i = 1; i < n; ++i) rhs_[i - 1] = m_dt2 * (z_[i] + dt * v_[i]) + c_dt * z_[i];
-  for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
-    rhs_[lattice_.neighbours[k] - 1] += ks * z0;
-  // Solve P^T L D L^T P x = rhs.
+void ForceMesh::implicit_solve() {
+  const int nf = lattice_.node_count() - 1;
+  // Solve P^T L D L^T P x = rhs_ into work_.
   for (int k = 0; k < nf; ++k) work_[perm_[k]] = rhs_[k];
   for (int j = 0; j < nf; ++j) {
     const double yj = work_[j];
@@ -209,43 +260,75 @@ void ForceMesh::implicit_step(double z0) {
       if (l_row_[p] > j) s -= l_val_[p] * work_[l_row_[p]];
     work_[j] = s;
   }
-  for (int k = 0; k < nf; ++k) {
-    const double z_new = work_[perm_[k]];
-    v_[k + 1] = (z_new - z_[k + 1]) / dt;
-    z_[k + 1] = z_new;
-  }
-  z_[0] = z0;
 }
 
-void ForceMesh::advance(double contact_deflection_m) {
-  const double z0 = std::max(0.0, contact_deflection_m);
-  if (!std::isfinite(z0)) throw std::runtime_error("force mesh: non-finite contact deflection");
+void ForceMesh::step_free_nodes(double z0_old, double z0_new) {
+  const int n = lattice_.node_count();
+  const int nf = n - 1;
   const double dt = settings_.time_step_s;
+  if (settings_.integrator == MeshIntegrator::QuasiStatic) {
+    for (int i = 1; i < n; ++i) z_[i] = influence_[i] * z0_new, v_[i] = 0.0;
+  } else if (!use_implicit_) {
+    const double h = dt / substeps_;
+    for (int s = 1; s <= substeps_; ++s) explicit_substep(h, z0_old + (z0_new - z0_old) * s / substeps_);
+  } else if (nf > 0) {
+    const double m_dt2 = mass_kg_ / (dt * dt);
+    const double c_dt = params_.node_damping_N_s_per_m / dt;
+    const double ks = params_.surface_stiffness_N_per_m;
+    // rhs = M/dt^2 (z + dt v) + C/dt z + b z0
+    for (int i = 1; i < n; ++i) rhs_[i - 1] = m_dt2 * (z_[i] + dt * v_[i]) + c_dt * z_[i];
+    for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
+      rhs_[lattice_.neighbours[k] - 1] += ks * z0_new;
+    implicit_solve();
+    for (int k = 0; k < nf; ++k) {
+      const double z_new = work_[perm_[k]];
+      v_[k + 1] = (z_new - z_[k + 1]) / dt;
+      z_[k + 1] = z_new;
+    }
+  }
+  z_[0] = z0_new;
+}
+
+void ForceMesh::predict() {
+  // The step from the committed state with z0 = 0 at its end, in the scratch
+  // vectors; the committed state is swapped back in afterwards.
   const double z0_old = z_[0];
-  switch (settings_.integrator) {
-    case MeshIntegrator::QuasiStatic:
-      z_ = influence_ * z0;
-      break;
-    case MeshIntegrator::Explicit:
-      if (!use_implicit_) {
-        const double h = dt / substeps_;
-        for (int s = 1; s <= substeps_; ++s) explicit_substep(h, z0_old + (z0 - z0_old) * s / substeps_);
-        break;
-      }
-      implicit_step(z0);
-      break;
-    case MeshIntegrator::Implicit:
-      implicit_step(z0);
-      break;
+  pz_ = z_;
+  pv_ = v_;
+  z_.swap(pz_);
+  v_.swap(pv_);  // (z_, v_) = copies; (pz_, pv_) = committed state
+  step_free_nodes(z0_old, 0.0);
+  z_.swap(pz_);
+  v_.swap(pv_);  // (z_, v_) = committed state again; (pz_, pv_) = predicted
+  double f = 0.0;
+  for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
+    f -= params_.surface_stiffness_N_per_m * pz_[lattice_.neighbours[k]];
+  predicted_intercept_N_ = f;
+  predicted_ = true;
+}
+
+void ForceMesh::commit(double contact_deflection_m) {
+  if (!std::isfinite(contact_deflection_m)) throw std::runtime_error("force mesh: non-finite contact deflection");
+  if (!predicted_) predict();
+  const double z0 = std::max(0.0, contact_deflection_m);
+  const double z0_old = z_[0];
+  const int n = lattice_.node_count();
+  for (int i = 1; i < n; ++i) {
+    z_[i] = pz_[i] + z0 * qz_[i];
+    v_[i] = pv_[i] + z0 * qv_[i];
   }
   z_[0] = z0;
-  v_[0] = (z0 - z0_old) / dt;
-  // Quasi-static: the free nodes are at equilibrium and carry no kinetic energy.
-  if (settings_.integrator == MeshIntegrator::QuasiStatic) v_.tail(v_.size() - 1).setZero();
+  v_[0] = (z0 - z0_old) / settings_.time_step_s;
+  predicted_ = false;
   update_derived();
   if (!std::isfinite(ring_mean_m_.sum()) || !std::isfinite(v_.sum()))
     throw std::runtime_error("force mesh: deflections became non-finite (integrator " +
                              std::string(to_string(settings_.integrator)) + ")");
+}
+
+void ForceMesh::advance(double contact_deflection_m) {
+  predict();
+  commit(contact_deflection_m);
 }
 
 void ForceMesh::update_derived() {
@@ -256,6 +339,8 @@ void ForceMesh::update_derived() {
     positions_.col(i) = rest_.col(i) - z_[i] * normals_.col(i);
   }
   ring_mean_m_.array() /= ring_size_.array();
+  max_abs_deflection_m_ = z_.cwiseAbs().maxCoeff();
+  max_abs_velocity_m_per_s_ = v_.cwiseAbs().maxCoeff();
 }
 
 double ForceMesh::contact_reaction_N() const {

@@ -1,47 +1,45 @@
 #include "puncture/resumption.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "puncture/shape_matching.hpp"
-
 namespace puncture {
 
-SurfaceResumption::SurfaceResumption(const Eigen::Matrix3Xd& rest_positions, const Eigen::VectorXd& masses_kg,
-                                     double resumption_rate)
-    : rest_(rest_positions),
-      broken_(rest_positions),
-      current_(rest_positions),
-      goals_(rest_positions),
-      masses_(masses_kg),
-      rate_(resumption_rate) {
-  if (!(resumption_rate > 0.0 && resumption_rate <= 1.0))
-    throw std::invalid_argument("resumption_rate (eta_r) must be in (0, 1] (got " + std::to_string(resumption_rate) +
-                                ")");
-  if (masses_kg.size() != rest_positions.cols())
-    throw std::invalid_argument("resumption: one mass per node is required");
+SurfaceResumption::SurfaceResumption(const Eigen::Matrix3Xd& rest_positions, double recovery_time_s)
+    : rest_(rest_positions), broken_(rest_positions), current_(rest_positions), recovery_time_s_(recovery_time_s) {
+  if (!(recovery_time_s > 0.0) || !std::isfinite(recovery_time_s))
+    throw std::invalid_argument("resumption: recovery time must be > 0 s (got " + std::to_string(recovery_time_s) + ")");
+  if (!rest_positions.allFinite()) throw std::invalid_argument("resumption: non-finite rest positions");
 }
 
-void SurfaceResumption::start(const Eigen::Matrix3Xd& broken_positions) {
+void SurfaceResumption::set_rest_positions(const Eigen::Matrix3Xd& rest_positions) {
+  if (rest_positions.cols() != rest_.cols())
+    throw std::invalid_argument("resumption: rest positions must keep one column per node");
+  rest_ = rest_positions;
+  current_ = rest_positions;
+  broken_ = rest_positions;
+  active_ = false;
+  eta_ = 1.0;
+}
+
+void SurfaceResumption::start(const Eigen::Matrix3Xd& broken_positions, double time_s) {
   if (broken_positions.cols() != rest_.cols())
     throw std::invalid_argument("resumption: broken positions must have one column per node");
   broken_ = broken_positions;
   current_ = broken_positions;
+  start_time_s_ = time_s;
   eta_ = 1.0;
-  steps_ = 0;
   active_ = true;
 }
 
-void SurfaceResumption::step() {
-  if (!active_ || eta_ <= 0.0) return;
-  ++steps_;
-  // eta = 1 - k eta_r, computed from the step count so that rounding cannot
-  // leave a residue of 1e-16 after ceil(1 / eta_r) steps.
-  eta_ = 1.0 - steps_ * rate_;
+void SurfaceResumption::step(double time_s) {
+  if (!active_ || eta_ == 0.0) return;
+  eta_ = std::clamp(1.0 - (time_s - start_time_s_) / recovery_time_s_, 0.0, 1.0);
   if (eta_ < 1e-12) eta_ = 0.0;
-  shape_matching_goals(rest_, current_, masses_, goals_);
-  current_ = goals_ + eta_ * (broken_ - goals_);
+  // Eq. (8) with the rest shape as goal: p = g + eta (p^b - g).
+  current_ = rest_ + eta_ * (broken_ - rest_);
 }
 
 }  // namespace puncture

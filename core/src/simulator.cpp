@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include "puncture/cutting.hpp"
+#include "puncture/stiffening.hpp"
 
 namespace puncture {
 
@@ -20,9 +24,14 @@ PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique
   integration.integrator = parse_mesh_integrator(scene.realtime.integrator);
   integration.time_step_s = 1.0 / scene.realtime.haptic_rate_Hz;
   damping_on_ = scene.effects.damping;
+  cutting_on_ = scene.effects.cutting;
+  interaction_ = scene.effects.layer_interaction && scene.effects.surface_force;
+  if (interaction_ && scene.layers.size() > static_cast<std::size_t>(kMaxChainLinks))
+    throw std::invalid_argument("layer_interaction supports at most " + std::to_string(kMaxChainLinks) + " layers");
   // Rays searching for a contact start this far above the tip: above every surface.
   contact_search_height_m_ = std::max(0.0, scene.insertion.start_height_m) + scene.total_thickness_m() +
                              scene.sample.diameter_m;
+  relayout_tolerance_m_ = 1e-9;
 
   layers_.resize(scene.layers.size());
   for (std::size_t k = 0; k < scene.layers.size(); ++k) {
@@ -33,11 +42,17 @@ PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique
     layer.name = in.name;
     layer.top_depth_m = scene.layer_top_depth_m(k);
     layer.thickness_m = in.thickness_m;
+    layer.law = in.force_law;
     layer.surface = std::move(layer_surfaces[k]);
     if (damping_on_) {
       if (!(in.damping_N_s_per_m2 >= 0.0)) throw std::invalid_argument("layer \"" + in.name + "\": damping must be >= 0");
       layer.damping_N_s_per_m2 = in.damping_N_s_per_m2;
     }
+    layer.tip_contact_from_m = std::numeric_limits<double>::infinity();
+    if (scene.effects.friction) layer.friction.emplace(in.force_law.friction);
+    if (cutting_on_ && !(in.force_law.cutting_force_N >= 0.0 && in.force_law.cutting_release_m > 0.0))
+      throw std::invalid_argument("layer \"" + in.name + "\": cutting force must be >= 0 and its release distance > 0");
+    if (scene.effects.stiffening) layer.stiffening = &layer.law.stiffening;
     if (scene.effects.surface_force) {
       double s = 0.0;
       SurfacePoint centre;
@@ -45,10 +60,8 @@ PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique
       if (!layer.surface->intersect_ray(origin, -Eigen::Vector3d::UnitZ(), s, centre))
         throw std::invalid_argument("layer \"" + in.name + "\": the insertion axis misses its surface");
       layer.mesh.emplace(*layer.surface, centre, in.force_mesh, in.thickness_m, in.density_kg_per_m3, integration);
-      if (scene.effects.resumption) {
-        const Eigen::VectorXd masses = Eigen::VectorXd::Constant(layer.mesh->node_count(), layer.mesh->node_mass_kg());
-        layer.resumption.emplace(layer.mesh->rest_positions(), masses, in.resumption_rate);
-      }
+      layer.shifted_positions = layer.mesh->rest_positions();
+      if (scene.effects.resumption) layer.resumption.emplace(layer.mesh->rest_positions(), in.resumption_time_s);
     }
   }
   events_.reserve(layers_.size());
@@ -59,11 +72,22 @@ const Eigen::Matrix3Xd& PunctureSimulator::node_rest_positions(std::size_t k) co
   return layers_[k].mesh ? layers_[k].mesh->rest_positions() : empty_positions_;
 }
 
+double PunctureSimulator::surface_deflection_m(std::size_t k) const {
+  double y = 0.0;
+  for (std::size_t j = k; j < layers_.size(); ++j) y += layers_[j].deflection_m;
+  return y;
+}
+
 const Eigen::Matrix3Xd& PunctureSimulator::node_positions(std::size_t k) const {
   const LayerModel& layer = layers_[k];
   if (!layer.mesh) return empty_positions_;
-  if (layer.resumption && layer.resumption->active()) return layer.resumption->positions();
-  return layer.mesh->positions();
+  const Eigen::Matrix3Xd& own =
+      layer.resumption && layer.resumption->active() ? layer.resumption->positions() : layer.mesh->positions();
+  const double base = k + 1 < layers_.size() ? surface_deflection_m(k + 1) : 0.0;
+  if (!interaction_ || base == 0.0) return own;
+  // The layer rides on the surface of the layer below, moved by `base` along the normals.
+  layer.shifted_positions = own - base * layer.mesh->normals();
+  return layer.shifted_positions;
 }
 
 const std::vector<int>& PunctureSimulator::node_rings(std::size_t k) const {
@@ -77,63 +101,170 @@ double PunctureSimulator::mesh_energy_J() const {
   return e;
 }
 
-bool PunctureSimulator::press_active_layer(const NeedleState& needle, double& surface_force_sum_N) {
-  LayerModel& layer = layers_[active_];
-  LayerTickResult& out = result_.layers[active_];
-  const Eigen::Vector3d& tip = needle.tip_position_m;
-  const Eigen::Vector3d& dir = needle.direction;
-
-  if (!layer.contact_set) {
+void PunctureSimulator::lay_mesh_on_axis(std::size_t k, const NeedleState& needle, const SurfacePoint* hit) {
+  LayerModel& layer = layers_[k];
+  if (!layer.mesh) return;
+  SurfacePoint crossing;
+  if (hit) {
+    crossing = *hit;
+  } else {
     double s = 0.0;
-    SurfacePoint hit;
-    const Eigen::Vector3d origin = tip - dir * (contact_search_height_m_ + std::abs(tip.z()));
-    if (!layer.surface->intersect_ray(origin, dir, s, hit)) {
-      out.state = layer.state = LayerState::Untouched;
-      return false;  // the needle is not over this surface: try again next tick
+    const Eigen::Vector3d origin =
+        needle.tip_position_m - needle.direction * (contact_search_height_m_ + std::abs(needle.tip_position_m.z()));
+    if (!layer.surface->intersect_ray(origin, needle.direction, s, crossing)) return;
+  }
+  if (layer.mesh->laid_at(crossing, relayout_tolerance_m_)) return;
+  // Only a mesh at rest is moved (a loaded one keeps its layout until it relaxed).
+  if (layer.deflection_m != 0.0 || !layer.mesh->at_rest(1e-12)) return;
+  layer.mesh->relayout(*layer.surface, crossing);
+  if (layer.resumption && !layer.resumption->active()) layer.resumption->set_rest_positions(layer.mesh->rest_positions());
+}
+
+bool PunctureSimulator::try_contact(const NeedleState& needle) {
+  LayerModel& layer = layers_[active_];
+  const Eigen::Vector3d& tip = needle.tip_position_m;
+  double s = 0.0;
+  SurfacePoint hit;
+  const Eigen::Vector3d origin = tip - needle.direction * (contact_search_height_m_ + std::abs(tip.z()));
+  if (!layer.surface->intersect_ray(origin, needle.direction, s, hit)) return false;  // not over this surface
+  const double penetration = hit.normal.dot(hit.position - tip);
+  const double surface_moved = interaction_ ? surface_deflection_m(active_) : 0.0;
+  if (penetration < surface_moved) return false;  // the tip has not reached the surface yet
+  layer.contact = hit;
+  layer.contact_at_tip = false;
+  if (!interaction_ && penetration > 0.0 && std::isfinite(layer.tip_contact_from_m)) {
+    // Reached with the tip already below the rest surface (see the header):
+    // pressed from where the tip is, once it cut through the layer above.
+    if (needle.tip_position_m.dot(needle.direction) < layer.tip_contact_from_m) return false;
+    layer.contact.position = tip;
+    layer.contact_at_tip = true;
+  }
+  layer.contact_set = true;
+  lay_mesh_on_axis(active_, needle, &hit);
+  if (interaction_)
+    for (std::size_t j = active_ + 1; j < layers_.size(); ++j) lay_mesh_on_axis(j, needle, nullptr);
+  return true;
+}
+
+double PunctureSimulator::step_chain(const NeedleState& needle, double transmitted_force_N) {
+  const std::size_t a = active_;
+  LayerModel& top = layers_[a];
+  const std::size_t end = interaction_ ? layers_.size() : a + 1;
+  const int n = static_cast<int>(end - a);
+  double penetration = 0.0;
+  bool needle_driven = top.contact_set;
+  if (needle_driven) {
+    penetration = top.contact.normal.dot(top.contact.position - needle.tip_position_m);
+    if (penetration <= 0.0 && !top.contact_at_tip) {
+      top.contact_set = false;  // the tip is back above the rest surface: the next touch lays the mesh anew
+      needle_driven = false;
     }
-    layer.contact = hit;
-    // The tip is already past the crossing: the contact starts where the tip is.
-    if (hit.normal.dot(hit.position - tip) > 0.0) layer.contact.position = tip;
-    layer.contact_set = true;
+    result_.layers[a].contact_deflection_m = std::max(0.0, penetration);
+  }
+  if (!(needle_driven && penetration > 0.0)) {
+    // Force-driven (or relaxing): nothing to do if it carries no load and is at rest.
+    bool idle = transmitted_force_N == 0.0;
+    for (std::size_t j = a; j < end && idle; ++j) idle = layers_[j].deflection_m == 0.0 && layers_[j].mesh->at_rest();
+    if (idle) return 0.0;
   }
 
-  const double deflection = std::max(0.0, layer.contact.normal.dot(layer.contact.position - tip));
-  out.contact_deflection_m = deflection;
+  for (int i = 0; i < n; ++i) {
+    LayerModel& layer = layers_[a + i];
+    layer.mesh->predict();
+    links_[i].intercept_N = layer.mesh->predicted_reaction_N(0.0);
+    links_[i].slope_N_per_m = layer.mesh->reaction_slope_N_per_m();
+    links_[i].stiffening = layer.stiffening;
+  }
+  double force = transmitted_force_N;
+  bool pushing = false;
+  if (needle_driven && penetration > 0.0) {
+    force = solve_series_chain(links_.data(), n, penetration, link_deflection_m_.data());
+    pushing = force > 0.0;
+    if (!pushing) force = 0.0;  // the meshes' own motion carries the surface past the tip
+  }
+  if (!pushing)
+    for (int i = 0; i < n; ++i) link_deflection_m_[i] = link_deflection_m(links_[i], force);
 
   double surface_force = 0.0;
-  bool broke = false;
-  if (layer.mesh) {
-    layer.mesh->advance(deflection);
-    surface_force = std::max(0.0, layer.mesh->contact_reaction_N());
+  for (int i = 0; i < n; ++i) {
+    LayerModel& layer = layers_[a + i];
+    LayerTickResult& out = result_.layers[a + i];
+    const double r = link_deflection_m_[i];
+    layer.mesh->commit(r);
+    layer.deflection_m = r;
     out.deformed_rings = layer.mesh->deformed_rings();
-    broke = layer.mesh->broken();
-  } else {
-    broke = deflection > 0.0;
-  }
-  layer.state = deflection > 0.0 ? LayerState::Pressed : LayerState::Untouched;
-
-  if (!broke) {
+    if (i == 0 && needle_driven) {
+      if (pushing) surface_force = std::max(0.0, link_force_N(links_[0], r));
+      out.surface_force_N = surface_force;
+      layer.state = pushing ? LayerState::Pressed : LayerState::Untouched;
+    } else {
+      out.contact_deflection_m = r;
+      out.support_force_N = r > 0.0 ? force : 0.0;
+      layer.state = r > 0.0 ? LayerState::Pressed : LayerState::Untouched;
+    }
     out.state = layer.state;
-    out.surface_force_N = surface_force;
-    surface_force_sum_N += surface_force;
-    return false;
   }
+  return surface_force;
+}
 
-  // Breakthrough: the surface force vanishes from this tick on.
+bool PunctureSimulator::breakthrough(std::size_t k, double surface_force_N) {
+  const LayerModel& layer = layers_[k];
+  if (!layer.mesh) return result_.layers[k].contact_deflection_m > 0.0;
+  if (layer.state != LayerState::Pressed) return false;
+  const BreakthroughCriterion& c = layer.law.breakthrough;
+  switch (c.kind) {
+    case BreakthroughCriterion::Kind::Rings: return layer.mesh->broken();
+    case BreakthroughCriterion::Kind::CriticalForce: return surface_force_N >= c.critical_force_N;
+    case BreakthroughCriterion::Kind::CriticalEnergy: {
+      double e = layer.mesh->virtual_spring_energy_J() + layer.mesh->surface_spring_energy_J();
+      if (layer.stiffening) e += stiffening_energy_J(*layer.stiffening, layer.deflection_m);
+      result_.layers[k].stored_energy_J = e;
+      return e >= c.critical_energy_J;
+    }
+  }
+  return false;
+}
+
+void PunctureSimulator::record_puncture(const NeedleState& needle, double surface_force_N) {
+  LayerModel& layer = layers_[active_];
+  LayerTickResult& out = result_.layers[active_];
   layer.state = LayerState::Punctured;
   out.state = LayerState::Punctured;
-  out.surface_force_N = 0.0;
+  out.surface_force_N = 0.0;  // the surface force vanishes from this tick on
   PunctureEvent event;
   event.layer = static_cast<int>(active_);
   event.layer_name = layer.name;
   event.time_s = needle.time_s;
   event.depth_m = needle.depth_m();
-  event.surface_force_N = surface_force;
-  event.total_force_N = surface_force;  // tick() adds the damping of the layers above
-  events_.push_back(event);  // capacity reserved at construction
-  if (layer.resumption) layer.resumption->start(layer.mesh->positions());
+  event.surface_force_N = surface_force_N;
+  event.total_force_N = surface_force_N;  // tick() adds the friction of the layers above
+  events_.push_back(event);               // capacity reserved at construction
+  if (layer.mesh && layer.mesh->layout_pending()) {
+    // The drawn surface must be complete before it recovers (a break within
+    // a few ticks of the contact: rare).
+    layer.mesh->refine_layout(layer.mesh->node_count());
+    if (layer.resumption) layer.resumption->set_rest_positions(layer.mesh->rest_positions());
+  }
+  if (layer.resumption) layer.resumption->start(layer.mesh->positions(), needle.time_s);
+  const double tip_axial = needle.tip_position_m.dot(needle.direction);
+  layer.front_m = tip_axial;
   ++active_;
-  return true;
+  if (active_ < layers_.size() && !interaction_) {
+    LayerModel& next = layers_[active_];
+    next.tip_contact_from_m = std::numeric_limits<double>::infinity();
+    double s = 0.0;
+    SurfacePoint hit;
+    const Eigen::Vector3d origin =
+        needle.tip_position_m - needle.direction * (contact_search_height_m_ + std::abs(needle.tip_position_m.z()));
+    if (next.surface->intersect_ray(origin, needle.direction, s, hit) &&
+        hit.normal.dot(hit.position - needle.tip_position_m) > 0.0) {
+      // The tip is already below the next rest surface. Where the broken
+      // layer's top surface was on the axis at the break: at the tip when a
+      // force mesh carried it down, at the rest surface without one.
+      const double top_axial = layer.mesh ? tip_axial : tip_axial - result_.layers[active_ - 1].contact_deflection_m;
+      next.tip_contact_from_m = top_axial + layer.thickness_m;
+    }
+  }
 }
 
 const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
@@ -145,32 +276,99 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   result_.depth_m = needle.depth_m();
   result_.velocity_m_per_s = needle.axial_velocity_m_per_s;
   for (LayerTickResult& r : result_.layers) r = LayerTickResult{};
+  const std::size_t n = layers_.size();
+  const double tip_axial_m = needle.tip_position_m.dot(needle.direction);
 
   // 1. Resumption of the layers broken in earlier ticks.
   for (std::size_t k = 0; k < active_; ++k)
-    if (layers_[k].resumption) layers_[k].resumption->step();
+    if (layers_[k].resumption) layers_[k].resumption->step(needle.time_s);
 
-  // 2-4. The reachable layer; a breakthrough hands the needle to the next one.
-  double surface_total = 0.0;
-  const std::size_t events_before = events_.size();
-  while (active_ < layers_.size() && press_active_layer(needle, surface_total)) {
+  // 2. Contact of the needle layer (a tip that starts below the first
+  // surface is in contact at once).
+  if (first_tick_) layers_[0].tip_contact_from_m = -std::numeric_limits<double>::infinity();
+  if (active_ < n && !layers_[active_].contact_set) try_contact(needle);
+  if (first_tick_) layers_[0].tip_contact_from_m = std::numeric_limits<double>::infinity();
+  first_tick_ = false;
+
+  // Cutting force of the punctured layer the tip is in (the next layer has no contact yet).
+  auto cutting = [&]() {
+    if (!cutting_on_ || active_ == 0 || (active_ < n && layers_[active_].contact_set)) return 0.0;
+    LayerModel& p = layers_[active_ - 1];
+    const double f = cutting_force_N(p.law.cutting_force_N, p.law.cutting_release_m, p.front_m, tip_axial_m);
+    p.front_m = std::max(p.front_m, tip_axial_m);
+    return f;
+  };
+  double cut = cutting();
+
+  // 3. The chain under the needle (or the needle layer alone).
+  double surface_force = 0.0;
+  if (active_ < n) {
+    if (layers_[active_].mesh) {
+      surface_force = step_chain(needle, interaction_ ? cut : 0.0);
+    } else if (layers_[active_].contact_set) {
+      const LayerModel& layer = layers_[active_];
+      const double d = layer.contact.normal.dot(layer.contact.position - needle.tip_position_m);
+      result_.layers[active_].contact_deflection_m = std::max(0.0, d);
+    }
   }
 
-  // 5. Damping of the punctured layers.
-  double damping_total = 0.0;
+  // 4. Breakthrough; the next layer becomes the needle layer in the same tick.
+  bool broke = false;
+  while (active_ < n && layers_[active_].contact_set && breakthrough(active_, surface_force)) {
+    record_puncture(needle, surface_force);
+    surface_force = 0.0;
+    broke = true;
+    if (active_ < n && try_contact(needle) && !layers_[active_].mesh) {
+      const LayerModel& layer = layers_[active_];
+      result_.layers[active_].contact_deflection_m =
+          std::max(0.0, layer.contact.normal.dot(layer.contact.position - needle.tip_position_m));
+    }
+  }
+  if (active_ < n && !layers_[active_].mesh && layers_[active_].contact_set) {
+    // Without a force mesh the layer the tip touches is pressed at zero force.
+    LayerTickResult& out = result_.layers[active_];
+    layers_[active_].state = out.contact_deflection_m > 0.0 ? LayerState::Pressed : LayerState::Untouched;
+    out.state = layers_[active_].state;
+  }
+  if (broke) cut = cutting();  // the crack through the layer that just broke starts at the tip
+  if (active_ > 0) result_.layers[active_ - 1].cutting_force_N = cut;
+
+  // 5. Shaft friction and damping of the punctured layers.
+  double friction_total = 0.0;
   for (std::size_t k = 0; k < active_; ++k) {
     LayerTickResult& out = result_.layers[k];
+    LayerModel& layer = layers_[k];
     out.state = LayerState::Punctured;
-    if (!damping_on_) continue;
-    const LayerModel& layer = layers_[k];
+    if (!damping_on_ && !layer.friction) continue;
     out.shaft_length_m = shaft_length_in_layer_m(result_.depth_m, layer.top_depth_m, layer.thickness_m);
-    out.damping_force_N =
-        puncture_damping_force_N(layer.damping_N_s_per_m2, out.shaft_length_m, needle.axial_velocity_m_per_s);
-    damping_total += out.damping_force_N;
+    if (layer.friction) out.friction_force_N = layer.friction->update(needle.axial_velocity_m_per_s) * out.shaft_length_m;
+    if (damping_on_)
+      out.damping_force_N =
+          puncture_damping_force_N(layer.damping_N_s_per_m2, out.shaft_length_m, needle.axial_velocity_m_per_s);
+    friction_total += out.friction_force_N + out.damping_force_N;
   }
-  result_.total_force_N = surface_total + damping_total;
-  for (std::size_t e = events_before; e < events_.size(); ++e)
-    for (int k = 0; k < events_[e].layer; ++k) events_[e].total_force_N += result_.layers[k].damping_force_N;
+  result_.tip_force_N = surface_force;
+  result_.cutting_force_N = cut;
+  result_.friction_force_N = friction_total;
+  result_.total_force_N = surface_force + cut + friction_total;
+  if (broke)
+    for (PunctureEvent& e : events_)
+      if (e.time_s == needle.time_s)
+        for (int k = 0; k < e.layer; ++k)
+          e.total_force_N += result_.layers[k].damping_force_N + result_.layers[k].friction_force_N;
+
+  // 6. Meshes laid at a new contact point get their nodes projected onto the
+  // surface a few per tick (only the drawn surface depends on it).
+  int budget = kLayoutNodesPerTick;
+  for (LayerModel& layer : layers_) {
+    if (budget <= 0) break;
+    if (!layer.mesh || !layer.mesh->layout_pending()) continue;
+    const int nodes = std::min(budget, layer.mesh->pending_nodes());
+    layer.mesh->refine_layout(nodes);
+    budget -= nodes;
+    if (!layer.mesh->layout_pending() && layer.resumption && !layer.resumption->active())
+      layer.resumption->set_rest_positions(layer.mesh->rest_positions());
+  }
 
   if (!std::isfinite(result_.total_force_N))
     throw std::runtime_error("PunctureSimulator::tick: the needle force became non-finite at t = " +

@@ -55,7 +55,7 @@ TEST(CalibrateCommand, RecoversSkinStiffnessFromAReferenceCurveAndWritesARunnabl
   // The curves of the reference and of the model before and after, and their plot.
   std::ifstream curves(work / "calibration" / "calibration_curves.csv");
   std::string line = test::header_after_provenance(curves);
-  EXPECT_EQ(line, "curve,time_s,depth_mm,force_N");
+  EXPECT_EQ(line, "curve,time_s,depth_mm,force_N,phase");
   std::set<std::string> names;
   while (std::getline(curves, line)) names.insert(line.substr(0, line.find(',')));
   EXPECT_EQ(names, (std::set<std::string>{"measured", "before", "after"}));
@@ -76,6 +76,84 @@ TEST(CalibrateCommand, RecoversSkinStiffnessFromAReferenceCurveAndWritesARunnabl
   rerun.quiet = true;
   EXPECT_EQ(run_command(rerun, out, err), 0) << err.str();
   fs::remove_all(work);
+}
+
+TEST(CalibrateCommand, DepthAndForceCurveWithGivenPunctureDepthsReportsEveryTerm) {
+  // A measured-style curve with only depth and force (the default scene's
+  // run with the skin's cutting force at 1.8 N), the skin's puncture depth
+  // given on the command line: the summary lists every term, with n/a where
+  // the curve cannot give one, and the tuned parameters with their bounds.
+  const fs::path work = fresh_dir("calibrate_depth_force");
+  fs::create_directories(work);
+  Scene truth = load_scene(kSourceDir / "scenes" / "default.json");
+  truth.layers[0].force_law.cutting_force_N = 1.8;
+  truth.name = "truth";
+  std::ofstream(work / "truth.json") << scene_to_json_text(truth);
+  RunOptions run;
+  run.scene = work / "truth.json";
+  run.output_dir = work / "truth_run";
+  run.write_frames = false;
+  run.quiet = true;
+  std::ostringstream out, err;
+  ASSERT_EQ(run_command(run, out, err), 0) << err.str();
+  std::ifstream summary_in(work / "truth_run" / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_in);
+  const double skin_depth_mm = summary.at("puncture_events").at(0).at("depth_mm").get<double>();
+  {
+    std::ifstream in(work / "truth_run" / "realtime_curve.csv");
+    std::ofstream curve(work / "depth_force.csv");
+    curve << "# speed_mm_per_s: 10\ndepth_mm,force_N\n";
+    std::string line = test::header_after_provenance(in);
+    while (std::getline(in, line)) {
+      std::vector<std::string> f;
+      std::istringstream s(line);
+      for (std::string x; std::getline(s, x, ',');) f.push_back(x);
+      curve << f[1] << ',' << f[3] << '\n';
+    }
+  }
+  CalibrateOptions options;
+  options.scene = kSourceDir / "scenes" / "default.json";
+  options.reference = work / "depth_force.csv";
+  options.output_dir = work / "calibration";
+  options.layers = {"skin"};
+  options.integrator = "quasi_static";
+  options.puncture_depths_mm = {skin_depth_mm};
+  options.keep = {"K", "breakthrough", "friction"};
+  options.quiet = true;
+  ASSERT_EQ(calibrate_command(options, out, err), 0) << err.str();
+  std::ifstream md_in(work / "calibration" / "calibration_summary.md");
+  std::stringstream md;
+  md << md_in.rdbuf();
+  for (const char* text : {"## Objective, term by term", "| pressing skin |", "| withdrawal |", "n/a",
+                           "the reference has no part columns", "1 puncture depth(s) given", "cutting_force (N)",
+                           "--puncture-depths", "--keep K,breakthrough,friction"})
+    EXPECT_NE(md.str().find(text), std::string::npos) << text << "\n" << md.str();
+  const Scene tuned = load_scene(work / "calibration" / "default_tuned.json");
+  EXPECT_NEAR(tuned.layers[0].force_law.cutting_force_N, 1.8, 0.05 * 1.8);
+  EXPECT_EQ(tuned.layers[0].force_mesh.virtual_stiffness_N_per_m,
+            load_scene(kSourceDir / "scenes" / "default.json").layers[0].force_mesh.virtual_stiffness_N_per_m);
+  fs::remove_all(work);
+}
+
+TEST(CalibrateCommand, BadKeepOrPunctureDepthsAreErrorsWithNoOutput) {
+  const fs::path dir = fresh_dir("calibrate_bad_keep");
+  const fs::path ref_dir = fresh_dir("calibrate_bad_keep_reference");
+  fs::create_directories(ref_dir);
+  std::ofstream(ref_dir / "curve.csv") << "depth_mm,force_N\n0,0\n1,0.5\n2,1.0\n";
+  for (int which = 0; which < 2; ++which) {
+    CalibrateOptions options;
+    options.scene = kSourceDir / "scenes" / "default.json";
+    options.reference = ref_dir / "curve.csv";
+    options.output_dir = dir;
+    options.quiet = true;
+    if (which == 0) options.keep = {"everything"};
+    else options.puncture_depths_mm = {-1.0};
+    std::ostringstream out, err;
+    EXPECT_NE(calibrate_command(options, out, err), 0);
+    EXPECT_NE(err.str().find(which == 0 ? "--keep" : "--puncture-depths"), std::string::npos) << err.str();
+    EXPECT_FALSE(fs::exists(dir));
+  }
+  fs::remove_all(ref_dir);
 }
 
 TEST(CalibrateCommand, UnknownExtraParameterIsAnErrorWithNoOutput) {

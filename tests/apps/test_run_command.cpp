@@ -60,10 +60,20 @@ TEST(RunCommand, DefaultSceneWritesCurveSummaryAndFrames) {
   // Curve CSV: header with per-layer columns and one row per tick.
   std::ifstream csv(dir / "realtime_curve.csv");
   const std::string header = test::header_after_provenance(csv);
-  EXPECT_EQ(header.rfind("time_s,depth_mm,velocity_mm_per_s,force_N,skin_state,", 0), 0u) << header;
+  EXPECT_EQ(header.rfind("time_s,depth_mm,velocity_mm_per_s,force_N,tip_force_N,cutting_force_N,friction_force_N,"
+                         "phase,skin_state,",
+                         0),
+            0u)
+      << header;
   std::size_t rows = 0;
   for (std::string line; std::getline(csv, line);) ++rows;
-  EXPECT_EQ(rows, summary.at("tick_timing_us").at("ticks").get<std::size_t>());
+  const auto& timing = summary.at("tick_timing_us");
+  EXPECT_EQ(rows, timing.at("ticks").get<std::size_t>());
+  // The cost where the work is: ticks with contact, mean and p99.
+  EXPECT_GT(timing.at("contact_ticks").get<std::size_t>(), rows / 2);
+  EXPECT_LT(timing.at("contact_ticks").get<std::size_t>(), rows);
+  EXPECT_GT(timing.at("contact_mean").get<double>(), 0.0);
+  EXPECT_GE(timing.at("contact_p99").get<double>(), timing.at("all_median").get<double>());
 
   EXPECT_TRUE(fs::exists(dir / "sh_fit_error.csv"));
   EXPECT_TRUE(fs::exists(dir / "realtime.pvd"));

@@ -1,21 +1,33 @@
 // bench_effects.cpp: what each effect costs in the haptic tick, and that an
 // effect which is off costs (next to) nothing (DESIGN.md, user demand 3).
 //
-// Default scene (l = 16, implicit force mesh), with the effects switched:
-//   all_on              surface_force + damping + resumption (the default)
+// Default scene (l = 16, implicit force mesh; its effects: surface_force,
+// damping, resumption, cutting, friction), with the effects switched:
+//   all_on              the default scene
+//   paper               surface_force + damping + resumption (Table 1 and
+//                       Eq. 8 only: cutting and friction off)
 //   surface_force_off   no force meshes (and therefore no resumption); a
 //                       layer breaks as soon as the tip passes its surface
 //   damping_off         no d h v term
 //   resumption_off      force meshes but no shape-matching resumption
-//   all_off             none of the three
+//   cutting_off         no cutting force
+//   friction_off        no Karnopp shaft friction
+//   stiffening_on       + tip stiffening (polynomial, 0.05 N/mm^2)
+//   interaction_on      + layers in series (fat and muscle break at the
+//                       critical surface force they reach in the default run,
+//                       1.3 N and 2.6 N, as the ring rule cannot be used with
+//                       interaction)
+//   all_off             none of the tick effects
 // surface_output is not part of the tick (it only decides whether frames
 // are written), so it is left as the scene sets it.
 //
 // Families (time per iteration = per tick, replayed as in bench_replay.hpp):
 //   BM_effects/<config>/whole_insertion    every tick of the trajectory
+//   BM_effects/<config>/in_tissue          the ticks with contact (tip below
+//       the skin surface): where the work is
 //   BM_effects/<config>/inside_punctured   after the last puncture until the
-//       target depth: damping of every punctured layer, resumption during
-//       its first ceil(1 / eta_r) ticks
+//       target depth: damping, friction and cutting of the punctured layers,
+//       resumption during its first ticks
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -30,7 +42,7 @@ namespace {
 
 struct EffectsConfig {
   std::string name;
-  bool surface_force, damping, resumption;
+  void (*apply)(Scene&);
 };
 
 struct Setup {
@@ -45,9 +57,7 @@ const Setup& setup_for(const EffectsConfig& config) {
   if (it == cache.end()) {
     auto s = std::make_unique<Setup>();
     s->scene = default_scene();
-    s->scene.effects.surface_force = config.surface_force;
-    s->scene.effects.damping = config.damping;
-    s->scene.effects.resumption = config.resumption;
+    config.apply(s->scene);
     validate_scene(s->scene, "bench_effects:" + config.name);
     s->model = build_realtime_model(s->scene);
     s->script = make_script(s->scene, s->model);
@@ -58,15 +68,40 @@ const Setup& setup_for(const EffectsConfig& config) {
 
 void register_all() {
   const std::vector<EffectsConfig> configs{
-      {"all_on", true, true, true},         {"surface_force_off", false, true, false},
-      {"damping_off", true, false, true},   {"resumption_off", true, true, false},
-      {"all_off", false, false, false},
+      {"all_on", [](Scene&) {}},
+      {"paper", [](Scene& s) { s.effects.cutting = s.effects.friction = false; }},
+      {"surface_force_off", [](Scene& s) { s.effects.surface_force = s.effects.resumption = false; }},
+      {"damping_off", [](Scene& s) { s.effects.damping = false; }},
+      {"resumption_off", [](Scene& s) { s.effects.resumption = false; }},
+      {"cutting_off", [](Scene& s) { s.effects.cutting = false; }},
+      {"friction_off", [](Scene& s) { s.effects.friction = false; }},
+      {"stiffening_on",
+       [](Scene& s) {
+         s.effects.stiffening = true;
+         for (Layer& l : s.layers) l.force_law.stiffening.quadratic_N_per_m2 = 0.05e6;
+       }},
+      {"interaction_on",
+       [](Scene& s) {
+         s.effects.layer_interaction = true;
+         const double critical_N[] = {2.4, 1.3, 2.6};
+         for (std::size_t k = 0; k < s.layers.size() && k < 3; ++k) {
+           s.layers[k].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+           s.layers[k].force_law.breakthrough.critical_force_N = critical_N[k];
+         }
+       }},
+      {"all_off",
+       [](Scene& s) {
+         s.effects.surface_force = s.effects.damping = s.effects.resumption = false;
+         s.effects.cutting = s.effects.friction = s.effects.stiffening = s.effects.layer_interaction = false;
+       }},
   };
   for (const EffectsConfig& config : configs)
-    for (const std::string phase : {"whole_insertion", "inside_punctured"}) {
+    for (const std::string phase : {"whole_insertion", "in_tissue", "inside_punctured"}) {
       // Built now, so the iteration count can follow the phase length.
       const Setup& s = setup_for(config);
-      const TickRange range = phase == "whole_insertion" ? s.script.whole : s.script.inside_punctured;
+      const TickRange range = phase == "whole_insertion" ? s.script.whole
+                              : phase == "in_tissue"     ? s.script.in_tissue
+                                                         : s.script.inside_punctured;
       benchmark::RegisterBenchmark(("BM_effects/" + config.name + "/" + phase).c_str(),
                                    [&s, range](benchmark::State& st) {
                                      run_replay(st, s.scene, s.model, s.script, range);

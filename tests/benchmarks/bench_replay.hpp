@@ -10,7 +10,8 @@
 //     which the skin is pressed before it breaks, the window right after the
 //     skin breaks (skin resumption + fat pressing), the ticks after the last
 //     puncture while the needle still moves in (damping of every punctured
-//     layer + resumption), and the whole trajectory.
+//     layer + resumption), the ticks with contact (tip below the skin
+//     surface: where the work is) and the whole trajectory.
 //   * TickReplay owns a simulator and replays the ticks [begin, end) of one
 //     phase; when it reaches `end`, restart() builds a fresh simulator (copies
 //     of the already fitted SH layer surfaces, so no refit) and advances it
@@ -55,8 +56,9 @@ struct InsertionScript {
   std::size_t insertion_end_tick = 0;  ///< first tick at or after the target depth is reached
   TickRange whole;             ///< every tick of the trajectory
   TickRange press_skin;        ///< skin Pressed (tip below its contact point), before it breaks
-  TickRange after_skin_break;  ///< ceil(1 / eta_r(skin)) ticks after the skin broke
+  TickRange after_skin_break;  ///< the ticks of the skin's recovery time after it broke
   TickRange inside_punctured;  ///< after the last puncture, until the target depth is reached
+  TickRange in_tissue;         ///< ticks with contact: first to last tick with the tip below the skin surface
 };
 
 /// Copies of the fitted layer surfaces, ready to hand to a new simulator.
@@ -83,6 +85,10 @@ inline InsertionScript make_script(const Scene& scene, const RealtimeModel& mode
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t events_before = sim.puncture_events().size();
     const TickResult& r = sim.tick(script.needle[i]);
+    if (r.depth_m > 0.0) {
+      if (script.in_tissue.size() == 0) script.in_tissue.begin = i;
+      script.in_tissue.end = i + 1;
+    }
     if (!skin_pressed_seen && r.layers[0].state == LayerState::Pressed) {
       skin_pressed_seen = true;
       script.press_skin.begin = i;
@@ -96,8 +102,8 @@ inline InsertionScript make_script(const Scene& scene, const RealtimeModel& mode
     const std::size_t skin_break = script.puncture_ticks.front();
     if (!skin_pressed_seen) script.press_skin.begin = skin_break;
     script.press_skin.end = skin_break;
-    const std::size_t window =
-        static_cast<std::size_t>(std::ceil(1.0 / scene.layers[0].resumption_rate - 1e-9));
+    const std::size_t window = static_cast<std::size_t>(
+        std::ceil(scene.layers[0].resumption_time_s * scene.realtime.haptic_rate_Hz - 1e-9));
     script.after_skin_break = {skin_break + 1, std::min(n, skin_break + 1 + window)};
     script.inside_punctured = {script.puncture_ticks.back() + 1, std::max(script.puncture_ticks.back() + 1,
                                                                           script.insertion_end_tick)};

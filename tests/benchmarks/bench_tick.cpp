@@ -4,7 +4,8 @@
 // Families (time per iteration = per tick; see bench_replay.hpp for how the
 // stateful tick is replayed):
 //   BM_tick_phase/<phase>               default scene; phases press_skin,
-//       after_skin_break, inside_punctured, whole_insertion
+//       after_skin_break, inside_punctured, in_tissue (every tick with the
+//       tip below the skin surface: the ticks with contact), whole_insertion
 //   BM_tick_integrator/<name>/<phase>   force-mesh integrator quasi_static,
 //       explicit, implicit (the default) for press_skin and whole_insertion
 //   BM_tick_rings_w/<w>/<phase>         every layer's w set to 2..32; L scaled
@@ -16,8 +17,15 @@
 //   BM_tick_distribution/whole_insertion   one iteration = one whole insertion
 //       with every tick timed by steady_clock (~20 ns overhead per tick);
 //       counters: percentiles of the single-tick wall time (us) over all
-//       ticks and over the press_skin ticks (the haptic loop cares about
+//       ticks, over the press_skin ticks and over the ticks with contact
+//       (mean and p99 there: where the work is; the haptic loop cares about
 //       the slow ticks, which a mean per phase hides)
+//   BM_force_mesh_relayout/<layer>      ForceMesh::relayout on the layer's SH
+//       surface (l = 16) at an off-axis point (tangent-plane layout): the
+//       extra work of the tick in which an off-axis needle first touches it
+//   BM_force_mesh_refine/<layer>        the projection of kLayoutNodesPerTick
+//       nodes onto the SH surface: the extra work of each of the following
+//       ticks until the mesh lies on the surface
 //   BM_build_realtime_model/<l>         SH fit + simulator construction
 //       (outside the haptic loop; ms)
 // Run through scripts/benchmarks.sh, which writes results/benchmarks/.
@@ -62,6 +70,7 @@ TickRange phase_range(const InsertionScript& script, const std::string& phase) {
   if (phase == "press_skin") return script.press_skin;
   if (phase == "after_skin_break") return script.after_skin_break;
   if (phase == "inside_punctured") return script.inside_punctured;
+  if (phase == "in_tissue") return script.in_tissue;
   if (phase == "whole_insertion") return script.whole;
   throw std::invalid_argument("unknown phase " + phase);
 }
@@ -109,7 +118,8 @@ Scene scene_with_integrator(const std::string& name) {
 }
 
 void register_all() {
-  const std::vector<std::string> phases{"press_skin", "after_skin_break", "inside_punctured", "whole_insertion"};
+  const std::vector<std::string> phases{"press_skin", "after_skin_break", "inside_punctured", "in_tissue",
+                                        "whole_insertion"};
   const std::vector<std::string> scaling_phases{"press_skin", "whole_insertion"};
 
   for (const std::string& phase : phases)
@@ -118,9 +128,11 @@ void register_all() {
   benchmark::RegisterBenchmark("BM_tick_distribution/whole_insertion", [](benchmark::State& st) {
     const Setup& s = setup_for("default", default_scene());
     const TickRange press = s.script.press_skin;
-    std::vector<double> all_us, press_us;
+    const TickRange contact = s.script.in_tissue;
+    std::vector<double> all_us, press_us, contact_us;
     all_us.reserve(64 * s.script.needle.size());
     press_us.reserve(64 * press.size());
+    contact_us.reserve(64 * contact.size());
     for (auto _ : st) {
       st.PauseTiming();
       PunctureSimulator sim(s.scene, copy_surfaces(s.model));
@@ -133,6 +145,7 @@ void register_all() {
         const double us = std::chrono::duration<double, std::micro>(stop - start).count();
         all_us.push_back(us);
         if (i >= press.begin && i < press.end) press_us.push_back(us);
+        if (i >= contact.begin && i < contact.end) contact_us.push_back(us);
       }
     }
     const auto percentile = [](std::vector<double>& v, double q) {
@@ -149,7 +162,62 @@ void register_all() {
     st.counters["press_p99_us"] = percentile(press_us, 0.99);
     st.counters["press_max_us"] = press_us.empty() ? 0.0 : *std::max_element(press_us.begin(), press_us.end());
     st.counters["ticks_per_insertion"] = static_cast<double>(s.script.needle.size());
+    double contact_sum = 0.0;
+    for (double us : contact_us) contact_sum += us;
+    st.counters["contact_mean_us"] = contact_us.empty() ? 0.0 : contact_sum / static_cast<double>(contact_us.size());
+    st.counters["contact_p50_us"] = percentile(contact_us, 0.50);
+    st.counters["contact_p99_us"] = percentile(contact_us, 0.99);
+    st.counters["contact_ticks"] = static_cast<double>(contact.size());
   })->Unit(benchmark::kMillisecond)->Iterations(10);
+
+  for (std::size_t k : {std::size_t{0}, std::size_t{2}}) {
+    benchmark::RegisterBenchmark(("BM_force_mesh_relayout/" + std::to_string(k)).c_str(), [k](benchmark::State& st) {
+      const Setup& s = setup_for("default", default_scene());
+      const Layer& layer = s.scene.layers[k];
+      const LayerSurface& surface = *s.model.surfaces[k];
+      MeshIntegrationSettings integration;
+      integration.integrator = parse_mesh_integrator(s.scene.realtime.integrator);
+      integration.time_step_s = 1.0 / s.scene.realtime.haptic_rate_Hz;
+      SurfacePoint a, b;
+      double t = 0.0;
+      surface.intersect_ray(Eigen::Vector3d(3e-3, -2e-3, 1.0), -Eigen::Vector3d::UnitZ(), t, a);
+      surface.intersect_ray(Eigen::Vector3d(-4e-3, 1e-3, 1.0), -Eigen::Vector3d::UnitZ(), t, b);
+      ForceMesh mesh(surface, a, layer.force_mesh, layer.thickness_m, layer.density_kg_per_m3, integration);
+      bool flip = false;
+      for (auto _ : st) {
+        mesh.relayout(surface, flip ? a : b);
+        flip = !flip;
+        benchmark::DoNotOptimize(mesh.rest_positions().data());
+      }
+      st.counters["mesh_nodes"] = mesh.node_count();
+    });
+    benchmark::RegisterBenchmark(("BM_force_mesh_refine/" + std::to_string(k)).c_str(), [k](benchmark::State& st) {
+      const Setup& s = setup_for("default", default_scene());
+      const Layer& layer = s.scene.layers[k];
+      const LayerSurface& surface = *s.model.surfaces[k];
+      MeshIntegrationSettings integration;
+      integration.integrator = parse_mesh_integrator(s.scene.realtime.integrator);
+      integration.time_step_s = 1.0 / s.scene.realtime.haptic_rate_Hz;
+      SurfacePoint a, b;
+      double t = 0.0;
+      surface.intersect_ray(Eigen::Vector3d(3e-3, -2e-3, 1.0), -Eigen::Vector3d::UnitZ(), t, a);
+      surface.intersect_ray(Eigen::Vector3d(-4e-3, 1e-3, 1.0), -Eigen::Vector3d::UnitZ(), t, b);
+      ForceMesh mesh(surface, a, layer.force_mesh, layer.thickness_m, layer.density_kg_per_m3, integration);
+      bool flip = false;
+      for (auto _ : st) {
+        if (!mesh.layout_pending()) {
+          st.PauseTiming();
+          mesh.relayout(surface, flip ? a : b);
+          flip = !flip;
+          st.ResumeTiming();
+        }
+        mesh.refine_layout(kLayoutNodesPerTick);  // the work one tick adds after an off-axis contact
+        benchmark::DoNotOptimize(mesh.rest_positions().data());
+      }
+      st.counters["mesh_nodes"] = mesh.node_count();
+      st.counters["ticks_to_complete"] = (mesh.node_count() - 1 + kLayoutNodesPerTick - 1) / kLayoutNodesPerTick;
+    });
+  }
 
   for (const std::string& integrator : {std::string("quasi_static"), std::string("explicit"), std::string("implicit")})
     for (const std::string& phase : scaling_phases)

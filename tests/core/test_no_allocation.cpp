@@ -51,3 +51,48 @@ TEST_P(NoAllocationTick, FullInsertionAllocatesNothing) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, NoAllocationTick, ::testing::Values("quasi_static", "explicit", "implicit"));
+
+// Every force-law effect on (layer interaction, cutting, Karnopp friction,
+// tip stiffening, critical-force and critical-energy breakthrough) and the
+// needle off the scene axis, so that the force meshes are laid out again at
+// the contact point inside the counted ticks.
+TEST_P(NoAllocationTick, EveryForceLawEffectOffAxisAllocatesNothing) {
+  Scene scene = test::table2_scene(GetParam());
+  scene.effects.layer_interaction = scene.effects.cutting = scene.effects.friction = scene.effects.stiffening = true;
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    ForceLaw& law = scene.layers[k].force_law;
+    law.breakthrough.kind = k == 1 ? BreakthroughCriterion::Kind::CriticalEnergy : BreakthroughCriterion::Kind::CriticalForce;
+    law.breakthrough.critical_force_N = 0.6;
+    law.breakthrough.critical_energy_J = 0.2e-3;
+    law.cutting_force_N = 0.3;
+    law.friction.dynamic_N_per_m = law.friction.static_N_per_m = 10.0;
+    law.stiffening.quadratic_N_per_m2 = 2e4;
+  }
+  scene.layers[0].force_mesh.virtual_stiffness_N_per_m = 2000.0;
+  PunctureSimulator sim(scene, test::plane_surfaces(scene));
+  const ScriptedTrajectory tr(scene.insertion);
+  const int ticks = static_cast<int>(tr.duration() / 1e-3);
+  std::vector<NeedleState> states;
+  states.reserve(ticks);
+  for (int i = 0; i < ticks; ++i) {
+    states.push_back(tr.sample(i * 1e-3));
+    states.back().tip_position_m.x() += 2e-3;
+    states.back().tip_position_m.y() -= 1e-3;
+  }
+
+  double sum = 0.0, cutting = 0.0, friction = 0.0;
+  test::start_counting_allocations();
+  for (const NeedleState& s : states) {
+    const TickResult& r = sim.tick(s);
+    sum += r.total_force_N;
+    cutting += r.cutting_force_N;
+    friction += std::abs(r.friction_force_N);
+  }
+  EXPECT_EQ(test::stop_counting_allocations(), 0) << GetParam();
+  EXPECT_TRUE(std::isfinite(sum));
+  EXPECT_EQ(sim.puncture_events().size(), 3u);
+  EXPECT_GT(cutting, 0.0);
+  EXPECT_GT(friction, 0.0);
+  EXPECT_NEAR(sim.force_mesh(0)->rest_positions()(0, 0), 2e-3, 1e-15);  // laid where the needle touched
+  EXPECT_NEAR(sim.force_mesh(2)->rest_positions()(1, 0), -1e-3, 1e-15);
+}

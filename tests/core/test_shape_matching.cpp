@@ -109,8 +109,10 @@ TEST(ShapeMatching, RejectsNonFiniteAndMismatchedInput) {
   EXPECT_THROW(shape_matching_goals(p, p, Eigen::VectorXd::Zero(4), g), std::invalid_argument);
 }
 
-TEST(Resumption, ApproachesGoalMonotonicallyAndArrivesAfterCeilSteps) {
-  // A dented disc: rest on z = 0, the broken surface pushed down near the centre.
+TEST(Resumption, ReturnsToTheRestShapeInTheRecoveryTimeWhateverTheStep) {
+  // A dented disc: rest on z = 0, the broken surface pushed down near the
+  // centre (all nodes below rest: its centre of mass is sunk, which a
+  // rigid-fit goal would keep).
   const int n = 19;
   Eigen::Matrix3Xd rest(3, n), broken(3, n);
   for (int i = 0; i < n; ++i) {
@@ -118,41 +120,65 @@ TEST(Resumption, ApproachesGoalMonotonicallyAndArrivesAfterCeilSteps) {
     rest.col(i) = Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0.0);
     broken.col(i) = rest.col(i) - Eigen::Vector3d(0, 0, 2e-3 * std::exp(-r * r / 4e-6));
   }
-  const Eigen::VectorXd masses = Eigen::VectorXd::Constant(n, 1e-6);
-  for (double rate : {0.05, 0.3, 0.07, 1.0}) {
-    SurfaceResumption res(rest, masses, rate);
-    res.start(broken);
+  const double T = 0.02, t_break = 1.3;
+  const double initial = (broken - rest).norm();
+  // Eq. 8 with eta = 1 - (t - t_b) / T: the distance to the rest shape at
+  // time t is (1 - (t - t_b) / T) times the initial one, for any step.
+  for (double dt : {1e-3, 2.5e-4, 7e-3}) {
+    SurfaceResumption res(rest, T);
+    res.start(broken, t_break);
     EXPECT_DOUBLE_EQ(res.recovery_factor(), 1.0);
-    Eigen::Matrix3Xd goal(3, n);
-    shape_matching_goals(rest, broken, masses, goal);
-    double previous = (broken - goal).norm();
-    const int expected_steps = static_cast<int>(std::ceil(1.0 / rate - 1e-12));
-    for (int s = 1; s <= expected_steps; ++s) {
-      res.step();
-      const double distance = (res.positions() - goal).norm();
-      EXPECT_LT(distance, previous + 1e-15) << "rate " << rate << " step " << s;
-      // Eq. 8: distance to the goal = eta * initial distance.
-      EXPECT_NEAR(distance, res.recovery_factor() * (broken - goal).norm(), 1e-12);
+    double previous = initial;
+    for (int s = 1; t_break + s * dt <= t_break + T + 2 * dt; ++s) {
+      const double t = t_break + s * dt;
+      res.step(t);
+      const double distance = (res.positions() - rest).norm();
+      const double eta = std::max(0.0, 1.0 - s * dt / T);
+      EXPECT_NEAR(distance, eta * initial, 1e-9 * initial) << "dt " << dt << " step " << s;
+      EXPECT_LE(distance, previous + 1e-15);
       previous = distance;
-      if (s < expected_steps) EXPECT_GT(res.recovery_factor(), 0.0);
     }
     EXPECT_EQ(res.recovery_factor(), 0.0);
-    EXPECT_LT((res.positions() - goal).cwiseAbs().maxCoeff(), 1e-15);
-    res.step();  // no further motion once at the goal
-    EXPECT_EQ(res.steps_taken(), expected_steps);
+    EXPECT_TRUE(res.recovered());
+    // Back at rest: not at a sunk copy of it (mean height 0, not the broken mean).
+    EXPECT_LT((res.positions() - rest).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_NEAR(res.positions().row(2).mean(), 0.0, 1e-15);
+    EXPECT_LT(broken.row(2).mean(), -1e-4);
   }
-  EXPECT_THROW(SurfaceResumption(rest, masses, 0.0), std::invalid_argument);
-  EXPECT_THROW(SurfaceResumption(rest, masses, 1.5), std::invalid_argument);
+  EXPECT_THROW(SurfaceResumption(rest, 0.0), std::invalid_argument);
+  EXPECT_THROW(SurfaceResumption(rest, -1.0), std::invalid_argument);
 }
 
-TEST(Resumption, SingleNodeSetStaysFinite) {
+TEST(Resumption, RigidFitGoalWouldLeaveTheSurfaceSunk) {
+  // Why the goal is the rest shape: Eq. (6)-(7)'s goal for the dented disc
+  // keeps the dented centre of mass.
+  const int n = 7;
+  Eigen::Matrix3Xd rest(3, n), broken(3, n), goal(3, n);
+  for (int i = 0; i < n; ++i) {
+    const double a = i * M_PI / 3.0, r = i == 0 ? 0.0 : 1e-3;
+    rest.col(i) = Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0.0);
+    broken.col(i) = rest.col(i) - Eigen::Vector3d(0, 0, i == 0 ? 1e-3 : 0.4e-3);
+  }
+  shape_matching_goals(rest, broken, Eigen::VectorXd::Ones(n), goal);
+  const double sunk = broken.row(2).mean();  // (1 + 6 x 0.4) / 7 mm below rest
+  EXPECT_NEAR(sunk, -(1e-3 + 6 * 0.4e-3) / 7.0, 1e-15);
+  EXPECT_NEAR(goal.row(2).mean(), sunk, 1e-15);
+  SurfaceResumption res(rest, 0.01);
+  res.start(broken, 0.0);
+  res.step(0.01);
+  EXPECT_NEAR(res.positions().row(2).mean(), 0.0, 1e-18);
+}
+
+TEST(Resumption, SingleNodeReturnsToRest) {
+  // A one-node mesh (w = 1): shape matching has nothing to match (A = 0),
+  // but the rest-shape goal still brings it back.
   Eigen::Matrix3Xd rest = Eigen::Matrix3Xd::Zero(3, 1), broken(3, 1);
   broken << 0, 0, -1e-3;
-  SurfaceResumption res(rest, Eigen::VectorXd::Ones(1), 0.5);
-  res.start(broken);
-  res.step();
-  res.step();
+  SurfaceResumption res(rest, 0.5);
+  res.start(broken, 0.0);
+  res.step(0.25);
+  EXPECT_NEAR(res.positions()(2, 0), -0.5e-3, 1e-15);
+  res.step(0.5);
   EXPECT_TRUE(res.positions().allFinite());
-  // A single node is its own centre of mass: its goal is where it is.
-  EXPECT_LT((res.positions() - broken).norm(), 1e-15);
+  EXPECT_LT((res.positions() - rest).norm(), 1e-15);
 }

@@ -80,9 +80,13 @@ TEST_P(DefaultInsertion, ThreePuncturesInOrderWithFinitePositiveForces) {
   }
   EXPECT_GT(ev[0].depth_m, 1e-3);  // skin tents a few mm
   EXPECT_LT(ev[0].depth_m, 5e-3);
-  // Thin skin pressed deeper than its thickness: the fat contact starts at the tip.
+  // Thin skin pressed deeper than its thickness: the tip first cuts through
+  // the skin's thickness below its tented top (at the tip at the break), and
+  // the fat contact starts at the tip there (within one tick of travel).
   EXPECT_GT(ev[0].depth_m, scene.layers[0].thickness_m);
-  EXPECT_NEAR(sim.contact_point(1).position.z(), -ev[0].depth_m, 1e-12);
+  const double fat_contact_depth = ev[0].depth_m + scene.layers[0].thickness_m;
+  EXPECT_LE(-sim.contact_point(1).position.z(), fat_contact_depth + scene.insertion.speed_m_per_s * 1e-3 + 1e-12);
+  EXPECT_GE(-sim.contact_point(1).position.z(), fat_contact_depth - 1e-12);
   // The muscle was reached from above: its contact is on its surface.
   EXPECT_NEAR(sim.contact_point(2).position.z(), -scene.layer_top_depth_m(2), 1e-12);
   // Resumption brought the broken surfaces to their goals by the end.

@@ -5,7 +5,10 @@
 // EVERY effect the scene schema knows turned on: scene_io's known_effects(),
 // so an effect added to the schema is soaked without touching this file;
 // effect-specific scene changes go in SoakOptions::scene_edits, one line
-// each), the integrator cycling through quasi_static, explicit, implicit,
+// each; with layer_interaction on, layers below the first that use the ring
+// rule get a critical_force breakthrough at the force the ring rule broke
+// them with in a scripted insertion of the scene without layer_interaction,
+// because scene_io refuses the ring rule there), the integrator cycling through quasi_static, explicit, implicit,
 // and drives it with a random trajectory: segments to random depths between
 // the start height and near the sample base (so some pass every layer and
 // most reverse), each at a random speed (log-uniform in [min, max]), with

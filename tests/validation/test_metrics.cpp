@@ -75,9 +75,17 @@ TEST(Metrics, ReadErrorsNameFileLineAndColumn) {
     return std::string("no error");
   };
   const std::string header = "time_s,depth_mm,velocity_mm_per_s,force_N,fat_state\n";
-  std::string m = message("time_s,depth_mm,force_N\n0,0,0\n");
+  // Depth and force are required (time and velocity are optional).
+  std::string m = message("time_s,depth_mm,velocity_mm_per_s\n0,0,0\n");
   EXPECT_NE(m.find("bad.csv:1"), std::string::npos) << m;
-  EXPECT_NE(m.find("velocity_mm_per_s"), std::string::npos) << m;
+  EXPECT_NE(m.find("force_N"), std::string::npos) << m;
+  m = message("time_s,force_N\n0,0\n");
+  EXPECT_NE(m.find("depth_mm"), std::string::npos) << m;
+  m = message("depth_mm,force_N,tip_force_N,cutting_force_N\n0,0,0,0\n");
+  EXPECT_NE(m.find("friction_force_N"), std::string::npos) << m;
+  m = message("depth_mm,force_N,phase\n0,0,retraction\n");
+  EXPECT_NE(m.find("bad.csv:2"), std::string::npos) << m;
+  EXPECT_NE(m.find("column 'phase'"), std::string::npos) << m;
   m = message(header + "0,0,10,0,untouched\n0.1,0.5,10,abc,pressed\n");
   EXPECT_NE(m.find("bad.csv:3"), std::string::npos) << m;
   EXPECT_NE(m.find("column 'force_N'"), std::string::npos) << m;
@@ -206,19 +214,26 @@ TEST(Metrics, PerLayerRmseAndShiftedPunctureDepth) {
   EXPECT_DOUBLE_EQ(n.layer("skin")->puncture_depth_error_m, 0.0);
 }
 
-TEST(Metrics, ReferenceWithoutStatesUsesTheModelsPressedInterval) {
-  auto model = ramp_curve(21, 0.5e-3, [](double d) { return 100.0 * d; }, 4e-3);
+TEST(Metrics, ReferenceWithoutStatesIsJudgedOnItsOwnForceDrop) {
+  // The model punctures the skin early (at 1 mm); the reference has no state
+  // columns and drops at 3.5 mm. The skin's pressed interval is the
+  // reference's own (contact onset to its drop), not the model's tiny one.
+  auto model = ramp_curve(21, 0.5e-3, [](double d) { return 100.0 * d; }, 1e-3);
   auto ref = ramp_curve(21, 0.5e-3, [](double d) { return 100.0 * d + 0.02; }, 4e-3);
   ref.layer_names.clear();
   ref.layer_states.clear();
+  ref.force_N[8] = 0.1;  // drop after 3.5 mm (100 x 3.5 mm + 0.02 = 0.37 N there)
+  for (std::size_t i = 9; i < ref.size(); ++i) ref.force_N[i] = 0.1 + 10.0 * (ref.depth_m[i] - 4e-3);
   const pv::CurveComparison c = pv::compare_curves(model, ref);
   const pv::LayerMetrics* skin = c.layer("skin");
   ASSERT_NE(skin, nullptr);
-  EXPECT_NEAR(skin->pressed_to_depth_m, 3.5e-3, 1e-15);
-  EXPECT_EQ(skin->n_samples, 8u);
-  EXPECT_NEAR(skin->force_rmse_N, 0.02, 1e-14);
-  EXPECT_FALSE(skin->reference_puncture.found);
+  ASSERT_TRUE(skin->reference_puncture.found);
+  EXPECT_NEAR(skin->reference_puncture.depth_m, 4e-3, 1e-15);  // first sample after the maximum
+  EXPECT_NEAR(skin->reference_puncture.force_N, 0.37, 1e-12);
+  EXPECT_NEAR(skin->pressed_to_depth_m, 4e-3, 1e-15);
+  EXPECT_GE(skin->n_samples, 7u);  // from the contact onset to the drop, not the model's 2 samples
   EXPECT_TRUE(skin->model_puncture.found);
+  EXPECT_NEAR(skin->puncture_depth_error_m, 1e-3 - 4e-3, 1e-15);
 }
 
 TEST(Metrics, CurveFromRunCopiesTicks) {

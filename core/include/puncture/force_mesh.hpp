@@ -36,6 +36,20 @@
 // whose ring (and all rings inside it) is deformed; when it reaches w the
 // layer breaks (Table 1 post-puncture).
 //
+// Contact point. The mesh is laid out at the contact point it is given and
+// along the surface normal there; relayout() lays it again at another point
+// (e.g. where an off-axis needle actually touches the surface) without
+// allocating: the matrices depend only on the lattice, K, k_s, mass and dt,
+// not on where the lattice lies.
+//
+// Split step. Every integrator's step is affine in the contact deflection z0
+// prescribed at the end of the step: predict() integrates the free nodes with
+// z0 = 0 at the end of the step, and commit(z0) adds z0 times the unit
+// response (precomputed at construction). In between, predicted_reaction_N(z0)
+// = intercept + slope z0 is the contact reaction the step would give, so a
+// caller can choose z0 from a force balance (layers in series, see
+// simulator.hpp) before committing. advance(z0) = predict(); commit(z0).
+//
 // Time integration (one fixed step dt per advance(), the haptic step):
 //   QuasiStatic: equilibrium every step, z = u z_0 with the unit-deflection
 //       influence vector u precomputed at construction (O(N) per step).
@@ -93,8 +107,40 @@ class ForceMesh {
   /// (m, into the tissue; negative values are clamped to 0). No allocation.
   /// Throws std::runtime_error if the state becomes non-finite.
   void advance(double contact_deflection_m);
+  /// First half of advance(): the step with zero contact deflection at its
+  /// end (scratch state; the mesh is unchanged until commit). No allocation.
+  void predict();
+  /// Contact reaction (N) the predicted step gives for contact deflection z0 (m).
+  double predicted_reaction_N(double contact_deflection_m) const {
+    return predicted_intercept_N_ + reaction_slope_N_per_m_ * contact_deflection_m;
+  }
+  /// d(reaction)/d(z0) of one step (N/m): the static stiffness for the
+  /// quasi-static integrator, the stiffer dynamic one otherwise.
+  double reaction_slope_N_per_m() const { return reaction_slope_N_per_m_; }
+  /// Second half of advance(): the predicted step with contact deflection z0
+  /// (m, negative values are clamped to 0). Throws std::runtime_error if the
+  /// state becomes non-finite.
+  void commit(double contact_deflection_m);
   /// Back to the undeformed state at rest.
   void reset();
+  /// Lays the mesh out again at `contact` on `surface` (at rest), at once in
+  /// the tangent plane of the contact point with the contact normal at every
+  /// node (exact for a flat surface); the projections of the nodes onto the
+  /// surface follow in refine_layout(). The mechanics do not depend on the
+  /// node positions (scalar deflections along the normals), so the force is
+  /// exact from the first tick; only the drawn surface is refined. No
+  /// allocation (ContactSurface::project must not allocate).
+  void relayout(const ContactSurface& surface, const SurfacePoint& contact);
+  /// Projects up to max_nodes pending nodes onto the surface (a few us each
+  /// on an SH surface: the simulator spreads them over ticks). Returns the
+  /// number still pending. Throws std::invalid_argument if a projection is
+  /// not finite. `surface` must be the one given to relayout().
+  int refine_layout(int max_nodes);
+  bool layout_pending() const { return next_projection_ < lattice_.node_count(); }
+  int pending_nodes() const { return lattice_.node_count() - next_projection_; }
+  /// True if the mesh is laid out at `contact` (position within tolerance_m,
+  /// normal within 1e-9).
+  bool laid_at(const SurfacePoint& contact, double tolerance_m) const;
 
   // --- forces (N, positive resisting insertion) ---
   double contact_reaction_N() const;  ///< elastic reaction at the contact node
@@ -107,6 +153,11 @@ class ForceMesh {
   int node_count() const { return lattice_.node_count(); }
   double ring_mean_deflection_m(int ring) const { return ring_mean_m_[ring - 1]; }  ///< ring in 1..w
   int deformed_rings() const;
+  /// True when every node's deflection is below tolerance_m and its speed
+  /// below tolerance_m per time step (nothing left to integrate).
+  bool at_rest(double tolerance_m = 1e-15) const {
+    return max_abs_deflection_m_ <= tolerance_m && max_abs_velocity_m_per_s_ * settings_.time_step_s <= tolerance_m;
+  }
   bool broken() const { return deformed_rings() >= params_.rings_w; }
   const Eigen::VectorXd& deflections_m() const { return z_; }       ///< size N, [0] = contact node
   const Eigen::VectorXd& velocities_m_per_s() const { return v_; }  ///< size N, [0] = contact node rate
@@ -140,8 +191,15 @@ class ForceMesh {
 
  private:
   void explicit_substep(double dt, double z0);
-  void implicit_step(double z0);
+  /// Backward-Euler solve of the free nodes for rhs_ (+ b z0 added by the caller) into work_.
+  void implicit_solve();
   void update_derived();
+  void layout(const ContactSurface& surface, const SurfacePoint& contact);
+  void set_frame(const SurfacePoint& contact);
+  void project_node(int i);
+  /// Free-node state after one step from (z_, v_) with contact deflection
+  /// z0_old -> z0_new, written to (z_, v_) (used at construction for the unit response).
+  void step_free_nodes(double z0_old, double z0_new);
 
   ForceMeshParams params_;
   MeshIntegrationSettings settings_;
@@ -155,7 +213,20 @@ class ForceMesh {
   bool use_implicit_ = false;
 
   Eigen::Matrix3Xd rest_, normals_, positions_;
+  // Layout frame: contact point, normal and in-plane axes; nodes >= next_projection_ are
+  // still in the tangent plane (relayout) and wait for their projection onto *layout_surface_.
+  const ContactSurface* layout_surface_ = nullptr;
+  Eigen::Vector3d frame_origin_ = Eigen::Vector3d::Zero(), frame_normal_ = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d frame_e1_ = Eigen::Vector3d::UnitX(), frame_e2_ = Eigen::Vector3d::UnitY();
+  int next_projection_ = 0;
   Eigen::VectorXd z_, v_, influence_, rhs_, work_;
+  Eigen::VectorXd pz_, pv_;  ///< predicted free-node state for z0 = 0 (index 0 unused)
+  Eigen::VectorXd qz_, qv_;  ///< unit response of the free nodes to z0 = 1 at the end of a step
+  double max_abs_deflection_m_ = 0.0;
+  double max_abs_velocity_m_per_s_ = 0.0;
+  double predicted_intercept_N_ = 0.0;
+  double reaction_slope_N_per_m_ = 0.0;
+  bool predicted_ = false;
   Eigen::VectorXd ring_mean_m_;
   Eigen::VectorXd ring_size_;
 

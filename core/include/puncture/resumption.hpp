@@ -1,20 +1,28 @@
 // resumption.hpp: surface resumption after breakthrough (seed paper Eq. 8).
 //
 // When a layer's surface breaks, its force-mesh nodes stop following the
-// needle and return to their shape-matching goals (shape_matching.hpp)
-// gradually. With p_i^b the node positions at the moment of breakthrough,
-// every step
-//     eta <- max(0, eta - eta_r)                   (eta starts at 1)
-//     g_i  = shape-matching goals of the current positions (Eq. 6-7,
-//            recomputed every step: "A is updated in real time")
-//     p_i <- g_i + eta (p_i^b - g_i)               (Eq. 8)
-// so the distance to the goal shrinks linearly to zero and the node sits on
-// its goal after ceil(1 / eta_r) steps. (For this motion the goals do not
-// drift: p - p_cm = R q + eta r keeps the polar rotation R of A.)
+// needle and return to their goals gradually. With p_i^b the node positions
+// at the moment of breakthrough (time t_b) and T the recovery time (s):
+//     eta(t) = max(0, 1 - (t - t_b) / T)           (eta starts at 1)
+//     p_i(t) = g_i + eta(t) (p_i^b - g_i)          (Eq. 8)
+// so the distance to the goal shrinks linearly in time and the node sits on
+// its goal from t_b + T on, whatever the haptic rate: T is given in seconds
+// (Layer::resumption_time_s), not as a drop per haptic step.
 //
-// In: rest positions (3 x n, m), node masses (n, kg), eta_r in (0, 1]
-// (Layer::resumption_rate, per haptic step). All storage is allocated at
-// construction; start() and step() do not allocate.
+// Goal. g_i = p_i^0, the rest position. Eq. (6)-(7) (shape matching,
+// Mueller et al. 2005) would take as goal the best rigid fit of the rest
+// shape to the current nodes, which keeps their centre of mass: a surface
+// pushed down by the needle would recover its shape but stay sunk by its
+// mean deflection, and a one-node mesh would not move at all. The layer's
+// surface is bonded to the tissue around it, so neither a translation nor a
+// rotation is free: the goal is the rest shape where it was (Fig. 5 of the
+// paper shows the surfaces back at the guideline). For a deformation
+// symmetric about the needle axis Eq. (6)-(7) give R = I, so this differs
+// from the rigid fit only by the sinking translation. shape_matching.hpp
+// keeps Eq. (6)-(7) (shape_matching_goals) for comparison.
+//
+// In: rest positions (3 x n, m), recovery time T > 0 (s). All storage is
+// allocated at construction; start() and step() do not allocate.
 #pragma once
 
 #include <Eigen/Core>
@@ -23,27 +31,28 @@ namespace puncture {
 
 class SurfaceResumption {
  public:
-  /// Throws std::invalid_argument for eta_r outside (0, 1] or mismatched sizes.
-  SurfaceResumption(const Eigen::Matrix3Xd& rest_positions, const Eigen::VectorXd& masses_kg,
-                    double resumption_rate);
+  /// Throws std::invalid_argument for T <= 0 or non-finite rest positions.
+  SurfaceResumption(const Eigen::Matrix3Xd& rest_positions, double recovery_time_s);
 
-  /// The surface broke with the nodes at broken_positions (3 x n): eta = 1.
-  void start(const Eigen::Matrix3Xd& broken_positions);
-  /// One step of Eq. (8). No effect before start() or after eta reached 0.
-  void step();
+  /// The surface broke at time_s with the nodes at broken_positions (3 x n): eta = 1.
+  void start(const Eigen::Matrix3Xd& broken_positions, double time_s);
+  /// Eq. (8) at time_s (>= the start time). No effect before start().
+  void step(double time_s);
+  /// The rest positions changed (the mesh was laid out elsewhere); stops any recovery.
+  void set_rest_positions(const Eigen::Matrix3Xd& rest_positions);
 
   bool active() const { return active_; }
+  bool recovered() const { return active_ && eta_ == 0.0; }
   double recovery_factor() const { return eta_; }
-  int steps_taken() const { return steps_; }
+  double recovery_time_s() const { return recovery_time_s_; }
   const Eigen::Matrix3Xd& positions() const { return current_; }
-  const Eigen::Matrix3Xd& goals() const { return goals_; }
+  const Eigen::Matrix3Xd& goals() const { return rest_; }
 
  private:
-  Eigen::Matrix3Xd rest_, broken_, current_, goals_;
-  Eigen::VectorXd masses_;
-  double rate_;
+  Eigen::Matrix3Xd rest_, broken_, current_;
+  double recovery_time_s_;
+  double start_time_s_ = 0.0;
   double eta_ = 1.0;
-  int steps_ = 0;
   bool active_ = false;
 };
 

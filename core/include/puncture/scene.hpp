@@ -89,6 +89,51 @@ struct ShaftFriction {
   std::string source;
 };
 
+/// Real-time force law of one layer beyond the paper's Table 1 (each part is
+/// used only when its effect is on, see Effects). core/README.md "Force law"
+/// gives the equations; scenes/README.md the keys of the layer's `force_law`
+/// object.
+struct StiffeningLaw {
+  /// Extra force of the virtual spring under the needle tip (the contact
+  /// node), on top of its linear K z:
+  ///   Polynomial:  a2 z^2 + a3 z^3            (with a linear mesh: F = S z + a2 z^2 + a3 z^3)
+  ///   Exponential: k_e z_s (exp(z / z_s) - 1 - z / z_s)
+  enum class Kind { Polynomial, Exponential };
+  Kind kind = Kind::Polynomial;
+  double quadratic_N_per_m2 = 0.0;      ///< a2 (>= 0)
+  double cubic_N_per_m3 = 0.0;          ///< a3 (>= 0)
+  double exponential_stiffness_N_per_m = 0.0;  ///< k_e (>= 0): stiffness scale of the exponential law
+  double strain_scale_m = 1e-3;         ///< z_s (> 0): deflection over which the exponential law stiffens by e
+};
+
+/// When the layer the needle presses breaks (the real-time model's criterion;
+/// the FEM has its own, PunctureCriterion).
+struct BreakthroughCriterion {
+  /// Rings: the paper's rule (ring w deformed beyond ForceMeshParams::deformed_threshold_m);
+  /// CriticalForce: the layer's surface force reaches critical_force_N;
+  /// CriticalEnergy: the elastic energy stored in the layer's force mesh reaches critical_energy_J.
+  enum class Kind { Rings, CriticalForce, CriticalEnergy };
+  Kind kind = Kind::Rings;
+  double critical_force_N = 1.0;
+  double critical_energy_J = 1e-3;
+};
+
+/// Karnopp shaft friction per unit length of shaft inside a punctured layer
+/// (the viscous part is the paper's d h v, Layer::damping_N_s_per_m2).
+struct ShaftFrictionLaw {
+  double static_N_per_m = 0.0;          ///< f_s: largest friction per metre of shaft while the shaft sticks
+  double dynamic_N_per_m = 0.0;         ///< f_d: friction per metre of shaft while it slides (<= f_s)
+  double velocity_band_m_per_s = 1e-4;  ///< Karnopp's band: |v| below it counts as sticking
+};
+
+struct ForceLaw {
+  BreakthroughCriterion breakthrough;
+  StiffeningLaw stiffening;
+  double cutting_force_N = 0.0;         ///< force to advance the crack through the layer (~ G_c x cut width)
+  double cutting_release_m = 0.1e-3;    ///< retraction over which the cutting force falls to 0
+  ShaftFrictionLaw friction;
+};
+
 struct Layer {
   std::string name;
   double thickness_m = 1e-3;
@@ -97,7 +142,13 @@ struct Layer {
   /// d: damping per unit inserted needle length, N s / m^2 (Table 1 reads
   /// F = d h v; see core/README.md for why this unit).
   double damping_N_s_per_m2 = 3000.0;
-  double resumption_rate = 0.05;  ///< eta_r of Eq. (8): drop of the recovery factor per haptic step
+  double resumption_rate = 0.05;  ///< eta_r of Eq. (8): drop of the recovery factor per haptic step (as read; see resumption_time_s)
+  /// Time (s) in which a broken surface returns to its rest shape (Eq. 8 with
+  /// eta falling linearly in time). What the simulator uses: independent of the
+  /// haptic rate. A scene file giving only resumption_rate sets it to
+  /// 1 / (eta_r x haptic rate of that file).
+  double resumption_time_s = 0.02;
+  ForceLaw force_law;
   ContinuumMaterial material;
   PunctureCriterion puncture;
   ShaftFriction shaft_friction;  ///< FEM reference: needle shaft - tissue friction
@@ -181,6 +232,11 @@ struct Effects {
   bool damping = true;         ///< puncture damping force d h v inside punctured layers (Table 1)
   bool resumption = true;      ///< shape-matching surface resumption after breakthrough (Eq. 6-8)
   bool surface_output = true;  ///< deformed layer surfaces written as VTK frames
+  // Force-law effects beyond Table 1 (off unless a scene lists them; see ForceLaw).
+  bool cutting = false;            ///< cutting force while the tip advances the crack in a punctured layer
+  bool friction = false;           ///< Karnopp shaft friction per punctured layer (Coulomb part; d h v is `damping`)
+  bool stiffening = false;         ///< strain-stiffening virtual spring under the tip
+  bool layer_interaction = false;  ///< layers in series: a layer pressed by the one above carries the load in its own force mesh
 };
 
 struct Scene {

@@ -1,40 +1,73 @@
-// simulator.hpp: the haptic tick of the real-time model (seed paper Sec. 2.2-2.3).
+// simulator.hpp: the haptic tick of the real-time model (seed paper Sec.
+// 2.2-2.3, with the force law of core/README.md "Force law").
 //
 // PunctureSimulator owns, per layer (top to bottom): the layer's contact
 // surface, its force mesh (Effects::surface_force), its surface resumption
-// (Effects::resumption, needs the force mesh) and its damping coefficient
-// (Effects::damping). An effect that is off is not constructed and costs one
-// check per tick. Everything is allocated at construction: tick() does no
-// heap allocation.
+// (Effects::resumption, needs the force mesh), its damping coefficient
+// (Effects::damping), its Karnopp shaft friction (Effects::friction), its
+// cutting force (Effects::cutting) and its tip stiffening
+// (Effects::stiffening). An effect that is off is not constructed and costs
+// one check per tick. Everything is allocated at construction: tick() does
+// no heap allocation.
+//
+// Names. The needle layer is the first layer not yet punctured (the tip can
+// touch no other). With Effects::layer_interaction the needle layer and
+// every layer below it form a chain of springs in series along the needle
+// axis (layer_chain.hpp): each layer's force mesh is deflected relative to
+// the surface of the layer below, so a layer pressed by the one above
+// carries the load in its own force mesh (its state is Pressed) and the
+// surface the needle meets next has already moved. Without it only the
+// needle layer is loaded (the paper's model).
 //
 // One tick (needle state in, TickResult out; forces in N, positive when they
 // resist insertion, see puncture_force.hpp):
-//   1. punctured layers with resumption advance one step of Eq. (8);
-//   2. the active layer (first not punctured; lower layers are unreachable)
-//      gets its contact point the first time it is reached: where the
-//      needle axis crosses its surface (ContactSurface::intersect_ray), or,
-//      if the tip is already below that crossing (e.g. thin skin pressed
-//      deeper than its own thickness before it broke), the tip's current
-//      position. The contact point stays fixed afterwards;
-//   3. contact deflection = depth of the tip past the contact point along
-//      the contact normal (>= 0); the force mesh advances one haptic step
-//      with it; the surface force is its contact reaction, clamped to >= 0
-//      (a blunt tip can only push);
-//   4. when the force mesh reaches ring w the layer breaks: its surface force
-//      vanishes from this tick on, a PunctureEvent is recorded, resumption
-//      starts from the broken node positions and the next layer becomes the
-//      active one (step 2-3 run for it in the same tick). Without a force
-//      mesh (surface_force off) a layer breaks as soon as the tip passes
-//      its contact point;
-//   5. every punctured layer adds the damping force d h v (Table 1), with h
-//      the shaft length inside the layer's depth range [top, top + thickness]
-//      taken from the scene's layer thicknesses.
+//   1. punctured layers with resumption advance Eq. (8) to the tick's time;
+//   2. contact: the needle layer's contact point is where the needle axis
+//      crosses its rest surface (ContactSurface::intersect_ray), set when the
+//      tip reaches the surface (with layer interaction: the surface as moved
+//      by the chain). The force mesh is laid out there, along the surface
+//      normal (ForceMesh::relayout, if it is not already laid there; with
+//      layer interaction the meshes of the layers below are laid at the
+//      axis' crossings with their surfaces when they are at rest). A contact
+//      is released when the tip is back above the rest surface, so the next
+//      touch lays the mesh where it happens.
+//      Without layer interaction the layer below does not move, so a thin
+//      layer pressed deeper than its own thickness (the skin) leaves the tip
+//      below the next layer's rest surface when it breaks. The tip then first
+//      cuts through the broken layer's thickness (from where its top surface
+//      was at the break) and the next layer's contact is made at the tip
+//      there (its deflection counts from that point);
+//   3. the tip's penetration D past the contact point along the contact
+//      normal drives the chain (displacement-driven: one common force F,
+//      deflections summing to D; without interaction the chain is the needle
+//      layer alone and F its mesh reaction). F >= 0 is the surface force. If
+//      the needle layer has no contact yet, the chain below is loaded by the
+//      cutting force of the layer above (force-driven) or relaxes;
+//   4. breakthrough of the needle layer by its criterion
+//      (BreakthroughCriterion: ring w deformed, critical surface force, or
+//      critical stored energy); the surface force vanishes from this tick
+//      on, a PunctureEvent is recorded, resumption starts from the broken
+//      node positions, the crack front is set at the tip and the next layer
+//      becomes the needle layer (its contact is checked in the same tick).
+//      Without a force mesh (surface_force off) a layer breaks as soon as the
+//      tip passes its contact point;
+//   5. cutting: the last punctured layer, while the tip is inside it (the
+//      next layer has no contact yet), adds the cutting force (cutting.hpp);
+//   6. every punctured layer adds its shaft friction phi h (shaft_friction.hpp)
+//      and the damping force d h v (Table 1), with h the shaft length inside
+//      the layer's depth range [top, top + thickness] of the scene;
+//   7. a mesh laid out anew (step 2) starts in the tangent plane of the
+//      contact point (exact force at once: the mechanics are deflections
+//      along the normals) and gets its nodes projected onto the curved
+//      surface kLayoutNodesPerTick per tick (a few us each on an SH surface),
+//      so an off-axis contact costs no spike in one tick.
 // The force meshes are laid out at construction around the point where the
 // scene's insertion axis (x = y = 0, direction -z) crosses each surface; the
 // mesh step is the fixed haptic step 1 / RealtimeSettings::haptic_rate_Hz.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -42,29 +75,41 @@
 
 #include "puncture/contact_surface.hpp"
 #include "puncture/force_mesh.hpp"
+#include "puncture/layer_chain.hpp"
 #include "puncture/needle.hpp"
 #include "puncture/puncture_force.hpp"
 #include "puncture/resumption.hpp"
 #include "puncture/scene.hpp"
+#include "puncture/shaft_friction.hpp"
 
 namespace puncture {
 
 struct LayerTickResult {
   LayerState state = LayerState::Untouched;
-  double surface_force_N = 0.0;       ///< force-mesh reaction (0 unless Pressed)
+  double surface_force_N = 0.0;       ///< force of the layer's surface on the tip (the needle layer only)
+  double support_force_N = 0.0;       ///< load carried from the layer above (layer interaction; not on the needle)
+  double cutting_force_N = 0.0;       ///< crack advance (the punctured layer the tip is in)
+  double friction_force_N = 0.0;      ///< Karnopp shaft friction phi h (0 unless Punctured)
   double damping_force_N = 0.0;       ///< d h v (0 unless Punctured)
   int deformed_rings = 0;             ///< rings whose mean deflection exceeds the threshold
-  double contact_deflection_m = 0.0;  ///< depth of the tip past the contact point
+  double contact_deflection_m = 0.0;  ///< needle layer: tip past the contact point; chain layers: own deflection
   double shaft_length_m = 0.0;        ///< h: needle length inside the layer
+  double stored_energy_J = 0.0;       ///< elastic energy of the needle layer's mesh (critical-energy criterion only)
 };
 
 struct TickResult {
   double time_s = 0.0;
   double depth_m = 0.0;           ///< tip depth below the undeformed skin surface
   double velocity_m_per_s = 0.0;  ///< along the needle axis, > 0 inserting
-  double total_force_N = 0.0;     ///< sum of all surface and damping forces
+  double total_force_N = 0.0;     ///< tip + cutting + friction
+  double tip_force_N = 0.0;       ///< surface force of the needle layer
+  double cutting_force_N = 0.0;   ///< sum of the layers' cutting forces
+  double friction_force_N = 0.0;  ///< sum of shaft friction and damping d h v
   std::vector<LayerTickResult> layers;  ///< one per layer, sized at construction
 };
+
+/// Node projections per tick after a mesh was laid at a new contact point.
+constexpr int kLayoutNodesPerTick = 4;
 
 class PunctureSimulator {
  public:
@@ -81,11 +126,13 @@ class PunctureSimulator {
   std::size_t layer_count() const { return layers_.size(); }
   const std::string& layer_name(std::size_t k) const { return layers_[k].name; }
   LayerState layer_state(std::size_t k) const { return layers_[k].state; }
-  /// Index of the layer the needle can touch (== layer_count() once all are punctured).
+  /// Index of the needle layer (== layer_count() once all are punctured).
   std::size_t active_layer() const { return active_; }
   const std::vector<PunctureEvent>& puncture_events() const { return events_; }
 
+  /// True while the needle is in contact with layer k (and after it broke).
   bool has_contact(std::size_t k) const { return layers_[k].contact_set; }
+  /// Where layer k's contact deflection is measured from (its last contact).
   const SurfacePoint& contact_point(std::size_t k) const { return layers_[k].contact; }
 
   /// nullptr when Effects::surface_force is off.
@@ -93,9 +140,22 @@ class PunctureSimulator {
   const SurfaceResumption* resumption(std::size_t k) const {
     return layers_[k].resumption ? &*layers_[k].resumption : nullptr;
   }
-  /// Force-mesh node positions (3 x N, m); empty (3 x 0) without force meshes.
+  /// Deflection (m) of layer k's contact node relative to the layer below.
+  double relative_deflection_m(std::size_t k) const { return layers_[k].deflection_m; }
+  /// Deflection (m) of layer k's surface at its contact node: its own plus
+  /// that of every layer below (layer interaction), along the normals.
+  double surface_deflection_m(std::size_t k) const;
+  /// Crack front of a punctured layer along the needle axis (m), see cutting.hpp.
+  double crack_front_m(std::size_t k) const { return layers_[k].front_m; }
+  const KarnoppFriction* friction(std::size_t k) const {
+    return layers_[k].friction ? &*layers_[k].friction : nullptr;
+  }
+
+  /// Force-mesh node rest positions (3 x N, m); empty (3 x 0) without force meshes.
   const Eigen::Matrix3Xd& node_rest_positions(std::size_t k) const;
-  /// Current positions: the mesh while the layer is intact, the resumption after it broke.
+  /// Current positions: the mesh while the layer is intact, the resumption
+  /// after it broke; with layer interaction shifted by the deflection of the
+  /// layers below (not for use inside the haptic loop).
   const Eigen::Matrix3Xd& node_positions(std::size_t k) const;
   /// 1-based ring index of every node; empty without force meshes.
   const std::vector<int>& node_rings(std::size_t k) const;
@@ -109,23 +169,48 @@ class PunctureSimulator {
     double top_depth_m = 0.0;
     double thickness_m = 0.0;
     double damping_N_s_per_m2 = 0.0;
+    ForceLaw law;
     std::unique_ptr<ContactSurface> surface;
     std::optional<ForceMesh> mesh;
     std::optional<SurfaceResumption> resumption;
+    std::optional<KarnoppFriction> friction;
+    const StiffeningLaw* stiffening = nullptr;  ///< &law.stiffening when the effect is on
     LayerState state = LayerState::Untouched;
     bool contact_set = false;
+    bool contact_at_tip = false;  ///< contact below the rest surface (no layer interaction)
+    /// Without layer interaction: from this position of the tip along the
+    /// needle axis on, a contact below the rest surface is made at the tip
+    /// (+inf: only at the surface crossing). See try_contact.
+    double tip_contact_from_m = 0.0;
     SurfacePoint contact;
+    double deflection_m = 0.0;    ///< committed deflection of the contact node relative to the layer below
+    double front_m = 0.0;         ///< crack front along the needle axis (punctured layers)
+    mutable Eigen::Matrix3Xd shifted_positions;
   };
 
-  /// Steps 2-4 for the active layer; returns true if it broke this tick.
-  bool press_active_layer(const NeedleState& needle, double& surface_force_sum_N);
+  /// Sets the contact of the needle layer if the tip has reached its surface.
+  bool try_contact(const NeedleState& needle);
+  /// Lays the force mesh of layer k where the needle axis crosses its rest
+  /// surface, if it is at rest and laid elsewhere.
+  void lay_mesh_on_axis(std::size_t k, const NeedleState& needle, const SurfacePoint* hit);
+  /// Steps the meshes of the chain [active_, chain_end_) (see the header).
+  /// Returns the needle layer's surface force (0 without contact).
+  double step_chain(const NeedleState& needle, double transmitted_force_N);
+  bool breakthrough(std::size_t k, double surface_force_N);
+  void record_puncture(const NeedleState& needle, double surface_force_N);
 
   std::vector<LayerModel> layers_;
   std::vector<PunctureEvent> events_;
   TickResult result_;
   std::size_t active_ = 0;
   bool damping_on_ = false;
+  bool cutting_on_ = false;
+  bool interaction_ = false;
+  bool first_tick_ = true;
   double contact_search_height_m_ = 0.0;
+  double relayout_tolerance_m_ = 0.0;
+  std::array<ChainLink, kMaxChainLinks> links_{};
+  std::array<double, kMaxChainLinks> link_deflection_m_{};
   Eigen::Matrix3Xd empty_positions_;
   std::vector<int> empty_rings_;
 };

@@ -1,6 +1,9 @@
 #include "puncture/model/realtime_model.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
+#include <numeric>
 #include <cmath>
 #include <stdexcept>
 
@@ -38,6 +41,36 @@ std::vector<LayerFitErrorEntry> scene_fit_error_sweep(const Scene& scene, const 
       out.push_back({scene.layers[k].name, row});
   }
   return out;
+}
+
+bool tick_has_contact(const TickResult& tick) {
+  if (tick.depth_m > 0.0) return true;
+  for (const LayerTickResult& l : tick.layers)
+    if (l.state == LayerState::Pressed) return true;
+  return false;
+}
+
+TickCost tick_cost(const ScriptedRunResult& run) {
+  TickCost c;
+  c.ticks = run.tick_wall_time_s.size();
+  std::vector<double> contact, all = run.tick_wall_time_s;
+  for (std::size_t i = 0; i < run.tick_wall_time_s.size() && i < run.ticks.size(); ++i)
+    if (tick_has_contact(run.ticks[i])) contact.push_back(run.tick_wall_time_s[i]);
+  c.contact_ticks = contact.size();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  c.contact_mean_s = contact.empty() ? nan : std::accumulate(contact.begin(), contact.end(), 0.0) / contact.size();
+  if (contact.empty()) {
+    c.contact_p99_s = nan;
+  } else {
+    const std::size_t k = std::min(contact.size() - 1, static_cast<std::size_t>(0.99 * contact.size()));
+    std::nth_element(contact.begin(), contact.begin() + static_cast<long>(k), contact.end());
+    c.contact_p99_s = contact[k];
+  }
+  if (!all.empty()) {
+    std::nth_element(all.begin(), all.begin() + static_cast<long>(all.size() / 2), all.end());
+    c.all_median_s = all[all.size() / 2];
+  }
+  return c;
 }
 
 ScriptedRunResult run_scripted_insertion(RealtimeModel& model, const Scene& scene, const FrameCallback& on_frame,

@@ -20,11 +20,18 @@ namespace {
 
 Scene default_scene() { return load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json"); }
 
-Scene scene_with_effects(bool surface_force, bool damping, bool resumption) {
+/// The paper's three tick effects as given; the force-law effects (cutting,
+/// friction, stiffening, layer interaction) off unless asked for.
+Scene scene_with_effects(bool surface_force, bool damping, bool resumption, bool cutting = false,
+                         bool friction = false) {
   Scene s = default_scene();
   s.effects.surface_force = surface_force;
   s.effects.damping = damping;
   s.effects.resumption = resumption;
+  s.effects.cutting = cutting;
+  s.effects.friction = friction;
+  s.effects.stiffening = false;
+  s.effects.layer_interaction = false;
   validate_scene(s, "test_effects_off");
   return s;
 }
@@ -45,6 +52,8 @@ TEST(EffectsOff, DefaultSceneHasEveryTickEffectOn) {
   EXPECT_TRUE(s.effects.surface_force);
   EXPECT_TRUE(s.effects.damping);
   EXPECT_TRUE(s.effects.resumption);
+  EXPECT_TRUE(s.effects.cutting);
+  EXPECT_TRUE(s.effects.friction);
 }
 
 TEST(EffectsOff, AllOnBuildsEveryForceMeshAndResumption) {
@@ -78,7 +87,8 @@ TEST(EffectsOff, AllOnBuildsEveryForceMeshAndResumption) {
   EXPECT_GT(max_surface_force_N, 0.0);
   EXPECT_TRUE(damping_seen);
   // The skin broke: its resumption was started.
-  EXPECT_GT(m.simulator->resumption(0)->steps_taken(), 0);
+  EXPECT_TRUE(m.simulator->resumption(0)->active());
+  EXPECT_LT(m.simulator->resumption(0)->recovery_factor(), 1.0);
 }
 
 TEST(EffectsOff, SurfaceForceOffBuildsNoForceMeshAndGivesZeroSurfaceForce) {
@@ -172,6 +182,39 @@ TEST(EffectsOff, AllOffBuildsNothingAndGivesZeroForce) {
   const ScriptedRunResult run = run_scripted_insertion(m, s);
   EXPECT_FALSE(run.events.empty());
   for (const TickResult& t : run.ticks) EXPECT_EQ(t.total_force_N, 0.0);
+}
+
+TEST(EffectsOff, CuttingAndFrictionOffGiveExactlyZeroAndBuildNoFriction) {
+  // Off: no Karnopp state exists and the cutting and friction forces are
+  // exactly 0 on every tick; on: both act after the punctures (cutting while
+  // the tip advances a crack, friction growing with the shaft length) and
+  // the friction reverses on withdrawal.
+  for (bool on : {false, true}) {
+    const Scene s = scene_with_effects(true, true, true, on, on);
+    RealtimeModel m = build_realtime_model(s);
+    for (std::size_t k = 0; k < s.layers.size(); ++k) EXPECT_EQ(m.simulator->friction(k) != nullptr, on);
+    const ScriptedRunResult run = run_scripted_insertion(m, s);
+    ASSERT_EQ(run.events.size(), 3u);
+    double max_cutting = 0.0, min_friction = 0.0, max_friction = 0.0;
+    for (const TickResult& t : run.ticks) {
+      double friction = 0.0, cutting = 0.0;
+      for (const LayerTickResult& l : t.layers) friction += l.friction_force_N, cutting += l.cutting_force_N;
+      EXPECT_EQ(t.cutting_force_N, cutting);
+      max_cutting = std::max(max_cutting, cutting);
+      min_friction = std::min(min_friction, friction);
+      max_friction = std::max(max_friction, friction);
+      if (!on) EXPECT_EQ(cutting, 0.0);
+      if (!on) EXPECT_EQ(friction, 0.0);
+      double parts = t.tip_force_N + t.cutting_force_N + t.friction_force_N;
+      EXPECT_NEAR(t.total_force_N, parts, 1e-12);
+    }
+    if (on) {
+      EXPECT_NEAR(max_cutting, 1.44, 1e-12);  // the skin's cutting force of the scene
+      // Friction at the deepest point: f_d x shaft length in tissue (30 mm at 0.01 N/mm).
+      EXPECT_NEAR(max_friction, 0.01e3 * s.insertion.target_depth_m, 1e-9);
+      EXPECT_NEAR(min_friction, -max_friction, 1e-5);  // reversed on withdrawal
+    }
+  }
 }
 
 }  // namespace

@@ -117,7 +117,7 @@ const BadCase kBadCases[] = {
     {"negative_spacing", [](json& j) { j["layers"][2]["force_mesh"]["L_mm"] = -1.0; }, "/layers/2/force_mesh/L_mm"},
     {"unknown_key", [](json& j) { j["layers"][0]["thicknes_mm"] = 1.0; }, "/layers/0/thicknes_mm"},
     {"unknown_top_key", [](json& j) { j["colour"] = "red"; }, "/colour"},
-    {"unknown_effect", [](json& j) { j["effects"].push_back("bleeding"); }, "/effects/4"},
+    {"unknown_effect", [](json& j) { j["effects"].push_back("bleeding"); }, "/effects/6"},
     {"unknown_model", [](json& j) { j["models"] = {"bem"}; }, "/models/0"},
     {"missing_thickness", [](json& j) { j["layers"][0].erase("thickness_mm"); }, "/layers/0/thickness_mm"},
     {"missing_needle", [](json& j) { j.erase("needle"); }, "/needle"},

@@ -8,32 +8,83 @@
 
 namespace puncture::validation {
 
-std::string calibration_metrics_table(const CalibrationResult& r) {
+namespace {
+
+std::string num(double x, int precision = 4) {
   std::ostringstream s;
-  s << "| layer | force RMSE before (N) | after (N) | after (% of reference peak) | puncture depth error before (mm) "
-       "| after (mm) |\n"
-       "|---|---|---|---|---|---|\n";
-  if (r.before.empty() || r.after.empty()) return s.str();
-  for (const auto& before : r.before.front().layers) {
-    const LayerMetrics* after = r.after.front().layer(before.layer);
-    s << "| " << before.layer << " | " << std::setprecision(4) << before.force_rmse_N << " | "
-      << (after ? after->force_rmse_N : 0.0) << " | " << std::setprecision(3)
-      << (after ? 100.0 * after->force_rmse_relative : 0.0) << " | " << std::setprecision(4)
-      << before.puncture_depth_error_m * 1e3 << " | " << (after ? after->puncture_depth_error_m * 1e3 : 0.0)
-      << " |\n";
+  s << std::setprecision(precision) << x;
+  return s.str();
+}
+
+}  // namespace
+
+std::string calibration_terms_table(const CalibrationResult& r) {
+  std::ostringstream s;
+  if (r.trajectory_before.empty() || r.trajectory_after.empty()) return s.str();
+  const TrajectoryComparison& before = r.trajectory_before.front();
+  const TrajectoryComparison& after = r.trajectory_after.front();
+  s << "| term | before | after | error after | weight | reference samples | note |\n|---|---|---|---|---|---|---|\n";
+  auto value = [](const ObjectiveTerm* t) { return t && t->available ? num(t->value, 3) : std::string("n/a"); };
+  for (const ObjectiveTerm& t : after.terms) {
+    const ObjectiveTerm* b = before.term(t.name, t.layer);
+    std::string error = "n/a";
+    if (t.available) error = t.name == "puncture_depth" ? num(t.raw * 1e3, 3) + " mm"
+                             : t.name == "missing_puncture" ? num(t.value, 1)
+                                                            : num(t.raw, 3) + " N";
+    s << "| " << t.label() << " | " << value(b) << " | " << value(&t) << " | " << error << " | " << num(t.weight, 3)
+      << " | " << t.samples << " | " << t.note << " |\n";
+  }
+  s << "\nValues are dimensionless: force RMSEs over the reference's peak force ("
+    << num(after.reference_peak_force_N, 4) << " N), puncture force errors over the reference's puncture force, "
+       "depth errors over min(L, layer thickness); the objective is the sum of weight x value^2 over the available "
+       "terms: "
+    << num(before.objective, 4) << " before, " << num(after.objective, 4) << " after.\n";
+  return s.str();
+}
+
+std::string calibration_parameters_table(const CalibrationResult& r) {
+  std::ostringstream s;
+  s << "| layer | parameter | start | tuned | physical bounds | at a bound |\n|---|---|---|---|---|---|\n";
+  for (const TunedParameterRecord& p : r.parameters)
+    s << "| " << p.layer << " | " << p.name << " (" << p.unit << ") | " << num(p.start)
+      << (p.start_moved_inside ? " (outside: moved in)" : "") << " | " << num(p.tuned) << " | [" << num(p.lower)
+      << ", " << num(p.upper) << "] | " << (p.at_bound.empty() ? "no" : "**" + p.at_bound + "**") << " |\n";
+  return s.str();
+}
+
+std::string calibration_punctures_table(const CalibrationResult& r, const Scene& scene) {
+  std::ostringstream s;
+  if (r.reference_events.empty() || r.trajectory_after.empty()) return s.str();
+  const ReferenceEvents& ev = r.reference_events.front();
+  s << "Reference punctures: " << ev.note
+    << ".\n\n| layer | reference depth (mm) | reference force (N) | model depth after (mm) | model force after (N) "
+       "|\n|---|---|---|---|---|\n";
+  const auto& model = r.trajectory_after.front().model_punctures;
+  for (std::size_t k = 0; k < scene.layers.size() && k < ev.punctures.size(); ++k) {
+    const auto& p = ev.punctures[k];
+    const bool m_found = k < model.size() && model[k].found;
+    s << "| " << scene.layers[k].name << " | " << (p.found ? num(p.depth_m * 1e3) : "n/a") << " | "
+      << (p.found ? num(p.force_N) : "n/a") << " | " << (m_found ? num(model[k].depth_m * 1e3) : "n/a") << " | "
+      << (m_found ? num(model[k].force_N) : "n/a") << " |\n";
   }
   return s.str();
 }
 
 std::string calibration_curves_csv(const std::vector<std::pair<std::string, const InsertionCurve*>>& curves,
                                    const io::Provenance& provenance) {
-  io::CsvWriter csv({"curve", "time_s", "depth_mm", "force_N"});
+  io::CsvWriter csv({"curve", "time_s", "depth_mm", "force_N", "phase"});
   csv.add_provenance(provenance);
-  for (const auto& [name, c] : curves)
-    for (std::size_t i = 0; i < c->size(); ++i) {
-      if (i > 0 && c->velocity_m_per_s[i] < 0.0) break;  // withdrawal: not compared
-      csv.text(name).number(c->time_s[i], 9).number(c->depth_m[i] * 1e3, 9).number(c->force_N[i], 9).end_row();
-    }
+  for (const auto& [name, c] : curves) {
+    const std::vector<CurvePhase> phase =
+        c->phase.size() == c->size() ? c->phase : std::vector<CurvePhase>(c->size(), CurvePhase::Insertion);
+    for (std::size_t i = 0; i < c->size(); ++i)
+      csv.text(name)
+          .number(c->time_s[i], 9)
+          .number(c->depth_m[i] * 1e3, 9)
+          .number(c->force_N[i], 9)
+          .text(to_string(phase[i]))
+          .end_row();
+  }
   return csv.str();
 }
 

@@ -211,7 +211,8 @@ LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size
 
   const auto after = fem.after_breakthrough.find(layer.name);
   if (after != fem.after_breakthrough.end() && broke < run.ticks.size()) {
-    const auto delay_ticks = static_cast<std::size_t>(std::ceil(1.0 / layer.resumption_rate - 1e-9));
+    const auto delay_ticks =
+        static_cast<std::size_t>(std::ceil(layer.resumption_time_s * scene.realtime.haptic_rate_Hz - 1e-9));
     const std::size_t tick = std::min(run.ticks.size() - 1, broke + delay_ticks);
     c.recovery_delay_s = run.ticks[tick].time_s - run.ticks[broke].time_s;
     c.recovery_realtime_depth_m = run.ticks[tick].depth_m;

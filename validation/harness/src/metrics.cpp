@@ -10,6 +10,7 @@
 #include "puncture/io/atomic_file.hpp"
 #include "puncture/io/csv_reader.hpp"
 #include "puncture/io/csv_writer.hpp"
+#include "puncture/validation/puncture_events.hpp"
 
 namespace puncture::validation {
 
@@ -41,6 +42,14 @@ bool parse_state(const std::string& text, LayerState& state) {
   return true;
 }
 
+bool parse_phase(const std::string& text, CurvePhase& phase) {
+  if (text == "insertion") phase = CurvePhase::Insertion;
+  else if (text == "dwell") phase = CurvePhase::Dwell;
+  else if (text == "withdrawal") phase = CurvePhase::Withdrawal;
+  else return false;
+  return true;
+}
+
 std::string describe_time(const InsertionCurve& c, std::size_t i) {
   std::ostringstream s;
   s << "sample " << i + 1 << " (time_s = " << c.time_s[i] << ")";
@@ -55,6 +64,15 @@ CurveFormatError::CurveFormatError(const std::string& file, int line, const std:
       file_(file),
       line_(line),
       column_(column) {}
+
+const char* to_string(CurvePhase phase) {
+  switch (phase) {
+    case CurvePhase::Insertion: return "insertion";
+    case CurvePhase::Dwell: return "dwell";
+    case CurvePhase::Withdrawal: return "withdrawal";
+  }
+  return "unknown";
+}
 
 int InsertionCurve::layer_index(const std::string& name) const {
   for (std::size_t k = 0; k < layer_names.size(); ++k)
@@ -75,7 +93,8 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
   curve.source = source_name;
   const io::CsvDocument doc = parse_document(text, source_name);
   curve.metadata = doc.metadata_map();
-  int col_time = -1, col_depth = -1, col_vel = -1, col_force = -1;
+  int col_time = -1, col_depth = -1, col_vel = -1, col_force = -1, col_phase = -1;
+  int col_tip = -1, col_cut = -1, col_fric = -1;
   std::vector<int> state_cols;
   for (std::size_t j = 0; j < doc.header.size(); ++j) {
     const std::string& h = doc.header[j];
@@ -84,15 +103,26 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
     else if (h == "depth_mm") col_depth = jj;
     else if (h == "velocity_mm_per_s") col_vel = jj;
     else if (h == "force_N") col_force = jj;
+    else if (h == "phase") col_phase = jj;
+    else if (h == "tip_force_N") col_tip = jj;
+    else if (h == "cutting_force_N") col_cut = jj;
+    else if (h == "friction_force_N") col_fric = jj;
     else if (h.size() > 6 && h.compare(h.size() - 6, 6, "_state") == 0) {
       state_cols.push_back(jj);
       curve.layer_names.push_back(h.substr(0, h.size() - 6));
     }
   }
-  const std::pair<int, const char*> required[] = {
-      {col_time, "time_s"}, {col_depth, "depth_mm"}, {col_vel, "velocity_mm_per_s"}, {col_force, "force_N"}};
+  const std::pair<int, const char*> required[] = {{col_depth, "depth_mm"}, {col_force, "force_N"}};
   for (const auto& [col, name] : required)
     if (col < 0) throw CurveFormatError(source_name, doc.header_line, name, "required column missing from the header");
+  const int parts = (col_tip >= 0) + (col_cut >= 0) + (col_fric >= 0);
+  if (parts != 0 && parts != 3)
+    throw CurveFormatError(source_name, doc.header_line,
+                           col_tip < 0 ? "tip_force_N" : col_cut < 0 ? "cutting_force_N" : "friction_force_N",
+                           "the force's parts go together: tip_force_N, cutting_force_N and friction_force_N");
+  curve.has_time = col_time >= 0;
+  curve.has_velocity = col_vel >= 0;
+  curve.phase_from_column = col_phase >= 0;
   curve.layer_states.resize(state_cols.size());
   for (const io::CsvRecord& record : doc.records) {
     const int line_no = record.line;
@@ -104,10 +134,22 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
                                "not a finite number: '" + fields[static_cast<std::size_t>(col)] + "'");
       return v * scale;
     };
-    curve.time_s.push_back(number(col_time, 1.0));
+    curve.time_s.push_back(col_time >= 0 ? number(col_time, 1.0) : static_cast<double>(curve.time_s.size()));
     curve.depth_m.push_back(number(col_depth, kMm));
-    curve.velocity_m_per_s.push_back(number(col_vel, kMm));
+    curve.velocity_m_per_s.push_back(col_vel >= 0 ? number(col_vel, kMm) : 0.0);
     curve.force_N.push_back(number(col_force, 1.0));
+    if (col_tip >= 0) {
+      curve.tip_force_N.push_back(number(col_tip, 1.0));
+      curve.cutting_force_N.push_back(number(col_cut, 1.0));
+      curve.friction_force_N.push_back(number(col_fric, 1.0));
+    }
+    if (col_phase >= 0) {
+      CurvePhase ph;
+      const std::string& f = fields[static_cast<std::size_t>(col_phase)];
+      if (!parse_phase(f, ph))
+        throw CurveFormatError(source_name, line_no, "phase", "phase must be insertion, dwell or withdrawal (got '" + f + "')");
+      curve.phase.push_back(ph);
+    }
     for (std::size_t k = 0; k < state_cols.size(); ++k) {
       LayerState s;
       const std::string& f = fields[static_cast<std::size_t>(state_cols[k])];
@@ -129,7 +171,29 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
     }
   }
   if (curve.size() == 0) throw CurveFormatError(source_name, 0, "", "no data rows");
+  if (!curve.phase_from_column) infer_phases(curve);
+  if (!curve.has_velocity) {
+    // Sign from the phase; magnitude from the metadata speed (else 1 mm/s).
+    double speed = 1.0;
+    curve.metadata_number("speed_mm_per_s", speed);
+    for (std::size_t i = 0; i < curve.size(); ++i)
+      curve.velocity_m_per_s[i] = curve.phase[i] == CurvePhase::Insertion    ? speed * kMm
+                                  : curve.phase[i] == CurvePhase::Withdrawal ? -speed * kMm
+                                                                             : 0.0;
+  }
   return curve;
+}
+
+void infer_phases(InsertionCurve& curve) {
+  curve.phase.assign(curve.size(), CurvePhase::Insertion);
+  if (curve.size() == 0) return;
+  const std::size_t deepest = static_cast<std::size_t>(
+      std::max_element(curve.depth_m.begin(), curve.depth_m.end()) - curve.depth_m.begin());
+  const double max_depth = curve.depth_m[deepest];
+  for (std::size_t i = deepest + 1; i < curve.size(); ++i) {
+    const bool at_rest = curve.has_velocity ? curve.velocity_m_per_s[i] == 0.0 : curve.depth_m[i] == max_depth;
+    curve.phase[i] = at_rest ? CurvePhase::Dwell : CurvePhase::Withdrawal;
+  }
 }
 
 InsertionCurve read_insertion_curve(const std::filesystem::path& path) {
@@ -159,12 +223,29 @@ InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, 
     c.force_N.push_back(force);
     for (std::size_t k = 0; k < c.layer_states.size() && k < t.layers.size(); ++k)
       c.layer_states[k].push_back(t.layers[k].state);
+    double damping = 0.0;
+    if (!include_damping)
+      for (const auto& layer : t.layers) damping += layer.damping_force_N;
+    c.tip_force_N.push_back(t.tip_force_N);
+    c.cutting_force_N.push_back(t.cutting_force_N);
+    c.friction_force_N.push_back(t.friction_force_N - damping);
   }
+  // Phases from the scripted trajectory of the run.
+  const ScriptedTrajectory trajectory(scene.insertion);
+  c.phase.reserve(n);
+  for (const TickResult& t : run.ticks)
+    c.phase.push_back(t.time_s < trajectory.insertion_end_s()      ? CurvePhase::Insertion
+                      : t.time_s < trajectory.withdrawal_start_s() ? CurvePhase::Dwell
+                                                                   : CurvePhase::Withdrawal);
+  c.phase_from_column = true;
   return c;
 }
 
 std::string insertion_curve_csv(const InsertionCurve& curve, const io::Provenance* provenance) {
   std::vector<std::string> columns{"time_s", "depth_mm", "velocity_mm_per_s", "force_N"};
+  if (curve.has_parts()) columns.insert(columns.end(), {"tip_force_N", "cutting_force_N", "friction_force_N"});
+  const bool phases = curve.phase.size() == curve.size();
+  if (phases) columns.push_back("phase");
   for (const auto& name : curve.layer_names) columns.push_back(name + "_state");
   io::CsvWriter csv(columns);
   if (provenance) csv.add_provenance(*provenance);
@@ -174,19 +255,55 @@ std::string insertion_curve_csv(const InsertionCurve& curve, const io::Provenanc
       csv.add_metadata(k, v);
   for (std::size_t i = 0; i < curve.size(); ++i) {
     csv.number(curve.time_s[i]).number(curve.depth_m[i] / kMm).number(curve.velocity_m_per_s[i] / kMm).number(curve.force_N[i]);
+    if (curve.has_parts()) csv.number(curve.tip_force_N[i]).number(curve.cutting_force_N[i]).number(curve.friction_force_N[i]);
+    if (phases) csv.text(to_string(curve.phase[i]));
     for (const auto& states : curve.layer_states) csv.text(to_string(states[i]));
     csv.end_row();
   }
   return csv.str();
 }
 
+namespace {
+/// The curve's phases: its own, or inferred when a caller built it by hand.
+std::vector<CurvePhase> phases_of(const InsertionCurve& curve) {
+  if (curve.phase.size() == curve.size()) return curve.phase;
+  InsertionCurve copy;
+  copy.depth_m = curve.depth_m;
+  copy.velocity_m_per_s = curve.velocity_m_per_s;
+  copy.time_s = curve.time_s;
+  copy.has_velocity = curve.has_velocity;
+  infer_phases(copy);
+  return copy.phase;
+}
+}  // namespace
+
+std::vector<std::size_t> dwell_phase(const InsertionCurve& curve) {
+  const std::vector<CurvePhase> phase = phases_of(curve);
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < curve.size(); ++i)
+    if (phase[i] == CurvePhase::Dwell) idx.push_back(i);
+  return idx;
+}
+
+std::vector<std::size_t> withdrawal_phase(const InsertionCurve& curve) {
+  const std::vector<CurvePhase> phase = phases_of(curve);
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < curve.size(); ++i) {
+    if (phase[i] != CurvePhase::Withdrawal) continue;
+    if (!idx.empty() && curve.depth_m[i] > curve.depth_m[idx.back()])
+      throw CurveFormatError(curve.source, 0, "depth_mm", "depth increases during the withdrawal at " + describe_time(curve, i));
+    idx.push_back(i);
+  }
+  return idx;
+}
+
 std::vector<std::size_t> insertion_phase(const InsertionCurve& curve) {
   if (curve.size() == 0) throw CurveFormatError(curve.source, 0, "", "empty curve");
-  const std::size_t deepest = static_cast<std::size_t>(
-      std::max_element(curve.depth_m.begin(), curve.depth_m.end()) - curve.depth_m.begin());
+  const std::vector<CurvePhase> phase = phases_of(curve);
   std::vector<std::size_t> idx;
-  for (std::size_t i = 0; i <= deepest; ++i) {
-    if (!(curve.velocity_m_per_s[i] > 0.0)) continue;
+  for (std::size_t i = 0; i < curve.size(); ++i) {
+    if (phase[i] != CurvePhase::Insertion) continue;
+    if (curve.has_velocity && !(curve.velocity_m_per_s[i] > 0.0)) continue;
     // Non-decreasing: a repeated depth is a force drop at one instant
     // (interpolation then takes the value after the drop).
     if (!idx.empty() && !(curve.depth_m[i] >= curve.depth_m[idx.back()]))
@@ -244,7 +361,8 @@ const LayerMetrics* CurveComparison::layer(const std::string& name) const {
   return nullptr;
 }
 
-CurveComparison compare_curves(const InsertionCurve& model, const InsertionCurve& reference, double max_depth_m) {
+CurveComparison compare_curves(const InsertionCurve& model, const InsertionCurve& reference, double max_depth_m,
+                               const std::vector<LayerGeometry>* geometry) {
   const std::vector<std::size_t> ref_phase = insertion_phase(reference);
   const std::vector<std::size_t> mod_phase = insertion_phase(model);
   std::vector<double> mx, my;
@@ -284,26 +402,52 @@ CurveComparison compare_curves(const InsertionCurve& model, const InsertionCurve
   std::vector<std::string> names = reference.layer_names;
   for (const auto& n : model.layer_names)
     if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+  // A reference without state columns: its own punctures from its force
+  // drops, in the model's layer order (never the model's states, which would
+  // let a model that breaks early judge itself on a tiny interval).
+  std::vector<LayerGeometry> own_geometry;
+  ReferenceEvents drop_events;
+  std::vector<LayerSegments> drop_segments;
+  if (!reference.has_layer_states()) {
+    if (geometry) {
+      own_geometry = *geometry;
+    } else {
+      for (const auto& n : model.layer_names) own_geometry.push_back({n, 0.0, 0.0, 0.0});
+    }
+    drop_events = reference_events(reference, own_geometry);
+    drop_segments = layer_segments(drop_events, own_geometry);
+  }
   for (const std::string& name : names) {
     LayerMetrics lm;
     lm.layer = name;
-    const bool from_reference = reference.layer_index(name) >= 0;
-    const InsertionCurve& states_curve = from_reference ? reference : model;
-    const auto& states = states_curve.layer_states[static_cast<std::size_t>(states_curve.layer_index(name))];
-    const std::vector<std::size_t>& phase = from_reference ? ref_phase : mod_phase;
-    for (std::size_t i : phase) {
-      if (states[i] != LayerState::Pressed) continue;
-      const double d = states_curve.depth_m[i];
-      if (!lm.has_pressed_interval) lm.pressed_from_depth_m = lm.pressed_to_depth_m = d;
-      lm.has_pressed_interval = true;
-      lm.pressed_from_depth_m = std::min(lm.pressed_from_depth_m, d);
-      lm.pressed_to_depth_m = std::max(lm.pressed_to_depth_m, d);
+    if (reference.has_layer_states()) {
+      const int li = reference.layer_index(name);
+      if (li >= 0) {
+        const auto& states = reference.layer_states[static_cast<std::size_t>(li)];
+        for (std::size_t i : ref_phase) {
+          if (states[i] != LayerState::Pressed) continue;
+          const double d = reference.depth_m[i];
+          if (!lm.has_pressed_interval) lm.pressed_from_depth_m = lm.pressed_to_depth_m = d;
+          lm.has_pressed_interval = true;
+          lm.pressed_from_depth_m = std::min(lm.pressed_from_depth_m, d);
+          lm.pressed_to_depth_m = std::max(lm.pressed_to_depth_m, d);
+        }
+      }
+    } else {
+      for (std::size_t k = 0; k < own_geometry.size(); ++k) {
+        if (own_geometry[k].name != name || !drop_segments[k].has_pressing) continue;
+        lm.has_pressed_interval = true;
+        lm.pressed_from_depth_m = drop_segments[k].pressing_from_m;
+        // The puncture sample itself is after the drop: up to the sample before it.
+        lm.pressed_to_depth_m = drop_segments[k].pressing_to_m;
+      }
     }
     if (lm.has_pressed_interval) {
       double s = 0.0;
+      const bool open_end = !reference.has_layer_states() && lm.reference_puncture.found;
       for (std::size_t c = 0; c < compared.size(); ++c) {
         const double d = reference.depth_m[compared[c]];
-        if (d < lm.pressed_from_depth_m || d > lm.pressed_to_depth_m) continue;
+        if (d < lm.pressed_from_depth_m || d > lm.pressed_to_depth_m || (open_end && d >= lm.pressed_to_depth_m)) continue;
         ++lm.n_samples;
         s += error[c] * error[c];
       }
@@ -311,6 +455,9 @@ CurveComparison compare_curves(const InsertionCurve& model, const InsertionCurve
       lm.force_rmse_relative = peak > 0.0 ? lm.force_rmse_N / peak : 0.0;
     }
     lm.reference_puncture = puncture_event(reference, name);
+    if (!reference.has_layer_states())
+      for (std::size_t k = 0; k < own_geometry.size(); ++k)
+        if (own_geometry[k].name == name) lm.reference_puncture = drop_events.punctures[k];
     lm.model_puncture = puncture_event(model, name);
     if (lm.reference_puncture.found && lm.model_puncture.found) {
       lm.puncture_depth_error_m = lm.model_puncture.depth_m - lm.reference_puncture.depth_m;

@@ -80,11 +80,20 @@ struct CalibrateOptions {
   /// one L weighs like a force RMSE of 32 % of the peak. With weight 1 the fat
   /// of the default scene trades 20 % force RMSE for a 0.1 mm better depth.
   double depth_weight = 0.1;
+  /// Puncture depths of the reference (mm), one per layer from the top; empty:
+  /// from its state columns, else from its force drops.
+  std::vector<double> puncture_depths_mm;
+  /// Parameters kept at the scene's values: "K", "breakthrough", "cutting",
+  /// "friction", "stiffening" (by default each is tuned where its effect is on).
+  std::vector<std::string> keep;
   bool quiet = false;
 };
 
-/// `puncture calibrate`: tunes the force-mesh parameters against a reference
-/// and writes a tuned preset (a scene `puncture run` accepts) + provenance.
+/// `puncture calibrate`: tunes the force-law parameters against a reference
+/// and writes a tuned preset (a scene `puncture run` accepts) + provenance;
+/// the summary shows every term of the objective before and after ("n/a"
+/// where it cannot be computed), the reference's punctures and how they were
+/// found, the tuned parameters with their bounds, and warnings.
 int calibrate_command(const CalibrateOptions& options, std::ostream& out, std::ostream& err);
 
 struct GradeOptions {

@@ -66,6 +66,20 @@ struct ScriptedRunResult {
   std::vector<double> tick_wall_time_s;  ///< measured wall time of each tick() call
 };
 
+/// What one haptic tick costs where the work is: wall times (s) of the ticks
+/// with contact (the tip below the undeformed skin surface, or a layer
+/// pressed), mean and 99th percentile, beside the median over all ticks
+/// (which, for a scripted run, is a tick without contact).
+struct TickCost {
+  std::size_t ticks = 0;
+  std::size_t contact_ticks = 0;
+  double contact_mean_s = 0.0;   ///< NaN without contact ticks
+  double contact_p99_s = 0.0;    ///< NaN without contact ticks
+  double all_median_s = 0.0;
+};
+bool tick_has_contact(const TickResult& tick);
+TickCost tick_cost(const ScriptedRunResult& run);
+
 using FrameCallback = std::function<void(const PunctureSimulator&, const TickResult&, int frame_index)>;
 using ProgressCallback = std::function<void(double fraction_done)>;
 

@@ -9,45 +9,59 @@
 //      scene file plus a provenance file.
 //
 // What is tuned (per layer, switchable in CalibrationOptions::parameters):
-//   K (virtual_stiffness), deformed_threshold, surface_stiffness, L (spacing)
-//   and d (damping) are continuous; they are optimised in log space,
-//   x = log(p), inside [p0 / bound_factor, p0 * bound_factor]; w (rings) is an
-//   integer, enumerated over w0 - r .. w0 + r (r = rings_search_radius, w >= 2,
-//   force mesh inside the sample) with a full continuous optimisation for
-//   each w; the best w wins.
-// Identifiability (quasi-static force mesh on a flat layer top): the force
-//   before breakthrough is S(K, k_s, w) * z0 and the layer breaks at
-//   z0 = threshold / u_w(K / k_s, w). A force-depth curve fixes two numbers
-//   per layer (slope and breakthrough point), so by default only K and the
-//   threshold are tuned; k_s and L change the ring deflection profile and
-//   are only identifiable with a deflection-profile reference (L does not
-//   enter the quasi-static force at all). d is tuned only when a reference
-//   carries rate information (see DampingPolicy).
+//   K (virtual stiffness) and the layer's breakthrough parameter (the ring
+//   deformation threshold, the critical force or the critical energy, by the
+//   layer's criterion) always; the cutting force, the dynamic shaft friction
+//   (the static level keeps its ratio to it) and the tip stiffening
+//   coefficient (a2 of the polynomial law, k_e of the exponential one) when
+//   their effects are on in the scene; k_s, L and w on request; d with rate
+//   information (DampingPolicy).
+// Bounds with physical meaning (parameter_bounds): every parameter stays
+//   inside an absolute physical range (e.g. a ring threshold between 1 um,
+//   below which a ring counts as deformed by numerical noise, and the layer
+//   thickness; a critical force between 0.1 mN and 50 N, the span of
+//   measured puncture forces; a cutting force between 0 and 20 N), and the
+//   scale parameters (K, k_s, L, d, threshold, critical force and energy)
+//   also within [p0 / bound_factor, p0 x bound_factor] of their start. A
+//   start outside the physical range is moved inside it (and reported).
+//   Scale parameters are optimised in log space, the ones that may be 0
+//   (cutting, friction, stiffening) in linear space scaled to a typical
+//   value. The result lists every tuned parameter with its bounds and
+//   whether it ended at one.
+// Identifiability: before breakthrough the force is S(K, k_s, w) z0 (+ the
+//   stiffening), and the breakthrough parameter sets where it breaks; after
+//   it, the cutting force sets the level and the friction the slope with
+//   the shaft length; on withdrawal only friction (and d h v) remain, with
+//   reversed sign, which separates friction from cutting. k_s and L change
+//   the ring deflection profile and are only identifiable with a
+//   deflection-profile reference (L does not enter the quasi-static force
+//   at all). d and the friction both grow with the shaft length: d is tuned
+//   only when a reference carries rate information.
+// Reference punctures: from given depths, the <layer>_state columns, or the
+//   force drops of a curve with depth and force only (puncture_events.hpp).
 // Sequential stages (what we do): layers are calibrated top to bottom. The
-//   stage of layer k tunes layer k's parameters on the reference samples down
-//   to the reference puncture depth of layer k plus depth_margin_m (the
-//   layers below are not reached before layer k breaks, and the layers above
-//   are already tuned). The model itself runs the whole insertion, so that
-//   its breakthrough of layer k is found even when a start value moves it
-//   far beyond the reference's (the puncture-depth term then stays a smooth
-//   guide instead of a flat "missing" penalty). When d is tuned, a final
-//   stage tunes the d of all calibrated layers together on the whole
-//   insertion phase.
-// Objective of a stage, summed over the references (dimensionless):
-//   w_rmse (RMSE / peak)^2 over the compared samples
-//   + sum over the stage's layers: w_layer (layer RMSE / peak)^2
-//     + w_depth (puncture depth error / min(ring spacing L, layer thickness))^2
-//     + w_force (puncture force error / reference puncture force)^2
-//     + w_missing if exactly one of model and reference punctures the layer.
+//   stage of layer k minimises the layer's terms of the trajectory objective
+//   (trajectory_objective.hpp: its pressing, its puncture force and depth,
+//   its cut (cutting and friction) and the overall and part terms) over the
+//   reference insertion down to the end of the cut through layer k, plus the
+//   withdrawal above that depth. The model itself runs the whole insertion,
+//   so that its breakthrough of layer k is found even when a start value
+//   moves it far beyond the reference's. When d is tuned, a stage tunes the
+//   d of all calibrated layers together; a final joint stage (joint_polish)
+//   refines every tuned parameter of every calibrated layer on the whole
+//   objective (every term, dwell included).
+// Objective of a stage, summed over the references: sum of weight x value^2
+//   of the selected terms (the header of trajectory_objective.hpp).
 // Model runs: a copy of the scene with realtime.integrator =
-//   options.integrator (default "quasi_static"), no frames, dwell 0, a fast
-//   withdrawal (not compared), the damping effect off when the reference is
-//   quasi-static (reference_is_quasi_static: the FEM), the insertion speed of the reference (its
-//   metadata "speed_mm_per_s" if present, else the scene's), and a haptic rate
-//   raised so that one tick moves the needle at most objective_depth_step_m
-//   (sharper breakthrough depths; for the quasi-static mesh the tick rate does
-//   not change the force). The SH layer surfaces depend only on geometry and
-//   degree: they are fitted once per calibrate() call (SurfaceCache).
+//   options.integrator, no frames, the reference's trajectory (its insertion
+//   speed: metadata "speed_mm_per_s", else the scene's; its deepest depth;
+//   its dwell in the joint stage and the report; its withdrawal speed, or a
+//   fast withdrawal when it has none), the damping effect off when the
+//   reference is quasi-static (reference_is_quasi_static: the FEM), and a
+//   haptic rate raised so that one tick moves the needle at most
+//   objective_depth_step_m (sharper breakthrough depths). The SH layer
+//   surfaces depend only on geometry and degree: they are fitted once per
+//   calibrate() call (SurfaceCache).
 // A candidate whose run throws (e.g. a non-finite force) gets the objective
 //   kFailedObjective; it is counted, never returned as a result.
 #pragma once
@@ -61,6 +75,8 @@
 #include "puncture/scene.hpp"
 #include "puncture/sh/layer_surface.hpp"
 #include "puncture/validation/metrics.hpp"
+#include "puncture/validation/puncture_events.hpp"
+#include "puncture/validation/trajectory_objective.hpp"
 
 namespace puncture::io {
 class OutputSession;
@@ -83,21 +99,18 @@ enum class DampingPolicy { Auto, Fixed, Tune };
 
 struct TunedParameterSet {
   bool virtual_stiffness = true;   ///< K
-  bool deformed_threshold = true;  ///< ring deformation threshold
+  bool deformed_threshold = true;  ///< the breakthrough parameter: ring threshold, critical force or energy (by criterion)
+  bool cutting = true;             ///< cutting force (if the cutting effect is on)
+  bool friction = true;            ///< dynamic shaft friction (if the friction effect is on)
+  bool stiffening = true;          ///< tip stiffening coefficient (if the stiffening effect is on)
   bool surface_stiffness = false;  ///< k_s (needs a deflection profile to be identifiable)
   bool spacing = false;            ///< L (needs a deflection profile)
   bool rings = false;              ///< w (integer, enumerated)
   DampingPolicy damping = DampingPolicy::Auto;
 };
 
-/// Weights of the objective terms (see the header comment).
-struct CalibrationWeights {
-  double overall_rmse = 1.0;
-  double layer_rmse = 1.0;
-  double puncture_depth = 1.0;
-  double puncture_force = 1.0;
-  double missing_puncture = 1.0;
-};
+/// Weights of the objective terms (trajectory_objective.hpp).
+using CalibrationWeights = ObjectiveWeights;
 
 /// GSL gsl_siman schedule (temperatures in units of the starting objective,
 /// the energy is objective / objective at the start point).
@@ -122,11 +135,23 @@ struct CalibrationOptions {
   CalibrationWeights weights;
   double bound_factor = 3.0;        ///< each continuous parameter stays in [p0 / f, p0 f]
   int rings_search_radius = 1;
-  int max_evaluations_per_stage = 300;  ///< NLopt evaluation budget per stage and w (shared by restarts)
+  int max_evaluations_per_stage = 300;  ///< NLopt evaluation budget per stage and w (shared by restarts) ...
+  int evaluations_per_parameter = 250;  ///< ... raised to this many per tuned parameter of the stage
   double log_x_tolerance = 1e-4;    ///< NLopt xtol_abs in log space (1e-4 = 0.01 %)
   std::string integrator = "quasi_static";
   double objective_depth_step_m = 2e-6;  ///< breakthrough depth resolution of the objective's model runs
-  double depth_margin_m = 1e-3;     ///< stage range beyond the layer's reference puncture depth
+  double depth_margin_m = 1e-3;     ///< stage range beyond the layer's reference puncture depth when the reference ends there
+  /// Puncture depths of the (first) reference, one per layer from the top;
+  /// empty: from its state columns, else from its force drops.
+  std::vector<double> puncture_depths_m;
+  PunctureDetectionOptions detection;
+  /// Final stage over every tuned parameter of every calibrated layer on the
+  /// whole objective (when more than one layer or parameter kind is tuned).
+  bool joint_polish = true;
+  /// Sweeps of the per-layer stages; 0: two for layers in series
+  /// (Effects::layer_interaction: a layer's stiffness changes the pressing of
+  /// the layers above it, so the second sweep revisits them), else one.
+  int passes = 0;
   /// Start each layer's stage from the scene's values scaled to the first
   /// reference's pressing slope and breakthrough deflection (see calibration.cpp,
   /// scaled_start); the local optimiser then refines.
@@ -151,6 +176,28 @@ struct LayerParameters {
   double spacing_L_m = 0.0;
   double surface_stiffness_N_per_m = 0.0;
   double deformed_threshold_m = 0.0;
+  std::string breakthrough;        ///< "rings", "critical_force" or "critical_energy"
+  double critical_force_N = 0.0;
+  double critical_energy_J = 0.0;
+  double cutting_force_N = 0.0;
+  double friction_dynamic_N_per_m = 0.0;
+  double friction_static_N_per_m = 0.0;
+  double stiffening_quadratic_N_per_m2 = 0.0;
+  double stiffening_cubic_N_per_m3 = 0.0;
+  double stiffening_exponential_N_per_m = 0.0;
+};
+
+/// One tuned parameter in the result: start, tuned value and physical
+/// bounds in the units named by `unit`, and whether it ended at a bound.
+struct TunedParameterRecord {
+  std::string layer;
+  std::string name;       ///< e.g. "K", "critical_force", "cutting_force"
+  std::string unit;       ///< e.g. "N/mm"
+  double start = 0.0;     ///< the scene's value
+  double tuned = 0.0;
+  double lower = 0.0, upper = 0.0;
+  std::string at_bound;   ///< "", "lower" or "upper"
+  bool start_moved_inside = false;  ///< the scene's value lay outside the bounds
 };
 std::vector<LayerParameters> layer_parameters(const Scene& scene);
 
@@ -180,6 +227,11 @@ struct CalibrationResult {
   std::vector<LayerParameters> tuned;
   std::vector<CurveComparison> before;  ///< one per reference, full insertion phase
   std::vector<CurveComparison> after;
+  /// The whole-trajectory objective, term by term, per reference.
+  std::vector<TrajectoryComparison> trajectory_before, trajectory_after;
+  std::vector<ReferenceEvents> reference_events;  ///< per reference
+  std::vector<TunedParameterRecord> parameters;   ///< every tuned parameter
+  std::vector<std::string> warnings;              ///< puncture depths more than L apart, bounds, detection
   std::vector<InsertionCurve> model_before;  ///< the model curves those comparisons were made with
   std::vector<InsertionCurve> model_after;
   double objective_before = 0.0;        ///< sum of the stage objectives at the start values

@@ -1,11 +1,19 @@
 // calibration_report.hpp: the report files of `puncture calibrate` beside the
 // tuned preset (calibration.hpp writes the preset and its provenance).
 //
-// calibration_metrics_table(result): markdown table, per layer force RMSE and
-//   puncture-depth error before and after, against the first reference.
-// calibration_curves_csv(curves, provenance): curve,time_s,depth_mm,force_N
-//   rows of the insertion phase of each named curve (reference, before,
-//   after), with the provenance header; read by scripts/plot_calibration.py.
+// calibration_terms_table(result): markdown table of every objective term
+//   against the first reference, before and after ("n/a" where a term could
+//   not be computed), with its error, weight, reference samples and note, then
+//   a line stating the normalisation and the objective before and after.
+// calibration_punctures_table(result, scene): how the reference's punctures
+//   were found and, per layer, their depth (mm) and force (N) beside the
+//   calibrated model's; empty when there is no reference event.
+// calibration_parameters_table(result): every tuned parameter with its start,
+//   tuned value, physical bounds and whether it ended at one.
+// calibration_curves_csv(curves, provenance): curve,time_s,depth_mm,force_N,phase
+//   rows of the whole trajectory of each named curve (reference, before,
+//   after; phase insertion, dwell or withdrawal), with the provenance header;
+//   read by scripts/plot_calibration.py.
 #pragma once
 
 #include <string>
@@ -13,12 +21,17 @@
 #include <vector>
 
 #include "puncture/io/provenance.hpp"
+#include "puncture/scene.hpp"
 #include "puncture/validation/calibration.hpp"
 #include "puncture/validation/metrics.hpp"
 
 namespace puncture::validation {
 
-std::string calibration_metrics_table(const CalibrationResult& result);
+std::string calibration_terms_table(const CalibrationResult& result);
+
+std::string calibration_punctures_table(const CalibrationResult& result, const Scene& scene);
+
+std::string calibration_parameters_table(const CalibrationResult& result);
 
 std::string calibration_curves_csv(const std::vector<std::pair<std::string, const InsertionCurve*>>& curves,
                                    const io::Provenance& provenance);

@@ -8,26 +8,40 @@
 //     "# needle_gauge: 18", "# speed_mm_per_s: 10", "# source: ..."),
 //     kept in InsertionCurve::metadata; other lines starting with '#' are
 //     comments;
-//   * a header line; required columns time_s, depth_mm, velocity_mm_per_s,
-//     force_N (any order); optional columns <layer>_state with values
-//     untouched | pressed | punctured; every other column is ignored;
+//   * a header line; required columns depth_mm and force_N; optional
+//     columns time_s, velocity_mm_per_s, phase (insertion | dwell |
+//     withdrawal), tip_force_N + cutting_force_N + friction_force_N (the
+//     force's parts, all three or none), <layer>_state (untouched | pressed |
+//     punctured); every other column is ignored (any order);
 //   * one row per sample. Depth is the tip depth below the undeformed skin
 //     surface (positive down), velocity > 0 while inserting, force > 0 when
-//     it resists insertion.
+//     it resists insertion (negative on withdrawal: friction reverses).
+//   * Without a phase column the phase is inferred: samples up to the first
+//     deepest one are the insertion; after it, a sample at rest (velocity 0,
+//     or at the deepest depth when there is no velocity column) is dwell,
+//     the others withdrawal. Without time_s, time is the sample number (no
+//     dwell comparison then); without velocity_mm_per_s, the velocity is the
+//     metadata speed (else 1 mm/s) with the phase's sign. A curve of the
+//     older format (time, depth, velocity, force, states) thus reads as
+//     before: its insertion is what it always was, parts are n/a.
 // Every problem throws CurveFormatError naming file, line and column.
 //
 // Comparison (compare_curves, model against reference):
-//   * only the INSERTION phase is compared: samples with velocity > 0 up to
-//     the deepest sample; depths must not decrease in that phase (a repeated depth is a force drop at one instant);
+//   * only the INSERTION phase is compared: insertion samples with velocity
+//     > 0 (any, without a velocity column); depths must not decrease in that
+//     phase (a repeated depth is a force drop at one instant);
 //   * the model force is interpolated piecewise linearly at the reference
 //     depths; reference samples outside the model's depth range are skipped
 //     (CurveComparison::n_compared counts the ones used);
 //   * per layer (matched by name): the pressed interval is the depth range
-//     where the reference's <layer>_state is "pressed" (the model's states
-//     when the reference has none); force RMSE inside it (N, and relative to
-//     the reference peak force); the puncture event of a curve is the first
-//     insertion sample whose state is "punctured": its depth, and as its force
-//     the maximum force over that layer's pressed samples just before it.
+//     where the reference's <layer>_state is "pressed"; a reference without
+//     state columns has its punctures found from its force drops
+//     (puncture_events.hpp) and layer k's pressed interval is from the end of
+//     the cut through layer k - 1 (or the contact onset) to its puncture;
+//     force RMSE inside it (N, and relative to the reference peak force); the
+//     puncture event of a curve is the first insertion sample whose state is
+//     "punctured": its depth, and as its force the maximum force over that
+//     layer's pressed samples just before it.
 #pragma once
 
 #include <filesystem>
@@ -57,6 +71,10 @@ class CurveFormatError : public std::runtime_error {
   std::string column_;
 };
 
+/// Part of the trajectory a sample belongs to.
+enum class CurvePhase { Insertion, Dwell, Withdrawal };
+const char* to_string(CurvePhase phase);
+
 struct InsertionCurve {
   std::string source;                              ///< file name or a description
   std::string content_hash;                        ///< FNV-1a 64 of the file bytes (hex), empty if not from a file
@@ -67,9 +85,16 @@ struct InsertionCurve {
   std::vector<double> force_N;
   std::vector<std::string> layer_names;            ///< from the <layer>_state columns, file order
   std::vector<std::vector<LayerState>> layer_states;  ///< [layer][sample]
+  std::vector<CurvePhase> phase;                   ///< per sample (column or inferred, see the header)
+  /// The force's parts per sample (tip + cutting + friction = force); empty when the curve has none.
+  std::vector<double> tip_force_N, cutting_force_N, friction_force_N;
+  bool has_time = true;       ///< false: time_s is the sample number
+  bool has_velocity = true;   ///< false: velocity_m_per_s is inferred from the phase
+  bool phase_from_column = false;
 
   std::size_t size() const { return time_s.size(); }
   bool has_layer_states() const { return !layer_names.empty(); }
+  bool has_parts() const { return !tip_force_N.empty(); }
   /// Index into layer_names, or -1.
   int layer_index(const std::string& name) const;
   /// Metadata value as a number (throws CurveFormatError if present but not a number).
@@ -88,10 +113,17 @@ InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, 
 /// provenance lines (when given), the curve's metadata, then the table.
 std::string insertion_curve_csv(const InsertionCurve& curve, const io::Provenance* provenance = nullptr);
 
-/// Indices of the insertion-phase samples (velocity > 0, up to the deepest
-/// sample). Throws CurveFormatError (with the sample's time) if depth
-/// decreases there, or if the phase is empty.
+/// Indices of the insertion-phase samples (phase insertion and velocity > 0;
+/// any velocity without a velocity column). Throws CurveFormatError (with the
+/// sample's time) if depth decreases there, or if the phase is empty.
 std::vector<std::size_t> insertion_phase(const InsertionCurve& curve);
+/// Indices of the dwell samples (possibly none).
+std::vector<std::size_t> dwell_phase(const InsertionCurve& curve);
+/// Indices of the withdrawal samples (possibly none). Throws CurveFormatError
+/// if depth increases there.
+std::vector<std::size_t> withdrawal_phase(const InsertionCurve& curve);
+/// Fills curve.phase from the velocity (or the depth) as described in the header.
+void infer_phases(InsertionCurve& curve);
 
 /// Piecewise-linear interpolation y(x) on strictly increasing x; false if
 /// query lies outside [x.front(), x.back()].
@@ -128,9 +160,14 @@ struct CurveComparison {
   const LayerMetrics* layer(const std::string& name) const;
 };
 
+struct LayerGeometry;
 /// max_depth_m: compare only reference samples not deeper than this.
+/// geometry: the scene's layers (puncture_events.hpp), used for a reference
+/// without state columns to place the cut through each layer; without it
+/// layer k's pressed interval runs from the previous puncture.
 CurveComparison compare_curves(const InsertionCurve& model, const InsertionCurve& reference,
-                               double max_depth_m = std::numeric_limits<double>::infinity());
+                               double max_depth_m = std::numeric_limits<double>::infinity(),
+                               const std::vector<LayerGeometry>* geometry = nullptr);
 
 /// Puncture event of one layer on a curve (see the header comment).
 PunctureEventMetrics puncture_event(const InsertionCurve& curve, const std::string& layer);

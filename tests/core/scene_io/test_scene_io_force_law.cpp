@@ -1,0 +1,161 @@
+// The layer's force_law object, the force-law effects and the recovery time
+// in seconds: units converted once, round trip, and bad input named by file
+// and JSON path.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "puncture/scene_io.hpp"
+
+namespace puncture {
+namespace {
+
+using nlohmann::json;
+
+json default_json() {
+  std::ifstream in(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json");
+  return json::parse(in);
+}
+
+json with_force_law() {
+  json j = default_json();
+  j["layers"][0]["force_law"] = {
+      {"breakthrough", {{"criterion", "critical_force"}, {"critical_force_N", 1.5}}},
+      {"stiffening", {{"law", "polynomial"}, {"quadratic_N_per_mm2", 0.2}, {"cubic_N_per_mm3", 0.03}}},
+      {"cutting_force_N", 1.44},
+      {"cutting_release_mm", 0.05},
+      {"friction", {{"static_N_per_mm", 0.015}, {"dynamic_N_per_mm", 0.01}, {"velocity_band_mm_per_s", 0.2}}}};
+  j["layers"][1]["force_law"] = {{"breakthrough", {{"criterion", "critical_energy"}, {"critical_energy_mJ", 2.5}}},
+                                 {"stiffening", {{"law", "exponential"}, {"stiffness_N_per_mm", 0.3}, {"strain_scale_mm", 1.5}}}};
+  j["layers"][2]["force_law"] = {{"breakthrough", {{"criterion", "critical_force"}, {"critical_force_N", 2.0}}},
+                                 {"friction", {{"dynamic_N_per_mm", 0.02}}}};
+  j["effects"] = {"surface_force", "damping", "resumption", "cutting", "friction", "stiffening", "layer_interaction"};
+  return j;
+}
+
+std::string error_of(const json& j) {
+  try {
+    parse_scene(j.dump(), "bad.json");
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "scene was accepted";
+  return {};
+}
+
+TEST(SceneIoForceLaw, KeysAreReadInSiUnits) {
+  const Scene s = parse_scene(with_force_law().dump(), "force_law.json");
+  const ForceLaw& skin = s.layers[0].force_law;
+  EXPECT_EQ(skin.breakthrough.kind, BreakthroughCriterion::Kind::CriticalForce);
+  EXPECT_DOUBLE_EQ(skin.breakthrough.critical_force_N, 1.5);
+  EXPECT_EQ(skin.stiffening.kind, StiffeningLaw::Kind::Polynomial);
+  EXPECT_NEAR(skin.stiffening.quadratic_N_per_m2, 0.2e6, 1e-9);  // N/mm^2 -> N/m^2
+  EXPECT_NEAR(skin.stiffening.cubic_N_per_m3, 0.03e9, 1e-6);     // N/mm^3 -> N/m^3
+  EXPECT_DOUBLE_EQ(skin.cutting_force_N, 1.44);
+  EXPECT_NEAR(skin.cutting_release_m, 0.05e-3, 1e-18);
+  EXPECT_NEAR(skin.friction.static_N_per_m, 15.0, 1e-12);  // N/mm -> N/m
+  EXPECT_NEAR(skin.friction.dynamic_N_per_m, 10.0, 1e-12);
+  EXPECT_NEAR(skin.friction.velocity_band_m_per_s, 0.2e-3, 1e-18);
+  const ForceLaw& fat = s.layers[1].force_law;
+  EXPECT_EQ(fat.breakthrough.kind, BreakthroughCriterion::Kind::CriticalEnergy);
+  EXPECT_NEAR(fat.breakthrough.critical_energy_J, 2.5e-3, 1e-18);
+  EXPECT_EQ(fat.stiffening.kind, StiffeningLaw::Kind::Exponential);
+  EXPECT_NEAR(fat.stiffening.exponential_stiffness_N_per_m, 300.0, 1e-9);
+  EXPECT_NEAR(fat.stiffening.strain_scale_m, 1.5e-3, 1e-18);
+  // Static level defaults to the dynamic one; cutting to 0.
+  EXPECT_NEAR(s.layers[2].force_law.friction.static_N_per_m, 20.0, 1e-12);
+  EXPECT_EQ(s.layers[2].force_law.cutting_force_N, 0.0);
+  EXPECT_TRUE(s.effects.cutting && s.effects.friction && s.effects.stiffening && s.effects.layer_interaction);
+  EXPECT_FALSE(s.effects.surface_output);
+}
+
+TEST(SceneIoForceLaw, RoundTripKeepsEveryForceLawValue) {
+  const Scene a = parse_scene(with_force_law().dump(), "a.json");
+  const Scene b = parse_scene(scene_to_json_text(a), "b.json");
+  for (std::size_t i = 0; i < a.layers.size(); ++i) {
+    const ForceLaw &x = a.layers[i].force_law, &y = b.layers[i].force_law;
+    EXPECT_EQ(x.breakthrough.kind, y.breakthrough.kind);
+    EXPECT_DOUBLE_EQ(x.breakthrough.critical_force_N, y.breakthrough.critical_force_N);
+    EXPECT_DOUBLE_EQ(x.breakthrough.critical_energy_J, y.breakthrough.critical_energy_J);
+    EXPECT_EQ(x.stiffening.kind, y.stiffening.kind);
+    EXPECT_DOUBLE_EQ(x.stiffening.quadratic_N_per_m2, y.stiffening.quadratic_N_per_m2);
+    EXPECT_DOUBLE_EQ(x.stiffening.cubic_N_per_m3, y.stiffening.cubic_N_per_m3);
+    EXPECT_DOUBLE_EQ(x.stiffening.exponential_stiffness_N_per_m, y.stiffening.exponential_stiffness_N_per_m);
+    EXPECT_DOUBLE_EQ(x.stiffening.strain_scale_m, y.stiffening.strain_scale_m);
+    EXPECT_DOUBLE_EQ(x.cutting_force_N, y.cutting_force_N);
+    EXPECT_DOUBLE_EQ(x.cutting_release_m, y.cutting_release_m);
+    EXPECT_DOUBLE_EQ(x.friction.static_N_per_m, y.friction.static_N_per_m);
+    EXPECT_DOUBLE_EQ(x.friction.dynamic_N_per_m, y.friction.dynamic_N_per_m);
+    EXPECT_DOUBLE_EQ(x.friction.velocity_band_m_per_s, y.friction.velocity_band_m_per_s);
+    EXPECT_DOUBLE_EQ(a.layers[i].resumption_time_s, b.layers[i].resumption_time_s);
+  }
+  EXPECT_EQ(a.effects.cutting, b.effects.cutting);
+  EXPECT_EQ(a.effects.friction, b.effects.friction);
+  EXPECT_EQ(a.effects.stiffening, b.effects.stiffening);
+  EXPECT_EQ(a.effects.layer_interaction, b.effects.layer_interaction);
+}
+
+TEST(SceneIoForceLaw, RecoveryTimeInSecondsOrFromThePapersRate) {
+  json j = default_json();
+  j["realtime"]["haptic_rate_Hz"] = 500;
+  for (auto& l : j["layers"]) l.erase("resumption_time_s");
+  j["layers"][0]["resumption_rate"] = 0.05;  // per step at 500 Hz: 20 steps = 40 ms
+  j["layers"][1]["resumption_time_s"] = 0.1;
+  const Scene s = parse_scene(j.dump(), "rate.json");
+  EXPECT_NEAR(s.layers[0].resumption_time_s, 0.04, 1e-15);
+  EXPECT_NEAR(s.layers[1].resumption_time_s, 0.1, 1e-15);
+  // Changing the haptic rate afterwards does not change the recovery time.
+  Scene faster = s;
+  faster.realtime.haptic_rate_Hz = 4000;
+  EXPECT_NEAR(parse_scene(scene_to_json_text(faster), "faster.json").layers[0].resumption_time_s, 0.04, 1e-15);
+}
+
+struct BadForceLaw {
+  const char* name;
+  void (*mutate)(json&);
+  const char* expected_path;
+};
+
+const BadForceLaw kBad[] = {
+    {"unknown_criterion", [](json& j) { j["layers"][0]["force_law"]["breakthrough"]["criterion"] = "strain"; },
+     "/layers/0/force_law/breakthrough/criterion"},
+    {"zero_critical_force", [](json& j) { j["layers"][0]["force_law"]["breakthrough"]["critical_force_N"] = 0.0; },
+     "/layers/0/force_law/breakthrough/critical_force_N"},
+    {"negative_energy", [](json& j) { j["layers"][1]["force_law"]["breakthrough"]["critical_energy_mJ"] = -1.0; },
+     "/layers/1/force_law/breakthrough/critical_energy_mJ"},
+    {"negative_cutting", [](json& j) { j["layers"][0]["force_law"]["cutting_force_N"] = -0.1; },
+     "/layers/0/force_law/cutting_force_N"},
+    {"static_below_dynamic", [](json& j) { j["layers"][0]["force_law"]["friction"]["static_N_per_mm"] = 0.005; },
+     "/layers/0/force_law/friction/static_N_per_mm"},
+    {"zero_band", [](json& j) { j["layers"][0]["force_law"]["friction"]["velocity_band_mm_per_s"] = 0.0; },
+     "/layers/0/force_law/friction/velocity_band_mm_per_s"},
+    {"negative_quadratic", [](json& j) { j["layers"][0]["force_law"]["stiffening"]["quadratic_N_per_mm2"] = -0.1; },
+     "/layers/0/force_law/stiffening/quadratic_N_per_mm2"},
+    {"exponential_without_scale", [](json& j) { j["layers"][1]["force_law"]["stiffening"].erase("strain_scale_mm"); },
+     "/layers/1/force_law/stiffening/strain_scale_mm"},
+    {"unknown_law", [](json& j) { j["layers"][0]["force_law"]["stiffening"]["law"] = "ogden"; },
+     "/layers/0/force_law/stiffening/law"},
+    {"unknown_force_law_key", [](json& j) { j["layers"][0]["force_law"]["cuting_force_N"] = 1.0; },
+     "/layers/0/force_law/cuting_force_N"},
+    {"rings_below_with_interaction",
+     [](json& j) { j["layers"][2]["force_law"]["breakthrough"] = {{"criterion", "rings"}}; },
+     "/layers/2/force_law/breakthrough/criterion"},
+    {"zero_recovery_time", [](json& j) { j["layers"][1]["resumption_time_s"] = 0.0; }, "/layers/1/resumption_time_s"},
+};
+
+class SceneIoBadForceLaw : public ::testing::TestWithParam<BadForceLaw> {};
+
+TEST_P(SceneIoBadForceLaw, ErrorNamesFileAndJsonPath) {
+  json j = with_force_law();
+  GetParam().mutate(j);
+  const std::string msg = error_of(j);
+  EXPECT_NE(msg.find("bad.json: "), std::string::npos) << msg;
+  EXPECT_NE(msg.find(std::string(GetParam().expected_path) + ":"), std::string::npos) << msg;
+}
+
+INSTANTIATE_TEST_SUITE_P(AllCases, SceneIoBadForceLaw, ::testing::ValuesIn(kBad),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace puncture

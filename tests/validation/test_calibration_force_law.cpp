@@ -1,0 +1,357 @@
+// Calibration of the whole force law: references produced by the real-time
+// model with KNOWN parameters (stiffness, critical force, cutting, shaft
+// friction, tip stiffening; insertion, dwell and withdrawal); the
+// calibration starts from perturbed values and must find the known ones
+// again, with state columns and from a curve with depth and force only.
+// Also: the report shows every term ("n/a" where a term cannot be computed),
+// parameters at their bounds, given puncture depths, force-drop detection.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "puncture/scene_io.hpp"
+#include "puncture/validation/calibration.hpp"
+#include "puncture/validation/puncture_events.hpp"
+#include "puncture/validation/trajectory_objective.hpp"
+
+namespace pv = puncture::validation;
+using puncture::Scene;
+
+namespace {
+
+/// Two layers with the force law: critical-force breakthrough, cutting,
+/// Karnopp friction; quasi-static force mesh, 5 kHz tick (2 um of travel);
+/// insertion to 9 mm at 10 mm/s, 0.2 s dwell, withdrawal at 20 mm/s.
+/// interaction: the layers in series (then the force has no drop at the end
+/// of a cut, as in tissue, and force drops mark the punctures).
+Scene truth_scene(bool interaction) {
+  std::string json = R"({
+    "schema_version": 1, "name": "force_law_truth",
+    "sample": { "diameter_mm": 40.0 },
+    "needle": { "radius_mm": 0.635, "tip": "blunt" },
+    "layers": [
+      { "name": "skin", "thickness_mm": 1.5, "density_kg_per_m3": 1100,
+        "force_mesh": { "K_N_per_mm": 0.4, "w": 5, "L_mm": 1.5, "surface_stiffness_N_per_mm": 0.2,
+                        "deformed_threshold_mm": 0.01, "node_damping_N_s_per_m": 0.05 },
+        "damping_d_N_s_per_m2": 0, "resumption_time_s": 0.02,
+        "force_law": { "breakthrough": { "criterion": "critical_force", "critical_force_N": 1.2 },
+                       "cutting_force_N": 0.7,
+                       "friction": { "dynamic_N_per_mm": 0.03 } } },
+      { "name": "fat", "thickness_mm": 12.0, "density_kg_per_m3": 920,
+        "force_mesh": { "K_N_per_mm": 0.25, "w": 4, "L_mm": 1.0, "surface_stiffness_N_per_mm": 0.05,
+                        "deformed_threshold_mm": 0.15, "node_damping_N_s_per_m": 0.05 },
+        "damping_d_N_s_per_m2": 0, "resumption_time_s": 0.02,
+        "force_law": { "breakthrough": { "criterion": "critical_force", "critical_force_N": 1.0 },
+                       "cutting_force_N": 0.4,
+                       "friction": { "dynamic_N_per_mm": 0.015 } } }
+    ],
+    "insertion": { "start_height_mm": 0.5, "speed_mm_per_s": 10.0, "target_depth_mm": 9.0,
+                   "dwell_s": 0.2, "withdrawal_speed_mm_per_s": 20.0, "angle_deg": 0.0 },
+    "realtime": { "sh_degree": 8, "haptic_rate_Hz": 5000, "integrator": "quasi_static", "frame_rate_Hz": 10 },
+    "models": ["realtime"],
+    "effects": ["surface_force", "resumption", "cutting", "friction"EFFECTS]
+  })";
+  json.replace(json.find("EFFECTS"), 7, interaction ? ", \"layer_interaction\"" : "");
+  Scene s = puncture::parse_scene(json, "force_law_truth");
+  if (interaction) {
+    // A skin stiffer than the fat below it (its own compression stays below its thickness).
+    s.layers[0].force_mesh.virtual_stiffness_N_per_m = 2000.0;
+    s.layers[0].force_law.breakthrough.critical_force_N = 1.0;
+    s.layers[1].force_law.breakthrough.critical_force_N = 1.3;
+  }
+  return s;
+}
+
+struct Truth {
+  double K, Fc, cut, fric;
+};
+Truth truth_of(const Scene& s, std::size_t k) {
+  const auto& l = s.layers[k];
+  return {l.force_mesh.virtual_stiffness_N_per_m, l.force_law.breakthrough.critical_force_N, l.force_law.cutting_force_N,
+          l.force_law.friction.dynamic_N_per_m};
+}
+
+Scene perturbed(const Scene& truth) {
+  Scene s = truth;
+  const double f[2][4] = {{1.25, 0.85, 0.6, 1.6}, {0.8, 1.2, 1.5, 0.6}};
+  for (std::size_t k = 0; k < 2; ++k) {
+    auto& l = s.layers[k];
+    l.force_mesh.virtual_stiffness_N_per_m *= f[k][0];
+    l.force_law.breakthrough.critical_force_N *= f[k][1];
+    l.force_law.cutting_force_N *= f[k][2];
+    l.force_law.friction.dynamic_N_per_m *= f[k][3];
+    l.force_law.friction.static_N_per_m = l.force_law.friction.dynamic_N_per_m;
+  }
+  return s;
+}
+
+void expect_recovered(const Scene& tuned, const Scene& truth, double tolerance, const std::string& what) {
+  for (std::size_t k = 0; k < 2; ++k) {
+    const Truth t = truth_of(truth, k), g = truth_of(tuned, k);
+    EXPECT_NEAR(g.K / t.K, 1.0, tolerance) << what << " layer " << k << " K";
+    EXPECT_NEAR(g.Fc / t.Fc, 1.0, tolerance) << what << " layer " << k << " critical force";
+    EXPECT_NEAR(g.cut / t.cut, 1.0, tolerance) << what << " layer " << k << " cutting";
+    EXPECT_NEAR(g.fric / t.fric, 1.0, tolerance) << what << " layer " << k << " friction";
+  }
+}
+
+/// The curve as a measured CSV with depth and force only.
+pv::InsertionCurve depth_and_force_only(const pv::InsertionCurve& c) {
+  std::ostringstream csv;
+  csv << "# source: depth and force only\n# speed_mm_per_s: 10\ndepth_mm,force_N\n";
+  csv.precision(17);
+  for (std::size_t i = 0; i < c.size(); ++i) csv << c.depth_m[i] * 1e3 << ',' << c.force_N[i] << '\n';
+  return pv::parse_insertion_curve(csv.str(), "depth_force.csv");
+}
+
+}  // namespace
+
+TEST(CalibrationForceLaw, ReferenceShowsPressingCuttingFrictionDwellAndWithdrawal) {
+  const Scene truth = truth_scene(false);
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  ASSERT_TRUE(ref.has_parts());
+  EXPECT_TRUE(pv::puncture_event(ref, "skin").found);
+  EXPECT_TRUE(pv::puncture_event(ref, "fat").found);
+  double max_cut = 0.0, min_force = 0.0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    max_cut = std::max(max_cut, ref.cutting_force_N[i]);
+    min_force = std::min(min_force, ref.force_N[i]);
+    EXPECT_NEAR(ref.tip_force_N[i] + ref.cutting_force_N[i] + ref.friction_force_N[i], ref.force_N[i], 1e-12);
+  }
+  EXPECT_NEAR(max_cut, 0.7, 1e-12);
+  EXPECT_LT(min_force, -0.05);  // friction reversed on withdrawal
+  EXPECT_FALSE(pv::dwell_phase(ref).empty());
+  EXPECT_FALSE(pv::withdrawal_phase(ref).empty());
+}
+
+TEST(CalibrationForceLaw, RecoversStiffnessCriticalForceCuttingAndFrictionOfTwoLayers) {
+  const Scene truth = truth_scene(false);
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  const pv::CalibrationResult r = pv::calibrate(perturbed(truth), ref);
+  expect_recovered(r.tuned_scene, truth, 0.03, "with states");
+  EXPECT_LT(r.objective_after, 1e-3 * r.objective_before);
+  // Every tuned parameter is listed with its physical bounds; none ended at one.
+  EXPECT_EQ(r.parameters.size(), 8u);
+  for (const pv::TunedParameterRecord& p : r.parameters) {
+    EXPECT_TRUE(p.at_bound.empty()) << p.layer << " " << p.name;
+    EXPECT_LE(p.lower, p.tuned);
+    EXPECT_GE(p.upper, p.tuned);
+  }
+  ASSERT_EQ(r.reference_events.size(), 1u);
+  EXPECT_EQ(r.reference_events[0].source, pv::PunctureSource::StateColumns);
+  // After calibration the withdrawal and the dwell are matched too.
+  const pv::TrajectoryComparison& after = r.trajectory_after.front();
+  ASSERT_NE(after.term("withdrawal"), nullptr);
+  EXPECT_TRUE(after.term("withdrawal")->available);
+  EXPECT_LT(after.term("withdrawal")->value, 0.01);
+  EXPECT_TRUE(after.term("dwell")->available);
+  EXPECT_LT(after.term("dwell")->value, 0.01);
+  EXPECT_TRUE(after.term("cutting_force")->available);
+}
+
+TEST(CalibrationForceLaw, RecoversThemFromACurveWithDepthAndForceOnly) {
+  // The same reference with time, velocity, phases, parts and states all
+  // removed: the punctures come from its force drops (the drop at the end
+  // of the cut through the skin, where the force falls from the cutting
+  // plateau onto the fat's rise, is told apart from a puncture by the
+  // slopes around it), the withdrawal from its decreasing depth.
+  const Scene truth = truth_scene(false);
+  const pv::InsertionCurve full = pv::simulate_insertion_curve(truth);
+  const pv::InsertionCurve ref = depth_and_force_only(full);
+  ASSERT_FALSE(ref.has_layer_states());
+  ASSERT_FALSE(ref.has_parts());
+  ASSERT_FALSE(ref.has_time);
+  const pv::CalibrationResult r = pv::calibrate(perturbed(truth), ref);
+  ASSERT_EQ(r.reference_events.size(), 1u);
+  const pv::ReferenceEvents& ev = r.reference_events[0];
+  EXPECT_EQ(ev.source, pv::PunctureSource::ForceDrops);
+  EXPECT_EQ(ev.drops.size(), 2u);
+  for (const char* layer : {"skin", "fat"}) {
+    const std::size_t k = std::string(layer) == "skin" ? 0 : 1;
+    ASSERT_TRUE(ev.punctures[k].found) << layer;
+    EXPECT_NEAR(ev.punctures[k].depth_m, pv::puncture_event(full, layer).depth_m, 1e-9) << layer;
+    EXPECT_NEAR(ev.punctures[k].force_N, pv::puncture_event(full, layer).force_N, 1e-9) << layer;
+  }
+  expect_recovered(r.tuned_scene, truth, 0.03, "depth and force only");
+  // What a force-only curve cannot give is n/a, never 0.
+  const pv::TrajectoryComparison& after = r.trajectory_after.front();
+  for (const char* name : {"tip_force", "cutting_force", "friction_force", "dwell"}) {
+    const pv::ObjectiveTerm* t = after.term(name);
+    ASSERT_NE(t, nullptr) << name;
+    EXPECT_FALSE(t->available) << name;
+    EXPECT_FALSE(t->note.empty()) << name;
+  }
+  EXPECT_TRUE(after.term("withdrawal")->available);  // inferred from the decreasing depth
+}
+
+TEST(CalibrationForceLaw, LayersInSeriesFromDepthAndForceOnly) {
+  // Layers in series (the FEM's situation): no drop at the end of a cut.
+  // Here a layer's stiffness also shapes the pressing of the layers above
+  // it, which the second sweep of stages and the joint stage take up; the
+  // fit must come back to the truth's objective level and the punctures,
+  // cutting and friction close to the truth.
+  const Scene truth = truth_scene(true);
+  const pv::InsertionCurve full = pv::simulate_insertion_curve(truth);
+  const pv::InsertionCurve ref = depth_and_force_only(full);
+  pv::CalibrationOptions o;
+  o.evaluations_per_parameter = 150;
+  const pv::CalibrationResult r = pv::calibrate(perturbed(truth), std::vector<pv::ReferenceCurve>{{ref, "measured"}}, o);
+  EXPECT_EQ(r.reference_events[0].drops.size(), 2u);
+  EXPECT_LT(r.objective_after, 0.01 * r.objective_before);
+  const pv::TrajectoryComparison& after = r.trajectory_after.front();
+  for (const char* layer : {"skin", "fat"}) {
+    ASSERT_TRUE(after.term("puncture_depth", layer)->available) << layer;
+    EXPECT_LT(std::abs(after.term("puncture_depth", layer)->raw), 0.05e-3) << layer;
+    EXPECT_LT(std::abs(after.term("puncture_force", layer)->value), 0.03) << layer;
+  }
+  EXPECT_LT(after.term("overall")->value, 0.02);
+}
+
+TEST(CalibrationForceLaw, WarnsWhenPunctureDepthsDisagreeByMoreThanL) {
+  const Scene truth = truth_scene(false);
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  Scene off = truth;
+  off.layers[0].force_law.breakthrough.critical_force_N *= 3.0;  // the skin breaks much deeper
+  const pv::InsertionCurve model = pv::simulate_insertion_curve(off);
+  const auto geometry = pv::layer_geometry(truth);
+  const pv::TrajectoryComparison c = pv::compare_trajectory(model, ref, pv::reference_events(ref, geometry), geometry);
+  const pv::ObjectiveTerm* depth = c.term("puncture_depth", "skin");
+  ASSERT_NE(depth, nullptr);
+  ASSERT_TRUE(depth->available);
+  EXPECT_GT(std::abs(depth->raw), truth.layers[0].force_mesh.spacing_L_m);
+  bool warned = false;
+  for (const std::string& w : c.warnings) warned = warned || (w.find("skin") != std::string::npos && w.find("apart") != std::string::npos);
+  EXPECT_TRUE(warned);
+  // The objective is the weighted sum of the available terms.
+  double sum = 0.0;
+  for (const pv::ObjectiveTerm& t : c.terms) sum += t.available ? t.weight * t.value * t.value : 0.0;
+  EXPECT_NEAR(c.objective, sum, 1e-12 * sum);
+}
+
+TEST(CalibrationForceLaw, ParametersThatEndAtABoundAreReported) {
+  const Scene truth = truth_scene(false);
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  Scene start = truth;
+  start.layers[0].force_mesh.virtual_stiffness_N_per_m *= 2.0;  // the truth lies outside [K0 / 1.2, 1.2 K0]
+  pv::CalibrationOptions o;
+  o.layers = {"skin"};
+  o.bound_factor = 1.2;
+  o.parameters.cutting = o.parameters.friction = false;
+  o.scaled_start = false;
+  const pv::CalibrationResult r = pv::calibrate(start, ref, o);
+  const pv::TunedParameterRecord* K = nullptr;
+  for (const auto& p : r.parameters)
+    if (p.name == "K") K = &p;
+  ASSERT_NE(K, nullptr);
+  EXPECT_EQ(K->at_bound, "lower");
+  EXPECT_NEAR(K->tuned, K->lower, 1e-9 * K->lower);
+  EXPECT_NEAR(K->lower, 2.0 * 0.4 / 1.2, 1e-9);  // N/mm
+  bool warned = false;
+  for (const std::string& w : r.warnings) warned = warned || w.find("ended at its lower bound") != std::string::npos;
+  EXPECT_TRUE(warned);
+  // A start outside the physical range is moved inside and said so.
+  Scene tiny = truth;
+  tiny.layers[0].force_law.breakthrough.kind = puncture::BreakthroughCriterion::Kind::Rings;
+  tiny.layers[0].force_mesh.deformed_threshold_m = 0.2e-6;  // below 1 um
+  o.max_evaluations_per_stage = 20;
+  const pv::CalibrationResult r2 = pv::calibrate(tiny, ref, o);
+  bool moved = false;
+  for (const auto& p : r2.parameters) moved = moved || (p.name == "deformed_threshold" && p.start_moved_inside);
+  EXPECT_TRUE(moved);
+}
+
+TEST(CalibrationForceLaw, ProvenanceListsEveryTermWithNaAsNull) {
+  const Scene truth = truth_scene(false);
+  pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  pv::CalibrationOptions o;
+  o.layers = {"skin"};
+  o.max_evaluations_per_stage = 30;
+  const pv::ReferenceCurve reference{depth_and_force_only(ref), "measured"};
+  const pv::CalibrationResult r = pv::calibrate(perturbed(truth), std::vector<pv::ReferenceCurve>{reference}, o);
+  const nlohmann::json j = nlohmann::json::parse(pv::tuned_preset_provenance_json("p", r, {reference}, o));
+  const auto& terms = j.at("references").at(0).at("objective_terms_after").at("terms");
+  bool saw_null = false, saw_value = false;
+  for (const auto& t : terms) {
+    if (t.at("value").is_null()) {
+      saw_null = true;
+      EXPECT_FALSE(t.at("note").get<std::string>().empty());
+    } else {
+      saw_value = true;
+    }
+  }
+  EXPECT_TRUE(saw_null);
+  EXPECT_TRUE(saw_value);
+  EXPECT_EQ(j.at("references").at(0).at("reference_punctures").at("source"), "force drops");
+  EXPECT_TRUE(j.contains("tuned_parameters"));
+  EXPECT_TRUE(j.contains("warnings"));
+}
+
+TEST(PunctureEvents, GivenDepthsOverrideDetectionAndBadOnesAreRejected) {
+  const Scene truth = truth_scene(true);
+  const pv::InsertionCurve ref = depth_and_force_only(pv::simulate_insertion_curve(truth));
+  const auto geometry = pv::layer_geometry(truth);
+  const pv::ReferenceEvents ev = pv::reference_events(ref, geometry, {3e-3});
+  EXPECT_EQ(ev.source, pv::PunctureSource::GivenDepths);
+  EXPECT_TRUE(ev.punctures[0].found);
+  EXPECT_FALSE(ev.punctures[1].found);
+  EXPECT_NEAR(ev.punctures[0].depth_m, 3e-3, 1e-15);
+  EXPECT_THROW(pv::reference_events(ref, geometry, {3e-3, 2e-3}), std::invalid_argument);   // not increasing
+  EXPECT_THROW(pv::reference_events(ref, geometry, {50e-3}), std::invalid_argument);        // beyond the curve
+  EXPECT_THROW(pv::reference_events(ref, geometry, {1e-3, 2e-3, 3e-3}), std::invalid_argument);  // three for two layers
+}
+
+TEST(PunctureEvents, OkamuraFormCurveWithNoiseHasOneDrop) {
+  // Quadratic rise to 2.3 N at 16.65 mm, then 0.94 N cutting plus friction
+  // growing 0.01 N/mm (Okamura et al. 2004 form), sampled every 0.02 mm with
+  // +-5 mN deterministic noise: one puncture, at 16.66 mm with 2.3 N.
+  std::ostringstream csv;
+  csv << "depth_mm,force_N\n";
+  for (int i = 0; i <= 1500; ++i) {
+    const double d = 0.02 * i;
+    const double noise = 0.005 * std::sin(12.9898 * i) * std::cos(78.233 * i);
+    const double f = d <= 16.65 + 1e-9 ? 2.3 * (d / 16.65) * (d / 16.65) : 0.94 + 0.01 * (d - 16.65);
+    csv << d << ',' << f + noise << '\n';
+  }
+  const pv::InsertionCurve c = pv::parse_insertion_curve(csv.str(), "okamura.csv");
+  const std::vector<pv::ForceDrop> drops = pv::detect_force_drops(c);
+  ASSERT_EQ(drops.size(), 1u);
+  EXPECT_NEAR(drops[0].depth_m, 16.66e-3, 1e-9);
+  EXPECT_NEAR(drops[0].peak_force_N, 2.3, 0.01);
+  EXPECT_NEAR(drops[0].drop_N, 2.3 - 0.94, 0.02);
+}
+
+TEST(InsertionCurveFormat, NewFemColumnsAndTheOlderFormat) {
+  // The new FEM file: parts, phases, two rows at the puncture depth.
+  const std::string fem =
+      "time_s,depth_mm,velocity_mm_per_s,force_N,tip_force_N,cutting_force_N,friction_force_N,tip_stretch,phase,skin_state\n"
+      "0.0,0.0,10,0.0,0.0,0,0,1.0,insertion,pressed\n"
+      "0.1,1.0,10,1.5,1.5,0,0,1.2,insertion,pressed\n"
+      "0.1,1.0,10,0.8,0.0,0.8,0,1.0,insertion,punctured\n"
+      "0.2,2.0,10,0.85,0.0,0.8,0.05,1.0,insertion,punctured\n"
+      "0.3,2.0,0,0.85,0.0,0.8,0.05,1.0,dwell,punctured\n"
+      "0.4,1.0,-10,-0.03,0.0,0,-0.03,1.0,withdrawal,punctured\n"
+      "0.5,0.0,-10,0.0,0.0,0,0,1.0,withdrawal,punctured\n";
+  const pv::InsertionCurve c = pv::parse_insertion_curve(fem, "fem_force_depth.csv");
+  ASSERT_TRUE(c.has_parts());
+  EXPECT_TRUE(c.phase_from_column);
+  EXPECT_EQ(pv::insertion_phase(c).size(), 4u);
+  EXPECT_EQ(pv::dwell_phase(c).size(), 1u);
+  EXPECT_EQ(pv::withdrawal_phase(c).size(), 2u);
+  EXPECT_DOUBLE_EQ(c.cutting_force_N[2], 0.8);
+  EXPECT_TRUE(pv::puncture_event(c, "skin").found);
+  // The older format: no parts, no phase: insertion only, parts n/a.
+  const std::string old =
+      "time_s,depth_mm,velocity_mm_per_s,force_N,skin_state\n"
+      "0.0,0.0,10,0.0,pressed\n0.1,1.0,10,1.5,pressed\n0.1,1.0,10,0.8,punctured\n0.2,2.0,10,0.85,punctured\n";
+  const pv::InsertionCurve o = pv::parse_insertion_curve(old, "old.csv");
+  EXPECT_FALSE(o.has_parts());
+  EXPECT_EQ(pv::insertion_phase(o).size(), 4u);
+  EXPECT_TRUE(pv::withdrawal_phase(o).empty());
+  EXPECT_TRUE(pv::dwell_phase(o).empty());
+  // Round trip of the new columns through the writer.
+  const pv::InsertionCurve back = pv::parse_insertion_curve(pv::insertion_curve_csv(c), "again.csv");
+  EXPECT_EQ(back.friction_force_N, c.friction_force_N);
+  EXPECT_EQ(back.phase, c.phase);
+}

@@ -1,0 +1,114 @@
+// puncture_events.hpp: where the layers of a reference curve break, and the
+// depth segments of an insertion that belong to each layer.
+//
+// Sources of a reference's punctures, in order of preference:
+//   * given depths (the user knows them: `puncture calibrate --puncture-depths`),
+//     one per layer from the top; the force is the largest insertion force
+//     within the detection window before the depth;
+//   * <layer>_state columns: the first insertion sample whose state is
+//     punctured (puncture_event in metrics.hpp);
+//   * force drops (a measured curve with depth and force only,
+//     detect_force_drops): a local maximum F_p of the insertion force after
+//     which the force falls by at least max(min_drop_fraction F_p,
+//     min_drop_of_peak x the curve's peak) by the next sample or before the
+//     tip has advanced window_m beyond it (and before it rises above F_p
+//     again; the next sample counts however coarse the sampling), and at
+//     which a stiff rise gives way to a softer course: the force's slope
+//     over slope_window_m before the maximum exceeds its slope over
+//     slope_window_m after the drop (least-squares lines). A puncture ends
+//     the pressing of a layer and leaves cutting and friction; a cut that
+//     ends on an unloaded layer below (a model without layer interaction)
+//     also drops the force, but from a plateau onto a new rise. The drop's
+//     depth is that of the first sample after the maximum (as a state column
+//     would mark it), its force F_p. Candidates closer than window_m are
+//     merged (the larger drop wins). With more drops than layers the largest
+//     drops are kept (in depth order); the k-th drop is layer k's puncture.
+//
+// Layer segments (layer_segments), from the reference's puncture depths P_k
+// and the scene's layer geometry (top depth, thickness t_k, bottom b_k):
+//   pressing k:  [start_k, P_k)  with start_0 = the contact onset (first
+//                insertion sample pressed, or above 1 % of the peak force
+//                without states) and start_k = end of after_(k-1);
+//                to the deepest sample if layer k has no puncture;
+//   after k:     [P_k, E_k) where the tip cuts through layer k (cutting and
+//                friction): E_k = b_k when the puncture is above the layer's
+//                bottom, else P_k + t_k (a thin layer pressed deeper than its
+//                thickness is cut through from where it broke), at most the
+//                next puncture and the deepest sample; with the force's
+//                parts, at most where the reference's tip force is back
+//                above 0 (ReferenceEvents::cut_end_m). compare_trajectory
+//                also ends it where the model's tip meets the next layer
+//                when the reference has no parts.
+// A layer the reference does not reach has neither segment.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "puncture/scene.hpp"
+#include "puncture/validation/metrics.hpp"
+
+namespace puncture::validation {
+
+struct PunctureDetectionOptions {
+  double min_drop_fraction = 0.1;  ///< a drop is at least this fraction of the force at its maximum
+  double min_drop_of_peak = 0.02;  ///< and at least this fraction of the curve's peak force
+  double window_m = 0.25e-3;       ///< the drop happens within this much further insertion (m)
+  double slope_window_m = 0.3e-3;  ///< depth range of the slopes before the maximum and after the drop (m)
+  double onset_fraction = 0.01;    ///< contact onset: first force above this fraction of the peak (no states)
+};
+
+struct ForceDrop {
+  std::size_t index = 0;    ///< curve sample of the maximum
+  double depth_m = 0.0;     ///< depth of the first sample after the maximum
+  double peak_force_N = 0.0;
+  double drop_N = 0.0;
+};
+
+/// Every force drop of the insertion phase that passes the thresholds, in depth order.
+std::vector<ForceDrop> detect_force_drops(const InsertionCurve& curve, const PunctureDetectionOptions& options = {});
+
+enum class PunctureSource { GivenDepths, StateColumns, ForceDrops };
+const char* to_string(PunctureSource source);
+
+struct LayerGeometry {
+  std::string name;
+  double top_depth_m = 0.0;
+  double thickness_m = 0.0;
+  double spacing_L_m = 0.0;  ///< the layer's force-mesh spacing (puncture-depth accuracy)
+};
+std::vector<LayerGeometry> layer_geometry(const Scene& scene);
+
+/// A reference's punctures, one entry per layer (top first).
+struct ReferenceEvents {
+  PunctureSource source = PunctureSource::ForceDrops;
+  std::vector<PunctureEventMetrics> punctures;  ///< per layer of the geometry
+  bool has_contact_onset = false;
+  double contact_onset_m = 0.0;
+  double deepest_m = 0.0;                       ///< deepest insertion sample
+  std::vector<ForceDrop> drops;                 ///< every candidate drop found (ForceDrops source)
+  /// Per layer: where the cut through it ends (the first insertion sample
+  /// after its puncture whose tip force is > 0: the tip presses the next
+  /// layer); NaN when the curve has no part columns or the tip never does.
+  std::vector<double> cut_end_m;
+  std::string note;                             ///< how they were found, for reports
+};
+
+/// given_depths_m: empty, or one depth per layer from the top (fewer: the
+/// layers below are not punctured). Throws std::invalid_argument for given
+/// depths that do not increase or lie outside the insertion.
+ReferenceEvents reference_events(const InsertionCurve& reference, const std::vector<LayerGeometry>& layers,
+                                 const std::vector<double>& given_depths_m = {},
+                                 const PunctureDetectionOptions& options = {});
+
+struct LayerSegments {
+  bool has_pressing = false;
+  double pressing_from_m = 0.0, pressing_to_m = 0.0;
+  bool has_after = false;
+  double after_from_m = 0.0, after_to_m = 0.0;
+};
+/// One entry per layer (see the header comment).
+std::vector<LayerSegments> layer_segments(const ReferenceEvents& events, const std::vector<LayerGeometry>& layers);
+
+}  // namespace puncture::validation

@@ -1,0 +1,197 @@
+#include "puncture/validation/puncture_events.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace puncture::validation {
+
+const char* to_string(PunctureSource source) {
+  switch (source) {
+    case PunctureSource::GivenDepths: return "given depths";
+    case PunctureSource::StateColumns: return "state columns";
+    case PunctureSource::ForceDrops: return "force drops";
+  }
+  return "unknown";
+}
+
+std::vector<LayerGeometry> layer_geometry(const Scene& scene) {
+  std::vector<LayerGeometry> out;
+  for (std::size_t k = 0; k < scene.layers.size(); ++k)
+    out.push_back({scene.layers[k].name, scene.layer_top_depth_m(k), scene.layers[k].thickness_m,
+                   scene.layers[k].force_mesh.spacing_L_m});
+  return out;
+}
+
+namespace {
+
+/// Least-squares slope of force against depth over the insertion samples
+/// from phase[from] going in `direction` (-1 back, +1 forward) over `window`
+/// of depth (at least two samples besides the first); NaN if fewer than
+/// three distinct depths.
+double slope(const InsertionCurve& c, const std::vector<std::size_t>& phase, std::size_t from, int direction,
+             double window) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int n = 0;
+  const double d0 = c.depth_m[phase[from]];
+  for (long q = static_cast<long>(from); q >= 0 && q < static_cast<long>(phase.size()); q += direction) {
+    const double x = c.depth_m[phase[static_cast<std::size_t>(q)]] - d0;
+    if (std::abs(x) > window && n >= 3) break;
+    const double y = c.force_N[phase[static_cast<std::size_t>(q)]];
+    sx += x, sy += y, sxx += x * x, sxy += x * y, ++n;
+  }
+  const double den = n * sxx - sx * sx;
+  if (n < 3 || !(den > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return (n * sxy - sx * sy) / den;
+}
+
+}  // namespace
+
+std::vector<ForceDrop> detect_force_drops(const InsertionCurve& curve, const PunctureDetectionOptions& o) {
+  const std::vector<std::size_t> phase = insertion_phase(curve);
+  double peak = 0.0;
+  for (std::size_t i : phase) peak = std::max(peak, std::abs(curve.force_N[i]));
+  std::vector<ForceDrop> found;
+  for (std::size_t p = 0; p + 1 < phase.size(); ++p) {
+    const double f = curve.force_N[phase[p]];
+    if (p > 0 && curve.force_N[phase[p - 1]] > f) continue;  // not a maximum
+    if (!(curve.force_N[phase[p + 1]] < f)) continue;          // no fall right after it
+    // The sample right after the maximum counts whatever the sampling; later
+    // ones while the tip is within the window.
+    double lowest = curve.force_N[phase[p + 1]];
+    std::size_t lowest_at = p + 1;
+    for (std::size_t q = p + 2; q < phase.size(); ++q) {
+      if (curve.depth_m[phase[q]] > curve.depth_m[phase[p + 1]] + o.window_m) break;
+      if (curve.force_N[phase[q]] > f) break;  // rose above the maximum again
+      if (curve.force_N[phase[q]] < lowest) lowest = curve.force_N[phase[q]], lowest_at = q;
+    }
+    const double drop = f - lowest;
+    if (!(drop >= o.min_drop_fraction * std::abs(f) && drop >= o.min_drop_of_peak * peak && drop > 0.0)) continue;
+    // A stiff rise before it, a softer course after it (see the header).
+    const double before = slope(curve, phase, p, -1, o.slope_window_m);
+    const double after = slope(curve, phase, lowest_at, +1, o.slope_window_m);
+    if (std::isfinite(before) && std::isfinite(after) && !(before > after)) continue;
+    const ForceDrop d{phase[p], curve.depth_m[phase[p + 1]], f, drop};
+    if (!found.empty() && d.depth_m - found.back().depth_m <= o.window_m) {
+      if (d.drop_N > found.back().drop_N) found.back() = d;  // one drop seen twice: keep the larger
+      continue;
+    }
+    found.push_back(d);
+  }
+  return found;
+}
+
+ReferenceEvents reference_events(const InsertionCurve& reference, const std::vector<LayerGeometry>& layers,
+                                 const std::vector<double>& given, const PunctureDetectionOptions& o) {
+  ReferenceEvents ev;
+  ev.punctures.resize(layers.size());
+  const std::vector<std::size_t> phase = insertion_phase(reference);
+  double peak = 0.0;
+  ev.deepest_m = reference.depth_m[phase.front()];
+  for (std::size_t i : phase) {
+    peak = std::max(peak, std::abs(reference.force_N[i]));
+    ev.deepest_m = std::max(ev.deepest_m, reference.depth_m[i]);
+  }
+  std::ostringstream note;
+  if (!given.empty()) {
+    ev.source = PunctureSource::GivenDepths;
+    if (given.size() > layers.size())
+      throw std::invalid_argument("puncture depths: " + std::to_string(given.size()) + " given for " +
+                                  std::to_string(layers.size()) + " layers");
+    for (std::size_t k = 0; k < given.size(); ++k) {
+      const double d = given[k];
+      if (!std::isfinite(d) || d <= reference.depth_m[phase.front()] || d > ev.deepest_m)
+        throw std::invalid_argument("puncture depth " + std::to_string(d * 1e3) + " mm of layer '" + layers[k].name +
+                                    "' lies outside the reference's insertion");
+      if (k > 0 && !(d > given[k - 1]))
+        throw std::invalid_argument("puncture depths must increase from the top layer down");
+      PunctureEventMetrics& e = ev.punctures[k];
+      e.found = true;
+      e.depth_m = d;
+      e.force_N = -std::numeric_limits<double>::infinity();
+      for (std::size_t i : phase)
+        if (reference.depth_m[i] <= d && reference.depth_m[i] >= d - o.window_m) e.force_N = std::max(e.force_N, reference.force_N[i]);
+      if (!std::isfinite(e.force_N)) e.force_N = 0.0;
+    }
+    note << given.size() << " puncture depth(s) given";
+  } else if (reference.has_layer_states()) {
+    ev.source = PunctureSource::StateColumns;
+    for (std::size_t k = 0; k < layers.size(); ++k) ev.punctures[k] = puncture_event(reference, layers[k].name);
+    note << "punctures from the <layer>_state columns";
+  } else {
+    ev.source = PunctureSource::ForceDrops;
+    ev.drops = detect_force_drops(reference, o);
+    std::vector<ForceDrop> kept = ev.drops;
+    if (kept.size() > layers.size()) {
+      std::sort(kept.begin(), kept.end(), [](const ForceDrop& a, const ForceDrop& b) { return a.drop_N > b.drop_N; });
+      kept.resize(layers.size());
+      std::sort(kept.begin(), kept.end(), [](const ForceDrop& a, const ForceDrop& b) { return a.depth_m < b.depth_m; });
+    }
+    for (std::size_t k = 0; k < kept.size(); ++k) ev.punctures[k] = {true, kept[k].depth_m, kept[k].peak_force_N};
+    note << ev.drops.size() << " force drop(s) found (>= " << 100.0 * o.min_drop_fraction << " % of the force and >= "
+         << 100.0 * o.min_drop_of_peak << " % of the peak within " << o.window_m * 1e3 << " mm)";
+    if (ev.drops.size() > kept.size()) note << "; the " << kept.size() << " largest kept";
+    note << "; no state columns";
+  }
+  ev.note = note.str();
+
+  // Where each cut ends: the tip force back above 0 after the puncture.
+  ev.cut_end_m.assign(layers.size(), std::numeric_limits<double>::quiet_NaN());
+  if (reference.has_parts())
+    for (std::size_t k = 0; k < layers.size(); ++k) {
+      if (!ev.punctures[k].found) continue;
+      bool after = false;
+      for (std::size_t i : phase) {
+        if (reference.depth_m[i] < ev.punctures[k].depth_m) continue;
+        if (!after) {  // skip the samples up to the drop itself
+          after = reference.tip_force_N[i] <= 1e-12 * std::max(1.0, peak);
+          continue;
+        }
+        if (reference.tip_force_N[i] > 1e-12 * std::max(1.0, peak)) {
+          ev.cut_end_m[k] = reference.depth_m[i];
+          break;
+        }
+      }
+    }
+
+  // Contact onset: the top layer first pressed, else the force first above a fraction of the peak.
+  const int top = !layers.empty() ? reference.layer_index(layers.front().name) : -1;
+  for (std::size_t i : phase) {
+    const bool pressed = top >= 0 ? reference.layer_states[static_cast<std::size_t>(top)][i] != LayerState::Untouched
+                                  : std::abs(reference.force_N[i]) > o.onset_fraction * peak;
+    if (pressed) {
+      ev.has_contact_onset = true;
+      ev.contact_onset_m = reference.depth_m[i];
+      break;
+    }
+  }
+  return ev;
+}
+
+std::vector<LayerSegments> layer_segments(const ReferenceEvents& ev, const std::vector<LayerGeometry>& layers) {
+  std::vector<LayerSegments> out(layers.size());
+  if (!ev.has_contact_onset) return out;
+  double start = ev.contact_onset_m;
+  for (std::size_t k = 0; k < layers.size(); ++k) {
+    LayerSegments& s = out[k];
+    const PunctureEventMetrics& p = ev.punctures[k];
+    if (start >= ev.deepest_m) break;  // the reference does not reach this layer
+    s.has_pressing = true;
+    s.pressing_from_m = start;
+    s.pressing_to_m = p.found ? p.depth_m : ev.deepest_m;
+    if (!p.found) break;
+    const double bottom = layers[k].top_depth_m + layers[k].thickness_m;
+    double end = p.depth_m < bottom ? bottom : p.depth_m + layers[k].thickness_m;
+    if (k < ev.cut_end_m.size() && std::isfinite(ev.cut_end_m[k])) end = std::min(end, ev.cut_end_m[k]);
+    if (k + 1 < layers.size() && ev.punctures[k + 1].found) end = std::min(end, ev.punctures[k + 1].depth_m);
+    end = std::min(end, ev.deepest_m);
+    s.has_after = end > p.depth_m;
+    s.after_from_m = p.depth_m;
+    s.after_to_m = std::max(end, p.depth_m);
+    start = s.after_to_m;
+  }
+  return out;
+}
+
+}  // namespace puncture::validation
