@@ -56,6 +56,26 @@ TEST(CohesiveLaw, WorkOfSeparationIsTheToughnessInEveryMode) {
   }
 }
 
+TEST(CohesiveLaw, DissipationIsWorkLessStoredEnergyAtEveryStageAndNeverExceedsTheToughness) {
+  // Halfway along the softening branch the dissipated energy is the work done
+  // so far less the energy still stored in the damaged spring (0.5 t lambda);
+  // a single huge viscous step (damage jumps to 1 at 10 x the failure
+  // separation) dissipates exactly G_c, not 0.5 K0 lambda^2.
+  CohesiveLawParameters p = skin_law();
+  for (double frac : {0.3, 0.6, 0.9}) {
+    const double s_end = p.onset_separation_m() + frac * (p.failure_separation_m() - p.onset_separation_m());
+    const auto [work, dissipated] = work_along_path(p, 0.0, s_end, 20000);
+    const CohesiveResponse r = cohesive_response(p, CohesiveHistory{}, s_end, 0.0, 0.0);
+    EXPECT_NEAR(dissipated, work - 0.5 * r.traction[0] * s_end, 1e-3 * p.toughness_J_per_m2) << frac;
+  }
+  p.viscosity_s = 1e-3;
+  const CohesiveResponse big = cohesive_response(p, CohesiveHistory{}, 10 * p.failure_separation_m(), 0.0, 1.0);
+  EXPECT_GT(big.history.damage, 0.99);
+  EXPECT_LE(big.history.dissipated_J_per_m2, p.toughness_J_per_m2 * (1 + 1e-12));
+  EXPECT_NEAR(bilinear_dissipation_J_per_m2(p, 1.0), p.toughness_J_per_m2, 1e-9 * p.toughness_J_per_m2);
+  EXPECT_EQ(bilinear_dissipation_J_per_m2(p, 0.0), 0.0);
+}
+
 TEST(CohesiveLaw, PeakTractionIsTheStrengthAtOnset) {
   const CohesiveLawParameters p = skin_law();
   const CohesiveResponse r = cohesive_response(p, {}, p.onset_separation_m(), 0.0, 0.0);

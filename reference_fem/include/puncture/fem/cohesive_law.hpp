@@ -82,6 +82,23 @@ inline double bilinear_damage(const CohesiveLawParameters& p, double lambda_max,
   return df * (lambda_max - d0) / (lambda_max * (df - d0));
 }
 
+/// Energy per unit area the rate-independent bilinear law has dissipated when
+/// its damage is D (J/m^2): the area under the law up to the separation
+/// lambda(D) at which it reaches D, less the energy still stored,
+/// 0.5 (1 - D) K0 lambda^2. Phi(0) = 0, Phi(1) = G_c, increasing. A state
+/// function of D, so the crack's dissipation never exceeds G_c per unit area
+/// whatever the step (the viscous regularisation's own dissipation is not
+/// fracture energy and is not counted).
+inline double bilinear_dissipation_J_per_m2(const CohesiveLawParameters& p, double D) {
+  D = std::clamp(D, 0.0, 1.0);
+  if (D <= 0.0) return 0.0;
+  const double d0 = p.onset_separation_m(), df = p.failure_separation_m(), sc = p.strength_Pa;
+  const double lambda = df * d0 / (df - D * (df - d0));  // inverse of bilinear_damage
+  const double x = (df - lambda) / (df - d0);
+  const double area = 0.5 * sc * d0 + 0.5 * sc * (df - d0) * (1.0 - x * x);
+  return area - 0.5 * (1.0 - D) * p.initial_stiffness_Pa_per_m() * lambda * lambda;
+}
+
 /// Evaluates the law at separation (delta_n, delta_t) from the committed
 /// history over a step of dt seconds.
 inline CohesiveResponse cohesive_response(const CohesiveLawParameters& p, const CohesiveHistory& committed,
@@ -103,8 +120,7 @@ inline CohesiveResponse cohesive_response(const CohesiveLawParameters& p, const 
   }
   D = std::clamp(std::max(D, committed.damage), 0.0, 1.0);
   r.history.damage = D;
-  r.history.dissipated_J_per_m2 =
-      committed.dissipated_J_per_m2 + 0.5 * K0 * lambda * lambda * std::max(D - committed.damage, 0.0);
+  r.history.dissipated_J_per_m2 = bilinear_dissipation_J_per_m2(p, D);
   const double s = (1.0 - D) * K0;
   r.traction[0] = delta_n > 0.0 ? s * delta_n : K0 * delta_n;
   r.traction[1] = s * delta_t;
