@@ -109,3 +109,31 @@ TEST(AxisymmetricInsertion, WithoutFrictionTheWithdrawalForceIsNeverNegative) {
   ASSERT_GE(r.punctures.size(), 1u);
   EXPECT_EQ(r.punctures[0].layer_name, "skin");
 }
+
+TEST(AxisymmetricInsertion, HardCasesConvergeOrStopWithAClearErrorAndNeverNaN) {
+  // Very brittle and very tough skin (G_c 1 and 30 000 J/m^2), nearly
+  // incompressible (nu 0.499), on the small slab to 4 mm and back. Either the
+  // run completes with finite values (the brittle skin punctures) or it stops
+  // with an error that says where and why.
+  for (const double gc : {1.0, 30000.0}) {
+    Scene s = small_default_scene();
+    s.layers[0].puncture.toughness_J_per_m2 = gc;
+    for (auto& l : s.layers) l.material.poisson_ratio = 0.499;
+    s.insertion.target_depth_m = 4e-3;
+    try {
+      const FemRunSummary r = run_needle_insertion(s, quiet(), MPI_COMM_WORLD);
+      for (std::size_t k = 0; k < r.force_N.size(); ++k)
+        ASSERT_TRUE(std::isfinite(r.force_N[k]) && std::isfinite(r.friction_force_N[k])) << "G_c " << gc << " row " << k;
+      if (gc == 1.0) {
+        ASSERT_GE(r.punctures.size(), 1u) << "brittle skin punctures";
+        EXPECT_EQ(r.punctures[0].layer_name, "skin");
+        EXPECT_LT(r.punctures[0].force_N, 0.5) << "a brittle skin breaks early";
+      }
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("no convergence"), std::string::npos) << what;
+      EXPECT_NE(what.find("mm"), std::string::npos) << "names the depth: " << what;
+      EXPECT_NE(gc, 1.0) << "the brittle case should complete: " << what;
+    }
+  }
+}
