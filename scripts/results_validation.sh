@@ -2,6 +2,7 @@
 # Regenerates the committed validation results of the default scene:
 #   results/validation_default/  puncture validate: the default (Table 2) real-time
 #                                model against the FEM reference
+#   results/fem_vs_literature.md the FEM reference's numbers beside the measurements
 #   results/tuned_preset/        puncture calibrate: tuned preset of the Table 2 slab,
 #                                provenance, before/after plot, wall time
 #   results/validation_tuned/    puncture validate of the tuned preset
@@ -19,6 +20,9 @@ cd "$root"
 export OMPI_ALLOW_RUN_AS_ROOT="${OMPI_ALLOW_RUN_AS_ROOT:-1}" OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="${OMPI_ALLOW_RUN_AS_ROOT_CONFIRM:-1}"
 mpi=(mpirun --oversubscribe -np "$ranks")
 "${mpi[@]}" "$build/apps/puncture" validate scenes/default.json -o results/validation_default
+# The FEM reference beside the measurements (from the cached FEM run just used).
+fem_dir="$(ls -td out/.fem_cache/*/ | head -1)"
+"${PYTHON:-$(command -v /usr/bin/python3 || command -v python3)}" scripts/fem_vs_literature.py "${fem_dir%/}" scenes/default.json results/fem_vs_literature.md
 "$build/apps/puncture" calibrate scenes/default.json -o results/tuned_preset --name default_tuned --also-tune surface_stiffness
 "${mpi[@]}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json -o results/validation_tuned
 "$build/apps/puncture" sweep results/tuned_preset/default_tuned.json --no-fem-knobs -o results/accuracy_cost

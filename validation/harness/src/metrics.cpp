@@ -43,7 +43,9 @@ bool parse_state(const std::string& text, LayerState& state) {
 }
 
 bool parse_phase(const std::string& text, CurvePhase& phase) {
-  if (text == "insertion") phase = CurvePhase::Insertion;
+  // "approach": the FEM's needle moving down before it touches; it is part of
+  // the insertion stroke.
+  if (text == "insertion" || text == "approach") phase = CurvePhase::Insertion;
   else if (text == "dwell") phase = CurvePhase::Dwell;
   else if (text == "withdrawal") phase = CurvePhase::Withdrawal;
   else return false;
@@ -147,7 +149,7 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
       CurvePhase ph;
       const std::string& f = fields[static_cast<std::size_t>(col_phase)];
       if (!parse_phase(f, ph))
-        throw CurveFormatError(source_name, line_no, "phase", "phase must be insertion, dwell or withdrawal (got '" + f + "')");
+        throw CurveFormatError(source_name, line_no, "phase", "phase must be approach, insertion, dwell or withdrawal (got '" + f + "')");
       curve.phase.push_back(ph);
     }
     for (std::size_t k = 0; k < state_cols.size(); ++k) {
