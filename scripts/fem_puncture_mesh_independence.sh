@@ -2,7 +2,7 @@
 # fem_puncture_mesh_independence.sh: is the axisymmetric reference's skin
 # puncture (force and depth) independent of the mesh?
 #
-# The default scene, inserted to TARGET_MM (default 10.5 mm: past the skin and
+# The default scene, inserted to TARGET_MM (default 14 mm: past the skin and
 # fat punctures) on two meshes: the default's (elements_per_needle_radius and
 # path_element_size_mm from the scene) and one twice as fine in both. Same
 # load step, same physics. Writes results/fem_puncture_mesh_independence.md
@@ -15,7 +15,7 @@ ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=${1:-$ROOT/build}
 EXE=$BUILD/apps/puncture
 SCENE=${SCENE:-$ROOT/scenes/default.json}
-TARGET=${TARGET_MM:-10.5}
+TARGET=${TARGET_MM:-14}
 WORK=$ROOT/out/mesh_independence
 OUT=$ROOT/results/fem_puncture_mesh_independence.md
 mkdir -p "$WORK"

@@ -367,10 +367,10 @@ FemRunSummary run_axisymmetric_insertion(const Scene& scene, const FemRunOptions
             e.time_s = peak_time[i];
             summary.punctures.push_back(e);
             for (const auto& [r, uz] : peak_profile[i])
-              recovery_csv << e.layer_name << ",before," << fmt(peak_depth[i] * 1e3) << "," << fmt(r * 1e3) << ","
+              recovery_csv << i << ",before," << fmt(peak_depth[i] * 1e3) << "," << fmt(r * 1e3) << ","
                            << fmt(uz * 1e3) << "\n";
             for (const auto& [r, uz] : layer_top_profile(i))
-              recovery_csv << e.layer_name << ",after," << fmt(depth * 1e3) << "," << fmt(r * 1e3) << ","
+              recovery_csv << i << ",after," << fmt(depth * 1e3) << "," << fmt(r * 1e3) << ","
                            << fmt(uz * 1e3) << "\n";
             std::ostringstream m;
             m << "fem: " << e.layer_name << " punctured: peak " << e.force_N << " N at " << e.depth_m * 1e3
