@@ -228,6 +228,16 @@ Scene read_scene(const json& root, const std::string& file) {
     s.effects.resumption = on("resumption");
     s.effects.surface_output = on("surface_output");
   }
+  if (r.has("haptics")) {
+    ObjectReader o(r.raw("haptics"), "/haptics", file);
+    Haptics& h = s.haptics;
+    h.max_force_N = o.number("max_force_N", h.max_force_N);
+    h.max_force_rate_N_per_s = o.number("max_force_rate_N_per_s", h.max_force_rate_N_per_s);
+    h.device_damping_N_s_per_m = o.number("device_damping_N_s_per_m", h.device_damping_N_s_per_m);
+    h.device_max_stiffness_N_per_m =
+        o.number("device_max_stiffness_N_per_mm", h.device_max_stiffness_N_per_m * kMm) / kMm;
+    o.reject_unknown_keys();
+  }
   r.reject_unknown_keys();
   validate_scene(s, file);
   return s;
@@ -329,6 +339,14 @@ void validate_scene(const Scene& s, const std::string& file) {
   require(f.newton_tolerance > 0 && f.newton_tolerance < 1, file, "/fem/newton_tolerance", "in (0, 1)",
           f.newton_tolerance);
   if (s.models.empty()) throw SceneError(file, "/models", "must name at least one model (realtime, fem)");
+
+  const Haptics& h = s.haptics;
+  require(h.max_force_N > 0, file, "/haptics/max_force_N", "> 0", h.max_force_N);
+  require(h.max_force_rate_N_per_s > 0, file, "/haptics/max_force_rate_N_per_s", "> 0", h.max_force_rate_N_per_s);
+  require(h.device_damping_N_s_per_m >= 0, file, "/haptics/device_damping_N_s_per_m", ">= 0",
+          h.device_damping_N_s_per_m);
+  require(h.device_max_stiffness_N_per_m > 0, file, "/haptics/device_max_stiffness_N_per_mm", "> 0",
+          h.device_max_stiffness_N_per_m * kMm);
 }
 
 Scene parse_scene(const std::string& text, const std::string& source_name) {
@@ -410,6 +428,10 @@ std::string scene_to_json_text(const Scene& s) {
   if (s.effects.resumption) effects.push_back("resumption");
   if (s.effects.surface_output) effects.push_back("surface_output");
   root["effects"] = effects;
+  root["haptics"] = {{"max_force_N", s.haptics.max_force_N},
+                     {"max_force_rate_N_per_s", s.haptics.max_force_rate_N_per_s},
+                     {"device_damping_N_s_per_m", s.haptics.device_damping_N_s_per_m},
+                     {"device_max_stiffness_N_per_mm", s.haptics.device_max_stiffness_N_per_m * kMm}};
   return root.dump(2) + "\n";
 }
 
