@@ -179,6 +179,7 @@ void HapticLoop::run_paced() {
       double next = deadline + dt_;
       stats_.add_tick(start, end, next);
       ticks_done_.store(n + 1, std::memory_order_relaxed);
+      missed_live_.store(stats_.missed_deadlines, std::memory_order_relaxed);
       if (end > next + dt_) {
         const double lost = std::floor((end - next) / dt_);
         stats_.skipped_periods += static_cast<std::int64_t>(lost);

@@ -22,6 +22,7 @@ ModelSupplier::~ModelSupplier() {
 void ModelSupplier::collect(RealtimeModel* model) {
   if (!model) return;
   events_.push_back(model->simulator ? model->simulator->puncture_events() : std::vector<PunctureEvent>{});
+  for (PunctureEvent& e : events_.back()) e.layer_name = {};  // a view into the model destroyed below
   delete model;
 }
 

@@ -81,8 +81,9 @@ class HapticLoop {
   void request_stop() noexcept { stop_.store(true, std::memory_order_release); }
   void join();
   bool finished() const noexcept { return finished_.load(std::memory_order_acquire); }
-  /// Ticks done so far (any thread).
+  /// Ticks done and deadlines missed so far (any thread, while running).
   std::int64_t ticks_done() const noexcept { return ticks_done_.load(std::memory_order_relaxed); }
+  std::int64_t missed_so_far() const noexcept { return missed_live_.load(std::memory_order_relaxed); }
 
   /// The paced loop (what the thread runs).
   void run_paced();
@@ -118,7 +119,7 @@ class HapticLoop {
   HapticLoopCounters counters_;
   std::string scheduling_, error_;
   std::atomic<bool> stop_{false}, finished_{false};
-  std::atomic<std::int64_t> ticks_done_{0};
+  std::atomic<std::int64_t> ticks_done_{0}, missed_live_{0};
   std::thread thread_;
 };
 

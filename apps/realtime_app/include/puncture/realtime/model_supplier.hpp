@@ -45,7 +45,8 @@ class ModelSupplier {
   RealtimeModel* try_exchange(RealtimeModel* old) noexcept;
 
   /// Stops the builder thread and destroys every model. Returns the puncture
-  /// events of every model used, in order. Call once, after the haptic loop stopped.
+  /// events of every model used, in order (layer_name is cleared: it viewed
+  /// the destroyed model; use the layer index). Call once, after the haptic loop stopped.
   std::vector<std::vector<PunctureEvent>> finish();
 
   /// Empty unless building a spare failed (the message of the exception).
