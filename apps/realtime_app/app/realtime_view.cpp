@@ -207,7 +207,7 @@ RealtimeView::RealtimeView(const Scene& scene, const RealtimeModel& model, ViewO
   m.window = vtkSmartPointer<vtkRenderWindow>::New();
   m.window->SetSize(options.width, options.height);
   m.window->SetWindowName(options.title.c_str());
-  m.window->SetMultiSamples(options.offscreen ? 0 : 4);
+  m.window->SetMultiSamples(0);  // multisampling costs 4x in software rendering (llvmpipe)
   if (options.offscreen) m.window->SetOffScreenRendering(1);
 
   m.renderer = vtkSmartPointer<vtkRenderer>::New();
@@ -454,6 +454,8 @@ void RealtimeView::screenshot(const std::string& png_path) {
   std::filesystem::rename(partial, png_path, ec);
   if (ec) throw std::runtime_error(png_path + ": cannot rename the screenshot: " + ec.message());
 }
+
+vtkRenderWindowInteractor* RealtimeView::interactor() { return impl_->interactor; }
 
 void RealtimeView::run_interactive(int period_ms, const std::function<bool()>& on_frame) {
   Impl& m = *impl_;

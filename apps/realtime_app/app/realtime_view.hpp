@@ -65,6 +65,8 @@ class RealtimeView {
 
   /// Interactive mode: calls `on_frame` every `period_ms` from the event loop until it returns false or the window closes.
   void run_interactive(int period_ms, const std::function<bool()>& on_frame);
+  /// The window's interactor (nullptr offscreen); tests send it key and mouse events.
+  vtkRenderWindowInteractor* interactor();
 
  private:
   struct Impl;
