@@ -288,6 +288,27 @@ TEST(PunctureApp, UdpBridgeDrivesTheApp) {
   EXPECT_EQ(s.at("puncture_events")[0].at("layer").get<std::string>(), "skin");
 }
 
+TEST(PunctureApp, PythonBridgeExampleDrivesTheApp) {
+  const fs::path dir = work_dir("python_bridge");
+  const std::uint16_t port = free_udp_port();
+  auto session = std::async(std::launch::async, [&] {
+    return app("--device udp --udp-port " + std::to_string(port) + " --offscreen --duration 4 --size 480x300 "
+               "--stats " + (dir / "stats.json").string());
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the app builds its models first
+  const ProcessResult bridge = run("python3 " + std::string(PUNCTURE_SOURCE_DIR) +
+                                   "/apps/realtime_app/tools/udp_bridge_example.py --port " + std::to_string(port) +
+                                   " --seconds 1.5 --speed-mm-s 20");
+  const ProcessResult r = session.get();
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(bridge.exit_code, 0) << bridge.output;
+  EXPECT_NE(bridge.output.find("received"), std::string::npos) << bridge.output;
+  const json s = read_json(dir / "stats.json");
+  EXPECT_GT(s.at("udp").at("received").get<long>(), 500);
+  EXPECT_EQ(s.at("udp").at("malformed").get<long>(), 0);  // the script's packing matches the protocol
+  EXPECT_EQ(s.at("puncture_events").at(0).at("layer").get<std::string>(), "skin");
+}
+
 TEST(PunctureApp, BadSceneExitsTwoNamingFileAndPath) {
   const fs::path dir = work_dir("bad_scene");
   std::ifstream in(kDefaultScene);
