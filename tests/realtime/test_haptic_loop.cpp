@@ -18,6 +18,7 @@
 
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/realtime/haptic_loop.hpp"
+#include "puncture/realtime/pointer_device.hpp"
 #include "puncture/realtime/scripted_device.hpp"
 #include "puncture/realtime/udp_device.hpp"
 #include "realtime_test_scenes.hpp"
@@ -105,6 +106,43 @@ TEST(HapticLoop, NoAllocationInTheHapticPath) {
   TickSample s;
   EXPECT_TRUE(samples.try_pop(s));
   recorder.finish();
+  models.finish();
+}
+
+TEST(HapticLoop, NoAllocationWithTheUdpAndMouseDevices) {
+  const Scene scene = testing::short_insertion_scene();
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  ModelSupplier models([&] { return std::make_unique<RealtimeModel>(build_realtime_model(scene)); });
+  UdpDeviceOptions uo;
+  uo.port = 0;
+  UdpDevice udp(uo);
+  PointerDevice mouse(scene, dt);
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(udp.port());
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  for (HapticDevice* device : {static_cast<HapticDevice*>(&udp), static_cast<HapticDevice*>(&mouse)}) {
+    HapticLoop loop(scene, models, *device, ForceGuard(scene.haptics, dt), HapticLoopOptions{}, HapticLoopSinks{});
+    mouse.set_target(Eigen::Vector3d(0.0, 0.0, -0.003));  // the view thread's part (allocation-free too)
+    allocations = 0;
+    for (std::int64_t n = 0; n < 600; ++n) {
+      udp::PoseMessage m;
+      m.sequence = static_cast<std::uint32_t>(n + 1);
+      m.position_m = Eigen::Vector3d(0.0, 0.0, 0.002 - 1e-5 * n);
+      std::uint8_t b[udp::kPoseSize];
+      udp::encode(m, b);
+      ::sendto(fd, b, sizeof b, 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+      counting = true;
+      loop.step(n, n * dt);
+      counting = false;
+    }
+    EXPECT_EQ(allocations.load(), 0) << device->name();
+    EXPECT_GT(loop.counters().model_ticks, 0);
+  }
+  ::close(fd);
+  EXPECT_GT(udp.counters().received, 0);
+  EXPECT_GT(udp.counters().sent, 0);
   models.finish();
 }
 

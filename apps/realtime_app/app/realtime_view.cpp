@@ -211,9 +211,7 @@ RealtimeView::RealtimeView(const Scene& scene, const RealtimeModel& model, ViewO
   if (options.offscreen) m.window->SetOffScreenRendering(1);
 
   m.renderer = vtkSmartPointer<vtkRenderer>::New();
-  m.renderer->GradientBackgroundOn();
-  m.renderer->SetBackground(0.10, 0.12, 0.16);
-  m.renderer->SetBackground2(0.32, 0.36, 0.44);
+  m.renderer->SetBackground(0.20, 0.23, 0.29);  // solid: a gradient costs a full-screen pass in software rendering
   m.window->AddRenderer(m.renderer);
 
   // Layers: back half of the top face and side wall, and the cut face at y = 0.
