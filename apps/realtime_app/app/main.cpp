@@ -272,9 +272,12 @@ int run(const Options& o, const std::string& command) {
   }
   loop.request_stop();
   loop.join();
-  // Last frame (the final state), and the screenshot if it was not taken yet.
-  final_frame = true;
-  frame();
+  // Offscreen (or for a screenshot): one last frame with the final state. An
+  // interactive window may be closed already: it is not drawn again.
+  if (o.offscreen || (!o.screenshot.empty() && !screenshot_taken)) {
+    final_frame = true;
+    frame();
+  }
   if (!o.screenshot.empty() && !screenshot_taken) view.screenshot(o.screenshot);
 
   const nlohmann::json load_after = load_average_json();
