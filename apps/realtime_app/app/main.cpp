@@ -104,7 +104,20 @@ std::string command_line(int argc, char** argv) {
   return s;
 }
 
+/// Creates the folder an output file goes to, before the session (not after it).
+void prepare_output(const std::string& file) {
+  if (file.empty()) return;
+  const fs::path parent = fs::path(file).parent_path();
+  std::error_code ec;
+  if (!parent.empty()) fs::create_directories(parent, ec);
+  if (ec) throw std::runtime_error(file + ": cannot create its folder: " + ec.message());
+}
+
 int run(const Options& o, const std::string& command) {
+  if ((o.verify || !o.export_csv.empty()) && o.recording.empty())
+    throw std::runtime_error("--verify and --export-csv need --recording FILE");
+  for (const std::string* f : {&o.record, &o.stats, &o.screenshot, &o.export_csv}) prepare_output(*f);
+
   // ---- offline recording tools
   if (!o.recording.empty() && (o.verify || !o.export_csv.empty())) {
     const Recording rec = read_recording(o.recording);
