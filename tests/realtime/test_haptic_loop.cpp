@@ -86,9 +86,11 @@ TEST(HapticLoop, NoAllocationInTheHapticPath) {
   RecordingWriter recorder(dir / "session.pncrec", {{"format", "puncture-recording"}, {"scene_text", text}});
   TripleBuffer<ViewSnapshot> snapshots([&](ViewSnapshot& s) { init_snapshot(s, *models.initial()->simulator); });
   SpscRing<TickSample> samples(1024);
-  HapticLoopSinks sinks{&recorder, &snapshots, &samples};
+  TripleBuffer<ViewSnapshot> capture([&](ViewSnapshot& s) { init_snapshot(s, *models.initial()->simulator); });
+  HapticLoopSinks sinks{&recorder, &snapshots, &samples, &capture};
   HapticLoopOptions options;
   options.snapshot_rate_Hz = 1000.0;  // a snapshot every tick: the worst case
+  options.capture_at_s = 0.3;
   HapticLoop loop(scene, models, device, ForceGuard(scene.haptics, dt), options, sinks);
   // Let the builder thread finish the spare so the fresh-tissue swap happens without holding.
   while (models.models_built() < 2) std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -105,6 +107,11 @@ TEST(HapticLoop, NoAllocationInTheHapticPath) {
   EXPECT_GT(loop.counters().samples_dropped, 0);  // nobody drained the view ring: dropped, never grown
   TickSample s;
   EXPECT_TRUE(samples.try_pop(s));
+  // The capture holds the state of the first tick at or after 0.3 s, published once.
+  ASSERT_TRUE(capture.update());
+  EXPECT_GE(capture.front().needle.time_s, 0.3);
+  EXPECT_LT(capture.front().needle.time_s, 0.3 + dt);
+  EXPECT_FALSE(capture.update());
   recorder.finish();
   models.finish();
 }

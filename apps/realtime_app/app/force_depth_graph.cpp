@@ -142,27 +142,32 @@ void ForceDepthGraph::rebuild_axes() {
   if (hidden_) hide();
 }
 
-void ForceDepthGraph::update(const std::deque<TickSample>& history) {
+void ForceDepthGraph::update(const std::deque<TickSample>& history, double until_s) {
+  std::size_t count = 0;
   bool grow = false;
   for (const TickSample& s : history) {
+    if (s.time_s > until_s) break;
+    ++count;
     const double d = s.depth_m / kMm;
-    const double f = std::max(s.tissue_force_N, s.sent_axial_N);
+    const double hi = std::max(s.tissue_force_N, s.sent_axial_N), lo = std::min(s.tissue_force_N, s.sent_axial_N);
     if (d > d1_) d1_ = 1.25 * d, grow = true;
-    if (f > f1_) f1_ = 1.25 * f, grow = true;
-    if (std::min(s.tissue_force_N, s.sent_axial_N) < f0_) f0_ = 1.25 * std::min(s.tissue_force_N, s.sent_axial_N), grow = true;
+    if (hi > f1_) f1_ = 1.25 * hi, grow = true;
+    if (lo < f0_) f0_ = 1.25 * lo, grow = true;
   }
   if (grow) rebuild_axes();
   auto fill = [&](vtkPolyData* data, bool sent) {
     vtkPoints* pts = data->GetPoints();
     vtkCellArray* cells = data->GetLines();
-    pts->SetNumberOfPoints(static_cast<vtkIdType>(history.size()));
+    pts->SetNumberOfPoints(static_cast<vtkIdType>(count));
     vtkIdType i = 0;
-    for (const TickSample& s : history)
+    for (const TickSample& s : history) {
+      if (i == static_cast<vtkIdType>(count)) break;
       pts->SetPoint(i++, to_x(s.depth_m / kMm), to_y(sent ? s.sent_axial_N : s.tissue_force_N), 0.0);
+    }
     cells->Reset();
-    if (history.size() >= 2) {
-      cells->InsertNextCell(static_cast<vtkIdType>(history.size()));
-      for (vtkIdType k = 0; k < static_cast<vtkIdType>(history.size()); ++k) cells->InsertCellPoint(k);
+    if (count >= 2) {
+      cells->InsertNextCell(static_cast<vtkIdType>(count));
+      for (vtkIdType k = 0; k < static_cast<vtkIdType>(count); ++k) cells->InsertCellPoint(k);
     }
     pts->Modified();
     cells->Modified();

@@ -24,7 +24,8 @@ class ForceDepthGraph {
   /// Viewport-normalised box (x0, y0) - (x1, y1); initial ranges in mm and N.
   void build(vtkRenderer* renderer, double x0, double y0, double x1, double y1, double max_depth_mm,
              double max_force_N);
-  void update(const std::deque<TickSample>& history);
+  /// Draws the samples with time_s <= until_s.
+  void update(const std::deque<TickSample>& history, double until_s = 1e300);
   void hide();
 
  private:

@@ -212,6 +212,7 @@ int run(const Options& o, const std::string& command) {
   }
   TripleBuffer<ViewSnapshot> snapshots([&](ViewSnapshot& s) { init_snapshot(s, *models.initial()->simulator); });
   SpscRing<TickSample> samples(8192);
+  TripleBuffer<ViewSnapshot> capture([&](ViewSnapshot& s) { init_snapshot(s, *models.initial()->simulator); });
 
   int width = 1280, height = 800;
   if (std::sscanf(o.size.c_str(), "%dx%d", &width, &height) != 2 || width < 200 || height < 150)
@@ -232,8 +233,9 @@ int run(const Options& o, const std::string& command) {
   lo.snapshot_rate_Hz = std::min(rate, 2.0 * o.fps);
   lo.velocity_cutoff_Hz = o.velocity_cutoff_Hz;
   lo.stability_warning = !stability.warnings.empty();
+  lo.capture_at_s = o.screenshot.empty() ? -1.0 : o.screenshot_at_s;
   HapticLoop loop(scene, models, *device, ForceGuard(scene.haptics, dt), lo,
-                  HapticLoopSinks{recorder.get(), &snapshots, &samples});
+                  HapticLoopSinks{recorder.get(), &snapshots, &samples, &capture});
 
   const nlohmann::json load_before = load_average_json();
   const std::string started = apps::utc_timestamp();
@@ -260,14 +262,14 @@ int run(const Options& o, const std::string& command) {
     status.view_fps = view_stats.achieved_fps();
     if (recording)
       status.note = "replay: tick " + std::to_string(ticks) + " of " + std::to_string(recording->records.size());
-    const bool shoot = !o.screenshot.empty() && !screenshot_taken && o.screenshot_at_s >= 0.0 &&
-                       snapshots.front().needle.time_s >= o.screenshot_at_s;
-    view.render(snapshots.front(), status, shoot || final_frame);
-    view_stats.add_frame(start, monotonic_now_s());
-    if (shoot) {
+    if (!screenshot_taken && capture.update()) {
+      // The state at --screenshot-at, captured by the haptic thread at that tick.
+      view.render(capture.front(), status, true, capture.front().needle.time_s);
       view.screenshot(o.screenshot);
       screenshot_taken = true;
     }
+    view.render(snapshots.front(), status, final_frame);
+    view_stats.add_frame(start, monotonic_now_s());
     return !loop.finished() && !interrupted;
   };
 
@@ -403,7 +405,8 @@ int main(int argc, char** argv) {
   app.add_option("--duration", o.duration_s, "Stop after this many seconds of haptic time (0: until the window closes)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--screenshot", o.screenshot, "Write a PNG of the view (at the end, or at --screenshot-at)");
-  app.add_option("--screenshot-at", o.screenshot_at_s, "Take the screenshot when the needle time reaches this (s)");
+  app.add_option("--screenshot-at", o.screenshot_at_s,
+                 "Screenshot of the state at this needle time (s), captured by the haptic thread at that tick");
   app.add_option("--stats", o.stats, "Write the loop statistics (JSON)");
   app.add_option("--fps", o.fps, "View frame rate (default 60)")->check(CLI::Range(1.0, 240.0));
   app.add_option("--size", o.size, "Window size WIDTHxHEIGHT (default 1280x800)");

@@ -187,8 +187,8 @@ struct RealtimeView::Impl {
   void reset_camera() {
     vtkCamera* c = renderer->GetActiveCamera();
     const double R = 0.5 * scene.sample.diameter_m;
-    c->SetFocalPoint(0.05 * R, 0.25 * R, -0.28 * R);
-    c->SetPosition(0.75 * R, -1.85 * R, 0.85 * R);
+    c->SetFocalPoint(0.05 * R, 0.2 * R, -0.25 * R);
+    c->SetPosition(0.6 * R, -1.5 * R, 0.7 * R);
     c->SetViewUp(0.0, 0.0, 1.0);
     c->SetViewAngle(30.0);
     renderer->ResetCameraClippingRange();
@@ -355,7 +355,7 @@ void RealtimeView::add_sample(const TickSample& s) {
   while (m.history.size() > 4000) m.history.pop_front();
 }
 
-void RealtimeView::render(const ViewSnapshot& snap, const ViewStatus& status, bool force_text) {
+void RealtimeView::render(const ViewSnapshot& snap, const ViewStatus& status, bool force_text, double graph_until_s) {
   Impl& m = *impl_;
   for (std::size_t k = 0; k < m.layers.size(); ++k) {
     Impl::LayerActors& a = m.layers[k];
@@ -401,7 +401,7 @@ void RealtimeView::render(const ViewSnapshot& snap, const ViewStatus& status, bo
 
   // The overlay's text is rasterised again whenever it changes: 15 times a second is enough.
   if (force_text || m.frame_count++ % 4 == 0) m.update_text(snap, status);
-  m.graph.update(m.history);
+  m.graph.update(m.history, graph_until_s);
   m.renderer->ResetCameraClippingRange();
   m.window->Render();
 }

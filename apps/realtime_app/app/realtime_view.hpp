@@ -58,8 +58,10 @@ class RealtimeView {
   /// Adds samples of the current insertion to the graph history.
   void add_sample(const TickSample& sample);
   /// Updates every actor from the snapshot and renders one frame (the
-  /// overlay text every fourth frame, or now if `force_text`).
-  void render(const ViewSnapshot& snapshot, const ViewStatus& status, bool force_text = false);
+  /// overlay text every fourth frame, or now if `force_text`). The graph shows
+  /// the samples up to `graph_until_s` (needle time; default: all).
+  void render(const ViewSnapshot& snapshot, const ViewStatus& status, bool force_text = false,
+              double graph_until_s = 1e300);
   /// Writes the last rendered frame as PNG (staged under a temporary name, then renamed).
   void screenshot(const std::string& png_path);
 

@@ -147,8 +147,7 @@ void HapticLoop::publish(std::int64_t n, double wall_time_s, const TickResult& r
     s.model_generation = generation_;
     if (!sinks_.samples->try_push(s)) ++counters_.samples_dropped;
   }
-  if (sinks_.snapshots && (n - last_snapshot_tick_ >= snapshot_every_)) {
-    ViewSnapshot& v = sinks_.snapshots->back();
+  auto fill = [&](ViewSnapshot& v) {
     v.tick = n;
     v.model_generation = generation_;
     v.wall_time_s = wall_time_s;
@@ -157,9 +156,17 @@ void HapticLoop::publish(std::int64_t n, double wall_time_s, const TickResult& r
     v.force_sent_N = out.force_sent_N;
     v.flags = flags;
     fill_snapshot(v, *model_->simulator, result);
+  };
+  if (sinks_.snapshots && (n - last_snapshot_tick_ >= snapshot_every_)) {
+    fill(sinks_.snapshots->back());
     sinks_.snapshots->publish();
     last_snapshot_tick_ = n;
     ++counters_.snapshots;
+  }
+  if (sinks_.capture && !captured_ && options_.capture_at_s >= 0.0 && held_needle_.time_s >= options_.capture_at_s) {
+    fill(sinks_.capture->back());
+    sinks_.capture->publish();
+    captured_ = true;
   }
 }
 

@@ -8,7 +8,8 @@
 // force (compute_tick); writes the force to the device; compares it with the
 // recording when replaying; pushes a TickRecord to the recorder and a
 // TickSample to the view's ring; every 1 / snapshot_rate publishes a
-// ViewSnapshot. Nothing in this path allocates, locks or waits for the renderer
+// ViewSnapshot (and once, at the needle time capture_at_s, a snapshot to the
+// capture buffer, so a screenshot shows that moment however slow the view is). Nothing in this path allocates, locks or waits for the renderer
 // (tested: tests/realtime/test_haptic_loop.cpp).
 //
 // Pacing: tick n is scheduled at t0 + n T (steady clock); the thread sleeps
@@ -43,12 +44,14 @@ struct HapticLoopOptions {
   double snapshot_rate_Hz = 120.0;   ///< view snapshots per second
   double velocity_cutoff_Hz = 100.0; ///< low-pass of differentiated device positions
   bool stability_warning = false;    ///< sets kOutStabilityWarning in every output
+  double capture_at_s = -1.0;        ///< publish one snapshot to HapticLoopSinks::capture at this needle time (< 0: never)
 };
 
 struct HapticLoopSinks {
   RecordingWriter* recorder = nullptr;
   TripleBuffer<ViewSnapshot>* snapshots = nullptr;  ///< sized with init_snapshot()
   SpscRing<TickSample>* samples = nullptr;
+  TripleBuffer<ViewSnapshot>* capture = nullptr;    ///< the state at options.capture_at_s (for a screenshot)
 };
 
 struct HapticLoopCounters {
@@ -115,6 +118,7 @@ class HapticLoop {
   std::uint64_t generation_ = 0;
   std::int64_t snapshot_every_ = 1;
   std::int64_t last_snapshot_tick_ = -1000000;
+  bool captured_ = false;
   LoopStatistics stats_;
   HapticLoopCounters counters_;
   std::string scheduling_, error_;
