@@ -6,12 +6,15 @@
 #   realtime_stats.md    the table (haptic rate, tick period p50/p99/max,
 #                        compute p50/p99, frame rate, missed deadlines), with
 #                        command, machine, date, git revision and load average
-#   realtime_stats.json  the app's --stats output
+#   realtime_stats.json  the app's --stats output (and realtime_stats_normal.json:
+#                        the same session without real-time priority)
 #   tick_period.png      tick period over the session and its histogram
 #   view.png             a frame of the view at the end of the muscle's press
 #   view_skin_pressed.png  a frame of a short second session: the skin pressed
 #                        (the README's picture)
-# The 60 s recording itself (about 12 MB) is checked and then deleted.
+# The same session runs a second time with normal scheduling (--rt-priority 0),
+# for users whose processes may not use SCHED_FIFO. The 60 s recording itself
+# (about 12 MB) is checked and then deleted.
 #
 # Usage: scripts/results_realtime.sh [SCENE] [DURATION_S]   (default scenes/default.json, 60)
 # Env:   PUNCTURE_BUILD_DIR (default ./build), PUNCTURE_REALTIME_OUT (default results/realtime)
@@ -40,6 +43,9 @@ echo "[realtime] load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "[realtime] running $duration s of scripted session with rendering (xvfb-run)"
 xvfb-run -a -s "-screen 0 1280x1024x24" "$app" "$scene" --device scripted --offscreen --duration "$duration" \
   --record "$tmp/session.pncrec" --stats "$tmp/stats.json" --screenshot "$tmp/view.png" --screenshot-at 1.25
+echo "[realtime] the same session with normal scheduling (no SCHED_FIFO), for comparison"
+xvfb-run -a -s "-screen 0 1280x1024x24" "$app" "$scene" --device scripted --offscreen --duration "$duration" \
+  --rt-priority 0 --stats "$tmp/stats_normal.json" -q
 echo "[realtime] a short session for the skin-pressed picture"
 xvfb-run -a -s "-screen 0 1280x1024x24" "$app" "$scene" --device scripted --offscreen --duration 0.6 -q \
   --screenshot "$tmp/view_skin_pressed.png" --screenshot-at 0.38
@@ -56,31 +62,37 @@ import numpy as np
 
 tmp, out, command, app_command, revision = sys.argv[1:6]
 s = json.load(open(os.path.join(tmp, "stats.json")))
+sn = json.load(open(os.path.join(tmp, "stats_normal.json")))
 verify = open(os.path.join(tmp, "verify.txt")).read().strip()
-verify = verify.split(": ", 1)[1] if ": " in verify else verify  # drop "replay of <temporary path>" 
+verify = verify.split(": ", 1)[1] if ": " in verify else verify  # drop "replay of <temporary path>"
 h, v, g = s["haptic"], s["view"], s["guard"]
+hn, vn = sn["haptic"], sn["view"]
 before, after = s["load_average"]["before"], s["load_average"]["after"]
 quiet = bool(before) and before[0] < 1.0
 target = h["target_rate_Hz"]
 T_us = 1e6 / target
 ok = lambda c: "yes" if c else "**no**"
 
+def rate(h): return f'{h["achieved_rate_Hz"]:.2f} Hz ({h["rate_error_percent"]:+.3f} %)'
+def period(h): return f'{h["tick_period_us"]["p50"]:.1f} / {h["tick_period_us"]["p99"]:.1f} us'
+def tail(h): return f'{h["tick_period_us"]["p999"]:.1f} / {h["tick_period_us"]["max"]:.1f} / {h["tick_period_us"]["min"]:.1f} us'
+def compute(h): return f'{h["tick_compute_us"]["p50"]:.1f} / {h["tick_compute_us"]["p99"]:.1f} / {h["tick_compute_us"]["max"]:.1f} us'
+def missed(h): return f'{h["missed_deadlines"]} of {h["ticks"]} (skipped periods {h["skipped_periods"]})'
+def fps(v): return f'{v["achieved_fps"]:.1f} fps, {v["frames"]} frames'
+def frame(v): return f'{v["render_ms"]["p50"]:.1f} / {v["render_ms"]["p99"]:.1f} ms'
+
 rows = [
-    ("haptic rate (with rendering)", f'{h["achieved_rate_Hz"]:.2f} Hz ({h["rate_error_percent"]:+.3f} %)',
-     f"within 1 % of {target:.0f} Hz", ok(abs(h["rate_error_percent"]) <= 1.0)),
-    ("tick period p50 / p99", f'{h["tick_period_us"]["p50"]:.1f} / {h["tick_period_us"]["p99"]:.1f} us',
-     f"p99 < {1.1 * T_us:.0f} us", ok(h["tick_period_us"]["p99"] < 1.1 * T_us)),
-    ("tick period p99.9 / max / min", f'{h["tick_period_us"]["p999"]:.1f} / {h["tick_period_us"]["max"]:.1f} / '
-     f'{h["tick_period_us"]["min"]:.1f} us', "", ""),
-    ("tick compute p50 / p99 / max", f'{h["tick_compute_us"]["p50"]:.1f} / {h["tick_compute_us"]["p99"]:.1f} / '
-     f'{h["tick_compute_us"]["max"]:.1f} us', "far inside the period", ok(h["tick_compute_us"]["p99"] < 0.5 * T_us)),
-    ("missed deadlines", f'{h["missed_deadlines"]} of {h["ticks"]} ticks (skipped periods {h["skipped_periods"]})',
-     "0", ok(h["missed_deadlines"] == 0)),
-    ("view frame rate", f'{v["achieved_fps"]:.1f} fps over {v["frames"]} frames (target {v["target_fps"]:.0f})', "", ""),
-    ("view frame time p50 / p99", f'{v["render_ms"]["p50"]:.1f} / {v["render_ms"]["p99"]:.1f} ms', "", ""),
-    ("fresh tissues (insertion cycles)", f'{h["fresh_tissues"] + 1} (held ticks waiting for one: {h["held_ticks"]})', "", ""),
-    ("force to device clamped", f'magnitude {g["magnitude_clamped_ticks"]} ticks, rate {g["rate_clamped_ticks"]} ticks', "", ""),
-    ("recording replayed offline", verify.replace("|", "/"), "bit for bit", ok("identical bit for bit" in verify)),
+    ("haptic rate (with rendering)", rate(h), rate(hn), f"within 1 % of {target:.0f} Hz", ok(abs(h["rate_error_percent"]) <= 1.0)),
+    ("tick period p50 / p99", period(h), period(hn), f"p99 < {1.1 * T_us:.0f} us", ok(h["tick_period_us"]["p99"] < 1.1 * T_us)),
+    ("tick period p99.9 / max / min", tail(h), tail(hn), "", ""),
+    ("tick compute p50 / p99 / max", compute(h), compute(hn), "far inside the period", ok(h["tick_compute_us"]["p99"] < 0.5 * T_us)),
+    ("missed deadlines", missed(h), missed(hn), "0", ok(h["missed_deadlines"] == 0)),
+    ("view frame rate (target 60 fps)", fps(v), fps(vn), "", ""),
+    ("view frame time p50 / p99", frame(v), frame(vn), "", ""),
+    ("insertion cycles (fresh tissues)", f'{h["fresh_tissues"] + 1} (ticks held waiting for one: {h["held_ticks"]})',
+     f'{hn["fresh_tissues"] + 1} (held: {hn["held_ticks"]})', "", ""),
+    ("force to device clamped", f'magnitude {g["magnitude_clamped_ticks"]} ticks, rate {g["rate_clamped_ticks"]} ticks', "", "", ""),
+    ("recording replayed offline", verify, "", "bit for bit", ok("identical bit for bit" in verify)),
 ]
 lines = [
     "# Measured real time of puncture-app",
@@ -93,12 +105,14 @@ lines = [
     f"Haptic thread: {h['scheduling']}, sleep until {h['spin_margin_us']:.0f} us before each deadline, then spin  ",
     f"Load average (1, 5, 15 min) before: {', '.join(f'{x:.2f}' for x in before)}; after: "
     f"{', '.join(f'{x:.2f}' for x in after)}"
-    + ("" if quiet else " -- **the machine was loaded by other processes during this measurement**"),
+    + ("" if quiet else " -- **the machine was loaded by other processes during this measurement**") + "  ",
+    f"Comparison run (`--rt-priority 0`), load average before: "
+    f"{', '.join(f'{x:.2f}' for x in sn['load_average']['before'])}",
     "",
-    "| quantity | measured | target | met |",
-    "|---|---|---|---|",
+    f"| quantity | measured: {h['scheduling'].split(',')[0]} | same, normal scheduling | target | met |",
+    "|---|---|---|---|---|",
 ]
-lines += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in rows]
+lines += [f"| {a} | {b} | {c} | {d} | {e} |" for a, b, c, d, e in rows]
 lines += [
     "",
     "Tick period = start-to-start interval of consecutive haptic ticks (steady clock); compute = the tick's work",
@@ -113,6 +127,7 @@ lines += [
 ]
 open(os.path.join(out, "realtime_stats.md"), "w").write("\n".join(lines))
 shutil.copy(os.path.join(tmp, "stats.json"), os.path.join(out, "realtime_stats.json"))
+shutil.copy(os.path.join(tmp, "stats_normal.json"), os.path.join(out, "realtime_stats_normal.json"))
 shutil.copy(os.path.join(tmp, "view.png"), os.path.join(out, "view.png"))
 shutil.copy(os.path.join(tmp, "view_skin_pressed.png"), os.path.join(out, "view_skin_pressed.png"))
 
