@@ -4,6 +4,8 @@
 // node's deflection and leaves the far rim alone.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/realtime/layer_view_geometry.hpp"
 #include "realtime_test_scenes.hpp"
@@ -29,7 +31,27 @@ TEST(LayerViewGeometry, TopFaceOnTheShSurfaceAndCutAtYZero) {
     EXPECT_GT(m.cap_triangles.rows(), 0);
     for (Eigen::Index t = 0; t < m.cap_triangles.rows(); ++t)
       for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.rest_vertices(m.cap_triangles(t, c), 1), 0.0, 1e-9);
-    EXPECT_LE(m.shell_triangles.maxCoeff(), m.rest_vertices.rows() - 1);
+    EXPECT_LE(m.top_triangles.maxCoeff(), m.rest_vertices.rows() - 1);
+    EXPECT_LE(m.side_triangles.maxCoeff(), m.rest_vertices.rows() - 1);
+    // Orientation (backface culling relies on it): top triangles face +z,
+    // side triangles face away from the axis, cap triangles face -y.
+    auto normal = [&](const Eigen::MatrixX3i& t, Eigen::Index i) {
+      const Eigen::Vector3d a = m.rest_vertices.row(t(i, 0)), b = m.rest_vertices.row(t(i, 1)),
+                            c = m.rest_vertices.row(t(i, 2));
+      return Eigen::Vector3d((b - a).cross(c - a));
+    };
+    for (Eigen::Index t = 0; t < m.top_triangles.rows(); ++t) ASSERT_GT(normal(m.top_triangles, t).z(), 0.0) << t;
+    for (Eigen::Index t = 0; t < m.side_triangles.rows(); ++t) {
+      const Eigen::Vector3d centre = (m.rest_vertices.row(m.side_triangles(t, 0)) +
+                                      m.rest_vertices.row(m.side_triangles(t, 1)) +
+                                      m.rest_vertices.row(m.side_triangles(t, 2))).transpose() / 3.0;
+      const Eigen::Vector3d n = normal(m.side_triangles, t);
+      if (n.norm() > 1e-18) ASSERT_GT(n.dot(Eigen::Vector3d(centre.x(), centre.y(), 0.0)), 0.0) << t;
+    }
+    for (Eigen::Index t = 0; t < m.cap_triangles.rows(); ++t) {
+      const Eigen::Vector3d n = normal(m.cap_triangles, t);
+      if (n.norm() > 1e-18) ASSERT_LT(n.y(), 0.0) << t;
+    }
   }
 }
 

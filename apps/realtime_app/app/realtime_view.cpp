@@ -166,6 +166,8 @@ struct RealtimeView::Impl {
     vtkSmartPointer<vtkActor> shell_actor, cap_actor, hole_actor, nodes_actor;
     vtkSmartPointer<vtkPoints> node_points;
     vtkSmartPointer<vtkPolyData> nodes;
+    bool drawn = false, drawn_valid = false;  ///< what the drawn surface was deformed from
+    Eigen::Matrix3Xd drawn_current, drawn_rest;
   };
 
   Scene scene;
@@ -227,13 +229,14 @@ RealtimeView::RealtimeView(const Scene& scene, const RealtimeModel& model, ViewO
     set_points(a.points, a.vertices);
     const Rgb c = layer_colour(k);
 
+    // Top face: points shared with the cap, updated when the force mesh moves;
+    // its normals are recomputed then. Side wall: its own points, never deformed.
     a.shell = vtkSmartPointer<vtkPolyData>::New();
     a.shell->SetPoints(a.points);
-    a.shell->SetPolys(triangles_of(a.mesh.shell_triangles));
-    vtkNew<vtkPolyDataNormals> normals;  // recomputed every frame from the deformed points
+    a.shell->SetPolys(triangles_of(a.mesh.top_triangles));
+    vtkNew<vtkPolyDataNormals> normals;
     normals->SetInputData(a.shell);
-    normals->SetFeatureAngle(60.0);
-    normals->SplittingOn();
+    normals->SplittingOff();  // a smooth surface: no feature edges to split
     normals->ConsistencyOff();
     normals->AutoOrientNormalsOff();
     vtkNew<vtkPolyDataMapper> shell_mapper;
@@ -245,7 +248,26 @@ RealtimeView::RealtimeView(const Scene& scene, const RealtimeModel& model, ViewO
     a.shell_actor->GetProperty()->SetDiffuse(0.75);
     a.shell_actor->GetProperty()->SetSpecular(0.15);
     a.shell_actor->GetProperty()->SetSpecularPower(20.0);
+    a.shell_actor->GetProperty()->BackfaceCullingOn();
     m.renderer->AddActor(a.shell_actor);
+
+    vtkNew<vtkPoints> side_points;
+    side_points->SetDataTypeToDouble();
+    set_points(side_points, a.mesh.rest_vertices);
+    vtkNew<vtkPolyData> side;
+    side->SetPoints(side_points);
+    side->SetPolys(triangles_of(a.mesh.side_triangles));
+    vtkNew<vtkPolyDataNormals> side_normals;
+    side_normals->SetInputData(side);
+    side_normals->SplittingOff();
+    side_normals->ConsistencyOff();
+    side_normals->AutoOrientNormalsOff();
+    vtkNew<vtkPolyDataMapper> side_mapper;
+    side_mapper->SetInputConnection(side_normals->GetOutputPort());
+    vtkNew<vtkActor> side_actor;
+    side_actor->SetMapper(side_mapper);
+    side_actor->SetProperty(a.shell_actor->GetProperty());
+    m.renderer->AddActor(side_actor);
 
     a.cap = vtkSmartPointer<vtkPolyData>::New();
     a.cap->SetPoints(a.points);
@@ -257,6 +279,7 @@ RealtimeView::RealtimeView(const Scene& scene, const RealtimeModel& model, ViewO
     a.cap_actor->GetProperty()->SetColor(0.85 * c.r, 0.85 * c.g, 0.85 * c.b);
     a.cap_actor->GetProperty()->SetAmbient(0.35);
     a.cap_actor->GetProperty()->SetDiffuse(0.70);
+    a.cap_actor->GetProperty()->BackfaceCullingOn();
     m.renderer->AddActor(a.cap_actor);
 
     // Puncture hole: a dark ring around the needle at the entry point.
@@ -360,14 +383,20 @@ void RealtimeView::render(const ViewSnapshot& snap, const ViewStatus& status, bo
   for (std::size_t k = 0; k < m.layers.size(); ++k) {
     Impl::LayerActors& a = m.layers[k];
     const bool have = k < snap.layers.size();
-    if (have && a.deformer)
-      a.deformer->apply(snap.layers[k], a.mesh, a.vertices);
-    else
-      a.vertices = a.mesh.rest_vertices;
-    set_points(a.points, a.vertices);
-    a.shell->Modified();
-    a.cap->Modified();
     if (!have) continue;
+    // Deform (and upload, and recompute normals) only when the force mesh moved.
+    const LayerSnapshot& now = snap.layers[k];
+    const bool moved = !a.drawn || now.nodes_valid != a.drawn_valid ||
+                       (now.nodes_valid && (now.current_m != a.drawn_current || now.rest_m != a.drawn_rest));
+    if (moved && a.deformer) {
+      a.deformer->apply(now, a.mesh, a.vertices);
+      set_points(a.points, a.vertices);
+      a.shell->Modified();
+      a.cap->Modified();
+    }
+    a.drawn = true;
+    a.drawn_valid = now.nodes_valid;
+    if (now.nodes_valid) a.drawn_current = now.current_m, a.drawn_rest = now.rest_m;
     const LayerSnapshot& l = snap.layers[k];
     const bool punctured = l.state == LayerState::Punctured && l.has_contact;
     a.hole_actor->SetVisibility(punctured);

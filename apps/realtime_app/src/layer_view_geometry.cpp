@@ -54,20 +54,20 @@ LayerViewMesh build_layer_view_mesh(const LayerSurface& surface, double bottom_z
   m.rest_vertices.resize(static_cast<Eigen::Index>(v.size()), 3);
   for (std::size_t i = 0; i < v.size(); ++i) m.rest_vertices.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
 
-  std::vector<Eigen::Vector3i> shell, cap;
+  std::vector<Eigen::Vector3i> top, side, cap;
   // Top face, seen from above (+z): counter-clockwise = increasing azimuth.
-  for (int j = 0; j + 1 < na; ++j) shell.emplace_back(0, top_id(1, j), top_id(1, j + 1));
+  for (int j = 0; j + 1 < na; ++j) top.emplace_back(0, top_id(1, j), top_id(1, j + 1));
   for (int i = 1; i + 1 < nr; ++i)
     for (int j = 0; j + 1 < na; ++j) {
-      shell.emplace_back(top_id(i, j), top_id(i + 1, j), top_id(i + 1, j + 1));
-      shell.emplace_back(top_id(i, j), top_id(i + 1, j + 1), top_id(i, j + 1));
+      top.emplace_back(top_id(i, j), top_id(i + 1, j), top_id(i + 1, j + 1));
+      top.emplace_back(top_id(i, j), top_id(i + 1, j + 1), top_id(i, j + 1));
     }
   // Side wall, seen from outside.
   for (int row = 0; row < o.side_rows; ++row)
     for (int j = 0; j + 1 < na; ++j) {
       const int a = side0 + row * na + j, b = a + 1, c = a + na, d = c + 1;
-      shell.emplace_back(a, c, d);
-      shell.emplace_back(a, d, b);
+      side.emplace_back(a, c, d);
+      side.emplace_back(a, d, b);
     }
   // Cap in the plane y = 0, seen from the front (-y).
   for (std::size_t k = 0; k + 1 < cap_top.size(); ++k) {
@@ -81,7 +81,8 @@ LayerViewMesh build_layer_view_mesh(const LayerSurface& surface, double bottom_z
     for (std::size_t i = 0; i < t.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = t[i].transpose();
     return out;
   };
-  m.shell_triangles = to_matrix(shell);
+  m.top_triangles = to_matrix(top);
+  m.side_triangles = to_matrix(side);
   m.cap_triangles = to_matrix(cap);
   return m;
 }

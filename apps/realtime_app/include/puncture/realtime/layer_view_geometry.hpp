@@ -13,8 +13,9 @@
 //   i.e. the SH surface at the scene's degree; side wall: `side_rows` rows of
 //   the SH surface between the top and bottom rim; cap: the top-face vertices
 //   at azimuth 0 and pi (x = +-r) joined to points on z = bottom_z.
-//   Out: vertices (V x 3, m), shell and cap triangles (counter-clockwise seen
-//   from outside/front), and the indices of the top-face vertices.
+//   Out: vertices (V x 3, m), top-face, side-wall and cap triangles
+//   (counter-clockwise seen from outside: from above, from outside the
+//   cylinder, from the front -y), and the indices of the top-face vertices.
 // LayerDeformer: from a LayerSnapshot (force-mesh node rest and current
 //   positions), the piecewise-linear displacement field over the lattice
 //   (LatticeDisplacementField) applied to the top-face vertices; other
@@ -39,8 +40,9 @@ struct LayerViewMeshOptions {
 
 struct LayerViewMesh {
   Eigen::MatrixX3d rest_vertices;
-  Eigen::MatrixX3i shell_triangles;
-  Eigen::MatrixX3i cap_triangles;
+  Eigen::MatrixX3i top_triangles;   ///< top face (deformed by the force mesh)
+  Eigen::MatrixX3i side_triangles;  ///< side wall (never deformed)
+  Eigen::MatrixX3i cap_triangles;   ///< cross-section in the plane y = 0
   std::vector<int> top_face;  ///< vertex indices on the top face
   double top_z_m = 0.0, bottom_z_m = 0.0;
 };
