@@ -322,5 +322,11 @@ TEST(PunctureApp, BadSceneExitsTwoNamingFileAndPath) {
   EXPECT_FALSE(fs::exists(dir / "stats.json"));
 }
 
+TEST(PunctureApp, NoDisplayIsAClearError) {
+  const ProcessResult r = run("env -u DISPLAY " + kApp + " --device scripted --offscreen --duration 1");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("xvfb-run"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace puncture::realtime

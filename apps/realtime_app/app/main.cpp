@@ -13,6 +13,7 @@
 
 #include <csignal>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -151,6 +152,11 @@ int run(const Options& o, const std::string& command) {
     scene_text = read_text(scene_file);
   }
   const Scene scene = parse_scene(scene_text, scene_file);
+  // VTK's X11 render window (also offscreen) needs a display; without one it crashes.
+  const char* display = std::getenv("DISPLAY");
+  if (!display || !*display)
+    throw std::runtime_error(std::string("no X display (DISPLAY is not set): run in a desktop session") +
+                             (o.offscreen ? ", or under xvfb-run -a" : ", or use --offscreen under xvfb-run -a"));
   if (scene.layers.size() > 16) throw std::runtime_error("puncture-app shows at most 16 layers");
   const double rate = scene.realtime.haptic_rate_Hz;
   const double dt = 1.0 / rate;
