@@ -39,13 +39,34 @@ if [[ -n "$(git status --porcelain -- core apps scenes 2>/dev/null)" ]]; then
 fi
 command="scripts/results_realtime.sh $scene $duration"
 app_command="puncture-app $scene --device scripted --offscreen --duration $duration --record REC --stats JSON --screenshot PNG --screenshot-at 1.25"
+# measured NAME CMD...: runs CMD and writes $tmp/NAME.cpu: wall seconds, CPU seconds of
+# CMD and its children (the app and its Xvfb), CPU seconds of the whole machine
+# (/proc/stat, all CPUs, idle and iowait excluded) and the hypervisor's steal.
+measured() {
+  local name="$1"; shift
+  local before after
+  before="$(head -1 /proc/stat)"
+  /usr/bin/time -f "%e %U %S" -o "$tmp/$name.time" "$@"
+  after="$(head -1 /proc/stat)"
+  /usr/bin/python3 - "$before" "$after" "$(cat "$tmp/$name.time")" "$(getconf CLK_TCK)" > "$tmp/$name.cpu" <<'PY'
+import sys
+b = [int(x) for x in sys.argv[1].split()[1:]]
+a = [int(x) for x in sys.argv[2].split()[1:]]
+wall, user, system = (float(x) for x in sys.argv[3].split())
+tick = float(sys.argv[4])
+d = [y - x for x, y in zip(b, a)]
+busy = (d[0] + d[1] + d[2] + d[5] + d[6] + d[7]) / tick   # user nice system irq softirq steal
+print(wall, user + system, busy, d[7] / tick)
+PY
+}
 echo "[realtime] load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "[realtime] running $duration s of scripted session with rendering (xvfb-run)"
-xvfb-run -a -s "-screen 0 1280x1024x24" "$app" "$scene" --device scripted --offscreen --duration "$duration" \
-  --record "$tmp/session.pncrec" --stats "$tmp/stats.json" --screenshot "$tmp/view.png" --screenshot-at 1.25
+measured fifo xvfb-run -a -s "-screen 0 1280x1024x24" "$app" "$scene" --device scripted --offscreen \
+  --duration "$duration" --record "$tmp/session.pncrec" --stats "$tmp/stats.json" --screenshot "$tmp/view.png" \
+  --screenshot-at 1.25
 echo "[realtime] the same session with normal scheduling (no SCHED_FIFO), for comparison"
-xvfb-run -a -s "-screen 0 1280x1024x24" "$app" "$scene" --device scripted --offscreen --duration "$duration" \
-  --rt-priority 0 --stats "$tmp/stats_normal.json" -q
+measured normal xvfb-run -a -s "-screen 0 1280x1024x24" "$app" "$scene" --device scripted --offscreen \
+  --duration "$duration" --rt-priority 0 --stats "$tmp/stats_normal.json" -q
 echo "[realtime] a short session for the skin-pressed picture"
 xvfb-run -a -s "-screen 0 1280x1024x24" "$app" "$scene" --device scripted --offscreen --duration 0.6 -q \
   --screenshot "$tmp/view_skin_pressed.png" --screenshot-at 0.38
@@ -68,7 +89,13 @@ verify = verify.split(": ", 1)[1] if ": " in verify else verify  # drop "replay 
 h, v, g = s["haptic"], s["view"], s["guard"]
 hn, vn = sn["haptic"], sn["view"]
 before, after = s["load_average"]["before"], s["load_average"]["after"]
-quiet = bool(before) and before[0] < 1.0
+ncpu = os.cpu_count() or 1
+def others(name):
+    wall, ours, busy, steal = (float(x) for x in open(os.path.join(tmp, name + ".cpu")).read().split())
+    return max(0.0, busy - ours) / (ncpu * wall), steal / (ncpu * wall), ours / (ncpu * wall)
+others_fifo, steal_fifo, ours_fifo = others("fifo")
+others_normal, steal_normal, _ = others("normal")
+quiet = others_fifo < 0.10
 target = h["target_rate_Hz"]
 T_us = 1e6 / target
 ok = lambda c: "yes" if c else "**no**"
@@ -103,11 +130,12 @@ lines = [
     f"Scene: `{s['scene']['file']}`, device `{s['device']}`, {s['duration_requested_s']:.0f} s of haptic time, "
     f"rendering offscreen at 60 Hz (Mesa llvmpipe under Xvfb)  ",
     f"Haptic thread: {h['scheduling']}, sleep until {h['spin_margin_us']:.0f} us before each deadline, then spin  ",
-    f"Load average (1, 5, 15 min) before: {', '.join(f'{x:.2f}' for x in before)}; after: "
-    f"{', '.join(f'{x:.2f}' for x in after)}"
+    f"Other processes used {100 * others_fifo:.1f} % of the {ncpu} CPUs during the run (hypervisor steal "
+    f"{100 * steal_fifo:.2f} %; the app and its Xvfb {100 * ours_fifo:.0f} %); load average before "
+    f"{', '.join(f'{x:.2f}' for x in before)}"
     + ("" if quiet else " -- **the machine was loaded by other processes during this measurement**") + "  ",
-    f"Comparison run (`--rt-priority 0`), load average before: "
-    f"{', '.join(f'{x:.2f}' for x in sn['load_average']['before'])}",
+    f"Comparison run (`--rt-priority 0`): other processes used {100 * others_normal:.1f} % of the CPUs "
+    f"(steal {100 * steal_normal:.2f} %)",
     "",
     f"| quantity | measured: {h['scheduling'].split(',')[0]} | same, normal scheduling | target | met |",
     "|---|---|---|---|---|",

@@ -11,7 +11,11 @@
 // 3 a replay whose forces differ from the recording.
 #include <CLI/CLI.hpp>
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <csignal>
+#include <deque>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -176,6 +180,19 @@ int run(const Options& o, const std::string& command) {
     for (const std::string& w : stability.warnings) std::cout << "[app] warning: " << w << "\n";
   }
 
+  // ---- keep this process's other threads (view, renderer, recorder, model
+  // builder: all created after this point inherit it) off the haptic CPU
+  if (o.haptic_cpu >= 0) {
+    cpu_set_t others;
+    CPU_ZERO(&others);
+    const int n = static_cast<int>(std::thread::hardware_concurrency());
+    if (o.haptic_cpu >= n) throw std::runtime_error("--haptic-cpu " + std::to_string(o.haptic_cpu) + ": this machine has " +
+                                                    std::to_string(n) + " CPUs");
+    for (int c = 0; c < n; ++c)
+      if (c != o.haptic_cpu) CPU_SET(c, &others);
+    if (n > 1) pthread_setaffinity_np(pthread_self(), sizeof others, &others);
+  }
+
   // ---- models, device, sinks
   ModelSupplier models([&] { return std::make_unique<RealtimeModel>(build_realtime_model(scene)); });
   std::unique_ptr<HapticDevice> device;
@@ -254,18 +271,21 @@ int run(const Options& o, const std::string& command) {
   status.device_name = device->name();
   status.warnings = stability.warnings;
   ViewStatistics view_stats;
-  const double view_start = monotonic_now_s();
+  std::deque<std::pair<double, std::int64_t>> recent;  // (frame start, haptic ticks done)
   bool screenshot_taken = false, final_frame = false;
   auto frame = [&]() -> bool {
     const double start = monotonic_now_s();
     TickSample s;
     while (samples.try_pop(s)) view.add_sample(s);
     snapshots.update();
+    // Live rates over the last second (the first frames include start-up).
     const std::int64_t ticks = loop.ticks_done();
-    const double elapsed = start - view_start;
-    status.haptic_rate_Hz = elapsed > 0.5 ? ticks / elapsed : rate;
+    recent.push_back({start, ticks});
+    while (recent.size() > 2 && start - recent.front().first > 1.0) recent.pop_front();
+    const double span = start - recent.front().first;
+    status.haptic_rate_Hz = span > 0.2 ? (ticks - recent.front().second) / span : 0.0;
+    status.view_fps = span > 0.2 ? (recent.size() - 1) / span : 0.0;
     status.missed_deadlines = loop.missed_so_far();
-    status.view_fps = view_stats.achieved_fps();
     if (recording)
       status.note = "replay: tick " + std::to_string(ticks) + " of " + std::to_string(recording->records.size());
     if (!screenshot_taken && capture.update()) {
@@ -425,7 +445,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1000.0));
   app.add_option("--rt-priority", o.rt_priority, "SCHED_FIFO priority of the haptic thread (0: normal; default 80)")
       ->check(CLI::Range(0, 99));
-  app.add_option("--haptic-cpu", o.haptic_cpu, "Pin the haptic thread to this CPU (default: no pinning)");
+  app.add_option("--haptic-cpu", o.haptic_cpu,
+                 "Pin the haptic thread to this CPU and keep the app's other threads off it (default: no pinning)");
   app.add_option("--velocity-cutoff", o.velocity_cutoff_Hz,
                  "Low-pass cut-off (Hz) for velocities differentiated from device positions (default 100; 0: none)")
       ->check(CLI::NonNegativeNumber);

@@ -454,7 +454,7 @@ void RealtimeView::Impl::update_text(const ViewSnapshot& snap, const ViewStatus&
     t << "\n";
   }
   t << std::setprecision(1) << "haptic " << status.haptic_rate_Hz << " Hz   missed " << status.missed_deadlines
-    << "   view " << status.view_fps << " fps";
+    << "   view " << status.view_fps << " fps (last second)";
   if (!status.note.empty()) t << "\n" << status.note;
   for (const std::string& w : status.warnings) t << "\nwarning: " << (w.size() > 90 ? w.substr(0, 87) + "..." : w);
   text->SetInput(t.str().c_str());
