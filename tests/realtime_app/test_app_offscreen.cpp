@@ -1,6 +1,7 @@
 // puncture-app as a program, offscreen under Xvfb: the screenshot shows the
 // three layers (pixel colours, not an exact image); the statistics file is
-// sane and its puncture events are those of the offline model run; a recorded
+// sane and its puncture events are those of the offline model run; the tuned
+// preset opens and runs its own calibrated values; a recorded
 // session replays bit for bit (and a changed scene does not); the stability
 // guard clamps the force sent to the device; a UDP bridge drives the app; a
 // bad scene exits 2 naming the file and JSON path.
@@ -166,6 +167,44 @@ TEST(PunctureApp, OffscreenScriptedRunScreenshotAndStatistics) {
     EXPECT_EQ(events[i].at("depth_mm").get<double>(), offline.events[i].depth_m * 1e3);
     EXPECT_EQ(events[i].at("total_force_N").get<double>(), offline.events[i].total_force_N);
   }
+}
+
+TEST(PunctureApp, TunedPresetOpensAndRunsItsOwnParameters) {
+  // The committed tuned preset (written by `puncture calibrate`) is a scene file with calibrated force-mesh
+  // values: the app opens it, shows three layers, and punctures where the offline model of the preset does,
+  // not where the default scene's does.
+  const std::string preset = std::string(PUNCTURE_SOURCE_DIR) + "/results/tuned_preset/default_tuned.json";
+  ASSERT_TRUE(fs::exists(preset)) << preset;
+  const fs::path dir = work_dir("tuned_preset");
+  const ProcessResult r = app(preset + " --device scripted --offscreen --duration 2.0 --size 640x400 --screenshot " +
+                              (dir / "view.png").string() + " --screenshot-at 0.3 --stats " +
+                              (dir / "stats.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const PixelStats px = pixel_stats(dir / "view.png");
+  EXPECT_GT(px.stddev, 20.0) << "blank image";
+  EXPECT_GT(px.skin, 0.01) << "skin";
+  EXPECT_GT(px.fat, 0.01) << "fat";
+  EXPECT_GT(px.muscle, 0.01) << "muscle";
+
+  const json s = read_json(dir / "stats.json");
+  EXPECT_EQ(s.at("scene").at("name").get<std::string>(), "default_tuned");
+  const Scene tuned = load_scene(preset);
+  RealtimeModel tuned_model = build_realtime_model(tuned);
+  const ScriptedRunResult offline = run_scripted_insertion(tuned_model, tuned);
+  const json& events = s.at("puncture_events");
+  ASSERT_EQ(events.size(), offline.events.size());
+  ASSERT_FALSE(offline.events.empty());
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    EXPECT_EQ(events[i].at("layer").get<std::string>(), tuned.layers[offline.events[i].layer].name);
+    EXPECT_EQ(events[i].at("depth_mm").get<double>(), offline.events[i].depth_m * 1e3);
+    EXPECT_EQ(events[i].at("total_force_N").get<double>(), offline.events[i].total_force_N);
+  }
+  const Scene plain = load_scene(kDefaultScene);
+  RealtimeModel plain_model = build_realtime_model(plain);
+  const ScriptedRunResult plain_run = run_scripted_insertion(plain_model, plain);
+  ASSERT_FALSE(plain_run.events.empty());
+  EXPECT_NE(events[0].at("total_force_N").get<double>(), plain_run.events[0].total_force_N)
+      << "the app ran the default scene's values, not the preset's";
 }
 
 TEST(PunctureApp, RecordedSessionReplaysBitForBit) {
