@@ -352,6 +352,16 @@ Scene read_scene(const json& root, const std::string& file) {
     s.effects.stiffening = on("stiffening");
     s.effects.layer_interaction = on("layer_interaction");
   }
+  if (r.has("haptics")) {
+    ObjectReader o(r.raw("haptics"), "/haptics", file);
+    Haptics& h = s.haptics;
+    h.max_force_N = o.number("max_force_N", h.max_force_N);
+    h.max_force_rate_N_per_s = o.number("max_force_rate_N_per_s", h.max_force_rate_N_per_s);
+    h.device_damping_N_s_per_m = o.number("device_damping_N_s_per_m", h.device_damping_N_s_per_m);
+    h.device_max_stiffness_N_per_m =
+        o.number("device_max_stiffness_N_per_mm", h.device_max_stiffness_N_per_m * kMm) / kMm;
+    o.reject_unknown_keys();
+  }
   r.reject_unknown_keys();
   // Recovery time in seconds: given, or the paper's eta_r per haptic step at
   // this file's haptic rate (so that it no longer changes with the rate);
@@ -578,6 +588,14 @@ void validate_scene(const Scene& s, const std::string& file) {
                          "critical_energy (the ring rule counts the deflection carried from the layer above)");
     if (s.layers.size() > 16) throw SceneError(file, "/layers", "layer_interaction supports at most 16 layers");
   }
+
+  const Haptics& h = s.haptics;
+  require(h.max_force_N > 0, file, "/haptics/max_force_N", "> 0", h.max_force_N);
+  require(h.max_force_rate_N_per_s > 0, file, "/haptics/max_force_rate_N_per_s", "> 0", h.max_force_rate_N_per_s);
+  require(h.device_damping_N_s_per_m >= 0, file, "/haptics/device_damping_N_s_per_m", ">= 0",
+          h.device_damping_N_s_per_m);
+  require(h.device_max_stiffness_N_per_m > 0, file, "/haptics/device_max_stiffness_N_per_mm", "> 0",
+          h.device_max_stiffness_N_per_m * kMm);
 }
 
 Scene parse_scene(const std::string& text, const std::string& source_name) {
@@ -726,6 +744,10 @@ std::string scene_to_json_text(const Scene& s) {
   if (s.effects.stiffening) effects.push_back("stiffening");
   if (s.effects.layer_interaction) effects.push_back("layer_interaction");
   root["effects"] = effects;
+  root["haptics"] = {{"max_force_N", s.haptics.max_force_N},
+                     {"max_force_rate_N_per_s", s.haptics.max_force_rate_N_per_s},
+                     {"device_damping_N_s_per_m", s.haptics.device_damping_N_s_per_m},
+                     {"device_max_stiffness_N_per_mm", s.haptics.device_max_stiffness_N_per_m * kMm}};
   return root.dump(2) + "\n";
 }
 

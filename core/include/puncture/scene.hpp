@@ -236,6 +236,19 @@ struct Effects {
   bool layer_interaction = false;  ///< layers in series: a layer pressed by the one above carries the load in its own force mesh
 };
 
+/// What the haptic device may be sent (the real-time app's stability guard,
+/// apps/realtime_app). Defaults: the Geomagic Touch (PHANTOM Omni) data
+/// sheet (3.3 N peak force, 1.02 N/mm stiffness along its weakest axis);
+/// device damping b = 0.51 N s/m is the value at which that stiffness is
+/// passive at 1 kHz by K T / 2 <= b (Colgate and Brown 1994), an inferred
+/// value: measure your device.
+struct Haptics {
+  double max_force_N = 3.3;                      ///< magnitude limit of the force sent to the device
+  double max_force_rate_N_per_s = 1000.0;        ///< limit on the change of that force per second
+  double device_damping_N_s_per_m = 0.51;        ///< b: physical damping of the device
+  double device_max_stiffness_N_per_m = 1020.0;  ///< largest stiffness the device renders (data sheet)
+};
+
 struct Scene {
   std::string name;
   std::string description;
@@ -248,6 +261,7 @@ struct Scene {
   FemSettings fem;
   std::vector<std::string> models{"realtime"};  ///< which models a run uses: "realtime", "fem"
   Effects effects;
+  Haptics haptics;  ///< optional "haptics" object of the scene file
 
   double total_thickness_m() const {
     double t = 0.0;
