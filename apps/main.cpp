@@ -5,6 +5,7 @@
 //   puncture calibrate [SCENE] [--reference CSV] [-o DIR]   tuned preset
 //   puncture sweep     [SCENE] [-o DIR]   accuracy versus time of every fidelity knob
 //   puncture grade SCORES.csv [-o DIR]    comprehensive weighted grading (paper Sec. 3.3)
+//   puncture compare   [SCENE] [-o DIR]   comparison models of both papers against the FEM
 #include <CLI/CLI.hpp>
 #include <iostream>
 
@@ -81,6 +82,20 @@ int main(int argc, char** argv) {
   grade_cmd->add_option("-o,--output", output, "Output directory; default: out/grading");
   grade_cmd->add_option("--mu", grade.mu, "Preference coefficient (share of the subjective weights), default 0.4");
 
+  CompareOptions compare;
+  auto* compare_cmd = app.add_subcommand("compare", "Comparison models of both papers against the FEM, graded (Sec. 3.3)");
+  compare_cmd->add_option("scene", scene, "Scene file (JSON); default: scenes/default.json");
+  compare_cmd->add_option("--models", compare.models, "Models (comma separated); default: all")->delimiter(',');
+  compare_cmd->add_option("-o,--output", output, "Output directory; default: out/<scene name>_comparison");
+  compare_cmd->add_option("--cache", cache, "FEM cache directory; default: out/.fem_cache");
+  compare_cmd->add_option("--weights", compare.weights, "Delphi weights file; default: scenes/delphi_weights.json");
+  compare_cmd->add_option("--identify", compare.identify, "Identify the mass-spring stiffnesses: simulated_annealing,isres")
+      ->delimiter(',');
+  compare_cmd->add_option("--identify-evaluations", compare.identify_evaluations, "Model runs per identification (40)");
+  compare_cmd->add_option("--frames", compare.frames, "ParaView frames per model (20; 0: none)");
+  compare_cmd->add_flag("--no-vtk", [&](std::int64_t) { compare.write_vtk = false; }, "No VTK output");
+  compare_cmd->add_flag("-q,--quiet", compare.quiet, "No progress output");
+
   CLI11_PARSE(app, argc, argv);
 
   const auto dispatch = [&]() -> int {
@@ -103,6 +118,10 @@ int main(int argc, char** argv) {
     if (*sweep_cmd) {
       sweep.scene = scene, sweep.output_dir = output, sweep.cache_dir = cache;
       return sweep_command(sweep, std::cout, std::cerr);
+    }
+    if (*compare_cmd) {
+      compare.scene = scene, compare.output_dir = output, compare.cache_dir = cache;
+      return compare_command(compare, std::cout, std::cerr);
     }
     if (*grade_cmd) {
       grade.scores = scores, grade.output_dir = output;

@@ -174,6 +174,7 @@ ComparisonSettings read_comparison(ObjectReader r, const std::string& file) {
   c.relative_tolerance = r.number("relative_tolerance", c.relative_tolerance);
   c.absolute_tolerance_m = r.number("absolute_tolerance_mm", c.absolute_tolerance_m / kMm) * kMm;
   c.mass_damping_per_s = r.number("mass_damping_per_s", c.mass_damping_per_s);
+  c.stiffness_damping_s = r.number("stiffness_damping_s", c.stiffness_damping_s);
   if (r.has("viscoelastic")) {
     ObjectReader v(r.raw("viscoelastic"), r.child("viscoelastic"), file);
     c.prony_g = number_list(v, "prony_g");
@@ -381,6 +382,7 @@ void validate_scene(const Scene& s, const std::string& file) {
           c.relative_tolerance);
   require(c.absolute_tolerance_m > 0, file, "/comparison/absolute_tolerance_mm", "> 0", c.absolute_tolerance_m / kMm);
   require(c.mass_damping_per_s >= 0, file, "/comparison/mass_damping_per_s", ">= 0", c.mass_damping_per_s);
+  require(c.stiffness_damping_s >= 0, file, "/comparison/stiffness_damping_s", ">= 0", c.stiffness_damping_s);
   if (c.prony_g.size() != c.prony_tau_s.size())
     throw SceneError(file, "/comparison/viscoelastic/prony_tau_s",
                      "must have as many entries as prony_g (" + std::to_string(c.prony_g.size()) + ")");
@@ -485,6 +487,7 @@ std::string scene_to_json_text(const Scene& s) {
                      {"relative_tolerance", c.relative_tolerance},
                      {"absolute_tolerance_mm", c.absolute_tolerance_m / kMm},
                      {"mass_damping_per_s", c.mass_damping_per_s},
+                     {"stiffness_damping_s", c.stiffness_damping_s},
                      {"viscoelastic", {{"prony_g", c.prony_g}, {"prony_tau_s", c.prony_tau_s}}}};
   if (!c.mass_spring_stiffness_scale.empty()) comparison["mass_spring_stiffness_scale"] = c.mass_spring_stiffness_scale;
   root["comparison"] = comparison;

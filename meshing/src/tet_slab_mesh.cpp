@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <stdexcept>
 #include <vector>
@@ -68,12 +69,19 @@ struct DistanceField {
   SizeField size;
   double radius_mm;
   FT operator()(const Point& p, const int, const Index&) const {
+    const double r = std::hypot(p.x(), p.y());
+    // The needle column's side: chords of at most 0.63 a (10 or more facets around).
+    if (r < 2.0 * size.needle_mm) return std::min(0.1 * size.size(p), 0.05 * size.needle_mm);
     return std::min(0.1 * size.size(p), 0.005 * radius_mm);
   }
 };
 
+int circle_segments(double radius, double max_segment) {
+  return std::max(16, static_cast<int>(std::ceil(2.0 * kPi * radius / max_segment)));
+}
+
 std::vector<Point> circle(double radius, double z, double max_segment) {
-  const int n = std::max(16, static_cast<int>(std::ceil(2.0 * kPi * radius / max_segment)));
+  const int n = circle_segments(radius, max_segment);
   std::vector<Point> c;
   c.reserve(static_cast<std::size_t>(n) + 1);
   for (int i = 0; i < n; ++i) {
@@ -147,36 +155,70 @@ comparison::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOpt
                                                   p::no_lloyd());
   if (c3t3.number_of_cells_in_complex() == 0) throw std::runtime_error("build_tet_slab_mesh: CGAL returned no cells");
 
+  // The finite cells whose centroid lies in the slab and whose vertices do
+  // not all lie on one boundary surface (the side r = R or one interface
+  // plane), labelled by their centroid. Mesh_3 labels cells by their
+  // circumcentre, and a flat cell spanning the thin skin can have its
+  // circumcentre outside the slab: the complex alone would leave a hole
+  // through the skin. Cells whose vertices all lie on one boundary surface are
+  // flat slivers on that surface (of the convex hull or of the complex).
   comparison::TetMesh mesh;
+  const Triangulation& tr = c3t3.triangulation();
   std::map<Triangulation::Vertex_handle, int> index;
   std::vector<Eigen::Vector3d> points;
   const int n_layers = g.layers();
-  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
+  const double tolerance_mm = 1e-6 * g.radius_mm;
+  const double on_surface_mm = 1e-4 * options.size_at_axis_m * kMmPerM;
+  // Rim vertices lie on the feature polyline, inside the circle by up to the
+  // sagitta of its segments.
+  const double rim_segment_mm = 2.0 * kPi * g.radius_mm / circle_segments(g.radius_mm, 0.25 * size.far_mm);
+  const double on_side_mm = 1.5 * rim_segment_mm * rim_segment_mm / (8.0 * g.radius_mm) + on_surface_mm;
+  for (auto c = tr.finite_cells_begin(); c != tr.finite_cells_end(); ++c) {
+    Eigen::Vector3d q[4];
+    bool outside = false, all_on_side = true;
+    std::vector<int> planes_shared;  // interface planes every vertex lies on
+    for (int i = 0; i < 4; ++i) {
+      const Point& v = c->vertex(i)->point().point();
+      q[i] = Eigen::Vector3d(v.x(), v.y(), v.z());
+      const double r = std::hypot(v.x(), v.y());
+      outside = outside || r > g.radius_mm + tolerance_mm || v.z() > g.interface_z_mm.front() + tolerance_mm ||
+                v.z() < g.interface_z_mm.back() - tolerance_mm;
+      all_on_side = all_on_side && std::abs(r - g.radius_mm) < on_side_mm;
+      std::vector<int> planes;
+      for (int k = 0; k <= n_layers; ++k)
+        if (std::abs(v.z() - g.interface_z_mm[static_cast<std::size_t>(k)]) < on_surface_mm) planes.push_back(k);
+      if (i == 0) {
+        planes_shared = planes;
+      } else {
+        std::vector<int> common;
+        std::set_intersection(planes_shared.begin(), planes_shared.end(), planes.begin(), planes.end(),
+                              std::back_inserter(common));
+        planes_shared = common;
+      }
+    }
+    if (outside) continue;  // a vertex outside the slab (none expected)
+    if (all_on_side || !planes_shared.empty()) continue;
+    const Eigen::Vector3d centroid = 0.25 * (q[0] + q[1] + q[2] + q[3]);
+    const int label = label_of(g, Point(centroid.x(), centroid.y(), centroid.z()));
+    if (label == 0) continue;
+    double longest = 0.0;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (q[i] - q[j]).norm());
+    const double volume = comparison::tet_signed_volume(q[0], q[1], q[2], q[3]);
+    if (std::abs(volume) < 1e-8 * longest * longest * longest) continue;  // flat cell on a boundary plane
     Eigen::Vector4i tet;
     for (int i = 0; i < 4; ++i) {
-      const auto v = c->vertex(i);
-      auto [it, inserted] = index.emplace(v, static_cast<int>(points.size()));
-      if (inserted) {
-        const Point& q = v->point().point();
-        points.emplace_back(q.x() / kMmPerM, q.y() / kMmPerM, q.z() / kMmPerM);
-      }
+      auto [it, inserted] = index.emplace(c->vertex(i), static_cast<int>(points.size()));
+      if (inserted) points.push_back(q[i] / kMmPerM);
       tet[i] = it->second;
     }
-    const int label = c3t3.subdomain_index(c);
-    if (label < 1 || label > 2 * n_layers) throw std::runtime_error("build_tet_slab_mesh: unexpected subdomain label");
-    const bool column = label > n_layers;
-    const int layer = (label - 1) % n_layers;
+    if (volume < 0.0) std::swap(tet[2], tet[3]);
     mesh.tets.push_back(tet);
-    mesh.layer.push_back(layer);
-    mesh.needle_column.push_back(column ? 1 : 0);
+    mesh.layer.push_back((label - 1) % n_layers);
+    mesh.needle_column.push_back(label > n_layers ? 1 : 0);
   }
   mesh.points_m.resize(3, static_cast<Eigen::Index>(points.size()));
   for (std::size_t i = 0; i < points.size(); ++i) mesh.points_m.col(static_cast<Eigen::Index>(i)) = points[i];
-  for (Eigen::Vector4i& t : mesh.tets) {
-    const double vol = comparison::tet_signed_volume(mesh.points_m.col(t[0]), mesh.points_m.col(t[1]),
-                                                     mesh.points_m.col(t[2]), mesh.points_m.col(t[3]));
-    if (vol < 0.0) std::swap(t[2], t[3]);
-  }
   comparison::check_tet_mesh(mesh, n_layers);
 
   if (report) {

@@ -112,9 +112,9 @@ struct Effects {
 /// the target edge length grows from size_at_axis at the needle radius by
 /// `grading` per unit radial distance, up to size_far.
 struct ComparisonMeshSettings {
-  double size_at_axis_m = 0.5e-3;  ///< tetrahedron size at the needle
-  double size_far_m = 6e-3;        ///< largest tetrahedron size, far from the axis
-  double grading = 0.3;            ///< growth of the size per metre of distance from the needle radius
+  double size_at_axis_m = 1.0e-3;  ///< tetrahedron size at the needle
+  double size_far_m = 8e-3;        ///< largest tetrahedron size, far from the axis
+  double grading = 0.5;            ///< growth of the size per metre of distance from the needle radius
 };
 
 /// Settings of the comparison models of `puncture compare` (core/comparison):
@@ -126,7 +126,8 @@ struct ComparisonSettings {
   std::string integrator = "implicit";
   double relative_tolerance = 1e-4;       ///< integrator relative tolerance
   double absolute_tolerance_m = 1e-7;     ///< integrator absolute tolerance on positions (velocities: per second)
-  double mass_damping_per_s = 20.0;       ///< alpha of the mass-proportional damping Y = alpha M (seed 001: M x'' = -K x - Y x')
+  double mass_damping_per_s = 20.0;       ///< alpha of the Rayleigh damping Y = alpha M + beta K0 (seed 001: M x'' = -K x - Y x')
+  double stiffness_damping_s = 1e-3;      ///< beta: stiffness-proportional part (K0 = tangent at rest); damps the mesh's high modes
   std::vector<double> prony_g{0.5};       ///< visco-elastic tensor-mass: Prony moduli g_k (relative to the long-term modulus)
   std::vector<double> prony_tau_s{0.5};   ///< and relaxation times tau_k
   /// Per layer factor on the mass-spring stiffnesses (empty: all 1); set by

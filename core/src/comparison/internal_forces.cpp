@@ -352,6 +352,44 @@ void ViscoelasticTensorMass::extra_state_decay_rates(std::vector<double>& rates)
       for (int c = 0; c < 6; ++c) rates[(t * terms + k) * 6 + static_cast<std::size_t>(c)] = 1.0 / prony_.tau_s[k];
 }
 
+void ViscoelasticTensorMass::add_internal_variable_forces(VectorRef x, const double* r_q, double gamma,
+                                                          MutableVectorRef f) const {
+  const std::size_t terms = prony_.g.size();
+  for (int t = 0; t < mesh_->tet_count(); ++t) {
+    if (removed_[static_cast<std::size_t>(t)]) continue;
+    const std::size_t base = static_cast<std::size_t>(t) * terms * 6;
+    Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+    for (std::size_t k = 0; k < terms; ++k) S += from_voigt(r_q + base + 6 * k) / (1.0 + gamma / prony_.tau_s[k]);
+    const TetShape& shape = shape_[static_cast<std::size_t>(t)];
+    const Matrix34d fe = forces_from_stress(shape, element_positions(x, t) * shape.grad, S);
+    const Eigen::Vector4i& nodes = mesh_->tets[static_cast<std::size_t>(t)];
+    for (int a = 0; a < 4; ++a) f.segment<3>(3 * nodes[a]) += fe.col(a);
+  }
+}
+
+void ViscoelasticTensorMass::internal_variable_correction(VectorRef x, VectorRef b, const double* r_q, double gamma,
+                                                          double* z_q) const {
+  const std::size_t terms = prony_.g.size();
+  for (int t = 0; t < mesh_->tet_count(); ++t) {
+    const std::size_t base = static_cast<std::size_t>(t) * terms * 6;
+    if (removed_[static_cast<std::size_t>(t)]) {
+      for (std::size_t i = 0; i < 6 * terms; ++i) z_q[base + i] = r_q[base + i];
+      continue;
+    }
+    const TetShape& shape = shape_[static_cast<std::size_t>(t)];
+    const Eigen::Matrix3d F = element_positions(x, t) * shape.grad;
+    const Eigen::Matrix3d Fdot = element_positions(b, t) * shape.grad;
+    const Eigen::Matrix3d Se_dot =
+        stvk_stress(0.5 * (F.transpose() * Fdot + Fdot.transpose() * F), lame_[static_cast<std::size_t>(t)]);
+    for (std::size_t k = 0; k < terms; ++k) {
+      double h[6];
+      to_voigt(prony_.g[k] * Se_dot, h);
+      const double denominator = 1.0 + gamma / prony_.tau_s[k];
+      for (int c = 0; c < 6; ++c) z_q[base + 6 * k + c] = (r_q[base + 6 * k + c] + gamma * h[c]) / denominator;
+    }
+  }
+}
+
 std::size_t ViscoelasticTensorMass::memory_bytes() const {
   return StvkTensorMass::memory_bytes() + static_cast<std::size_t>(extra_state_size()) * sizeof(double);
 }

@@ -140,6 +140,9 @@ SundialsIntegrator::SundialsIntegrator(OdeSystem& system, const IntegratorSettin
     if (system.has_jacobian_times()) check(CVodeSetJacTimes(impl_->memory, nullptr, jtimes_callback), "CVodeSetJacTimes");
     check(CVodeSetMaxNumSteps(impl_->memory, settings.max_steps_per_call), "CVodeSetMaxNumSteps");
     if (settings.max_step_s > 0.0) check(CVodeSetMaxStep(impl_->memory, settings.max_step_s), "CVodeSetMaxStep");
+    if (settings.max_bdf_order < 1 || settings.max_bdf_order > 5)
+      throw std::invalid_argument("SundialsIntegrator: max_bdf_order must be in 1..5");
+    check(CVodeSetMaxOrd(impl_->memory, settings.max_bdf_order), "CVodeSetMaxOrd");
   } else {
     impl_->memory = ERKStepCreate(rhs_callback, t0, impl_->y, impl_->context);
     if (!impl_->memory) throw std::runtime_error("SUNDIALS: ERKStepCreate failed");
@@ -176,10 +179,16 @@ void SundialsIntegrator::reinit(double t, const Eigen::VectorXd& y) {
   if (y.size() != impl_->n) throw std::invalid_argument("SundialsIntegrator::reinit: wrong size");
   std::copy(y.data(), y.data() + impl_->n, N_VGetArrayPointer(impl_->y));
   before_restarts_ = stats();  // the counters restart with the integrator
-  if (settings_.kind == IntegratorKind::ImplicitBdf)
+  realtype last_step = 0.0;
+  if (settings_.kind == IntegratorKind::ImplicitBdf) {
+    CVodeGetLastStep(impl_->memory, &last_step);
     check(CVodeReInit(impl_->memory, t, impl_->y), "CVodeReInit");
-  else
+    check(CVodeSetInitStep(impl_->memory, last_step > 0.0 ? 0.25 * last_step : 0.0), "CVodeSetInitStep");
+  } else {
+    ERKStepGetLastStep(impl_->memory, &last_step);
     check(ERKStepReInit(impl_->memory, rhs_callback, t, impl_->y), "ERKStepReInit");
+    check(ERKStepSetInitStep(impl_->memory, last_step > 0.0 ? 0.25 * last_step : 0.0), "ERKStepSetInitStep");
+  }
   time_ = t;
   ++reinits_;
 }

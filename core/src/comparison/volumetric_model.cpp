@@ -3,6 +3,7 @@
 #include "puncture/comparison/volumetric_model.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -14,6 +15,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kGeometryTolerance_m = 1e-6;
+constexpr double kReuseFactor = 5.0;
 
 /// Triangles of the layer's top face: faces of its tetrahedra on z = top.
 std::vector<Eigen::Vector3i> top_triangles(const TetMesh& mesh, int layer, double top_z_m) {
@@ -52,6 +54,7 @@ VolumetricSettings volumetric_settings(const Scene& scene) {
   s.relative_tolerance = scene.comparison.relative_tolerance;
   s.absolute_tolerance_m = scene.comparison.absolute_tolerance_m;
   s.mass_damping_per_s = scene.comparison.mass_damping_per_s;
+  s.stiffness_damping_s = scene.comparison.stiffness_damping_s;
   return s;
 }
 
@@ -149,8 +152,12 @@ VolumetricNeedleModel::VolumetricNeedleModel(const Scene& scene, std::shared_ptr
   y_ = Eigen::VectorXd::Zero(6 * nodes_ + extra_);
   y_.head(3 * nodes_) = rest_;
   law_->extra_state_decay_rates(decay_rates_);
-  if (settings_.integrator == IntegratorKind::ImplicitBdf)
-    tangent_ = NodeBlockMatrix(nodes_, tet_node_pairs(*mesh_));
+  const std::vector<std::pair<int, int>> pairs = tet_node_pairs(*mesh_);
+  if (settings_.integrator == IntegratorKind::ImplicitBdf) tangent_ = NodeBlockMatrix(nodes_, pairs);
+  if (settings_.stiffness_damping_s > 0.0) {
+    rest_tangent_ = NodeBlockMatrix(nodes_, pairs);
+    compute_rest_tangent();
+  }
   work_f_ = Eigen::VectorXd::Zero(3 * nodes_);
 }
 
@@ -173,11 +180,19 @@ void VolumetricNeedleModel::compute_masses() {
   }
 }
 
+void VolumetricNeedleModel::compute_rest_tangent() {
+  if (settings_.stiffness_damping_s <= 0.0) return;
+  rest_tangent_.set_zero();
+  law_->add_tangent(rest_, 0.0, rest_tangent_);
+}
+
 void VolumetricNeedleModel::compute_forces(const Eigen::VectorXd& y, Eigen::VectorXd& f) const {
   f.setZero(3 * nodes_);
   std::vector<double> qdot(static_cast<std::size_t>(extra_));
   law_->add_forces(y.head(3 * nodes_), y.segment(3 * nodes_, 3 * nodes_), y.data() + 6 * nodes_, f,
                    extra_ ? qdot.data() : nullptr);
+  if (settings_.stiffness_damping_s > 0.0)
+    f.noalias() -= settings_.stiffness_damping_s * (rest_tangent_.matrix() * y.segment(3 * nodes_, 3 * nodes_));
 }
 
 int VolumetricNeedleModel::rhs(double, const double* yp, double* ydot) {
@@ -186,6 +201,8 @@ int VolumetricNeedleModel::rhs(double, const double* yp, double* ydot) {
   work_f_.setZero();
   law_->add_forces(y.head(3 * nodes_), y.segment(3 * nodes_, 3 * nodes_), yp + 6 * nodes_, work_f_,
                    extra_ ? ydot + 6 * nodes_ : nullptr);
+  if (settings_.stiffness_damping_s > 0.0)
+    work_f_.noalias() -= settings_.stiffness_damping_s * (rest_tangent_.matrix() * y.segment(3 * nodes_, 3 * nodes_));
   out.head(3 * nodes_) = y.segment(3 * nodes_, 3 * nodes_);
   const double alpha = settings_.mass_damping_per_s;
   for (int a = 0; a < nodes_; ++a) {
@@ -207,16 +224,45 @@ bool VolumetricNeedleModel::has_jacobian_times() const {
 int VolumetricNeedleModel::preconditioner_setup(double, const double* yp, bool jok, bool& updated, double gamma) {
   const Eigen::Map<const Eigen::VectorXd> y(yp, y_.size());
   updated = false;
-  if (!jok || !have_tangent_ || extra_ > 0) {
+  if (!jok || !have_tangent_) {
     tangent_.set_zero();
     law_->add_tangent(y.head(3 * nodes_), gamma, tangent_);
-    if (!Eigen::Map<const Eigen::VectorXd>(tangent_.matrix().valuePtr(), tangent_.matrix().nonZeros()).allFinite())
-      return 1;
+    const Eigen::SparseMatrix<double>& K = tangent_.matrix();
+    if (!Eigen::Map<const Eigen::VectorXd>(K.valuePtr(), K.nonZeros()).allFinite()) return 1;
+    // Gershgorin bound on the largest eigenvalue of M^-1 K over the free dofs.
+    omega_squared_bound_ = 0.0;
+    for (Eigen::Index j = 0; j < K.outerSize(); ++j) {
+      if (dof_[static_cast<std::size_t>(j / 3)] != Dof::Free) continue;
+      double row = 0.0;  // K is symmetric: the column sum is the row sum
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, j); it; ++it) row += std::abs(it.value());
+      omega_squared_bound_ = std::max(omega_squared_bound_, row / mass_[j]);
+    }
     have_tangent_ = true;
+    have_factor_ = false;
     updated = true;
   }
-  const double alpha = settings_.mass_damping_per_s;
+  const double alpha = settings_.mass_damping_per_s, beta = settings_.stiffness_damping_s;
+  // Small steps: gamma^2 K (and gamma beta K0) are small beside M, the diagonal
+  // is a good enough preconditioner.
+  mass_only_ = (gamma * gamma + gamma * beta) * omega_squared_bound_ < 0.25;
+  if (mass_only_) {
+    diagonal_.resize(3 * nodes_);
+    const Eigen::SparseMatrix<double>& K = tangent_.matrix();
+    for (int d = 0; d < 3 * nodes_; ++d)
+      diagonal_[d] = dof_[static_cast<std::size_t>(d / 3)] == Dof::Free
+                         ? (1.0 + gamma * alpha) * mass_[d] + gamma * gamma * K.coeff(d, d) +
+                               (beta > 0.0 ? gamma * beta * rest_tangent_.matrix().coeff(d, d) : 0.0)
+                         : 1.0;
+    ++mass_only_setups_;
+    return 0;
+  }
+  // Reuse the factorisation while gamma stays within a factor kReuseFactor of
+  // the one it was made with: the preconditioned spectrum stays within
+  // [1/f^2, f^2] and GMRES absorbs the difference.
+  if (have_factor_ && gamma < kReuseFactor * factor_gamma_ && gamma > factor_gamma_ / kReuseFactor) return 0;
+  const auto start = std::chrono::steady_clock::now();
   full_ = tangent_.matrix() * (gamma * gamma);
+  if (beta > 0.0) full_ += rest_tangent_.matrix() * (gamma * beta);  // same pattern
   for (int d = 0; d < 3 * nodes_; ++d) full_.coeffRef(d, d) += (1.0 + gamma * alpha) * mass_[d];
   system_ = full_;
   for (Eigen::Index j = 0; j < system_.outerSize(); ++j) {
@@ -232,29 +278,55 @@ int VolumetricNeedleModel::preconditioner_setup(double, const double* yp, bool j
     pattern_analysed_ = true;
   }
   factor_.factorize(system_);
-  return factor_.info() == Eigen::Success ? 0 : 1;
+  factorisation_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ++factorisations_;
+  if (factor_.info() != Eigen::Success) {
+    have_factor_ = false;
+    return 1;
+  }
+  have_factor_ = true;
+  factor_gamma_ = gamma;
+  return 0;
 }
 
-int VolumetricNeedleModel::preconditioner_solve(double, const double*, const double* rp, double* zp, double gamma) {
+int VolumetricNeedleModel::preconditioner_solve(double, const double* yp, const double* rp, double* zp, double gamma) {
+  yp_current_ = yp;
   const int n3 = 3 * nodes_;
   const Eigen::Map<const Eigen::VectorXd> r(rp, y_.size());
   Eigen::Map<Eigen::VectorXd> z(zp, y_.size());
   const auto rx = r.head(n3);
   const auto rv = r.segment(n3, n3);
-  work_b_.setZero(n3);
-  for (int d = 0; d < n3; ++d)
-    if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) work_b_[d] = rv[d];
-  work_a_ = mass_.cwiseProduct(rv) - gamma * (tangent_.matrix() * rx) - full_ * work_b_;
-  for (int d = 0; d < n3; ++d)
-    if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) work_a_[d] = rv[d];
-  Eigen::VectorXd b = factor_.solve(work_a_);
+  const Eigen::SparseMatrix<double>& K = tangent_.matrix();
+  Eigen::VectorXd b;
+  // Internal variables (visco-elastic law): their residual enters the velocity
+  // equation through their forces, eliminated exactly.
+  Eigen::VectorXd q_force;
+  if (extra_ > 0) {
+    q_force = Eigen::VectorXd::Zero(n3);
+    law_->add_internal_variable_forces(Eigen::Map<const Eigen::VectorXd>(yp_current_, n3), rp + 6 * nodes_, gamma, q_force);
+  }
+  if (mass_only_) {
+    work_a_ = mass_.cwiseProduct(rv) - gamma * (K * rx);
+    if (extra_ > 0) work_a_ += gamma * q_force;
+    b = work_a_.cwiseQuotient(diagonal_);
+  } else {
+    work_b_.setZero(n3);
+    for (int d = 0; d < n3; ++d)
+      if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) work_b_[d] = rv[d];
+    work_a_ = mass_.cwiseProduct(rv) - gamma * (K * rx) - full_ * work_b_;
+    if (extra_ > 0) work_a_ += gamma * q_force;
+    for (int d = 0; d < n3; ++d)
+      if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) work_a_[d] = rv[d];
+    b = factor_.solve(work_a_);
+  }
   if (!b.allFinite()) return 1;
   for (int d = 0; d < n3; ++d)
     if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) b[d] = rv[d];
   z.head(n3) = rx + gamma * b;
   z.segment(n3, n3) = b;
-  for (int i = 0; i < extra_; ++i)
-    z[6 * nodes_ + i] = r[6 * nodes_ + i] / (1.0 + gamma * decay_rates_[static_cast<std::size_t>(i)]);
+  if (extra_ > 0)
+    law_->internal_variable_correction(Eigen::Map<const Eigen::VectorXd>(yp_current_, n3), b, rp + 6 * nodes_, gamma,
+                                       zp + 6 * nodes_);
   return 0;
 }
 
@@ -265,6 +337,8 @@ int VolumetricNeedleModel::jacobian_times(double, const double*, const double* v
   if (!have_tangent_) return -1;
   Jv.head(n3) = v.segment(n3, n3);
   work_a_ = tangent_.matrix() * v.head(n3);
+  if (settings_.stiffness_damping_s > 0.0)
+    work_a_.noalias() += settings_.stiffness_damping_s * (rest_tangent_.matrix() * v.segment(n3, n3));
   const double alpha = settings_.mass_damping_per_s;
   for (int d = 0; d < n3; ++d)
     Jv[n3 + d] = dof_[static_cast<std::size_t>(d / 3)] == Dof::Free ? -work_a_[d] / mass_[d] - alpha * v[n3 + d] : 0.0;
@@ -273,6 +347,7 @@ int VolumetricNeedleModel::jacobian_times(double, const double*, const double* v
 
 bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, bool withdrawing) {
   bool changed = false;
+  double snap = 0.0;
   if (withdrawing && active_ < layers_.size()) {
     compute_forces(y_, work_f_);
     for (int a = 0; a < nodes_; ++a)
@@ -291,19 +366,100 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
         layer.contact_started = true;
         layer.state = LayerState::Pressed;
       }
+      snap = std::max(snap, y_[3 * a + 2] - z_tip);
       y_[3 * a + 2] = z_tip;
       y_.segment<3>(3 * nodes_ + 3 * a) = Eigen::Vector3d(0.0, 0.0, velocity_z);
       dof_[static_cast<std::size_t>(a)] = Dof::Contact;
       changed = true;
     }
-    if (!layer.contact_started) break;
+    if (!layer.contact_started || withdrawing) break;  // layers break only while the needle advances
     std::vector<double> deflection = layer.ring_probe.deflection_m(y_, mesh_->points_m);
     for (std::size_t i = 0; i < deflection.size(); ++i) deflection[i] -= layer.baseline_m[i];
     if (!layer.criterion.broken(deflection)) break;
     puncture_active_layer();
     changed = true;
   }
+  // A node put onto the tip from far above it (the next layer's surface after
+  // a puncture lies below the tip) is an impulsive deformation; like the FEM
+  // reference, find the equilibrium with the new contact set at once.
+  if (changed) static_factor_valid_ = false;
+  if (snap > snap_relax_threshold_m_ && !settings_.quasi_static) relax_to_equilibrium();
   return changed;
+}
+
+void VolumetricNeedleModel::relax_to_equilibrium() {
+  const int n3 = 3 * nodes_;
+  Eigen::VectorXd state = y_;
+  state.segment(n3, n3).setZero();  // quasi-static: no damping forces
+  auto residual = [&](const Eigen::VectorXd& y, Eigen::VectorXd& r) {
+    compute_forces(y, r);
+    for (int d = 0; d < n3; ++d)
+      if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) r[d] = 0.0;
+    return r.norm();
+  };
+  auto factorise = [&]() {
+    NodeBlockMatrix K(nodes_, tet_node_pairs(*mesh_));
+    law_->add_tangent(state.head(n3), 0.0, K);
+    Eigen::SparseMatrix<double> A = K.matrix();
+    for (Eigen::Index j = 0; j < A.outerSize(); ++j) {
+      const bool col_free = dof_[static_cast<std::size_t>(j / 3)] == Dof::Free;
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it) {
+        if (col_free && dof_[static_cast<std::size_t>(it.row() / 3)] == Dof::Free) continue;
+        it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
+      }
+    }
+    if (!static_pattern_analysed_) {
+      static_solver_.analyzePattern(A);
+      static_pattern_analysed_ = true;
+    }
+    static_solver_.factorize(A);
+    ++relaxation_factorisations_;
+    static_factor_valid_ = static_solver_.info() == Eigen::Success;
+    return static_factor_valid_;
+  };
+  Eigen::VectorXd r(n3), trial_r(n3);
+  double norm = residual(state, r);
+  double reaction = 0.0;  // force scale: the load the contact nodes carry
+  {
+    Eigen::VectorXd f(n3);
+    compute_forces(state, f);
+    for (int d = 0; d < n3; ++d)
+      if (dof_[static_cast<std::size_t>(d / 3)] == Dof::Contact) reaction += std::abs(f[d]);
+  }
+  const double target = 1e-8 * std::max(reaction, 1e-12) + 1e-14;
+  bool fresh = false;  // the factorisation was made at this state
+  for (int iteration = 0; iteration < 60 && norm > target; ++iteration) {
+    if (!static_factor_valid_) {
+      if (!factorise()) return;  // leave the state to the dynamics
+      fresh = true;
+    }
+    const Eigen::VectorXd step = static_solver_.solve(r);  // K dx = f (f = -dW/dx)
+    double scale = 1.0, trial_norm = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd trial = state;
+    if (step.allFinite()) {
+      for (int cut = 0; cut < 8; ++cut, scale *= 0.5) {
+        trial.head(n3) = state.head(n3) + scale * step;
+        trial_norm = residual(trial, trial_r);
+        if (std::isfinite(trial_norm) && trial_norm < norm) break;
+      }
+    }
+    if (!(trial_norm < norm)) {
+      if (fresh) break;  // no descent even with a new tangent
+      static_factor_valid_ = false;
+      continue;
+    }
+    // Modified Newton: keep the factorisation while it still converges well.
+    if (trial_norm > 0.3 * norm) static_factor_valid_ = false;
+    fresh = false;
+    state = trial;
+    r = trial_r;
+    norm = trial_norm;
+  }
+  for (int a = 0; a < nodes_; ++a)
+    if (dof_[static_cast<std::size_t>(a)] == Dof::Contact)
+      state.segment<3>(n3 + 3 * a) = y_.segment<3>(n3 + 3 * a);  // contact nodes keep the needle's velocity
+  y_ = state;
+  ++relaxations_;
 }
 
 void VolumetricNeedleModel::puncture_active_layer() {
@@ -311,6 +467,7 @@ void VolumetricNeedleModel::puncture_active_layer() {
   for (std::size_t t = 0; t < mesh_->tets.size(); ++t)
     if (mesh_->layer[t] == k && mesh_->needle_column[t]) removed_[t] = 1;
   law_->set_removed(removed_);
+  compute_rest_tangent();
   for (Dof& d : dof_)
     if (d == Dof::Contact) d = Dof::Free;
   compute_masses();
@@ -319,6 +476,8 @@ void VolumetricNeedleModel::puncture_active_layer() {
   layers_[active_].state = LayerState::Punctured;
   ++active_;
   have_tangent_ = false;
+  have_factor_ = false;
+  static_factor_valid_ = false;
   ++events_;
 }
 
@@ -338,6 +497,19 @@ double VolumetricNeedleModel::step(const NeedleState& needle) {
   const double velocity_z = -needle.axial_velocity_m_per_s * needle.direction.dot(-Eigen::Vector3d::UnitZ());
   if (!needle.tip_position_m.allFinite() || !std::isfinite(t))
     throw std::invalid_argument(name() + ": non-finite needle state");
+  if (settings_.quasi_static) {
+    // Equilibrium at every step (the identification's fast mode): contact
+    // nodes move with the needle, no inertia, no damping.
+    started_ = true;
+    time_ = t;
+    for (int a = 0; a < nodes_; ++a)
+      if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * a + 2] = z_tip;
+    y_.segment(3 * nodes_, 3 * nodes_).setZero();
+    update_contacts(z_tip, 0.0, needle.axial_velocity_m_per_s < 0.0);
+    relax_to_equilibrium();
+    y_.segment(3 * nodes_, 3 * nodes_).setZero();
+    return contact_force_N();
+  }
   if (!started_) {
     started_ = true;
     time_ = t;
@@ -345,6 +517,7 @@ double VolumetricNeedleModel::step(const NeedleState& needle) {
     IntegratorSettings integration;
     integration.kind = settings_.integrator;
     integration.relative_tolerance = settings_.relative_tolerance;
+    integration.max_bdf_order = 2;  // A-stable: the mesh's oscillations stay damped
     integration.absolute_tolerance.resize(y_.size());
     integration.absolute_tolerance.head(3 * nodes_).setConstant(settings_.absolute_tolerance_m);
     integration.absolute_tolerance.segment(3 * nodes_, 3 * nodes_).setConstant(1e3 * settings_.absolute_tolerance_m);
@@ -363,7 +536,10 @@ double VolumetricNeedleModel::step(const NeedleState& needle) {
         any_contact = true;
         break;
       }
-    const double step_velocity = any_contact ? (z_tip - z_contact) / (t - time_) : velocity_z;
+    double step_velocity = any_contact ? (z_tip - z_contact) / (t - time_) : velocity_z;
+    // Rounding of the positions must not count as a change of speed.
+    if (std::abs(step_velocity - needle_velocity_z_) <= 1e-9 * std::max(std::abs(step_velocity), 1e-6))
+      step_velocity = needle_velocity_z_;
     if (any_contact && step_velocity != needle_velocity_z_) {
       for (int a = 0; a < nodes_; ++a)
         if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * nodes_ + 3 * a + 2] = step_velocity;
@@ -376,6 +552,7 @@ double VolumetricNeedleModel::step(const NeedleState& needle) {
       if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * a + 2] = z_tip;
   }
   if (update_contacts(z_tip, velocity_z, needle.axial_velocity_m_per_s < 0.0)) {
+    have_factor_ = false;  // the prescribed dofs changed
     needle_velocity_z_ = velocity_z;
     integrator_->reinit(time_, y_);
   }
@@ -461,13 +638,22 @@ VolumeFrame VolumetricNeedleModel::volume_frame() const {
 }
 
 std::string VolumetricNeedleModel::integrator_report() const {
+  if (settings_.quasi_static) {
+    std::ostringstream out;
+    out << "quasi-static: equilibrium at every step by modified Newton, " << relaxation_factorisations_
+        << " sparse LDL^T factorisations";
+    return out.str();
+  }
   if (!integrator_) return "not started";
   const IntegratorStats s = integrator_->stats();
   std::ostringstream out;
   out << to_string(integrator_->kind()) << ": " << s.steps << " steps, " << s.rhs_evaluations
       << " rhs evaluations, " << s.linear_iterations << " GMRES iterations, " << s.preconditioner_setups
       << " preconditioner set-ups, " << s.error_test_failures << " error-test and " << s.convergence_failures
-      << " convergence failures; " << s.reinitialisations << " restarts (contact, puncture, speed changes)";
+      << " convergence failures; " << factorisations_ << " sparse LDL^T factorisations (" << factorisation_seconds_
+      << " s), " << mass_only_setups_ << " diagonal preconditioners; " << relaxations_
+      << " static relaxations after a contact jump (" << relaxation_factorisations_ << " factorisations); "
+      << s.reinitialisations << " restarts (contact, puncture, speed changes)";
   return out.str();
 }
 

@@ -90,6 +90,18 @@ class InternalForceLaw {
   /// rates 1/tau of each (for the preconditioner).
   virtual double extra_state_abs_tolerance() const { return 1.0; }
   virtual void extra_state_decay_rates(std::vector<double>& rates) const { rates.clear(); }
+  /// For the implicit preconditioner of laws with internal variables (q' =
+  /// h(v) - q / tau, forces linear in q): f += the nodal forces of the
+  /// internal variables r_q / (1 + gamma / tau) at positions x.
+  virtual void add_internal_variable_forces(VectorRef x, const double* r_q, double gamma, MutableVectorRef f) const {
+    (void)x, (void)r_q, (void)gamma, (void)f;
+  }
+  /// z_q = (r_q + gamma h(b)) / (1 + gamma / tau): the internal variables' part
+  /// of the Newton correction once the velocity part b is known.
+  virtual void internal_variable_correction(VectorRef x, VectorRef b, const double* r_q, double gamma,
+                                            double* z_q) const {
+    (void)x, (void)b, (void)r_q, (void)gamma, (void)z_q;
+  }
 };
 
 /// Node pairs coupled by the mesh's tetrahedra (for NodeBlockMatrix).
@@ -188,6 +200,9 @@ class ViscoelasticTensorMass final : public StvkTensorMass {
   std::size_t memory_bytes() const override;
   double extra_state_abs_tolerance() const override { return abs_tol_Pa_; }
   void extra_state_decay_rates(std::vector<double>& rates) const override;
+  void add_internal_variable_forces(VectorRef x, const double* r_q, double gamma, MutableVectorRef f) const override;
+  void internal_variable_correction(VectorRef x, VectorRef b, const double* r_q, double gamma,
+                                    double* z_q) const override;
   const PronySeries& prony() const { return prony_; }
 
  private:

@@ -71,6 +71,9 @@ struct IntegratorSettings {
   long max_steps_per_call = 200000;    ///< internal steps allowed in one advance()
   int krylov_dimension = 10;           ///< GMRES subspace (implicit)
   double max_step_s = 0.0;             ///< > 0: bound on the internal step
+  /// Largest BDF order (1..5). BDF above order 2 is not A-stable: the lightly
+  /// damped oscillations of an elastic mesh need 2.
+  int max_bdf_order = 5;
 };
 
 struct IntegratorStats {
@@ -93,7 +96,10 @@ class SundialsIntegrator {
 
   /// Integrates to t_out (> current time) and returns y(t_out).
   void advance(double t_out, Eigen::VectorXd& y);
-  /// Restart from (t, y) (after a state change: contact, puncture).
+  /// Restart from (t, y) (after a state change: contact, puncture). The first
+  /// step tried is a quarter of the last one taken (the integrator's own
+  /// estimate when nothing was taken yet), so a restart does not climb up
+  /// from a microsecond again.
   void reinit(double t, const Eigen::VectorXd& y);
   /// The integrator does not step past t_stop (a kink of the forcing).
   void set_stop_time(double t_stop);

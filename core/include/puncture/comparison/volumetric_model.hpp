@@ -4,8 +4,11 @@
 //
 // Dynamics (seed 001: M x'' = -K x - Y x', here with the law's nonlinear
 // internal forces f(x, v, q)): lumped masses m_a = sum_T rho_T V_T / 4,
-// mass-proportional damping Y = alpha M (ComparisonSettings::mass_damping_per_s):
-//     x' = v,  M v' = f(x, v, q) - alpha M v,  q' = law's internal variables.
+// Rayleigh damping Y = alpha M + beta K0 (K0: the law's tangent at rest;
+// ComparisonSettings::mass_damping_per_s, stiffness_damping_s; beta damps the
+// mesh's high modes, whose transients would otherwise hold the steps at
+// fractions of a millisecond):
+//     x' = v,  M v' = f(x, v, q) - Y v,  q' = law's internal variables.
 // State y = [x (3N), v (3N), q]. Boundary conditions as the FEM reference:
 // base z = -total thickness and side r = R fixed.
 //
@@ -21,19 +24,32 @@
 //     released (no adhesion);
 //   * breakthrough: the ring-w rule (ring_criterion.hpp) on the deflection of
 //     the active layer's top surface at the force-mesh lattice points, measured
-//     from the moment the needle first touched the layer. The layer's
+//     from the moment the needle first touched the layer, checked while the
+//     needle advances (as the force mesh, whose deflections only shrink when
+//     the needle is withdrawn). The layer's
 //     needle-column tetrahedra (TetMesh::needle_column) are then removed (the
 //     cut), its contact nodes released (the surface springs back) and the
-//     next layer becomes active (it may be touched in the same step).
+//     next layer becomes active (it may be touched in the same step). When the
+//     next layer's surface lies below the tip (it is put onto the tip by more
+//     than 20 um), the free nodes are brought to static equilibrium at once
+//     (as the FEM reference does), instead of a dynamic impulse.
 // Every state change (contact, release, puncture, a change of needle speed)
 // re-initialises the integrator at that time.
 //
-// Implicit integration: CVODE BDF; its Newton matrix I - gamma J is
+// Implicit integration: CVODE BDF of order at most 2 (the A-stable ones: the
+// lightly damped oscillations of an elastic mesh make BDF3-5 unstable and
+// their steps collapse); its Newton matrix I - gamma J is
 // preconditioned exactly (up to lagging) by eliminating x:
-//   ((1 + gamma alpha) M + gamma^2 K) b = M r_v - gamma K r_x,  a = r_x + gamma b
+//   ((1 + gamma alpha) M + gamma beta K0 + gamma^2 K) b = M r_v - gamma K r_x,  a = r_x + gamma b
 // with the law's tangent K at the last setup (prescribed and fixed degrees of
 // freedom eliminated), factorised by a sparse LDL^T (Eigen); laws with an exact
-// tangent also give the Jacobian-vector product from it.
+// tangent also give the Jacobian-vector product from it. The factorisation is
+// reused while gamma stays within a factor 5 of the one it was made with;
+// the visco-elastic law's internal variables q (q' = g dS_e/dt - q / tau) are
+// eliminated too: their residual enters the velocity equation through their
+// nodal forces, and q's correction follows from the velocity one;
+// while gamma^2 times the Gershgorin bound of M^-1 K is below 1/4 (the small
+// steps after a restart) the diagonal of the matrix is used instead.
 #pragma once
 
 #include <memory>
@@ -57,6 +73,12 @@ struct VolumetricSettings {
   double relative_tolerance = 1e-4;
   double absolute_tolerance_m = 1e-7;
   double mass_damping_per_s = 20.0;
+  double stiffness_damping_s = 1e-3;
+  /// No time integration: static equilibrium at every step (contact nodes at
+  /// the tip, modified Newton on the law's tangent, factorisation kept while
+  /// the contact set is unchanged and Newton converges). Used by the
+  /// mass-spring identification against the quasi-static FEM.
+  bool quasi_static = false;
 };
 VolumetricSettings volumetric_settings(const Scene& scene);
 
@@ -125,9 +147,13 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   int jacobian_times(double t, const double* y, const double* v, double* Jv) override;
 
   void compute_masses();
+  void compute_rest_tangent();
   void compute_forces(const Eigen::VectorXd& y, Eigen::VectorXd& f) const;
   bool update_contacts(double z_tip_m, double velocity_z_m_per_s, bool withdrawing);
   void puncture_active_layer();
+  /// Static equilibrium of the free nodes with the current contact set
+  /// (modified Newton on the law's tangent); free velocities set to zero.
+  void relax_to_equilibrium();
   double contact_force_N();
   Eigen::Matrix3Xd deformed_points() const;
 
@@ -156,13 +182,29 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
 
   // Preconditioner data (implicit).
   NodeBlockMatrix tangent_;            ///< K at the last setup
+  NodeBlockMatrix rest_tangent_;       ///< K0 (for the stiffness-proportional damping)
   Eigen::SparseMatrix<double> system_; ///< (1 + gamma alpha) M + gamma^2 K, eliminated
   Eigen::SparseMatrix<double> full_;   ///< the same before elimination
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor_;
   bool pattern_analysed_ = false;
   bool have_tangent_ = false;
+  bool have_factor_ = false;
+  bool mass_only_ = false;          ///< the last setup chose the diagonal preconditioner
+  double factor_gamma_ = 0.0;
+  double omega_squared_bound_ = 0.0;
+  Eigen::VectorXd diagonal_;
+  long factorisations_ = 0;
+  long relaxations_ = 0;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> static_solver_;
+  bool static_pattern_analysed_ = false;
+  bool static_factor_valid_ = false;
+  long relaxation_factorisations_ = 0;
+  double snap_relax_threshold_m_ = 20e-6;
+  long mass_only_setups_ = 0;
+  double factorisation_seconds_ = 0.0;
   std::vector<double> decay_rates_;
   mutable Eigen::VectorXd work_f_, work_a_, work_b_;
+  const double* yp_current_ = nullptr;  ///< the state preconditioner_solve was called at
 };
 
 }  // namespace puncture::comparison
