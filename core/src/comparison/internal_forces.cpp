@@ -106,7 +106,7 @@ void MassSpringLaw::add_forces(VectorRef x, VectorRef, const double*, MutableVec
   }
 }
 
-void MassSpringLaw::add_tangent(VectorRef x, double, NodeBlockMatrix& K) const {
+void MassSpringLaw::add_tangent(VectorRef x, double gamma, NodeBlockMatrix& K) const {
   for (std::size_t e = 0; e < edges_.size(); ++e) {
     const double k = stiffness_[e];
     if (k == 0.0) continue;
@@ -116,10 +116,12 @@ void MassSpringLaw::add_tangent(VectorRef x, double, NodeBlockMatrix& K) const {
     if (!(length > 0.0)) continue;
     const Eigen::Vector3d n = d / length;
     const Eigen::Matrix3d nn = n * n.transpose();
-    // d(force on a)/dx_b = k [n n^T + (1 - l0/l)(I - n n^T)]; the transverse part
-    // is kept >= 0 (a compressed spring's negative geometric stiffness is left
-    // out of the preconditioner).
-    const double transverse = std::max(0.0, 1.0 - rest_length_[e] / length);
+    // d(force on a)/dx_b = k [n n^T + (1 - l0/l)(I - n n^T)]. For the implicit
+    // integrator (gamma > 0) the transverse part is kept >= 0 (a compressed
+    // spring's negative geometric stiffness is left out of the preconditioner,
+    // which stays positive definite); a static solve (gamma = 0) gets the exact
+    // tangent.
+    const double transverse = gamma > 0.0 ? std::max(0.0, 1.0 - rest_length_[e] / length) : 1.0 - rest_length_[e] / length;
     const Eigen::Matrix3d block = k * (nn + transverse * (Eigen::Matrix3d::Identity() - nn));
     K.add_block(a, a, block);
     K.add_block(b, b, block);

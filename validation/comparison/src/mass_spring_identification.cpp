@@ -200,7 +200,7 @@ IdentificationResult identify_mass_spring_stiffness(const Scene& scene, std::sha
     gsl_siman_params_t params{};
     params.n_tries = 1;
     params.iters_fixed_T = iters_per_temperature;
-    params.step_size = 0.5 * bound;
+    params.step_size = 0.25 * bound;
     params.k = 1.0;
     params.t_initial = 0.3 * std::max(result.before.objective, 1e-3);
     params.mu_t = std::pow(100.0, 1.0 / (temperatures - 1));

@@ -76,7 +76,9 @@ class InternalForceLaw {
                           double* qdot) const = 0;
   /// K += tangent stiffness -df/dx at x (symmetric). `gamma` is the implicit
   /// integrator's step scale (laws with internal variables fold their
-  /// short-time stiffening into K with it).
+  /// short-time stiffening into K with it); gamma = 0 asks for the exact
+  /// elastic tangent of a static solve (the mass-spring law otherwise drops
+  /// the negative stiffness of compressed springs).
   virtual void add_tangent(VectorRef x, double gamma, NodeBlockMatrix& K) const = 0;
   /// True if add_tangent is the exact derivative of add_forces (not for the
   /// visco-elastic law), so a Jacobian-vector product may use it.
