@@ -221,7 +221,22 @@ int compare_command(const CompareOptions& options, std::ostream& out, std::ostre
     if (!ref.skin_profiles.empty()) profile_radii = ref.skin_profiles.front().r_m;
 
     io::OutputSession session(dir);
-    const std::string command_line = "puncture compare " + scene_path.string() + " -o " + dir.string();
+    // The command as given: every option that changes the outputs.
+    std::string command_line = "puncture compare " + scene_path.string();
+    auto joined = [](const std::vector<std::string>& v) {
+      std::string s;
+      for (const std::string& x : v) s += (s.empty() ? "" : ",") + x;
+      return s;
+    };
+    if (!options.models.empty()) command_line += " --models " + joined(options.models);
+    command_line += " -o " + dir.string();
+    if (!options.cache_dir.empty()) command_line += " --cache " + options.cache_dir.string();
+    if (!options.weights.empty()) command_line += " --weights " + options.weights.string();
+    if (!options.identify.empty())
+      command_line += " --identify " + joined(options.identify) + " --identify-evaluations " +
+                      std::to_string(options.identify_evaluations);
+    if (options.frames != CompareOptions{}.frames) command_line += " --frames " + std::to_string(options.frames);
+    if (!options.write_vtk) command_line += " --no-vtk";
     const nlohmann::json provenance = provenance_json(command_line);
 
     // 2. The tetrahedral mesh.
