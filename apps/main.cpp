@@ -5,6 +5,7 @@
 //   puncture calibrate [SCENE] [--reference CSV] [-o DIR]   tuned preset
 //   puncture sweep     [SCENE] [-o DIR]   accuracy versus time of every fidelity knob
 //   puncture grade SCORES.csv [-o DIR]    comprehensive weighted grading (paper Sec. 3.3)
+//   puncture compare   [SCENE] [-o DIR]   comparison models of both papers against the FEM
 //   puncture --version
 // Exit codes: 0 success, 1 the run failed, 2 bad input (scene, CSV, command
 // line), 3 output not writable, 128 + n ended by signal n (apps/README.md).
@@ -103,6 +104,22 @@ int main(int argc, char** argv) {
   grade_cmd->add_option("--mu", grade.mu, "Preference coefficient (share of the subjective weights), default 0.4");
   grade_cmd->add_flag("-q,--quiet", grade.quiet, "Nothing on stdout");
 
+#ifdef PUNCTURE_HAVE_COMPARE
+  CompareOptions compare;
+  auto* compare_cmd = app.add_subcommand("compare", "Comparison models of both papers against the FEM, graded (Sec. 3.3)");
+  compare_cmd->add_option("scene", scene, "Scene file (JSON); default: scenes/default.json");
+  compare_cmd->add_option("--models", compare.models, "Models (comma separated); default: all")->delimiter(',');
+  compare_cmd->add_option("-o,--output", output, "Output directory; default: out/<scene name>_comparison");
+  compare_cmd->add_option("--cache", cache, "FEM cache directory; default: out/.fem_cache");
+  compare_cmd->add_option("--weights", compare.weights, "Delphi weights file; default: scenes/delphi_weights.json");
+  compare_cmd->add_option("--identify", compare.identify, "Identify the mass-spring stiffnesses: simulated_annealing,isres")
+      ->delimiter(',');
+  compare_cmd->add_option("--identify-evaluations", compare.identify_evaluations, "Model runs per identification (40)");
+  compare_cmd->add_option("--frames", compare.frames, "ParaView frames per model (20; 0: none)");
+  compare_cmd->add_flag("--no-vtk", [&](std::int64_t) { compare.write_vtk = false; }, "No VTK output");
+  compare_cmd->add_flag("-q,--quiet", compare.quiet, "No progress output");
+#endif
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -133,6 +150,12 @@ int main(int argc, char** argv) {
       sweep.scene = scene, sweep.output_dir = output, sweep.cache_dir = cache;
       return sweep_command(sweep, std::cout, std::cerr);
     }
+#ifdef PUNCTURE_HAVE_COMPARE
+    if (*compare_cmd) {
+      compare.scene = scene, compare.output_dir = output, compare.cache_dir = cache;
+      return compare_command(compare, std::cout, std::cerr);
+    }
+#endif
     if (*grade_cmd) {
       grade.scores = scores, grade.output_dir = output;
       return grade_command(grade, std::cout, std::cerr);

@@ -244,6 +244,45 @@ ForceLaw read_force_law(ObjectReader r, const std::string& file) {
   return law;
 }
 
+std::vector<double> number_list(ObjectReader& r, const std::string& key) {
+  const json& v = r.raw(key);
+  if (!v.is_array()) r.fail(r.child(key), "must be an array of numbers (got " + describe(v) + ")");
+  std::vector<double> out;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::string p = r.child(key) + "/" + std::to_string(i);
+    if (!v[i].is_number()) r.fail(p, "must be a number (got " + describe(v[i]) + ")");
+    const double x = v[i].get<double>();
+    if (!std::isfinite(x)) r.fail(p, "must be finite (got " + describe(v[i]) + ")");
+    out.push_back(x);
+  }
+  return out;
+}
+
+ComparisonSettings read_comparison(ObjectReader r, const std::string& file) {
+  ComparisonSettings c;
+  if (r.has("mesh")) {
+    ObjectReader m(r.raw("mesh"), r.child("mesh"), file);
+    c.mesh.size_at_axis_m = m.number("size_at_axis_mm", c.mesh.size_at_axis_m / kMm) * kMm;
+    c.mesh.size_far_m = m.number("size_far_mm", c.mesh.size_far_m / kMm) * kMm;
+    c.mesh.grading = m.number("grading", c.mesh.grading);
+    m.reject_unknown_keys();
+  }
+  c.integrator = r.string("integrator", c.integrator);
+  c.relative_tolerance = r.number("relative_tolerance", c.relative_tolerance);
+  c.absolute_tolerance_m = r.number("absolute_tolerance_mm", c.absolute_tolerance_m / kMm) * kMm;
+  c.mass_damping_per_s = r.number("mass_damping_per_s", c.mass_damping_per_s);
+  c.stiffness_damping_s = r.number("stiffness_damping_s", c.stiffness_damping_s);
+  if (r.has("viscoelastic")) {
+    ObjectReader v(r.raw("viscoelastic"), r.child("viscoelastic"), file);
+    c.prony_g = number_list(v, "prony_g");
+    c.prony_tau_s = number_list(v, "prony_tau_s");
+    v.reject_unknown_keys();
+  }
+  if (r.has("mass_spring_stiffness_scale")) c.mass_spring_stiffness_scale = number_list(r, "mass_spring_stiffness_scale");
+  r.reject_unknown_keys();
+  return c;
+}
+
 Layer read_layer(ObjectReader r, const std::string& file, bool& has_resumption_time) {
   Layer l;
   l.name = r.string("name");
@@ -340,6 +379,7 @@ Scene read_scene(const json& root, const std::string& file) {
     }
     o.reject_unknown_keys();
   }
+  if (r.has("comparison")) s.comparison = read_comparison(ObjectReader(r.raw("comparison"), "/comparison", file), file);
   if (r.has("models")) s.models = r.string_list("models", kModels, "model");
   if (r.has("effects")) {
     const auto list = r.string_list("effects", kEffects, "effect");
@@ -352,6 +392,16 @@ Scene read_scene(const json& root, const std::string& file) {
     s.effects.friction = on("friction");
     s.effects.stiffening = on("stiffening");
     s.effects.layer_interaction = on("layer_interaction");
+  }
+  if (r.has("haptics")) {
+    ObjectReader o(r.raw("haptics"), "/haptics", file);
+    Haptics& h = s.haptics;
+    h.max_force_N = o.number("max_force_N", h.max_force_N);
+    h.max_force_rate_N_per_s = o.number("max_force_rate_N_per_s", h.max_force_rate_N_per_s);
+    h.device_damping_N_s_per_m = o.number("device_damping_N_s_per_m", h.device_damping_N_s_per_m);
+    h.device_max_stiffness_N_per_m =
+        o.number("device_max_stiffness_N_per_mm", h.device_max_stiffness_N_per_m * kMm) / kMm;
+    o.reject_unknown_keys();
   }
   r.reject_unknown_keys();
   // Recovery time in seconds: given, or the paper's eta_r per haptic step at
@@ -581,6 +631,42 @@ void validate_scene(const Scene& s, const std::string& file) {
                          "critical_energy (the ring rule counts the deflection carried from the layer above)");
     if (s.layers.size() > 16) throw SceneError(file, "/layers", "layer_interaction supports at most 16 layers");
   }
+
+  const Haptics& h = s.haptics;
+  require(h.max_force_N > 0, file, "/haptics/max_force_N", "> 0", h.max_force_N);
+  require(h.max_force_rate_N_per_s > 0, file, "/haptics/max_force_rate_N_per_s", "> 0", h.max_force_rate_N_per_s);
+  require(h.device_damping_N_s_per_m >= 0, file, "/haptics/device_damping_N_s_per_m", ">= 0",
+          h.device_damping_N_s_per_m);
+  require(h.device_max_stiffness_N_per_m > 0, file, "/haptics/device_max_stiffness_N_per_mm", "> 0",
+          h.device_max_stiffness_N_per_m * kMm);
+
+  const ComparisonSettings& c = s.comparison;
+  require(c.mesh.size_at_axis_m > 0, file, "/comparison/mesh/size_at_axis_mm", "> 0", c.mesh.size_at_axis_m / kMm);
+  require(c.mesh.size_far_m >= c.mesh.size_at_axis_m, file, "/comparison/mesh/size_far_mm", ">= size_at_axis_mm",
+          c.mesh.size_far_m / kMm);
+  require(c.mesh.grading >= 0, file, "/comparison/mesh/grading", ">= 0", c.mesh.grading);
+  if (c.integrator != "implicit" && c.integrator != "explicit")
+    throw SceneError(file, "/comparison/integrator",
+                     "unknown integrator '" + c.integrator + "' (known: implicit, explicit)");
+  require(c.relative_tolerance > 0 && c.relative_tolerance < 1, file, "/comparison/relative_tolerance", "in (0, 1)",
+          c.relative_tolerance);
+  require(c.absolute_tolerance_m > 0, file, "/comparison/absolute_tolerance_mm", "> 0", c.absolute_tolerance_m / kMm);
+  require(c.mass_damping_per_s >= 0, file, "/comparison/mass_damping_per_s", ">= 0", c.mass_damping_per_s);
+  require(c.stiffness_damping_s >= 0, file, "/comparison/stiffness_damping_s", ">= 0", c.stiffness_damping_s);
+  if (c.prony_g.size() != c.prony_tau_s.size())
+    throw SceneError(file, "/comparison/viscoelastic/prony_tau_s",
+                     "must have as many entries as prony_g (" + std::to_string(c.prony_g.size()) + ")");
+  for (std::size_t i = 0; i < c.prony_g.size(); ++i) {
+    require(c.prony_g[i] >= 0, file, "/comparison/viscoelastic/prony_g/" + std::to_string(i), ">= 0", c.prony_g[i]);
+    require(c.prony_tau_s[i] > 0, file, "/comparison/viscoelastic/prony_tau_s/" + std::to_string(i), "> 0",
+            c.prony_tau_s[i]);
+  }
+  if (!c.mass_spring_stiffness_scale.empty() && c.mass_spring_stiffness_scale.size() != s.layers.size())
+    throw SceneError(file, "/comparison/mass_spring_stiffness_scale",
+                     "must have one entry per layer (" + std::to_string(s.layers.size()) + ")");
+  for (std::size_t i = 0; i < c.mass_spring_stiffness_scale.size(); ++i)
+    require(c.mass_spring_stiffness_scale[i] > 0, file,
+            "/comparison/mass_spring_stiffness_scale/" + std::to_string(i), "> 0", c.mass_spring_stiffness_scale[i]);
 }
 
 Scene parse_scene(const std::string& text, const std::string& source_name) {
@@ -730,6 +816,23 @@ std::string scene_to_json_text(const Scene& s) {
   if (s.effects.stiffening) effects.push_back("stiffening");
   if (s.effects.layer_interaction) effects.push_back("layer_interaction");
   root["effects"] = effects;
+  root["haptics"] = {{"max_force_N", s.haptics.max_force_N},
+                     {"max_force_rate_N_per_s", s.haptics.max_force_rate_N_per_s},
+                     {"device_damping_N_s_per_m", s.haptics.device_damping_N_s_per_m},
+                     {"device_max_stiffness_N_per_mm", s.haptics.device_max_stiffness_N_per_m * kMm}};
+  const ComparisonSettings& c = s.comparison;
+  json comparison = {{"mesh",
+                      {{"size_at_axis_mm", c.mesh.size_at_axis_m / kMm},
+                       {"size_far_mm", c.mesh.size_far_m / kMm},
+                       {"grading", c.mesh.grading}}},
+                     {"integrator", c.integrator},
+                     {"relative_tolerance", c.relative_tolerance},
+                     {"absolute_tolerance_mm", c.absolute_tolerance_m / kMm},
+                     {"mass_damping_per_s", c.mass_damping_per_s},
+                     {"stiffness_damping_s", c.stiffness_damping_s},
+                     {"viscoelastic", {{"prony_g", c.prony_g}, {"prony_tau_s", c.prony_tau_s}}}};
+  if (!c.mass_spring_stiffness_scale.empty()) comparison["mass_spring_stiffness_scale"] = c.mass_spring_stiffness_scale;
+  root["comparison"] = comparison;
   return root.dump(2) + "\n";
 }
 

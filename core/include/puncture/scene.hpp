@@ -239,6 +239,46 @@ struct Effects {
   bool layer_interaction = false;  ///< layers in series: a layer pressed by the one above carries the load in its own force mesh
 };
 
+/// What the haptic device may be sent (the real-time app's stability guard,
+/// apps/realtime_app). Defaults: the Geomagic Touch (PHANTOM Omni) data
+/// sheet (3.3 N peak force, 1.02 N/mm stiffness along its weakest axis);
+/// device damping b = 0.51 N s/m is the value at which that stiffness is
+/// passive at 1 kHz by K T / 2 <= b (Colgate and Brown 1994), an inferred
+/// value: measure your device.
+struct Haptics {
+  double max_force_N = 3.3;                      ///< magnitude limit of the force sent to the device
+  double max_force_rate_N_per_s = 1000.0;        ///< limit on the change of that force per second
+  double device_damping_N_s_per_m = 0.51;        ///< b: physical damping of the device
+  double device_max_stiffness_N_per_m = 1020.0;  ///< largest stiffness the device renders (data sheet)
+};
+
+/// Tetrahedral mesh of the slab for the comparison models (meshing/tet):
+/// the target edge length grows from size_at_axis at the needle radius by
+/// `grading` per unit radial distance, up to size_far.
+struct ComparisonMeshSettings {
+  double size_at_axis_m = 1.0e-3;  ///< tetrahedron size at the needle
+  double size_far_m = 8e-3;        ///< largest tetrahedron size, far from the axis
+  double grading = 0.5;            ///< growth of the size per metre of distance from the needle radius
+};
+
+/// Settings of the comparison models of `puncture compare` (core/comparison):
+/// volumetric mass-spring, tensor-mass (linear, StVK, visco-elastic), BEM, SHF.
+struct ComparisonSettings {
+  ComparisonMeshSettings mesh;
+  /// Time integration of the volumetric models through SUNDIALS: "implicit"
+  /// (CVODE BDF, Newton-Krylov) or "explicit" (ARKODE explicit Runge-Kutta).
+  std::string integrator = "implicit";
+  double relative_tolerance = 1e-4;       ///< integrator relative tolerance
+  double absolute_tolerance_m = 1e-7;     ///< integrator absolute tolerance on positions (velocities: per second)
+  double mass_damping_per_s = 20.0;       ///< alpha of the Rayleigh damping Y = alpha M + beta K0 (seed 001: M x'' = -K x - Y x')
+  double stiffness_damping_s = 1e-3;      ///< beta: stiffness-proportional part (K0 = tangent at rest); damps the mesh's high modes
+  std::vector<double> prony_g{0.5};       ///< visco-elastic tensor-mass: Prony moduli g_k (relative to the long-term modulus)
+  std::vector<double> prony_tau_s{0.5};   ///< and relaxation times tau_k
+  /// Per layer factor on the mass-spring stiffnesses (empty: all 1); set by
+  /// the parameter identification against the FEM.
+  std::vector<double> mass_spring_stiffness_scale;
+};
+
 struct Scene {
   std::string name;
   std::string description;
@@ -251,6 +291,8 @@ struct Scene {
   FemSettings fem;
   std::vector<std::string> models{"realtime"};  ///< which models a run uses: "realtime", "fem"
   Effects effects;
+  Haptics haptics;  ///< optional "haptics" object of the scene file
+  ComparisonSettings comparison;
 
   double total_thickness_m() const {
     double t = 0.0;

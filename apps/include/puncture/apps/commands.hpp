@@ -118,4 +118,24 @@ struct SweepOptions {
 /// and time per step for each fidelity knob; table + Pareto plot.
 int sweep_command(const SweepOptions& options, std::ostream& out, std::ostream& err);
 
+struct CompareOptions {
+  std::filesystem::path scene;
+  std::filesystem::path output_dir;   ///< empty: out/<scene name>_comparison
+  std::filesystem::path cache_dir;    ///< empty: out/.fem_cache
+  std::filesystem::path weights;      ///< Delphi weights file; empty: scenes/delphi_weights.json
+  std::vector<std::string> models;    ///< empty: all (realtime, shf, msm, mass_tensor, nonlinear_mass_tensor, viscoelastic_mass_tensor, bem, fem)
+  std::vector<std::string> identify;  ///< mass-spring identification methods: simulated_annealing, isres
+  int identify_evaluations = 40;      ///< model runs per identification
+  int frames = 20;                    ///< ParaView frames per model over the trajectory (0: none)
+  bool write_vtk = true;
+  bool quiet = false;
+};
+
+/// `puncture compare`: every comparison model and the real-time model on the
+/// identical insertion against the FEM reference: comparison.csv, ranking
+/// (Sec. 3.3 grading), plots, ParaView series, comparison.md.
+int compare_command(const CompareOptions& options, std::ostream& out, std::ostream& err);
+/// scenes/delphi_weights.json next to the default scene.
+std::filesystem::path default_delphi_weights_path();
+
 }  // namespace puncture::apps

@@ -1,0 +1,676 @@
+// volumetric_model.cpp: needle insertion into a tetrahedral mesh with an
+// internal force law, integrated by SUNDIALS; see volumetric_model.hpp.
+#include "puncture/comparison/volumetric_model.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace puncture::comparison {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kGeometryTolerance_m = 1e-6;
+constexpr double kReuseFactor = 5.0;
+
+/// Triangles of the layer's top face: faces of its tetrahedra on z = top.
+std::vector<Eigen::Vector3i> top_triangles(const TetMesh& mesh, int layer, double top_z_m) {
+  static constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+  std::vector<Eigen::Vector3i> triangles;
+  for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+    if (mesh.layer[t] != layer) continue;
+    for (const auto& face : kFaces) {
+      bool on_top = true;
+      Eigen::Vector3i tri;
+      for (int i = 0; i < 3; ++i) {
+        tri[i] = mesh.tets[t][face[i]];
+        on_top = on_top && std::abs(mesh.points_m(2, tri[i]) - top_z_m) < kGeometryTolerance_m;
+      }
+      if (on_top) triangles.push_back(tri);
+    }
+  }
+  return triangles;
+}
+
+bool barycentric(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                 Eigen::Vector3d& w) {
+  const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  if (std::abs(det) < 1e-30) return false;
+  const double l1 = ((p - a).x() * (c - a).y() - (p - a).y() * (c - a).x()) / det;
+  const double l2 = ((b - a).x() * (p - a).y() - (b - a).y() * (p - a).x()) / det;
+  w = Eigen::Vector3d(1.0 - l1 - l2, l1, l2);
+  return w.minCoeff() >= -1e-9;
+}
+
+}  // namespace
+
+VolumetricSettings volumetric_settings(const Scene& scene) {
+  VolumetricSettings s;
+  s.integrator = parse_integrator_kind(scene.comparison.integrator);
+  s.relative_tolerance = scene.comparison.relative_tolerance;
+  s.absolute_tolerance_m = scene.comparison.absolute_tolerance_m;
+  s.mass_damping_per_s = scene.comparison.mass_damping_per_s;
+  s.stiffness_damping_s = scene.comparison.stiffness_damping_s;
+  return s;
+}
+
+// ---------------------------------------------------------------------------- probe
+
+LayerSurfaceProbe::LayerSurfaceProbe(const TetMesh& mesh, int layer, double top_z_m,
+                                     const std::vector<Eigen::Vector2d>& points) {
+  const std::vector<Eigen::Vector3i> triangles = top_triangles(mesh, layer, top_z_m);
+  nodes_.assign(points.size(), Eigen::Vector3i::Zero());
+  weights_.assign(points.size(), Eigen::Vector3d::Zero());
+  found_.assign(points.size(), 0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (const Eigen::Vector3i& tri : triangles) {
+      const Eigen::Vector2d a = mesh.points_m.col(tri[0]).head<2>(), b = mesh.points_m.col(tri[1]).head<2>(),
+                            c = mesh.points_m.col(tri[2]).head<2>();
+      const Eigen::Vector2d lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
+      if ((points[i].array() < lo.array() - 1e-12).any() || (points[i].array() > hi.array() + 1e-12).any()) continue;
+      Eigen::Vector3d w;
+      if (barycentric(points[i], a, b, c, w)) {
+        nodes_[i] = tri;
+        weights_[i] = w;
+        found_[i] = 1;
+        break;
+      }
+    }
+  }
+}
+
+std::vector<double> LayerSurfaceProbe::deflection_m(const Eigen::VectorXd& x, const Eigen::Matrix3Xd& rest) const {
+  std::vector<double> out(weights_.size(), 0.0);
+  for (std::size_t i = 0; i < weights_.size(); ++i) {
+    if (!found_[i]) continue;
+    double uz = 0.0;
+    for (int k = 0; k < 3; ++k) uz += weights_[i][k] * (x[3 * nodes_[i][k] + 2] - rest(2, nodes_[i][k]));
+    out[i] = -uz;
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------- model
+
+VolumetricNeedleModel::VolumetricNeedleModel(const Scene& scene, std::shared_ptr<const TetMesh> mesh,
+                                             std::unique_ptr<InternalForceLaw> law, const VolumetricSettings& settings,
+                                             std::string description)
+    : scene_(&scene), mesh_(std::move(mesh)), law_(std::move(law)), settings_(settings),
+      description_(std::move(description)) {
+  if (!mesh_ || !law_) throw std::invalid_argument("VolumetricNeedleModel: null mesh or law");
+  const int n_layers = static_cast<int>(scene.layers.size());
+  check_tet_mesh(*mesh_, n_layers);
+  nodes_ = mesh_->node_count();
+  extra_ = law_->extra_state_size();
+  needle_radius_m_ = scene.needle.radius_m;
+  rest_ = Eigen::Map<const Eigen::VectorXd>(mesh_->points_m.data(), 3 * nodes_);
+  removed_.assign(mesh_->tets.size(), 0);
+
+  // Fixed base and side, as the FEM reference.
+  const double radius = 0.5 * scene.sample.diameter_m;
+  const double base_z = -scene.total_thickness_m();
+  dof_.assign(static_cast<std::size_t>(nodes_), Dof::Free);
+  for (int a = 0; a < nodes_; ++a) {
+    const Eigen::Vector3d p = mesh_->points_m.col(a);
+    if (p.z() < base_z + kGeometryTolerance_m || std::hypot(p.x(), p.y()) > radius - kGeometryTolerance_m)
+      dof_[static_cast<std::size_t>(a)] = Dof::Fixed;
+  }
+
+  // Per layer: contact candidates and the ring-criterion probe.
+  std::vector<std::vector<char>> in_layer(static_cast<std::size_t>(n_layers),
+                                          std::vector<char>(static_cast<std::size_t>(nodes_), 0));
+  for (std::size_t t = 0; t < mesh_->tets.size(); ++t)
+    for (int i = 0; i < 4; ++i) in_layer[static_cast<std::size_t>(mesh_->layer[t])][mesh_->tets[t][i]] = 1;
+  for (int k = 0; k < n_layers; ++k) {
+    const double top = -scene.layer_top_depth_m(static_cast<std::size_t>(k));
+    RingBreakthroughCriterion criterion(scene.layers[static_cast<std::size_t>(k)].force_mesh);
+    LayerSurfaceProbe probe(*mesh_, k, top, criterion.points_m());
+    for (std::size_t i = 0; i < probe.size(); ++i)
+      if (!probe.found(i))
+        throw std::invalid_argument("VolumetricNeedleModel: ring point " + std::to_string(i) + " of layer \"" +
+                                    scene.layers[static_cast<std::size_t>(k)].name +
+                                    "\" is not on the layer's top face of the mesh");
+    layers_.push_back(LayerRuntime{top, {}, LayerState::Untouched, false, criterion, probe, {}});
+    for (int a = 0; a < nodes_; ++a) {
+      const Eigen::Vector3d p = mesh_->points_m.col(a);
+      if (in_layer[static_cast<std::size_t>(k)][static_cast<std::size_t>(a)] &&
+          std::abs(p.z() - top) < kGeometryTolerance_m &&
+          std::hypot(p.x(), p.y()) <= needle_radius_m_ + kGeometryTolerance_m)
+        layers_.back().candidates.push_back(a);
+    }
+    if (layers_.back().candidates.empty())
+      throw std::invalid_argument("VolumetricNeedleModel: no mesh node of layer \"" +
+                                  scene.layers[static_cast<std::size_t>(k)].name +
+                                  "\" lies on its top face inside the needle radius (refine the mesh at the axis)");
+  }
+
+  compute_masses();
+  y_ = Eigen::VectorXd::Zero(6 * nodes_ + extra_);
+  y_.head(3 * nodes_) = rest_;
+  law_->extra_state_decay_rates(decay_rates_);
+  const std::vector<std::pair<int, int>> pairs = tet_node_pairs(*mesh_);
+  if (settings_.integrator == IntegratorKind::ImplicitBdf) tangent_ = NodeBlockMatrix(nodes_, pairs);
+  if (settings_.stiffness_damping_s > 0.0) {
+    rest_tangent_ = NodeBlockMatrix(nodes_, pairs);
+    compute_rest_tangent();
+  }
+  work_f_ = Eigen::VectorXd::Zero(3 * nodes_);
+}
+
+VolumetricNeedleModel::~VolumetricNeedleModel() = default;
+
+void VolumetricNeedleModel::compute_masses() {
+  std::vector<double> node_mass(static_cast<std::size_t>(nodes_), 0.0);
+  for (std::size_t t = 0; t < mesh_->tets.size(); ++t) {
+    if (removed_[t]) continue;
+    const Eigen::Vector4i& v = mesh_->tets[t];
+    const double volume = tet_signed_volume(mesh_->points_m.col(v[0]), mesh_->points_m.col(v[1]),
+                                            mesh_->points_m.col(v[2]), mesh_->points_m.col(v[3]));
+    const double m = scene_->layers[static_cast<std::size_t>(mesh_->layer[t])].density_kg_per_m3 * volume / 4.0;
+    for (int i = 0; i < 4; ++i) node_mass[static_cast<std::size_t>(v[i])] += m;
+  }
+  mass_.resize(3 * nodes_);
+  for (int a = 0; a < nodes_; ++a) {
+    mass_.segment<3>(3 * a).setConstant(node_mass[static_cast<std::size_t>(a)]);
+    if (!(node_mass[static_cast<std::size_t>(a)] > 0.0)) dof_[static_cast<std::size_t>(a)] = Dof::Fixed;  // orphan
+  }
+}
+
+void VolumetricNeedleModel::compute_rest_tangent() {
+  if (settings_.stiffness_damping_s <= 0.0) return;
+  rest_tangent_.set_zero();
+  law_->add_tangent(rest_, 0.0, rest_tangent_);
+}
+
+void VolumetricNeedleModel::compute_forces(const Eigen::VectorXd& y, Eigen::VectorXd& f) const {
+  f.setZero(3 * nodes_);
+  std::vector<double> qdot(static_cast<std::size_t>(extra_));
+  law_->add_forces(y.head(3 * nodes_), y.segment(3 * nodes_, 3 * nodes_), y.data() + 6 * nodes_, f,
+                   extra_ ? qdot.data() : nullptr);
+  if (settings_.stiffness_damping_s > 0.0)
+    f.noalias() -= settings_.stiffness_damping_s * (rest_tangent_.matrix() * y.segment(3 * nodes_, 3 * nodes_));
+}
+
+int VolumetricNeedleModel::rhs(double, const double* yp, double* ydot) {
+  const Eigen::Map<const Eigen::VectorXd> y(yp, y_.size());
+  Eigen::Map<Eigen::VectorXd> out(ydot, y_.size());
+  work_f_.setZero();
+  law_->add_forces(y.head(3 * nodes_), y.segment(3 * nodes_, 3 * nodes_), yp + 6 * nodes_, work_f_,
+                   extra_ ? ydot + 6 * nodes_ : nullptr);
+  if (settings_.stiffness_damping_s > 0.0)
+    work_f_.noalias() -= settings_.stiffness_damping_s * (rest_tangent_.matrix() * y.segment(3 * nodes_, 3 * nodes_));
+  out.head(3 * nodes_) = y.segment(3 * nodes_, 3 * nodes_);
+  const double alpha = settings_.mass_damping_per_s;
+  for (int a = 0; a < nodes_; ++a) {
+    const bool free = dof_[static_cast<std::size_t>(a)] == Dof::Free;
+    for (int i = 0; i < 3; ++i) {
+      const int d = 3 * a + i;
+      out[3 * nodes_ + d] = free ? work_f_[d] / mass_[d] - alpha * y[3 * nodes_ + d] : 0.0;
+    }
+  }
+  return 0;
+}
+
+bool VolumetricNeedleModel::has_preconditioner() const { return settings_.integrator == IntegratorKind::ImplicitBdf; }
+
+bool VolumetricNeedleModel::has_jacobian_times() const {
+  return settings_.integrator == IntegratorKind::ImplicitBdf && law_->tangent_is_exact() && extra_ == 0;
+}
+
+int VolumetricNeedleModel::preconditioner_setup(double, const double* yp, bool jok, bool& updated, double gamma) {
+  const Eigen::Map<const Eigen::VectorXd> y(yp, y_.size());
+  updated = false;
+  if (!jok || !have_tangent_) {
+    tangent_.set_zero();
+    law_->add_tangent(y.head(3 * nodes_), gamma, tangent_);
+    const Eigen::SparseMatrix<double>& K = tangent_.matrix();
+    if (!Eigen::Map<const Eigen::VectorXd>(K.valuePtr(), K.nonZeros()).allFinite()) return 1;
+    // Gershgorin bound on the largest eigenvalue of M^-1 K over the free dofs.
+    omega_squared_bound_ = 0.0;
+    for (Eigen::Index j = 0; j < K.outerSize(); ++j) {
+      if (dof_[static_cast<std::size_t>(j / 3)] != Dof::Free) continue;
+      double row = 0.0;  // K is symmetric: the column sum is the row sum
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, j); it; ++it) row += std::abs(it.value());
+      omega_squared_bound_ = std::max(omega_squared_bound_, row / mass_[j]);
+    }
+    have_tangent_ = true;
+    have_factor_ = false;
+    updated = true;
+  }
+  const double alpha = settings_.mass_damping_per_s, beta = settings_.stiffness_damping_s;
+  // Small steps: gamma^2 K (and gamma beta K0) are small beside M, the diagonal
+  // is a good enough preconditioner.
+  mass_only_ = (gamma * gamma + gamma * beta) * omega_squared_bound_ < 0.25;
+  if (mass_only_) {
+    diagonal_.resize(3 * nodes_);
+    const Eigen::SparseMatrix<double>& K = tangent_.matrix();
+    for (int d = 0; d < 3 * nodes_; ++d)
+      diagonal_[d] = dof_[static_cast<std::size_t>(d / 3)] == Dof::Free
+                         ? (1.0 + gamma * alpha) * mass_[d] + gamma * gamma * K.coeff(d, d) +
+                               (beta > 0.0 ? gamma * beta * rest_tangent_.matrix().coeff(d, d) : 0.0)
+                         : 1.0;
+    ++mass_only_setups_;
+    return 0;
+  }
+  // Reuse the factorisation while gamma stays within a factor kReuseFactor of
+  // the one it was made with: the preconditioned spectrum stays within
+  // [1/f^2, f^2] and GMRES absorbs the difference.
+  if (have_factor_ && gamma < kReuseFactor * factor_gamma_ && gamma > factor_gamma_ / kReuseFactor) return 0;
+  const auto start = std::chrono::steady_clock::now();
+  full_ = tangent_.matrix() * (gamma * gamma);
+  if (beta > 0.0) full_ += rest_tangent_.matrix() * (gamma * beta);  // same pattern
+  for (int d = 0; d < 3 * nodes_; ++d) full_.coeffRef(d, d) += (1.0 + gamma * alpha) * mass_[d];
+  system_ = full_;
+  for (Eigen::Index j = 0; j < system_.outerSize(); ++j) {
+    const bool col_free = dof_[static_cast<std::size_t>(j / 3)] == Dof::Free;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(system_, j); it; ++it) {
+      const bool row_free = dof_[static_cast<std::size_t>(it.row() / 3)] == Dof::Free;
+      if (row_free && col_free) continue;
+      it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
+    }
+  }
+  if (!pattern_analysed_) {
+    factor_.analyzePattern(system_);
+    pattern_analysed_ = true;
+  }
+  factor_.factorize(system_);
+  factorisation_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ++factorisations_;
+  if (factor_.info() != Eigen::Success) {
+    have_factor_ = false;
+    return 1;
+  }
+  have_factor_ = true;
+  factor_gamma_ = gamma;
+  return 0;
+}
+
+int VolumetricNeedleModel::preconditioner_solve(double, const double* yp, const double* rp, double* zp, double gamma) {
+  yp_current_ = yp;
+  const int n3 = 3 * nodes_;
+  const Eigen::Map<const Eigen::VectorXd> r(rp, y_.size());
+  Eigen::Map<Eigen::VectorXd> z(zp, y_.size());
+  const auto rx = r.head(n3);
+  const auto rv = r.segment(n3, n3);
+  const Eigen::SparseMatrix<double>& K = tangent_.matrix();
+  Eigen::VectorXd b;
+  // Internal variables (visco-elastic law): their residual enters the velocity
+  // equation through their forces, eliminated exactly.
+  Eigen::VectorXd q_force;
+  if (extra_ > 0) {
+    q_force = Eigen::VectorXd::Zero(n3);
+    law_->add_internal_variable_forces(Eigen::Map<const Eigen::VectorXd>(yp_current_, n3), rp + 6 * nodes_, gamma, q_force);
+  }
+  if (mass_only_) {
+    work_a_ = mass_.cwiseProduct(rv) - gamma * (K * rx);
+    if (extra_ > 0) work_a_ += gamma * q_force;
+    b = work_a_.cwiseQuotient(diagonal_);
+  } else {
+    work_b_.setZero(n3);
+    for (int d = 0; d < n3; ++d)
+      if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) work_b_[d] = rv[d];
+    work_a_ = mass_.cwiseProduct(rv) - gamma * (K * rx) - full_ * work_b_;
+    if (extra_ > 0) work_a_ += gamma * q_force;
+    for (int d = 0; d < n3; ++d)
+      if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) work_a_[d] = rv[d];
+    b = factor_.solve(work_a_);
+  }
+  if (!b.allFinite()) return 1;
+  for (int d = 0; d < n3; ++d)
+    if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) b[d] = rv[d];
+  z.head(n3) = rx + gamma * b;
+  z.segment(n3, n3) = b;
+  if (extra_ > 0)
+    law_->internal_variable_correction(Eigen::Map<const Eigen::VectorXd>(yp_current_, n3), b, rp + 6 * nodes_, gamma,
+                                       zp + 6 * nodes_);
+  return 0;
+}
+
+int VolumetricNeedleModel::jacobian_times(double, const double*, const double* vp, double* Jvp) {
+  const int n3 = 3 * nodes_;
+  const Eigen::Map<const Eigen::VectorXd> v(vp, y_.size());
+  Eigen::Map<Eigen::VectorXd> Jv(Jvp, y_.size());
+  if (!have_tangent_) return -1;
+  Jv.head(n3) = v.segment(n3, n3);
+  work_a_ = tangent_.matrix() * v.head(n3);
+  if (settings_.stiffness_damping_s > 0.0)
+    work_a_.noalias() += settings_.stiffness_damping_s * (rest_tangent_.matrix() * v.segment(n3, n3));
+  const double alpha = settings_.mass_damping_per_s;
+  for (int d = 0; d < n3; ++d)
+    Jv[n3 + d] = dof_[static_cast<std::size_t>(d / 3)] == Dof::Free ? -work_a_[d] / mass_[d] - alpha * v[n3 + d] : 0.0;
+  return 0;
+}
+
+bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, bool withdrawing) {
+  bool changed = false;
+  double snap = 0.0;
+  if (withdrawing && active_ < layers_.size()) {
+    compute_forces(y_, work_f_);
+    for (int a = 0; a < nodes_; ++a)
+      if (dof_[static_cast<std::size_t>(a)] == Dof::Contact && work_f_[3 * a + 2] < 0.0) {
+        dof_[static_cast<std::size_t>(a)] = Dof::Free;
+        changed = true;
+      }
+  }
+  while (active_ < layers_.size()) {
+    LayerRuntime& layer = layers_[active_];
+    for (int a : layer.candidates) {
+      if (dof_[static_cast<std::size_t>(a)] != Dof::Free) continue;
+      if (y_[3 * a + 2] < z_tip) continue;  // the tip has not reached this node
+      if (!layer.contact_started) {
+        layer.baseline_m = layer.ring_probe.deflection_m(y_, mesh_->points_m);
+        layer.contact_started = true;
+        layer.state = LayerState::Pressed;
+      }
+      snap = std::max(snap, y_[3 * a + 2] - z_tip);
+      y_[3 * a + 2] = z_tip;
+      y_.segment<3>(3 * nodes_ + 3 * a) = Eigen::Vector3d(0.0, 0.0, velocity_z);
+      dof_[static_cast<std::size_t>(a)] = Dof::Contact;
+      changed = true;
+    }
+    if (!layer.contact_started || withdrawing) break;  // layers break only while the needle advances
+    std::vector<double> deflection = layer.ring_probe.deflection_m(y_, mesh_->points_m);
+    for (std::size_t i = 0; i < deflection.size(); ++i) deflection[i] -= layer.baseline_m[i];
+    if (!layer.criterion.broken(deflection)) break;
+    puncture_active_layer();
+    changed = true;
+  }
+  // A node put onto the tip from far above it (the next layer's surface after
+  // a puncture lies below the tip) is an impulsive deformation; like the FEM
+  // reference, find the equilibrium with the new contact set at once.
+  if (changed) static_factor_valid_ = false;
+  if (snap > snap_relax_threshold_m_ && !settings_.quasi_static) relax_to_equilibrium();
+  return changed;
+}
+
+void VolumetricNeedleModel::relax_to_equilibrium() {
+  const int n3 = 3 * nodes_;
+  Eigen::VectorXd state = y_;
+  state.segment(n3, n3).setZero();  // quasi-static: no damping forces
+  auto residual = [&](const Eigen::VectorXd& y, Eigen::VectorXd& r) {
+    compute_forces(y, r);
+    for (int d = 0; d < n3; ++d)
+      if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) r[d] = 0.0;
+    return r.norm();
+  };
+  auto factorise = [&]() {
+    NodeBlockMatrix K(nodes_, tet_node_pairs(*mesh_));
+    law_->add_tangent(state.head(n3), 0.0, K);
+    Eigen::SparseMatrix<double> A = K.matrix();
+    for (Eigen::Index j = 0; j < A.outerSize(); ++j) {
+      const bool col_free = dof_[static_cast<std::size_t>(j / 3)] == Dof::Free;
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it) {
+        if (col_free && dof_[static_cast<std::size_t>(it.row() / 3)] == Dof::Free) continue;
+        it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
+      }
+    }
+    if (!static_pattern_analysed_) {
+      static_solver_.analyzePattern(A);
+      static_pattern_analysed_ = true;
+    }
+    static_solver_.factorize(A);
+    ++relaxation_factorisations_;
+    static_factor_valid_ = static_solver_.info() == Eigen::Success;
+    return static_factor_valid_;
+  };
+  Eigen::VectorXd r(n3), trial_r(n3);
+  double norm = residual(state, r);
+  double reaction = 0.0;  // force scale: the load the contact nodes carry
+  {
+    Eigen::VectorXd f(n3);
+    compute_forces(state, f);
+    for (int d = 0; d < n3; ++d)
+      if (dof_[static_cast<std::size_t>(d / 3)] == Dof::Contact) reaction += std::abs(f[d]);
+  }
+  // Out-of-balance forces below 1e-5 of the load the needle carries. A
+  // mass-spring network under a needle can have neighbouring equilibria
+  // (compressed springs buckle), where Newton stalls with tiny line-search
+  // steps: it stops after three slow iterations on fresh tangents and keeps
+  // the best state.
+  const double target = 1e-5 * std::max(reaction, 1e-12) + 1e-14;
+  bool fresh = false;  // the factorisation was made at this state
+  int slow = 0;
+  for (int iteration = 0; iteration < 40 && norm > target && slow < 3; ++iteration) {
+    if (!static_factor_valid_) {
+      if (!factorise()) return;  // leave the state to the dynamics
+      fresh = true;
+    }
+    const Eigen::VectorXd step = static_solver_.solve(r);  // K dx = f (f = -dW/dx)
+    double scale = 1.0, trial_norm = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd trial = state;
+    if (step.allFinite()) {
+      for (int cut = 0; cut < 8; ++cut, scale *= 0.5) {
+        trial.head(n3) = state.head(n3) + scale * step;
+        trial_norm = residual(trial, trial_r);
+        if (std::isfinite(trial_norm) && trial_norm < norm) break;
+      }
+    }
+    if (!(trial_norm < norm)) {
+      if (fresh) break;  // no descent even with a new tangent
+      static_factor_valid_ = false;
+      continue;
+    }
+    // Modified Newton: keep the factorisation while it still contracts
+    // (factorisations cost far more than iterations).
+    if (trial_norm > 0.7 * norm) {
+      if (fresh && trial_norm > 0.9 * norm) ++slow;
+      static_factor_valid_ = false;
+    }
+    fresh = false;
+    state = trial;
+    r = trial_r;
+    norm = trial_norm;
+  }
+  for (int a = 0; a < nodes_; ++a)
+    if (dof_[static_cast<std::size_t>(a)] == Dof::Contact)
+      state.segment<3>(n3 + 3 * a) = y_.segment<3>(n3 + 3 * a);  // contact nodes keep the needle's velocity
+  y_ = state;
+  ++relaxations_;
+}
+
+void VolumetricNeedleModel::puncture_active_layer() {
+  const int k = static_cast<int>(active_);
+  for (std::size_t t = 0; t < mesh_->tets.size(); ++t)
+    if (mesh_->layer[t] == k && mesh_->needle_column[t]) removed_[t] = 1;
+  law_->set_removed(removed_);
+  compute_rest_tangent();
+  for (Dof& d : dof_)
+    if (d == Dof::Contact) d = Dof::Free;
+  compute_masses();
+  for (int a = 0; a < nodes_; ++a)
+    if (dof_[static_cast<std::size_t>(a)] == Dof::Fixed) y_.segment<3>(3 * nodes_ + 3 * a).setZero();
+  layers_[active_].state = LayerState::Punctured;
+  ++active_;
+  have_tangent_ = false;
+  have_factor_ = false;
+  static_factor_valid_ = false;
+  ++events_;
+}
+
+double VolumetricNeedleModel::contact_force_N() {
+  compute_forces(y_, work_f_);
+  double force = 0.0;
+  for (int a = 0; a < nodes_; ++a)
+    if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) force += work_f_[3 * a + 2];
+  if (!std::isfinite(force)) throw std::runtime_error(name() + ": the contact force became non-finite at t = " +
+                                                      std::to_string(time_) + " s");
+  return force;
+}
+
+double VolumetricNeedleModel::step(const NeedleState& needle) {
+  const double t = needle.time_s;
+  const double z_tip = needle.tip_position_m.z();
+  const double velocity_z = -needle.axial_velocity_m_per_s * needle.direction.dot(-Eigen::Vector3d::UnitZ());
+  if (!needle.tip_position_m.allFinite() || !std::isfinite(t))
+    throw std::invalid_argument(name() + ": non-finite needle state");
+  if (settings_.quasi_static) {
+    // Equilibrium at every step (the identification's fast mode): contact
+    // nodes move with the needle, no inertia, no damping.
+    started_ = true;
+    time_ = t;
+    for (int a = 0; a < nodes_; ++a)
+      if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * a + 2] = z_tip;
+    y_.segment(3 * nodes_, 3 * nodes_).setZero();
+    update_contacts(z_tip, 0.0, needle.axial_velocity_m_per_s < 0.0);
+    relax_to_equilibrium();
+    y_.segment(3 * nodes_, 3 * nodes_).setZero();
+    return contact_force_N();
+  }
+  if (!started_) {
+    started_ = true;
+    time_ = t;
+    needle_velocity_z_ = velocity_z;
+    IntegratorSettings integration;
+    integration.kind = settings_.integrator;
+    integration.relative_tolerance = settings_.relative_tolerance;
+    integration.max_bdf_order = 2;  // A-stable: the mesh's oscillations stay damped
+    integration.absolute_tolerance.resize(y_.size());
+    integration.absolute_tolerance.head(3 * nodes_).setConstant(settings_.absolute_tolerance_m);
+    integration.absolute_tolerance.segment(3 * nodes_, 3 * nodes_).setConstant(1e3 * settings_.absolute_tolerance_m);
+    if (extra_ > 0) integration.absolute_tolerance.tail(extra_).setConstant(law_->extra_state_abs_tolerance());
+    update_contacts(z_tip, velocity_z, false);
+    integrator_ = std::make_unique<SundialsIntegrator>(static_cast<OdeSystem&>(*this), integration, time_, y_);
+    return contact_force_N();
+  }
+  if (t > time_) {
+    // The contact nodes follow the needle with its mean velocity over this step.
+    double z_contact = 0.0;
+    bool any_contact = false;
+    for (int a = 0; a < nodes_; ++a)
+      if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) {
+        z_contact = y_[3 * a + 2];
+        any_contact = true;
+        break;
+      }
+    double step_velocity = any_contact ? (z_tip - z_contact) / (t - time_) : velocity_z;
+    // Rounding of the positions must not count as a change of speed.
+    if (std::abs(step_velocity - needle_velocity_z_) <= 1e-9 * std::max(std::abs(step_velocity), 1e-6))
+      step_velocity = needle_velocity_z_;
+    if (any_contact && step_velocity != needle_velocity_z_) {
+      for (int a = 0; a < nodes_; ++a)
+        if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * nodes_ + 3 * a + 2] = step_velocity;
+      integrator_->reinit(time_, y_);
+    }
+    needle_velocity_z_ = step_velocity;
+    integrator_->advance(t, y_);
+    time_ = t;
+    for (int a = 0; a < nodes_; ++a)
+      if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * a + 2] = z_tip;
+  }
+  if (update_contacts(z_tip, velocity_z, needle.axial_velocity_m_per_s < 0.0)) {
+    have_factor_ = false;  // the prescribed dofs changed
+    needle_velocity_z_ = velocity_z;
+    integrator_->reinit(time_, y_);
+  }
+  return contact_force_N();
+}
+
+int VolumetricNeedleModel::contact_node_count() const {
+  return static_cast<int>(std::count(dof_.begin(), dof_.end(), Dof::Contact));
+}
+
+double VolumetricNeedleModel::mechanical_energy_J() const {
+  const Eigen::VectorXd v = y_.segment(3 * nodes_, 3 * nodes_);
+  return law_->energy_J(y_.head(3 * nodes_)) + 0.5 * v.dot(mass_.cwiseProduct(v));
+}
+
+std::vector<double> VolumetricNeedleModel::surface_deflection_m(std::size_t layer, const std::vector<double>& r_m) const {
+  constexpr int kAzimuths = 8;
+  std::vector<Eigen::Vector2d> points;
+  for (double r : r_m)
+    for (int j = 0; j < kAzimuths; ++j) {
+      const double phi = 2.0 * kPi * (j + 0.5) / kAzimuths;
+      points.emplace_back(r * std::cos(phi), r * std::sin(phi));
+    }
+  const LayerSurfaceProbe probe(*mesh_, static_cast<int>(layer), layers_.at(layer).top_z_m, points);
+  const std::vector<double> d = probe.deflection_m(y_, mesh_->points_m);
+  std::vector<double> out(r_m.size(), 0.0);
+  for (std::size_t i = 0; i < r_m.size(); ++i) {
+    int found = 0;
+    for (int j = 0; j < kAzimuths; ++j)
+      if (probe.found(i * kAzimuths + static_cast<std::size_t>(j))) {
+        out[i] += d[i * kAzimuths + static_cast<std::size_t>(j)];
+        ++found;
+      }
+    out[i] = found ? out[i] / found : std::numeric_limits<double>::quiet_NaN();
+  }
+  return out;
+}
+
+ModelSize VolumetricNeedleModel::model_size() const {
+  ModelSize s;
+  s.dofs = static_cast<long>(y_.size());
+  s.nodes = nodes_;
+  s.elements = mesh_->tet_count();
+  std::size_t bytes = law_->memory_bytes();
+  bytes += static_cast<std::size_t>(mesh_->points_m.size()) * sizeof(double) +
+           mesh_->tets.size() * (sizeof(Eigen::Vector4i) + sizeof(int) + 1);
+  bytes += static_cast<std::size_t>(y_.size() + rest_.size() + mass_.size() + work_f_.size()) * sizeof(double);
+  bytes += 2 * static_cast<std::size_t>(y_.size()) * sizeof(double);  // integrator state copies
+  if (settings_.integrator == IntegratorKind::ImplicitBdf) {
+    const std::size_t nnz = static_cast<std::size_t>(tangent_.matrix().nonZeros());
+    bytes += 3 * nnz * (sizeof(double) + sizeof(int));  // tangent, full and eliminated system
+    if (pattern_analysed_)
+      bytes += static_cast<std::size_t>(factor_.matrixL().nestedExpression().nonZeros()) * (sizeof(double) + sizeof(int));
+    // SUNDIALS BDF history (up to 6 vectors) and GMRES basis (krylov + 2 vectors).
+    bytes += 18 * static_cast<std::size_t>(y_.size()) * sizeof(double);
+  } else {
+    bytes += 8 * static_cast<std::size_t>(y_.size()) * sizeof(double);  // ERK stages
+  }
+  s.memory_bytes = bytes;
+  return s;
+}
+
+Eigen::Matrix3Xd VolumetricNeedleModel::deformed_points() const {
+  return Eigen::Map<const Eigen::Matrix3Xd>(y_.data(), 3, nodes_);
+}
+
+VolumeFrame VolumetricNeedleModel::volume_frame() const {
+  VolumeFrame frame;
+  const Eigen::Matrix3Xd x = deformed_points();
+  frame.points_m = x.transpose();
+  frame.displacement_m = (x - mesh_->points_m).transpose();
+  const long kept = static_cast<long>(std::count(removed_.begin(), removed_.end(), 0));
+  frame.tets.resize(kept, 4);
+  frame.layer.resize(kept);
+  long row = 0;
+  for (std::size_t t = 0; t < mesh_->tets.size(); ++t) {
+    if (removed_[t]) continue;
+    frame.tets.row(row) = mesh_->tets[t].transpose();
+    frame.layer[row] = mesh_->layer[t];
+    ++row;
+  }
+  return frame;
+}
+
+std::string VolumetricNeedleModel::integrator_report() const {
+  if (settings_.quasi_static) {
+    std::ostringstream out;
+    out << "quasi-static: equilibrium at every step by modified Newton, " << relaxation_factorisations_
+        << " sparse LDL^T factorisations";
+    return out.str();
+  }
+  if (!integrator_) return "not started";
+  const IntegratorStats s = integrator_->stats();
+  std::ostringstream out;
+  out << to_string(integrator_->kind()) << ": " << s.steps << " steps, " << s.rhs_evaluations
+      << " rhs evaluations, " << s.linear_iterations << " GMRES iterations, " << s.preconditioner_setups
+      << " preconditioner set-ups, " << s.error_test_failures << " error-test and " << s.convergence_failures
+      << " convergence failures; " << factorisations_ << " sparse LDL^T factorisations (" << factorisation_seconds_
+      << " s), " << mass_only_setups_ << " diagonal preconditioners; " << relaxations_
+      << " static relaxations after a contact jump (" << relaxation_factorisations_ << " factorisations); "
+      << s.reinitialisations << " restarts (contact, puncture, speed changes)";
+  return out.str();
+}
+
+long VolumetricNeedleModel::recovered_steps() const {
+  if (!integrator_) return 0;
+  const IntegratorStats s = integrator_->stats();
+  return s.error_test_failures + s.convergence_failures;
+}
+
+}  // namespace puncture::comparison

@@ -1,0 +1,60 @@
+// tet_slab_mesh.hpp: tetrahedral mesh of the layered cylindrical slab of a
+// Scene, made with CGAL Mesh_3 (Delaunay refinement of a labelled implicit
+// domain with protected circular features), for the comparison models of
+// core/comparison. The only CGAL translation unit of the project.
+//
+// In:  a Scene (SI units; geometry of scene.hpp: cylinder of radius
+//      sample.diameter_m / 2 on the z axis, skin top at z = 0, layers stacked
+//      downward), TetSlabMeshOptions.
+// Out: comparison::TetMesh (plain arrays: points 3 x N in m, positively
+//      oriented tetrahedra, layer index per tetrahedron, needle_column flag).
+//
+// Domain: every layer is split into two subdomains, the needle column
+// r <= needle radius (the path the needle cuts; flagged needle_column) and the
+// annulus around it, so the mesh conforms to the interfaces z = -depth_k, to
+// the cylinder r = needle radius and to the sample side r = R. The circles
+// r = needle radius and r = R on every interface plane are protected 1D
+// features (their vertices lie exactly on them), which keeps the sharp rims
+// and the needle disc exact.
+// Size field (edge size, facet size and cell size): h(r) = min(size_far,
+// size_at_axis + grading * max(0, r - needle radius)), graded toward the axis.
+// Facet distance (surface approximation): min(0.1 h, 0.005 R), so the side of
+// the sample loses well under 1 % of the volume.
+// Criteria: facet angle >= 25 deg, cell radius-edge ratio <= 3; then sliver
+// exudation. Random choices use a fixed seed, so the vertices are the same
+// from run to run; exudation breaks ties by memory address, so a few cells may
+// be connected differently (about 0.1 % of them; without exudation, which
+// leaves slivers, the mesh is identical).
+// Throws std::invalid_argument for bad options or scene geometry, and
+// std::runtime_error if CGAL returns an empty mesh.
+#pragma once
+
+#include <string>
+
+#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/scene.hpp"
+
+namespace puncture::meshing {
+
+struct TetSlabMeshOptions {
+  double size_at_axis_m = 1.0e-3;
+  double size_far_m = 8e-3;
+  double grading = 0.5;
+  bool exude_slivers = true;  ///< CGAL sliver exudation after refinement
+  unsigned random_seed = 0;
+};
+
+/// The options of scene.comparison.mesh.
+TetSlabMeshOptions tet_slab_mesh_options(const Scene& scene);
+
+struct TetSlabMeshReport {
+  double wall_time_s = 0.0;
+  int vertices = 0;
+  int tetrahedra = 0;
+  comparison::TetQuality quality;
+};
+
+comparison::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOptions& options,
+                                        TetSlabMeshReport* report = nullptr);
+
+}  // namespace puncture::meshing

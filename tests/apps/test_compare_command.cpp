@@ -1,0 +1,194 @@
+// `puncture compare` end to end on a small slab against a synthetic FEM
+// reference placed in the cache (the full default FEM takes minutes): table,
+// ranking, curves, ParaView series, summary; bad input.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "puncture/apps/commands.hpp"
+#include "puncture/apps/fem_reference.hpp"
+#include "puncture/scene_io.hpp"
+
+namespace fs = std::filesystem;
+
+namespace puncture::apps {
+namespace {
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("puncture_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+/// Skin 1 mm, fat 3 mm, muscle 4 mm, 10 mm across; 4 mm insertion.
+Scene small_scene() {
+  Scene s = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json");
+  s.name = "compare_test";
+  s.sample.diameter_m = 10e-3;
+  const double thickness[3] = {1e-3, 3e-3, 4e-3};
+  for (int k = 0; k < 3; ++k) {
+    Layer& l = s.layers[static_cast<std::size_t>(k)];
+    l.thickness_m = thickness[k];
+    l.force_mesh.rings_w = 3;
+    l.force_mesh.spacing_L_m = 1.5e-3;
+    l.force_mesh.deformed_threshold_m = 50e-6;
+  }
+  s.insertion.start_height_m = 0.2e-3;
+  s.insertion.target_depth_m = 4e-3;
+  s.insertion.dwell_s = 0.02;
+  s.insertion.withdrawal_speed_m_per_s = 0.05;
+  s.realtime.sh_degree = 8;
+  s.comparison.mesh.size_at_axis_m = 0.6e-3;
+  s.comparison.mesh.size_far_m = 2.5e-3;
+  s.comparison.mesh.grading = 0.5;
+  return s;
+}
+
+/// A synthetic FEM reference: the skin pressed 0..1.2 mm at 20 mN/mm, broken
+/// there; the fat pressed from 1.2 to 2.5 mm at 5 mN/mm, broken; the muscle
+/// pressed from 4 mm (the end). Skin profiles u_z(r) = -delta a / max(r, a).
+void write_synthetic_reference(const Scene& scene, const fs::path& cache) {
+  FemReferenceOptions options;
+  options.cache_dir = cache;
+  const fs::path dir = cache / fem_reference_hash(scene, options);
+  fs::create_directories(dir);
+  std::ofstream curve(dir / "fem_force_depth.csv");
+  curve << "time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch,skin_state,fat_state,muscle_state\n";
+  const double speed = 10.0;  // mm/s
+  auto row = [&](double depth, double force, const char* s, const char* f, const char* m) {
+    curve << (depth + 0.2) / speed << ',' << depth << ',' << speed << ',' << force << ",1," << s << ',' << f << ','
+          << m << '\n';
+  };
+  for (double d = -0.2; d < 1.2 - 1e-9; d += 0.1) row(d, d > 0 ? 0.02 * d : 0.0, d >= 0 ? "pressed" : "untouched", "untouched", "untouched");
+  row(1.2, 0.024, "pressed", "untouched", "untouched");
+  row(1.2, 0.0, "punctured", "pressed", "untouched");
+  for (double d = 1.3; d < 2.5 - 1e-9; d += 0.1) row(d, 0.005 * (d - 1.2), "punctured", "pressed", "untouched");
+  row(2.5, 0.0065, "punctured", "pressed", "untouched");
+  row(2.5, 0.0, "punctured", "punctured", "untouched");
+  for (double d = 2.6; d <= 4.0 + 1e-9; d += 0.1) row(d, 0.0, "punctured", "punctured", "untouched");
+  curve.close();
+  std::ofstream profile(dir / "fem_surface_profile.csv");
+  profile << "step,depth_mm,r_mm,uz_mm,surface\n";
+  for (int step = 1; step <= 3; ++step) {
+    const double depth = 0.3 * step;
+    for (double r : {0.0, 0.3, 0.635, 1.0, 2.0, 3.0, 4.0, 5.0})
+      profile << step << ',' << depth << ',' << r << ',' << -depth * 0.635 / std::max(r, 0.635) << ",skin\n";
+  }
+  profile.close();
+  std::ofstream(dir / "fem_recovery_profile.csv") << "layer,phase,depth_mm,r_mm,uz_mm\n";
+  std::ofstream(dir / "fem_summary.json")
+      << R"({"status": "ok", "n_dofs": 1234, "n_ranks": 1, "load_steps": 40, "wall_time_s": 20.0, "punctures": []})";
+}
+
+TEST(CompareCommand, TableRankingCurvesAndSeriesOnASmallSlab) {
+  const fs::path dir = fresh_dir("compare");
+  const Scene scene = small_scene();
+  const fs::path scene_file = dir / "small.json";
+  std::ofstream(scene_file) << scene_to_json_text(scene);
+  write_synthetic_reference(load_scene(scene_file), dir / "cache");
+  CompareOptions options;
+  options.scene = scene_file;
+  options.output_dir = dir / "out";
+  options.cache_dir = dir / "cache";
+  options.models = {"realtime", "shf", "bem", "mass_tensor", "fem"};
+  options.frames = 2;
+  options.quiet = true;
+  std::ostringstream out, err;
+  ASSERT_EQ(compare_command(options, out, err), 0) << err.str();
+  for (const char* f : {"comparison.csv", "ranking.csv", "comparison.md", "comparison_summary.json", "fem_curve.csv",
+                        "deflection_profiles.csv", "curves/realtime.csv", "curves/mass_tensor.csv", "mesh.vtu",
+                        "comparison.pvd"})
+    EXPECT_TRUE(fs::exists(options.output_dir / f)) << f;
+
+  std::ifstream table(options.output_dir / "comparison.csv");
+  std::string header, line;
+  std::getline(table, header);
+  EXPECT_NE(header.find("force_rmse_relative"), std::string::npos);
+  EXPECT_NE(header.find("step_time_p99_ms"), std::string::npos);
+  EXPECT_NE(header.find("memory_MB"), std::string::npos);
+  std::vector<std::string> columns;
+  {
+    std::istringstream s(header);
+    std::string c;
+    while (std::getline(s, c, ',')) columns.push_back(c);
+  }
+  const auto column = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(columns.begin(), columns.end(), name) - columns.begin());
+  };
+  std::vector<std::string> models;
+  while (std::getline(table, line)) {
+    std::vector<std::string> fields;
+    std::istringstream s(line);
+    std::string f;
+    while (std::getline(s, f, ',')) fields.push_back(f);
+    models.push_back(fields[0]);
+    const double rmse = std::stod(fields[column("force_rmse_relative")]);
+    if (models.back() == "fem") {
+      EXPECT_EQ(rmse, 0.0);
+    } else {
+      EXPECT_GT(rmse, 0.0) << models.back();
+      EXPECT_TRUE(std::isfinite(rmse)) << models.back();
+      EXPECT_GT(std::stod(fields[column("step_time_p99_ms")]), 0.0) << models.back();
+      EXPECT_GT(std::stod(fields[column("memory_MB")]), 0.0) << models.back();
+    }
+  }
+  EXPECT_EQ(models, (std::vector<std::string>{"realtime", "shf", "bem", "mass_tensor", "fem"}));
+
+  std::ifstream ranking(options.output_dir / "ranking.csv");
+  std::getline(ranking, header);
+  std::vector<int> ranks;
+  while (std::getline(ranking, line) && line[0] != '#') {
+    std::istringstream s(line);
+    std::string model, rank;
+    std::getline(s, model, ',');
+    std::getline(s, rank, ',');
+    ranks.push_back(std::stoi(rank));
+  }
+  std::sort(ranks.begin(), ranks.end());
+  EXPECT_EQ(ranks, (std::vector<int>{1, 2, 3, 4, 5}));
+  std::ifstream md(options.output_dir / "comparison.md");
+  std::stringstream text;
+  text << md.rdbuf();
+  EXPECT_NE(text.str().find("quasi-static and frictionless"), std::string::npos);
+  EXPECT_NE(text.str().find("Ranking"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(CompareCommand, BadInputFailsCleanly) {
+  const fs::path dir = fresh_dir("compare_bad");
+  const Scene scene = small_scene();
+  const fs::path scene_file = dir / "small.json";
+  std::ofstream(scene_file) << scene_to_json_text(scene);
+  CompareOptions options;
+  options.scene = scene_file;
+  options.output_dir = dir / "out";
+  options.cache_dir = dir / "cache";
+  options.quiet = true;
+  std::ostringstream out, err;
+  options.models = {"realtime", "cloth"};
+  EXPECT_EQ(compare_command(options, out, err), 1);
+  EXPECT_NE(err.str().find("unknown model 'cloth'"), std::string::npos) << err.str();
+  options.models = {"realtime"};
+  const fs::path weights = dir / "weights.json";
+  std::ofstream(weights) << R"({"schema": "puncture-delphi-weights/1", "indicators": [
+      {"name": "x", "metric": "force_rmse_relative", "best": 0, "worst": 1, "weight": 0.7}]})";
+  options.weights = weights;
+  err.str("");
+  EXPECT_EQ(compare_command(options, out, err), 1);
+  EXPECT_NE(err.str().find("/indicators: weights must sum to 1"), std::string::npos) << err.str();
+  std::ofstream(dir / "bad.json") << R"({"schema_version": 1, "name": "x"})";
+  options.scene = dir / "bad.json";
+  err.str("");
+  EXPECT_EQ(compare_command(options, out, err), 2);
+  EXPECT_FALSE(fs::exists(options.output_dir));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace puncture::apps

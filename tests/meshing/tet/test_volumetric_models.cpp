@@ -1,0 +1,242 @@
+// Volumetric comparison models (mass-spring and tensor-mass laws, SUNDIALS
+// integration, needle contact and puncture) on CGAL meshes of small slabs:
+// small-indentation stiffness against the layered half-space (itself tested
+// against Sneddon), a whole insertion for every law (finite forces, layers
+// broken in order by the ring rule, contact released on withdrawal), explicit
+// against implicit integration; the mass-spring identification recovering the
+// layer factors of a synthetic reference.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "puncture/comparison/model_factory.hpp"
+#include "puncture/comparison/surface_models.hpp"
+#include "puncture/comparison/volumetric_model.hpp"
+#include "puncture/meshing/tet_slab_mesh.hpp"
+#include "puncture/needle.hpp"
+#include "puncture/validation/mass_spring_identification.hpp"
+#include "tet_test_scenes.hpp"
+
+namespace puncture::comparison {
+namespace {
+
+std::shared_ptr<const TetMesh> mesh_of(const Scene& scene) {
+  return std::make_shared<TetMesh>(meshing::build_tet_slab_mesh(scene, meshing::tet_slab_mesh_options(scene)));
+}
+
+/// One soft layer, 6 mm thick, 16 mm across; a force mesh that never breaks;
+/// indented 0.03 mm at 1 mm/s (small strain, quasi-static).
+Scene single_layer_scene(double poisson, double size_at_axis_m) {
+  Scene s = testing::small_slab_scene();
+  s.layers.resize(1);
+  s.layers[0].thickness_m = 6e-3;
+  s.layers[0].material.youngs_modulus_Pa = 10e3;
+  s.layers[0].material.poisson_ratio = poisson;
+  s.layers[0].force_mesh.deformed_threshold_m = 1.0;  // no puncture
+  s.sample.diameter_m = 16e-3;
+  s.insertion.start_height_m = 0.0;
+  s.insertion.target_depth_m = 0.03e-3;
+  s.insertion.speed_m_per_s = 0.001;
+  s.comparison.mesh.size_at_axis_m = size_at_axis_m;
+  s.comparison.mesh.size_far_m = 2.5e-3;
+  s.comparison.mesh.grading = 0.4;
+  validate_scene(s, "single_layer_scene");
+  return s;
+}
+
+struct RunRecord {
+  std::vector<double> depth_m, force_N;
+  std::vector<std::vector<LayerState>> states;
+  double max_abs_force_N = 0.0;
+};
+
+RunRecord run(ComparisonModel& model, const Scene& scene, double until_s = -1.0) {
+  const ScriptedTrajectory trajectory(scene.insertion);
+  const double end = until_s > 0 ? until_s : trajectory.duration();
+  RunRecord record;
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  for (long i = 0; i * dt <= end + 1e-12; ++i) {
+    const NeedleState needle = trajectory.sample(i * dt);
+    const double force = model.step(needle);
+    EXPECT_TRUE(std::isfinite(force)) << model.name() << " at t = " << i * dt;
+    record.depth_m.push_back(needle.depth_m());
+    record.force_N.push_back(force);
+    record.max_abs_force_N = std::max(record.max_abs_force_N, std::abs(force));
+    std::vector<LayerState> states;
+    for (std::size_t k = 0; k < scene.layers.size(); ++k) states.push_back(model.layer_state(k));
+    record.states.push_back(states);
+  }
+  return record;
+}
+
+TEST(VolumetricModels, LinearTensorMassIndentationConvergesToTheLayeredHalfSpace) {
+  // Compressible (nu = 0.3) so the P1 elements do not lock; the reference is
+  // the BEM stiffness of the same layer on its rigid base (the BEM itself is
+  // checked against Sneddon). P1 tetrahedra are stiffer than the continuum,
+  // the more so at the flat tip's singular rim: the ratio is >= 1 and falls
+  // toward 1 as the mesh at the needle is refined.
+  double previous = 0.0;
+  for (double size : {0.3e-3, 0.15e-3}) {
+    const Scene scene = single_layer_scene(0.3, size);
+    const auto mesh = mesh_of(scene);
+    auto model = make_comparison_model("mass_tensor", scene, mesh);
+    const double until = scene.insertion.target_depth_m / scene.insertion.speed_m_per_s;
+    const RunRecord record = run(*model, scene, until);
+    const double slope = record.force_N.back() / record.depth_m.back();
+    const BoundaryElementModel bem(scene);
+    const double ratio = slope / bem.stiffness_N_per_m(0);
+    EXPECT_GT(ratio, 0.98) << "FE " << slope << " N/m, BEM " << bem.stiffness_N_per_m(0) << " N/m";
+    EXPECT_LT(ratio, size < 0.2e-3 ? 1.35 : 1.55) << "FE " << slope << " N/m, BEM " << bem.stiffness_N_per_m(0) << " N/m";
+    if (previous > 0.0) EXPECT_LT(ratio, previous - 0.05);
+    previous = ratio;
+    if (size > 0.2e-3) {
+      // At this small strain (5 % under the tip) the StVK model gives nearly the same force.
+      auto stvk = make_comparison_model("nonlinear_mass_tensor", scene, mesh);
+      const RunRecord nonlinear = run(*stvk, scene, until);
+      EXPECT_NEAR(nonlinear.force_N.back(), record.force_N.back(), 0.03 * record.force_N.back());
+    }
+  }
+}
+
+TEST(VolumetricModels, EveryLawInsertsThroughTheSmallSlab) {
+  const Scene scene = testing::small_slab_scene();
+  const auto mesh = mesh_of(scene);
+  for (const char* name : {"msm", "mass_tensor", "nonlinear_mass_tensor", "viscoelastic_mass_tensor"}) {
+    SCOPED_TRACE(name);
+    auto model = make_comparison_model(name, scene, mesh);
+    const RunRecord record = run(*model, scene);
+    // Layers break in order, the skin first, by the ring rule.
+    std::vector<double> broke(3, -1.0);
+    for (std::size_t i = 0; i < record.states.size(); ++i)
+      for (std::size_t k = 0; k < 3; ++k)
+        if (record.states[i][k] == LayerState::Punctured && broke[k] < 0) broke[k] = record.depth_m[i];
+    ASSERT_GT(broke[0], 0.0);
+    for (std::size_t k = 1; k < 3; ++k)
+      if (broke[k] > 0) EXPECT_GE(broke[k], broke[k - 1]);
+    EXPECT_GT(broke[1], 0.0) << "the fat should break before 6 mm";
+    // Pressing the skin pushes back; forces stay bounded.
+    double pressing = 0.0;
+    for (std::size_t i = 0; i < record.states.size(); ++i)
+      if (record.states[i][0] == LayerState::Pressed) pressing = std::max(pressing, record.force_N[i]);
+    EXPECT_GT(pressing, 1e-4);
+    EXPECT_LT(record.max_abs_force_N, 5.0);
+    // After withdrawal nothing touches the needle.
+    auto* volumetric = dynamic_cast<VolumetricNeedleModel*>(model.get());
+    ASSERT_NE(volumetric, nullptr);
+    EXPECT_EQ(volumetric->contact_node_count(), 0);
+    EXPECT_NEAR(record.force_N.back(), 0.0, 1e-9);
+    EXPECT_TRUE(std::isfinite(volumetric->mechanical_energy_J()));
+    EXPECT_GT(model->model_size().memory_bytes, 0u);
+  }
+}
+
+TEST(VolumetricModels, ExplicitIntegrationAgreesWithImplicit) {
+  Scene scene = testing::small_slab_scene();
+  scene.insertion.target_depth_m = 0.4e-3;  // press the skin only
+  scene.layers[0].force_mesh.deformed_threshold_m = 1.0;  // and never break it
+  scene.comparison.mass_damping_per_s = 200.0;
+  scene.comparison.stiffness_damping_s = 0.0;  // keeps the explicit step at the elastic limit
+  const auto mesh = mesh_of(scene);
+  const double until = (scene.insertion.start_height_m + scene.insertion.target_depth_m) / scene.insertion.speed_m_per_s;
+  auto implicit_model = make_comparison_model("mass_tensor", scene, mesh);
+  const RunRecord implicit_run = run(*implicit_model, scene, until);
+  scene.comparison.integrator = "explicit";
+  auto explicit_model = make_comparison_model("mass_tensor", scene, mesh);
+  const RunRecord explicit_run = run(*explicit_model, scene, until);
+  ASSERT_EQ(implicit_run.force_N.size(), explicit_run.force_N.size());
+  const double scale = implicit_run.force_N.back();
+  ASSERT_GT(scale, 0.0);
+  for (std::size_t i = implicit_run.force_N.size() / 2; i < implicit_run.force_N.size(); ++i)
+    EXPECT_NEAR(explicit_run.force_N[i], implicit_run.force_N[i], 0.02 * scale) << "step " << i;
+  EXPECT_NE(explicit_model->integrator_report().find("ERK"), std::string::npos);
+}
+
+TEST(VolumetricModels, BadInputIsRejected) {
+  const Scene scene = testing::small_slab_scene();
+  EXPECT_THROW(make_comparison_model("msm", scene, nullptr), std::invalid_argument);
+  EXPECT_THROW(make_comparison_model("cloth", scene, nullptr), std::invalid_argument);
+  auto model = make_comparison_model("mass_tensor", scene, mesh_of(scene));
+  NeedleState bad;
+  bad.tip_position_m.x() = std::nan("");
+  EXPECT_THROW(model->step(bad), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace puncture::comparison
+
+namespace puncture::validation {
+namespace {
+
+TEST(MassSpringIdentification, RecoversFactorsOfASyntheticReference) {
+  // Reference: the quasi-static mass-spring model itself with known layer
+  // factors (skin x3, fat x2, muscle untouched: the insertion stops in the
+  // fat); the search starts from 1, 1, 1. A coarse mesh without sliver
+  // exudation keeps the test quick and deterministic; thresholds of 0.2 mm
+  // keep each layer pressed over several samples.
+  Scene scene = testing::small_slab_scene();
+  scene.insertion.target_depth_m = 3.5e-3;
+  for (Layer& l : scene.layers) l.force_mesh.deformed_threshold_m = 0.2e-3;
+  meshing::TetSlabMeshOptions mesh_options = meshing::tet_slab_mesh_options(scene);
+  mesh_options.size_at_axis_m = 0.8e-3;
+  mesh_options.size_far_m = 3e-3;
+  mesh_options.exude_slivers = false;
+  const auto mesh = std::make_shared<comparison::TetMesh>(meshing::build_tet_slab_mesh(scene, mesh_options));
+  const std::vector<double> truth_factors{3.0, 2.0, 1.0};
+  comparison::VolumetricSettings settings = comparison::volumetric_settings(scene);
+  settings.quasi_static = true;
+  comparison::VolumetricNeedleModel truth(
+      scene, mesh,
+      std::make_unique<comparison::MassSpringLaw>(*mesh, comparison::layer_elasticity(scene), truth_factors), settings,
+      "truth");
+  ReferenceData reference;
+  reference.curve.layer_names = {"skin", "fat", "muscle"};
+  reference.curve.layer_states.resize(3);
+  for (int i = 0; i <= 14; ++i) {
+    const double depth = -0.2e-3 + 0.25e-3 * i;
+    NeedleState needle;
+    needle.tip_position_m = Eigen::Vector3d(0, 0, -depth);
+    needle.axial_velocity_m_per_s = 0.01;
+    needle.time_s = (depth + 0.2e-3) / 0.01;
+    reference.curve.force_N.push_back(truth.step(needle));
+    reference.curve.depth_m.push_back(depth);
+    reference.curve.time_s.push_back(needle.time_s);
+    reference.curve.velocity_m_per_s.push_back(0.01);
+    for (std::size_t k = 0; k < 3; ++k) reference.curve.layer_states[k].push_back(truth.layer_state(k));
+  }
+  IdentificationOptions options;
+  options.step_m = 0.25e-3;
+  // The truth scores (almost) zero, the start does not.
+  EXPECT_LT(evaluate_mass_spring(scene, mesh, reference, truth_factors, options).objective, 1e-6);
+  const double start = evaluate_mass_spring(scene, mesh, reference, {1.0, 1.0, 1.0}, options).objective;
+  ASSERT_GT(start, 0.05);
+  // Both searches are seeded (deterministic). Simulated annealing, which
+  // walks from the start, finds the truth's neighbourhood in 30 runs. ISRES
+  // with a population of 10 gets two generations in 20 runs: at that budget
+  // it is a global sampler of the box [1/30, 30]^3 (its convergence is
+  // NLopt's business), so it is only required to improve on the start.
+  for (const char* method : {"simulated_annealing", "isres"}) {
+    SCOPED_TRACE(method);
+    const bool annealing = std::string(method) == "simulated_annealing";
+    options.method = method;
+    options.max_evaluations = annealing ? 30 : 20;
+    options.population = 10;
+    const IdentificationResult r = identify_mass_spring_stiffness(scene, mesh, reference, options);
+    EXPECT_EQ(r.scale_before, (std::vector<double>{1.0, 1.0, 1.0}));
+    EXPECT_NEAR(r.before.objective, start, 1e-12);
+    EXPECT_LT(r.after.objective, 0.3 * r.before.objective);
+    EXPECT_LE(r.evaluations, options.max_evaluations + options.population);
+    EXPECT_GT(r.wall_time_s, 0.0);
+    if (annealing) {
+      EXPECT_LT(r.after.objective, 1e-2);
+      EXPECT_GT(r.scale_after[0] * r.scale_after[1], 2.0);  // the pressed layers stiffen toward 3 x 2
+      EXPECT_NEAR(r.scale_after[0], truth_factors[0], 0.5);  // the skin factor, which sets its puncture depth
+    }
+  }
+  options.method = "tabu";
+  EXPECT_THROW(identify_mass_spring_stiffness(scene, mesh, reference, options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace puncture::validation

@@ -1,0 +1,42 @@
+// tet_test_scenes.hpp: scenes for the tetrahedral-mesh and volumetric-model
+// tests: the shipped default scene, and a small three-layer slab (10 mm
+// across, 8 mm thick) whose mesh has a few thousand nodes.
+#pragma once
+
+#include <string>
+
+#include "puncture/scene_io.hpp"
+
+namespace puncture::testing {
+
+inline Scene default_scene() { return load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json"); }
+
+/// Skin 1 mm, fat 3 mm, muscle 4 mm; 10 mm across; force meshes that fit
+/// (w - 1) L < 5 mm; insertion 10 mm/s to 6 mm, no dwell, quick withdrawal.
+inline Scene small_slab_scene() {
+  Scene s = default_scene();
+  s.name = "small_slab";
+  s.sample.diameter_m = 10e-3;
+  const double thickness[3] = {1e-3, 3e-3, 4e-3};
+  const int rings[3] = {3, 3, 3};
+  const double spacing[3] = {1.5e-3, 1.5e-3, 1.5e-3};
+  const double threshold[3] = {50e-6, 50e-6, 50e-6};
+  for (int k = 0; k < 3; ++k) {
+    s.layers[static_cast<std::size_t>(k)].thickness_m = thickness[k];
+    s.layers[static_cast<std::size_t>(k)].force_mesh.rings_w = rings[k];
+    s.layers[static_cast<std::size_t>(k)].force_mesh.spacing_L_m = spacing[k];
+    s.layers[static_cast<std::size_t>(k)].force_mesh.deformed_threshold_m = threshold[k];
+  }
+  s.insertion.start_height_m = 0.2e-3;
+  s.insertion.speed_m_per_s = 0.01;
+  s.insertion.target_depth_m = 6e-3;
+  s.insertion.dwell_s = 0.02;
+  s.insertion.withdrawal_speed_m_per_s = 0.05;
+  s.comparison.mesh.size_at_axis_m = 0.5e-3;
+  s.comparison.mesh.size_far_m = 2e-3;
+  s.comparison.mesh.grading = 0.4;
+  validate_scene(s, "small_slab_scene");
+  return s;
+}
+
+}  // namespace puncture::testing

@@ -1,0 +1,279 @@
+// model_comparison.cpp: runs of the comparison models along the scene's
+// insertion and their metrics against the reference; see model_comparison.hpp.
+#include "puncture/validation/model_comparison.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <stdexcept>
+
+#include "puncture/cutting.hpp"
+#include "puncture/needle.hpp"
+#include "puncture/puncture_force.hpp"
+#include "puncture/shaft_friction.hpp"
+
+namespace puncture::validation {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double elapsed_s(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+}  // namespace
+
+double quantile(std::vector<double> values, double p) {
+  if (values.empty()) return kNaN;
+  std::sort(values.begin(), values.end());
+  const double position = std::clamp(p, 0.0, 1.0) * static_cast<double>(values.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(std::floor(position));
+  const std::size_t hi = std::min(values.size() - 1, lo + 1);
+  return values[lo] + (position - static_cast<double>(lo)) * (values[hi] - values[lo]);
+}
+
+ModelRun run_comparison_model(comparison::ComparisonModel& model, const Scene& scene, const ModelRunOptions& options) {
+  ModelRun run;
+  run.model = model.name();
+  run.description = model.description();
+  const ScriptedTrajectory trajectory(scene.insertion);
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  const double end = options.end_time_s > 0.0 ? std::min(options.end_time_s, trajectory.duration()) : trajectory.duration();
+  const long n_steps = static_cast<long>(std::ceil(end / dt - 1e-9)) + 1;
+  std::vector<double> profile_depths = options.profile_depths_m;
+  std::sort(profile_depths.begin(), profile_depths.end());
+  std::size_t next_profile = 0;
+  int next_frame = 0;
+  long next_progress = 0;
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t n_layers = scene.layers.size();
+  // Shaft forces of the force law, the same for every model (as the
+  // simulator computes them, core/simulator.hpp steps 5-6): per punctured
+  // layer Karnopp friction phi h and damping d h v; the cutting force of the
+  // last punctured layer while the next one is untouched, from the crack
+  // front (the deepest tip position since that layer broke).
+  std::vector<std::optional<KarnoppFriction>> friction(n_layers);
+  if (scene.effects.friction)
+    for (std::size_t k = 0; k < n_layers; ++k) friction[k].emplace(scene.layers[k].force_law.friction);
+  std::vector<double> front_m(n_layers, 0.0);
+  std::size_t punctured_before = 0;
+  for (long i = 0; i < n_steps; ++i) {
+    const double t = static_cast<double>(i) * dt;
+    const NeedleState needle = trajectory.sample(t);
+    double force = 0.0;
+    const auto step_start = std::chrono::steady_clock::now();
+    try {
+      force = model.step(needle);
+    } catch (const std::exception& e) {
+      run.failure = std::string("at t = ") + std::to_string(t) + " s: " + e.what();
+      break;
+    }
+    run.step_wall_time_s.push_back(elapsed_s(step_start));
+    run.time_s.push_back(t);
+    run.depth_m.push_back(needle.depth_m());
+    run.velocity_m_per_s.push_back(needle.axial_velocity_m_per_s);
+    run.contact_force_N.push_back(force);
+    std::vector<LayerState> states(n_layers);
+    double post = 0.0;
+    std::size_t punctured = 0;  // layers punctured from the top
+    for (std::size_t k = 0; k < n_layers; ++k) {
+      states[k] = model.layer_state(k);
+      if (states[k] == LayerState::Punctured && punctured == k) ++punctured;
+      if (states[k] != LayerState::Punctured) continue;
+      const double h = shaft_length_in_layer_m(needle.depth_m(), scene.layer_top_depth_m(k), scene.layers[k].thickness_m);
+      if (friction[k]) post += friction[k]->update(needle.axial_velocity_m_per_s) * h;
+      if (scene.effects.damping)
+        post += puncture_damping_force_N(scene.layers[k].damping_N_s_per_m2, h, needle.axial_velocity_m_per_s);
+    }
+    const double tip_axial_m = needle.tip_position_m.dot(needle.direction);
+    for (std::size_t k = punctured_before; k < punctured; ++k) front_m[k] = tip_axial_m;
+    punctured_before = std::max(punctured_before, punctured);
+    if (scene.effects.cutting && punctured > 0 &&
+        (punctured == n_layers || states[punctured] == LayerState::Untouched)) {
+      const ForceLaw& law = scene.layers[punctured - 1].force_law;
+      post += cutting_force_N(law.cutting_force_N, law.cutting_release_m, front_m[punctured - 1], tip_axial_m);
+      front_m[punctured - 1] = std::max(front_m[punctured - 1], tip_axial_m);
+    }
+    run.states.push_back(states);
+    run.post_puncture_force_N.push_back(post);
+    while (next_profile < profile_depths.size() && needle.axial_velocity_m_per_s > 0.0 &&
+           needle.depth_m() >= profile_depths[next_profile] - 1e-12) {
+      SurfaceSnapshot snapshot;
+      snapshot.depth_m = profile_depths[next_profile];  // taken at most one step of needle travel later
+      snapshot.r_m = options.profile_radii_m;
+      snapshot.deflection_m = model.surface_deflection_m(0, options.profile_radii_m);
+      run.skin_profiles.push_back(snapshot);
+      ++next_profile;
+    }
+    if (options.on_frame && options.frame_interval_s > 0.0 && t + 0.5 * dt >= next_frame * options.frame_interval_s) {
+      options.on_frame(model, t, next_frame);
+      ++next_frame;
+    }
+    if (options.on_progress && i >= next_progress) {
+      options.on_progress(static_cast<double>(i) / static_cast<double>(n_steps));
+      next_progress += std::max(1L, n_steps / 20);
+    }
+  }
+  run.run_wall_time_s = elapsed_s(start);
+  run.size = model.model_size();
+  run.recovered_steps = model.recovered_steps();
+  run.integrator_report = model.integrator_report();
+  if (options.on_progress) options.on_progress(1.0);
+  return run;
+}
+
+InsertionCurve curve_from_model_run(const Scene& scene, const ModelRun& run, bool include_post_puncture) {
+  InsertionCurve curve;
+  curve.source = run.model;
+  curve.metadata["model"] = run.model;
+  curve.metadata["force"] =
+      include_post_puncture ? "contact + shaft forces (cutting, Karnopp friction, Table 1 d h v)" : "contact";
+  curve.time_s = run.time_s;
+  curve.depth_m = run.depth_m;
+  curve.velocity_m_per_s = run.velocity_m_per_s;
+  curve.force_N = run.contact_force_N;
+  if (include_post_puncture)
+    for (std::size_t i = 0; i < curve.force_N.size(); ++i) curve.force_N[i] += run.post_puncture_force_N[i];
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    curve.layer_names.push_back(scene.layers[k].name);
+    std::vector<LayerState> states;
+    for (const auto& row : run.states) states.push_back(row[k]);
+    curve.layer_states.push_back(states);
+  }
+  return curve;
+}
+
+namespace {
+
+/// First depth of the insertion phase at which the curve's layer is punctured.
+double puncture_depth(const InsertionCurve& curve, const std::string& layer) {
+  const int k = curve.layer_index(layer);
+  if (k < 0) return kNaN;
+  for (std::size_t i = 0; i < curve.size(); ++i) {
+    if (curve.velocity_m_per_s[i] <= 0.0) continue;
+    if (curve.layer_states[static_cast<std::size_t>(k)][i] == LayerState::Punctured) return curve.depth_m[i];
+  }
+  return kNaN;
+}
+
+/// Force RMSE over the reference's withdrawal samples (velocity < 0), the
+/// model interpolated at the same depth on its own withdrawal branch.
+double withdrawal_rmse(const InsertionCurve& model, const InsertionCurve& reference) {
+  auto branch = [](const InsertionCurve& c, std::vector<double>& depth, std::vector<double>& force) {
+    std::vector<std::pair<double, double>> pts;
+    for (std::size_t i = 0; i < c.size(); ++i)
+      if (c.velocity_m_per_s[i] < 0.0) pts.emplace_back(c.depth_m[i], c.force_N[i]);
+    std::sort(pts.begin(), pts.end());
+    for (const auto& [d, f] : pts)
+      if (depth.empty() || d > depth.back()) depth.push_back(d), force.push_back(f);
+  };
+  std::vector<double> md, mf, rd, rf;
+  branch(model, md, mf);
+  branch(reference, rd, rf);
+  if (md.size() < 2 || rd.empty()) return kNaN;
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < rd.size(); ++i) {
+    double f = 0.0;
+    if (!interpolate_linear(md, mf, rd[i], f)) continue;
+    sum += (f - rf[i]) * (f - rf[i]);
+    ++n;
+  }
+  return n ? std::sqrt(sum / static_cast<double>(n)) : kNaN;
+}
+
+}  // namespace
+
+ModelMetrics metrics_against_reference(const Scene& scene, const ModelRun& run, const ReferenceData& reference,
+                                       std::size_t total_steps) {
+  ModelMetrics m;
+  m.model = run.model;
+  m.completed_fraction = total_steps ? static_cast<double>(run.steps()) / static_cast<double>(total_steps) : 0.0;
+  m.memory_bytes = static_cast<double>(run.size.memory_bytes);
+  m.dofs = run.size.dofs;
+  if (run.steps() < 2) return m;
+  const InsertionCurve curve = curve_from_model_run(scene, run, reference.has_shaft_forces);
+
+  try {
+    const CurveComparison cmp = compare_curves(curve, reference.curve);
+    if (cmp.n_compared > 0) {
+      m.compared_samples = cmp.n_compared;
+      m.force_rmse_N = cmp.force_rmse_N;
+      m.force_rmse_relative = cmp.force_rmse_relative;
+      m.reference_peak_force_N = cmp.reference_peak_force_N;
+    }
+  } catch (const std::exception&) {
+    // a curve without an insertion phase: the metrics stay n/a
+  }
+  double model_peak = 0.0, reference_peak = 0.0;
+  for (std::size_t i = 0; i < curve.size(); ++i)
+    if (curve.velocity_m_per_s[i] > 0.0) model_peak = std::max(model_peak, curve.force_N[i]);
+  for (std::size_t i = 0; i < reference.curve.size(); ++i)
+    if (reference.curve.velocity_m_per_s[i] > 0.0) reference_peak = std::max(reference_peak, reference.curve.force_N[i]);
+  m.model_peak_force_N = model_peak;
+  if (reference_peak > 0.0) {
+    m.reference_peak_force_N = reference_peak;
+    m.peak_force_error_relative = (model_peak - reference_peak) / reference_peak;
+  }
+  m.withdrawal_force_rmse_N = withdrawal_rmse(curve, reference.curve);
+
+  double depth_error_sum = 0.0;
+  int both = 0;
+  for (const Layer& layer : scene.layers) {
+    LayerPunctureComparison p;
+    p.layer = layer.name;
+    p.reference_depth_m = puncture_depth(reference.curve, layer.name);
+    p.model_depth_m = puncture_depth(curve, layer.name);
+    p.reference_punctured = std::isfinite(p.reference_depth_m);
+    p.model_punctured = std::isfinite(p.model_depth_m);
+    if (p.reference_punctured && p.model_punctured) {
+      depth_error_sum += std::abs(p.model_depth_m - p.reference_depth_m);
+      ++both;
+    } else if (p.reference_punctured != p.model_punctured) {
+      ++m.puncture_layers_disagreeing;
+    }
+    m.punctures.push_back(p);
+  }
+  if (both > 0) m.puncture_depth_error_m = depth_error_sum / both;
+
+  // Skin deflection u_z(r) while the skin is intact in both.
+  const double skin_limit = std::min(std::isfinite(m.punctures[0].reference_depth_m) ? m.punctures[0].reference_depth_m : 1e300,
+                                     std::isfinite(m.punctures[0].model_depth_m) ? m.punctures[0].model_depth_m : 1e300);
+  double sq = 0.0, max_ref = 0.0;
+  std::size_t n = 0;
+  for (const SurfaceSnapshot& s : run.skin_profiles) {
+    if (!(s.depth_m > 0.0) || s.depth_m >= skin_limit) continue;
+    const RadialProfile* ref = nullptr;
+    for (const RadialProfile& p : reference.skin_profiles)
+      if (std::abs(p.depth_m - s.depth_m) < 1e-6) ref = &p;
+    if (!ref) continue;
+    bool used = false;
+    for (std::size_t i = 0; i < s.r_m.size(); ++i) {
+      double uz = 0.0;
+      if (!std::isfinite(s.deflection_m[i]) || !interpolate_linear(ref->r_m, ref->uz_m, s.r_m[i], uz)) continue;
+      sq += (s.deflection_m[i] + uz) * (s.deflection_m[i] + uz);  // deflection = -u_z
+      max_ref = std::max(max_ref, std::abs(uz));
+      ++n;
+      used = true;
+    }
+    if (used) ++m.deflection_depths;
+  }
+  if (n > 0) {
+    m.deflection_rmse_m = std::sqrt(sq / static_cast<double>(n));
+    if (max_ref > 0.0) m.deflection_rmse_relative = m.deflection_rmse_m / max_ref;
+  }
+
+  std::vector<double> in_tissue;
+  for (std::size_t i = 0; i < run.steps(); ++i)
+    if (run.depth_m[i] > 0.0) in_tissue.push_back(run.step_wall_time_s[i]);
+  if (!in_tissue.empty()) {
+    double sum = 0.0;
+    for (double t : in_tissue) sum += t;
+    m.step_time_mean_s = sum / static_cast<double>(in_tissue.size());
+    m.step_time_p99_s = quantile(in_tissue, 0.99);
+    m.step_time_max_s = *std::max_element(in_tissue.begin(), in_tissue.end());
+  }
+  return m;
+}
+
+}  // namespace puncture::validation
