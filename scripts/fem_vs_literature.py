@@ -77,7 +77,12 @@ def main():
             nxt = events.get(layers[i + 1]["name"]) if i + 1 < len(layers) else None
             hi = nxt["depth_mm"] if nxt else 1e9
             vals = [f(r, "cutting_force_N") for r in ins if ev["depth_mm"] + 0.5 <= f(r, "depth_mm") < hi]
-        fem = f"{sum(vals) / len(vals):.2f} N (mean of {len(vals)} steps after its puncture)" if vals else "not reached"
+        if vals:
+            fem = f"{sum(vals) / len(vals):.2f} N (mean of {len(vals)} steps inside the layer after its puncture)"
+        elif ev:
+            fem = "no step inside the layer after its puncture (the next layer broke at once)"
+        else:
+            fem = "not punctured"
         L.append(f"| cutting force in {l['name']} | {fem} | G_c x 2a = {gc:g} J/m^2 x {2 * a_mm:g} mm = {expected:.2f} N | "
                  f"{p.get('source', '')[:100]} |")
     # Friction share of the total at the deepest insertion point.
