@@ -273,8 +273,8 @@ std::string validation_summary_markdown(const Scene& scene, const io::Provenance
   md << "# Validation: " << scene.name << "\n\n";
   md << "Real-time SHF + MSM model against the deal.II FEM reference on the identical insertion ("
      << num(scene.insertion.speed_m_per_s / kMm) << " mm/s to " << num(scene.insertion.target_depth_m / kMm)
-     << " mm), aligned on depth. Only the insertion phase is compared (the FEM is quasi-static and stops at the "
-        "target depth).\n\n";
+     << " mm), aligned on depth. Only the insertion phase is compared (dwell and withdrawal, where the FEM "
+        "simulates them, are in its curve and plot but not in the metrics).\n\n";
   md << "## Provenance\n\n";
   md << "- command: `" << provenance.command << "`\n";
   md << "- program " << provenance.program_version << ", git revision " << provenance.git_revision << "\n";
@@ -293,7 +293,8 @@ std::string validation_summary_markdown(const Scene& scene, const io::Provenance
      << num(cmp.compared_to_depth_m / kMm) << " mm, " << cmp.n_compared << " FEM samples): **"
      << num(cmp.force_rmse_N) << " N**, " << num(100 * cmp.force_rmse_relative, 3) << " % of the FEM peak "
      << num(cmp.reference_peak_force_N) << " N. The real-time force compared is the total minus the damping "
-        "force d h v of the punctured layers: the FEM is quasi-static and frictionless and has no counterpart for it "
+        "force d h v of the punctured layers: the FEM is quasi-static (no rate-dependent damping) and has no "
+        "counterpart for it "
         "(the same holds in `puncture calibrate`).\n\n";
   md << "| layer | force RMSE (N) | RMSE / FEM peak | FEM puncture depth (mm) | real-time puncture depth (mm) | "
         "depth error (mm) | force error (N) | deflection RMSE before breakthrough (mm) | max error (mm) | "
