@@ -58,7 +58,7 @@ cd "$build"
 # suppression can name them). They run with leak detection off; AddressSanitizer
 # (heap, stack, use-after-free) and UBSan stay on for them, and every other
 # test, which does not start MPI, runs with leak detection on.
-mpi_tests='FemReferenceCache|ValidateCommand.Report|SweepCommand'
+mpi_tests='FemReferenceCache|ValidateCommand.Report|SweepCommand|CompareCommand.TableRanking'
 status=0
 ctest --output-on-failure -j2 --timeout 3000 -LE reference_fem -E "$mpi_tests" "$@" || status=1
 no_leaks="${ASAN_OPTIONS/detect_leaks=1/detect_leaks=0}"
