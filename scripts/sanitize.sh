@@ -58,7 +58,12 @@ cd "$build"
 # suppression can name them). They run with leak detection off; AddressSanitizer
 # (heap, stack, use-after-free) and UBSan stay on for them, and every other
 # test, which does not start MPI, runs with leak detection on.
-mpi_tests='FemReferenceCache|ValidateCommand.Report|SweepCommand|CompareCommand.TableRanking'
+# The puncture-app tests (PunctureApp.*) render offscreen: Mesa's GL driver is
+# loaded and unloaded by the app, and the leak check at exit reports 240 bytes
+# in 3 allocations at addresses it attributes to whatever library now occupies
+# them (a different Trilinos library each run), so no suppression can name
+# them either; they too run with leak detection off.
+mpi_tests='FemReferenceCache|ValidateCommand.Report|SweepCommand|CompareCommand.TableRanking|PunctureApp\.'
 status=0
 ctest --output-on-failure -j2 --timeout 3000 -LE reference_fem -E "$mpi_tests" "$@" || status=1
 no_leaks="${ASAN_OPTIONS/detect_leaks=1/detect_leaks=0}"
