@@ -287,6 +287,49 @@ std::uint16_t free_udp_port() {
   return ntohs(a.sin_port);
 }
 
+/// A UDP client of the app on `port`: sends POSE messages (numbered in order).
+struct PoseClient {
+  int fd = -1;
+  sockaddr_in to{};
+  std::uint32_t sequence = 0;
+  long replies = 0;
+  explicit PoseClient(std::uint16_t port, std::uint32_t first_sequence = 1)
+      : fd(::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0)), sequence(first_sequence - 1) {
+    to.sin_family = AF_INET;
+    to.sin_port = htons(port);
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  }
+  ~PoseClient() { ::close(fd); }
+  void send(double z_m) {
+    udp::PoseMessage m;
+    m.sequence = ++sequence;
+    m.position_m = Eigen::Vector3d(0.0, 0.0, z_m);
+    std::uint8_t b[udp::kPoseSize];
+    udp::encode(m, b);
+    ::sendto(fd, b, sizeof b, 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+  }
+  long drain() {
+    std::uint8_t reply[256];
+    long n = 0;
+    while (::recv(fd, reply, sizeof reply, 0) > 0) ++n;
+    replies += n;
+    return n;
+  }
+  /// Sends poses at z_m until the app answers (its haptic loop runs) or the
+  /// session ends: building the models takes seconds under a sanitizer on a
+  /// loaded machine, so a fixed start-up wait is not enough.
+  bool wait_for_app(double z_m, const std::future<ProcessResult>& session) {
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (std::chrono::steady_clock::now() < give_up &&
+           session.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+      send(z_m);
+      if (drain() > 0) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return false;
+  }
+};
+
 TEST(PunctureApp, UdpBridgeDrivesTheApp) {
   const fs::path dir = work_dir("udp");
   const std::uint16_t port = free_udp_port();
@@ -294,28 +337,18 @@ TEST(PunctureApp, UdpBridgeDrivesTheApp) {
     return app("--device udp --udp-port " + std::to_string(port) + " --offscreen --duration 3.5 --size 480x300 "
                "--stats " + (dir / "stats.json").string());
   });
-  // The tiny bridge: the scene's insertion to 12 mm at 20 mm/s as POSE messages at ~1 kHz.
-  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
-  sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_port = htons(port);
-  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  long replies = 0;
+  // The tiny bridge: once the app answers, the scene's insertion to 12 mm at
+  // 20 mm/s as POSE messages at ~1 kHz.
+  PoseClient client(port);
+  ASSERT_TRUE(client.wait_for_app(0.002, session)) << "the app never answered a pose";
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < 3000 && session.wait_for(std::chrono::seconds(0)) != std::future_status::ready; ++i) {
     const double t = 1e-3 * i;
-    const double z = 0.002 - 0.02 * std::max(0.0, std::min(t - 1.0, 0.7));  // wait 1 s for the app to start
-    udp::PoseMessage m;
-    m.sequence = static_cast<std::uint32_t>(i + 1);
-    m.position_m = Eigen::Vector3d(0.0, 0.0, z);
-    std::uint8_t b[udp::kPoseSize];
-    udp::encode(m, b);
-    ::sendto(fd, b, sizeof b, 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
-    std::uint8_t reply[256];
-    while (::recv(fd, reply, sizeof reply, 0) > 0) ++replies;
+    client.send(0.002 - 0.02 * std::max(0.0, std::min(t - 0.2, 0.7)));
+    client.drain();
     std::this_thread::sleep_until(start + std::chrono::microseconds(1000 * (i + 1)));
   }
-  ::close(fd);
+  const long replies = client.replies;
   const ProcessResult r = session.get();
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const json s = read_json(dir / "stats.json");
@@ -334,7 +367,11 @@ TEST(PunctureApp, PythonBridgeExampleDrivesTheApp) {
     return app("--device udp --udp-port " + std::to_string(port) + " --offscreen --duration 4 --size 480x300 "
                "--stats " + (dir / "stats.json").string());
   });
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the app builds its models first
+  {  // the app builds its models first; the handshake's sequence numbers lie
+     // 2^30 behind the script's (which starts at 1), so none of the script's is stale
+    PoseClient client(port, 0xC0000001u);
+    ASSERT_TRUE(client.wait_for_app(0.002, session)) << "the app never answered a pose";
+  }
   const ProcessResult bridge = run("python3 " + std::string(PUNCTURE_SOURCE_DIR) +
                                    "/apps/realtime_app/tools/udp_bridge_example.py --port " + std::to_string(port) +
                                    " --seconds 1.5 --speed-mm-s 20");
