@@ -95,6 +95,10 @@ struct ContactPoint {
   /// round the shoulder sees no jump), and its gradient (1/m).
   double friction_weight = 0.0;
   Vec2 dfriction_weight_dx{0.0, 0.0};
+  /// Curvature of the touched face (1/m): 1/d on the rounded shoulder, where
+  /// the normal turns with the node (dn/dx = curvature (I - n n)), 0 on the
+  /// flat flank and shaft. Enters the consistent tangent of the contact force.
+  double curvature_per_m = 0.0;
 };
 
 /// Contact of a tissue node at x = (r, z) on the outer side of the crack,
@@ -152,6 +156,7 @@ inline ContactPoint outer_contact(const RigidNeedle& needle, const Vec2& x, doub
   const double span = 1.0 - std::cos(beta);
   const double s = span > 0.0 ? std::clamp((n[0] - std::cos(beta)) / span, 0.0, 1.0) : 1.0;
   c.friction_weight = s * s * (3.0 - 2.0 * s);
+  if (on_corner) c.curvature_per_m = 1.0 / d;
   if (on_corner && s > 0.0 && s < 1.0) {
     // d n_r / dx = (e_r - n_r n) / d on the rounded corner (n = v / |v|).
     const double dw_ds = 6.0 * s * (1.0 - s) / span;
@@ -226,9 +231,19 @@ inline NodalContactResponse nodal_contact(const ContactPoint& c, const Vec2& x, 
   NodalContactResponse out;
   if (!(c.penetration_m > 0.0)) return out;  // no contact: friction history reset
   const double N = penalty.force(c.penetration_m), dN = penalty.stiffness(c.penetration_m);
+  // dn/dx = kappa (I - n n) on the rounded shoulder (0 on a flat face); the
+  // tangent t = (-n_z, n_r) turns with it: dt/dx = (-dn_z/dx, dn_r/dx).
+  const double kappa = c.curvature_per_m;
+  std::array<std::array<double, 2>, 2> dn{}, dt{};
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) dn[i][j] = kappa * ((i == j ? 1.0 : 0.0) - c.normal[i] * c.normal[j]);
+  for (int j = 0; j < 2; ++j) {
+    dt[0][j] = -dn[1][j];
+    dt[1][j] = dn[0][j];
+  }
   for (int i = 0; i < 2; ++i) {
     out.normal_force[i] = N * c.normal[i];
-    for (int j = 0; j < 2; ++j) out.dforce_dx[i][j] = -dN * c.normal[i] * c.normal[j];
+    for (int j = 0; j < 2; ++j) out.dforce_dx[i][j] = -dN * c.normal[i] * c.normal[j] + N * dn[i][j];
   }
   out.history.in_contact = true;
   const Vec2 rel{x[0] - edge[0], x[1] - edge[1]};
@@ -238,7 +253,8 @@ inline NodalContactResponse nodal_contact(const ContactPoint& c, const Vec2& x, 
   // it sticks where it is when the step converges (the anchor above).
   if (!committed.in_contact) return out;
   const Vec2 anchor = committed.anchor;
-  const double xi = dot(Vec2{rel[0] - anchor[0], rel[1] - anchor[1]}, c.tangent);
+  const Vec2 slip{rel[0] - anchor[0], rel[1] - anchor[1]};
+  const double xi = dot(slip, c.tangent);
   // Regularised Coulomb friction, smooth within a step so that Newton sees no
   // switch: f = -mu N tanh(k_t xi / (mu N)) along t. Small slips stick
   // elastically (f = -k_t xi), large ones slide at mu N. Plastic slip is
@@ -254,13 +270,17 @@ inline NodalContactResponse nodal_contact(const ContactPoint& c, const Vec2& x, 
   const double f = -cap * th;
   const double df_dxi = -k_t * sech2;
   const double df_dN = -mu_now * (th - u * sech2);
-  // d xi / dx = t; d N / dx = dN (-n) (the penetration falls along n).
+  // d xi / dx = t + slip . dt/dx; d N / dx = dN (-n) (the penetration falls
+  // along n); the force w f t also turns with t on the shoulder.
   const double w = c.friction_weight;
   for (int i = 0; i < 2; ++i) {
     out.friction_force[i] = w * f * c.tangent[i];
-    for (int j = 0; j < 2; ++j)
-      out.dforce_dx[i][j] += c.tangent[i] * (w * (df_dxi * c.tangent[j] - df_dN * dN * c.normal[j]) +
-                                             f * c.dfriction_weight_dx[j]);
+    for (int j = 0; j < 2; ++j) {
+      const double dxi_dx = c.tangent[j] + slip[0] * dt[0][j] + slip[1] * dt[1][j];
+      out.dforce_dx[i][j] += c.tangent[i] * (w * (df_dxi * dxi_dx - df_dN * dN * c.normal[j]) +
+                                             f * c.dfriction_weight_dx[j]) +
+                             w * f * dt[i][j];
+    }
   }
   const double xi_max = kCommittedSlipRatio * cap / k_t;
   if (std::abs(xi) > xi_max) {
