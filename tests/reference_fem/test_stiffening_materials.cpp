@@ -276,3 +276,41 @@ TEST(StiffeningMaterials, RejectsInvalidParameters) {
   EXPECT_THROW(LayerMaterial(veronda_westmann(1e4, 0.45, 0.0)), std::invalid_argument);
   EXPECT_THROW(LayerMaterial(veronda_westmann(1e4, 0.45, -2.0)), std::invalid_argument);
 }
+
+// The residual-only path (isochoric_stress, no tangent) of every law: the
+// isochoric first Piola stress F S_iso against central differences of the
+// isochoric energy in F.
+TEST(StiffeningMaterials, StressWithoutTangentIsTheEnergyDerivativeForEveryLaw) {
+  ContinuumMaterial neo;
+  neo.model = "neo_hookean";
+  neo.youngs_modulus_Pa = 3e4;
+  neo.poisson_ratio = 0.45;
+  ContinuumMaterial mooney = neo;
+  mooney.model = "mooney_rivlin";
+  mooney.mooney_rivlin_c01_fraction = 0.3;
+  const LayerMaterial laws[] = {LayerMaterial(neo), LayerMaterial(mooney),
+                                LayerMaterial(ogden(2e4, 0.4, {{0.7, 2.0}, {0.3, 12.0}})),
+                                LayerMaterial(veronda_westmann(2e4, 0.45, 1.5))};
+  const double h = 1e-7;
+  for (const LayerMaterial& m : laws)
+    for (double a : {0.3, 1.0}) {
+      const Tensor<2, 3> F = general_deformation(a);
+      const Tensor<2, 3> P = F * Tensor<2, 3>(m.isochoric_stress(cauchy_green(F)));
+      double scale = m.youngs_modulus_Pa();
+      for (unsigned i = 0; i < 3; ++i)
+        for (unsigned J = 0; J < 3; ++J) scale = std::max(scale, std::abs(P[i][J]));
+      for (unsigned k = 0; k < 3; ++k)
+        for (unsigned L = 0; L < 3; ++L) {
+          Tensor<2, 3> Fp = F, Fm = F;
+          Fp[k][L] += h;
+          Fm[k][L] -= h;
+          const double fd = (m.isochoric_energy(cauchy_green(Fp)) - m.isochoric_energy(cauchy_green(Fm))) / (2 * h);
+          EXPECT_NEAR(P[k][L], fd, 2e-5 * scale) << "P[" << k << "][" << L << "] a " << a;
+        }
+      // The same stress as the stress-and-tangent path.
+      SymTensor2 S;
+      SymTensor4 CC;
+      m.isochoric_stress_and_tangent(cauchy_green(F), S, CC);
+      EXPECT_LT((S - m.isochoric_stress(cauchy_green(F))).norm(), 1e-12 * std::max(1.0, S.norm()));
+    }
+}

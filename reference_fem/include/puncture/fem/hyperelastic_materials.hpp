@@ -63,6 +63,17 @@ inline SymTensor4 symmetric_product(const SymTensor2& A) {
 /// with P = I - 1/3 C^{-1} x C, Ptilde = C^{-1} (.) C^{-1} - 1/3 C^{-1} x C^{-1},
 /// CCbar = J^{-4/3} (4 d^2 Psi / dCbar dCbar) = J^{-4/3} CC_hat.
 /// In: C, Sbar = 2 dPsi/dCbar, CC_hat (may be null for laws linear in Cbar).
+/// The stress part alone: S_iso = J^{-2/3} Dev(Sbar) (no tangent; for
+/// residual-only evaluations).
+inline SymTensor2 isochoric_stress_push(const SymTensor2& C, const SymTensor2& Sbar) {
+  const SymTensor2 C_inv = dealii::invert(C);
+  const double J_m23 = std::cbrt(1.0 / dealii::determinant(C));  // J^{-2/3} = det(C)^{-1/3}
+  return J_m23 * (Sbar - (dealii::scalar_product(Sbar, C) / 3.0) * C_inv);
+}
+
+/// Cbar = J^{-2/3} C.
+inline SymTensor2 isochoric_part(const SymTensor2& C) { return std::cbrt(1.0 / dealii::determinant(C)) * C; }
+
 inline void isochoric_push(const SymTensor2& C, const SymTensor2& Sbar, const SymTensor4* CC_hat,
                            SymTensor2& S_iso, SymTensor4& CC_iso) {
   const double J = std::sqrt(dealii::determinant(C));
@@ -94,18 +105,14 @@ class NeoHookean {
     const double J = std::sqrt(dealii::determinant(C));
     return 0.5 * mu_ * (std::pow(J, -2.0 / 3.0) * dealii::trace(C) - 3.0);
   }
-  SymTensor2 stress(const SymTensor2& C) const {
-    SymTensor2 S;
-    SymTensor4 CC;
-    stress_and_tangent(C, S, CC);
-    return S;
-  }
+  SymTensor2 stress(const SymTensor2& C) const { return isochoric_stress_push(C, fictitious_stress(C)); }
   SymTensor4 tangent(const SymTensor2& C) const {
     SymTensor2 S;
     SymTensor4 CC;
     stress_and_tangent(C, S, CC);
     return CC;
   }
+  SymTensor2 fictitious_stress(const SymTensor2& /*C*/) const { return mu_ * dealii::unit_symmetric_tensor<3>(); }
   /// Sbar = mu I; CC_hat = 0.
   void stress_and_tangent(const SymTensor2& C, SymTensor2& S, SymTensor4& CC) const {
     const SymTensor2 Sbar = mu_ * dealii::unit_symmetric_tensor<3>();
@@ -133,24 +140,22 @@ class MooneyRivlin {
     const double I2 = 0.5 * (I1 * I1 - dealii::scalar_product(Cbar, Cbar));
     return c10_ * (I1 - 3.0) + c01_ * (I2 - 3.0);
   }
-  SymTensor2 stress(const SymTensor2& C) const {
-    SymTensor2 S;
-    SymTensor4 CC;
-    stress_and_tangent(C, S, CC);
-    return S;
-  }
+  SymTensor2 stress(const SymTensor2& C) const { return isochoric_stress_push(C, fictitious_stress(C)); }
   SymTensor4 tangent(const SymTensor2& C) const {
     SymTensor2 S;
     SymTensor4 CC;
     stress_and_tangent(C, S, CC);
     return CC;
   }
-  /// Sbar = 2 (c10 + c01 I1bar) I - 2 c01 Cbar;  CC_hat = 4 c01 (I x I - II).
+  /// Sbar = 2 (c10 + c01 I1bar) I - 2 c01 Cbar.
+  SymTensor2 fictitious_stress(const SymTensor2& C) const {
+    const SymTensor2 Cbar = isochoric_part(C);
+    return 2.0 * (c10_ + c01_ * dealii::trace(Cbar)) * dealii::unit_symmetric_tensor<3>() - 2.0 * c01_ * Cbar;
+  }
+  /// Sbar as above;  CC_hat = 4 c01 (I x I - II).
   void stress_and_tangent(const SymTensor2& C, SymTensor2& S, SymTensor4& CC) const {
-    const double J = std::sqrt(dealii::determinant(C));
-    const SymTensor2 Cbar = std::pow(J, -2.0 / 3.0) * C;
     const SymTensor2 I = dealii::unit_symmetric_tensor<3>();
-    const SymTensor2 Sbar = 2.0 * (c10_ + c01_ * dealii::trace(Cbar)) * I - 2.0 * c01_ * Cbar;
+    const SymTensor2 Sbar = fictitious_stress(C);
     const SymTensor4 CC_hat =
         4.0 * c01_ * (dealii::outer_product(I, I) - dealii::identity_tensor<3>());
     isochoric_push(C, Sbar, &CC_hat, S, CC);
@@ -169,6 +174,19 @@ class MooneyRivlin {
 /// with the divided difference replaced by g' at the mean where two
 /// eigenvalues (nearly) coincide, so the result is smooth through repeated
 /// eigenvalues (e.g. the undeformed state).
+/// G(X) = sum_a g(x_a) N_a (x) N_a alone (no derivative).
+template <class G>
+SymTensor2 spectral_value(const SymTensor2& X, const G& g) {
+  const auto eig = dealii::eigenvectors(X, dealii::SymmetricTensorEigenvectorMethod::jacobi);
+  SymTensor2 value;
+  for (unsigned a = 0; a < 3; ++a) {
+    const double ga = g(eig[a].first);
+    for (unsigned i = 0; i < 3; ++i)
+      for (unsigned j = i; j < 3; ++j) value[i][j] += ga * eig[a].second[i] * eig[a].second[j];
+  }
+  return value;
+}
+
 template <class G, class DG>
 void spectral_function(const SymTensor2& X, const G& g, const DG& dg, SymTensor2& value, SymTensor4& derivative) {
   const auto eig = dealii::eigenvectors(X, dealii::SymmetricTensorEigenvectorMethod::jacobi);
@@ -245,14 +263,19 @@ class Ogden {
     }
     return psi;
   }
+  /// g(c) = sum_p 2 mu_p / alpha_p c^(alpha_p/2 - 1) (Sbar = sum_a g(cbar_a) N_a (x) N_a).
+  double principal_stress(double c) const {
+    double v = 0.0;
+    for (const Term& t : terms_) v += 2.0 * t.mu_Pa / t.alpha * std::pow(c, 0.5 * t.alpha - 1.0);
+    return v;
+  }
+  SymTensor2 fictitious_stress(const SymTensor2& C) const {
+    return spectral_value(isochoric_part(C), [this](double c) { return principal_stress(c); });
+  }
+  SymTensor2 stress(const SymTensor2& C) const { return isochoric_stress_push(C, fictitious_stress(C)); }
   void stress_and_tangent(const SymTensor2& C, SymTensor2& S, SymTensor4& CC) const {
-    const double J = std::sqrt(dealii::determinant(C));
-    const SymTensor2 Cbar = std::pow(J, -2.0 / 3.0) * C;
-    auto g = [this](double c) {
-      double v = 0.0;
-      for (const Term& t : terms_) v += 2.0 * t.mu_Pa / t.alpha * std::pow(c, 0.5 * t.alpha - 1.0);
-      return v;
-    };
+    const SymTensor2 Cbar = isochoric_part(C);
+    auto g = [this](double c) { return principal_stress(c); };
     auto dg = [this](double c) {
       double v = 0.0;
       for (const Term& t : terms_)
@@ -291,9 +314,15 @@ class VerondaWestmann {
     const double I2 = 0.5 * (I1 * I1 - dealii::scalar_product(Cbar, Cbar));
     return c1_ * (std::exp(gamma_ * (I1 - 3.0)) - 1.0) - 0.5 * c1_ * gamma_ * (I2 - 3.0);
   }
+  SymTensor2 fictitious_stress(const SymTensor2& C) const {
+    const SymTensor2 Cbar = isochoric_part(C);
+    const double I1 = dealii::trace(Cbar);
+    const double psi1 = c1_ * gamma_ * std::exp(gamma_ * (I1 - 3.0)), psi2 = -0.5 * c1_ * gamma_;
+    return 2.0 * (psi1 + I1 * psi2) * dealii::unit_symmetric_tensor<3>() - 2.0 * psi2 * Cbar;
+  }
+  SymTensor2 stress(const SymTensor2& C) const { return isochoric_stress_push(C, fictitious_stress(C)); }
   void stress_and_tangent(const SymTensor2& C, SymTensor2& S, SymTensor4& CC) const {
-    const double J = std::sqrt(dealii::determinant(C));
-    const SymTensor2 Cbar = std::pow(J, -2.0 / 3.0) * C;
+    const SymTensor2 Cbar = isochoric_part(C);
     const SymTensor2 I = dealii::unit_symmetric_tensor<3>();
     const double I1 = dealii::trace(Cbar);
     const double e = std::exp(gamma_ * (I1 - 3.0));
@@ -353,6 +382,10 @@ class LayerMaterial {
   }
   void isochoric_stress_and_tangent(const SymTensor2& C, SymTensor2& S, SymTensor4& CC) const {
     std::visit([&](const auto& law) { law.stress_and_tangent(C, S, CC); }, iso_);
+  }
+  /// S_iso alone (residual-only evaluations skip the tangent).
+  SymTensor2 isochoric_stress(const SymTensor2& C) const {
+    return std::visit([&](const auto& law) { return law.stress(C); }, iso_);
   }
 
  private:
