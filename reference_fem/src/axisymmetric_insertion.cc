@@ -1,9 +1,12 @@
 // axisymmetric_insertion.cc: the needle insertion in the meridian plane (see
-// needle_insertion.hpp and reference_fem/README.md). Reads top-down as the
-// algorithm: build the mesh and the solver, then walk the needle along the
-// scene's trajectory (approach, insertion, dwell, withdrawal) step by step:
-// advance the needle, solve (cutting the step when Newton fails), detect
-// punctures, record the row, the profiles and the frames; then write.
+// needle_insertion.hpp and reference_fem/README.md). run_axisymmetric_insertion
+// reads top-down as the algorithm: build the mesh and the solver
+// (AxisymmetricInsertionRun's constructor), then walk the needle along the
+// scene's trajectory (approach, insertion, dwell, withdrawal) and, at every
+// step, advance the needle (cutting the step when Newton fails), detect
+// punctures (the layer states, the crack opened), record the row, the
+// profiles and the frames; then write the outputs. Runs on rank 0; the other
+// ranks receive the outcome.
 #include <deal.II/base/mpi.h>
 
 #include <algorithm>
@@ -15,6 +18,7 @@
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -23,27 +27,16 @@
 #include <puncture/fem/needle_insertion.hpp>
 #include <puncture/meshing/axisymmetric_slab_mesh.hpp>
 
+#include "insertion_common.hpp"
+
 namespace puncture::fem {
 
 namespace {
 
+using insertion::format_double;
+using insertion::LayerState;
+
 constexpr double kPi = 3.14159265358979323846;
-
-enum class LayerState { untouched, pressed, punctured };
-const char* to_string(LayerState s) {
-  switch (s) {
-    case LayerState::untouched: return "untouched";
-    case LayerState::pressed: return "pressed";
-    case LayerState::punctured: return "punctured";
-  }
-  return "?";
-}
-
-std::string fmt(double v, int precision = 9) {
-  std::ostringstream s;
-  s << std::setprecision(precision) << v;
-  return s.str();
-}
 
 /// One point of the needle's trajectory: time, tip depth (m below the skin
 /// surface; negative above it) and phase.
@@ -116,398 +109,553 @@ LayerLaws layer_laws(const Scene& scene, double crack_radius_m) {
   return laws;
 }
 
+/// Newton settings of the axisymmetric solver from the scene.
+AxisymmetricSettings solver_settings(const Scene& scene, int degree) {
+  AxisymmetricSettings settings;
+  settings.degree = static_cast<unsigned>(degree);
+  settings.max_newton_iterations = scene.fem.max_newton_iterations;
+  settings.newton_tolerance = scene.fem.newton_tolerance;
+  settings.verbose = std::getenv("PUNCTURE_FEM_DEBUG") != nullptr;
+  settings.stabilization_time_s = scene.fem.stabilization_time_s;
+  return settings;
+}
+
+/// The scene checks of this reference; returns the element degree (1 or 2).
+int checked_element_degree(const Scene& scene, const FemRunOptions& options) {
+  insertion::check_axial_insertion(scene);
+  const int degree = insertion::element_degree(scene, options);
+  if (degree != 1 && degree != 2) throw std::invalid_argument("fem: element degree must be 1 or 2");
+  return degree;
+}
+
+/// One row of fem_force_depth.csv.
 struct Row {
   double time_s, depth_m, velocity_m_per_s, force_N, tip_N, cutting_N, friction_N, tip_stretch;
   std::string phase;
   std::vector<LayerState> states;
 };
 
+/// A converged step of the needle: where it started in time, how far the tip
+/// went (m, > 0 inward) and the cutting force over it (N).
+struct StepAdvance {
+  double t0_s;
+  double advance_m;
+  double cutting_N;
+  int newton_iterations;
+};
+
+/// The axisymmetric insertion on rank 0: the mesh and the solver, the state of
+/// the layers along the way, what is recorded, and the steps of the algorithm.
+class AxisymmetricInsertionRun {
+ public:
+  /// Checks the scene, builds the mesh and the solver, fills the model part of
+  /// `summary` and creates the output directory.
+  AxisymmetricInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm, FemRunSummary& summary);
+  /// Walks the needle along the whole trajectory, step by step.
+  void walk_trajectory();
+  /// Writes the CSV files, the Newton log, the PVD collection and the summary.
+  void write_outputs();
+
+ private:
+  std::optional<StepAdvance> advance_needle(std::size_t k);
+  void cut_step(const AxisymmetricNewtonReport& report, const std::string& phase, double d0, double d1);
+  void detect_punctures();
+  bool tip_reached_top(std::size_t i) const;
+  bool layer_breaks(std::size_t i, double force_N, bool first_intact) const;
+  void open_crack(std::size_t i);
+  void record_puncture(std::size_t i, double force_after_N);
+  void record_step(const std::string& phase, const StepAdvance& step);
+  void record(const std::string& phase, double velocity, double cutting_N);
+  void add_energy_totals();
+  void describe_model(MPI_Comm comm);
+  void place_needle(double depth);
+  int pressed_layer() const;
+  bool crack_through_top(std::size_t i) const;
+  insertion::SurfaceProfile layer_top_profile(std::size_t layer) const;
+  void write_frame(double time);
+  std::string force_depth_csv() const;
+  void write_pvd() const;
+  nlohmann::json summary_json() const;
+  void log(const std::string& s) const {
+    if (options_.verbose) std::cout << s << std::endl;
+  }
+
+  // What the scene asks for.
+  const Scene& scene_;
+  const FemRunOptions& options_;
+  FemRunSummary& summary_;
+  const std::chrono::steady_clock::time_point wall_start_ = std::chrono::steady_clock::now();
+  const int degree_;
+  const int refinement_;
+  const bool cutting_;  // a bevel or hollow tip (else a flat punch)
+  const std::size_t n_layers_;
+  const double a_;  // needle radius (m)
+  // Mesh and solver.
+  const meshing::AxisymmetricSlabMesh mesh_;
+  const LayerLaws laws_;
+  AxisymmetricSolver solver_;
+  // Outputs being collected.
+  const std::filesystem::path out_dir_;
+  const std::vector<TrajectoryPoint> plan_;
+  const int frame_every_;
+  std::vector<Row> rows_;
+  insertion::InsertionRecords records_;
+  std::vector<std::pair<double, std::string>> frames_;  // (time, file name)
+  // State of the layers.
+  std::vector<LayerState> states_;
+  std::vector<double> peak_force_, peak_depth_, peak_time_;
+  std::vector<insertion::SurfaceProfile> peak_profile_;
+  // State of the walk.
+  double depth_, time_ = 0.0;
+  double fraction_ = 1.0;  // of the planned step, grows back after cuts
+  int step_index_ = 0;
+  double last_advance_ = 0.0;  // depth change of the last converged step (for the predictor)
+};
+
+constexpr double kMinStepFraction = 1.0 / 256.0;
+
+AxisymmetricInsertionRun::AxisymmetricInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm,
+                                                   FemRunSummary& summary)
+    : scene_(scene),
+      options_(options),
+      summary_(summary),
+      degree_(checked_element_degree(scene, options)),
+      refinement_(insertion::refinement_level(scene, options)),
+      cutting_(scene.needle.tip != "blunt"),
+      n_layers_(scene.layers.size()),
+      a_(scene.needle.radius_m),
+      mesh_(meshing::build_axisymmetric_slab_mesh(scene, refinement_)),
+      laws_(layer_laws(scene, mesh_.crack_radius_m)),
+      solver_(mesh_, laws_.materials, laws_.cracks, laws_.friction, solver_settings(scene, degree_)),
+      out_dir_(options.output_dir),
+      plan_(trajectory(scene, options.stop_depth_m)),
+      frame_every_(std::max<int>(1, static_cast<int>(plan_.size()) / std::max(1, options.max_vtu_frames))),
+      states_(n_layers_, LayerState::untouched),
+      peak_force_(n_layers_, 0.0),
+      peak_depth_(n_layers_, 0.0),
+      peak_time_(n_layers_, 0.0),
+      peak_profile_(n_layers_),
+      depth_(-scene.insertion.start_height_m) {
+  solver_.setup(0.5 * scene.sample.diameter_m, scene.total_thickness_m());
+  describe_model(comm);
+  if (options.write_files) std::filesystem::create_directories(out_dir_);
+}
+
+// Fills the model part of the summary, warns about a coarse mesh, logs the model.
+void AxisymmetricInsertionRun::describe_model(MPI_Comm comm) {
+  summary_.geometry = "axisymmetric";
+  summary_.n_dofs = solver_.n_dofs();
+  summary_.n_cells = solver_.n_cells();
+  summary_.n_ranks = static_cast<int>(dealii::Utilities::MPI::n_mpi_processes(comm));
+  summary_.degree = degree_;
+  summary_.refinement = refinement_;
+  summary_.tip_element_size_m = mesh_.tip_element_size_m;
+  summary_.elements_through_layer = mesh_.elements_through_layer;
+  // Resolution the mesh-convergence study found within 3 % of the converged
+  // indentation force (results/fem_mesh_convergence.md).
+  const double per_radius = a_ / mesh_.tip_element_size_m;
+  const double needed = degree_ == 1 ? 8.0 : 4.0;
+  if (per_radius < needed - 1e-9)
+    summary_.warnings.push_back("mesh: " + format_double(per_radius, 3) + " elements per needle radius with Q" +
+                                std::to_string(degree_) + "; at least " + format_double(needed, 2) +
+                                " are needed for the indentation force to be within 3 % of its converged value");
+  for (std::size_t i = 0; i < n_layers_; ++i)
+    if (mesh_.elements_through_layer[i] < 4)
+      summary_.warnings.push_back("mesh: layer '" + scene_.layers[i].name + "' has only " +
+                                  std::to_string(mesh_.elements_through_layer[i]) + " elements through its thickness");
+  std::ostringstream s;
+  s << "fem: scene '" << scene_.name << "', axisymmetric, " << summary_.n_cells << " cells, Q" << degree_ << " ("
+    << summary_.n_dofs << " dofs), tip element " << mesh_.tip_element_size_m * 1e3 << " mm, needle tip '"
+    << scene_.needle.tip << "', crack radius " << mesh_.crack_radius_m * 1e3 << " mm";
+  log(s.str());
+  for (const auto& w : summary_.warnings) std::cerr << "warning: " << w << std::endl;
+}
+
+// The algorithm: at every point of the trajectory, advance the needle (cut
+// the step while Newton fails), detect punctures, record; then the energies.
+void AxisymmetricInsertionRun::walk_trajectory() {
+  record("approach", scene_.insertion.speed_m_per_s, 0.0);
+  write_frame(time_);
+  for (std::size_t k = 0; k < plan_.size(); ++k) {
+    const TrajectoryPoint& goal = plan_[k];
+    const std::string phase = goal.phase;
+    if (phase == "approach") {  // nothing touches the tissue above its surface
+      depth_ = goal.depth_m;
+      time_ = goal.time_s;
+      record(phase, scene_.insertion.speed_m_per_s, 0.0);
+      continue;
+    }
+    while (time_ < goal.time_s - 1e-12 * std::max(1.0, goal.time_s)) {
+      const std::optional<StepAdvance> step = advance_needle(k);
+      if (!step) continue;  // the step was cut: try again with half of it
+      detect_punctures();
+      record_step(phase, *step);
+    }
+  }
+  add_energy_totals();
+}
+
+// Moves the tip one (sub-)step toward plan point k and solves; a failed solve
+// cuts the step (nothing returned), a converged one advances the state.
+std::optional<StepAdvance> AxisymmetricInsertionRun::advance_needle(std::size_t k) {
+  const TrajectoryPoint& goal = plan_[k];
+  const TrajectoryPoint& from = plan_[k - 1];
+  const double t0 = time_, d0 = depth_;
+  const double t1 = std::min(goal.time_s, t0 + fraction_ * (goal.time_s - from.time_s));
+  // Sub-steps of a planned step follow the trajectory linearly.
+  const double s = (t1 - from.time_s) / (goal.time_s - from.time_s);
+  const double d1 = from.depth_m + s * (goal.depth_m - from.depth_m);
+  place_needle(d1);
+  solver_.set_time_step(t1 - t0);
+  const double advance = d1 - d0;
+  const double predictor = (last_advance_ != 0.0 && advance * last_advance_ > 0.0) ? advance / last_advance_ : 0.0;
+  const double dissipated_before = solver_.cohesive_dissipation_J();
+  const auto t_solve = std::chrono::steady_clock::now();
+  const AxisymmetricNewtonReport report = solver_.solve_step(predictor);
+  summary_.solve_time_s += insertion::seconds_since(t_solve);
+  summary_.newton_iterations += report.iterations;
+  records_.newton_log << "step " << step_index_ << "  " << goal.phase << "  depth " << d1 * 1e3 << " mm  t " << t1
+                      << " s\n";
+  for (const auto& line : report.table) records_.newton_log << line << "\n";
+  if (!report.converged) {
+    cut_step(report, goal.phase, d0, d1);
+    return std::nullopt;
+  }
+  ++step_index_;
+  ++summary_.load_steps;
+  time_ = t1;
+  depth_ = d1;
+  last_advance_ = advance;
+  fraction_ = std::min(1.0, 2.0 * fraction_);
+  const double dissipated = solver_.cohesive_dissipation_J();
+  const double cutting_N = advance > 0.0 ? (dissipated - dissipated_before) / advance : 0.0;
+  return StepAdvance{t0, advance, cutting_N, report.iterations};
+}
+
+// A failed step: halve it (stop with an error below 1/256 of the planned
+// step) and put the needle back where it was.
+void AxisymmetricInsertionRun::cut_step(const AxisymmetricNewtonReport& report, const std::string& phase, double d0,
+                                        double d1) {
+  ++summary_.step_cuts;
+  records_.newton_log << "  -> " << report.failure << "; step cut\n";
+  fraction_ *= 0.5;
+  if (fraction_ < kMinStepFraction) {
+    std::ostringstream m;
+    m << "no convergence at tip depth " << d1 * 1e3 << " mm (" << phase << ") even with 1/256 of the load step: "
+      << report.failure;
+    throw std::runtime_error(m.str());
+  }
+  place_needle(d0);
+}
+
+// Updates each intact layer: pressed once the tip reaches its top, its peak
+// force, and punctured when its criterion is met (the crack opened).
+void AxisymmetricInsertionRun::detect_punctures() {
+  const NeedleForce f = solver_.needle_force();
+  for (std::size_t i = 0; i < n_layers_; ++i) {
+    if (states_[i] == LayerState::punctured) continue;
+    const bool first_intact = static_cast<int>(i) == pressed_layer();
+    if (states_[i] == LayerState::untouched && first_intact && f.nodes_in_contact > 0 && tip_reached_top(i))
+      states_[i] = LayerState::pressed;
+    if (states_[i] != LayerState::pressed) continue;
+    if (f.total_N > peak_force_[i]) {
+      peak_force_[i] = f.total_N;
+      peak_depth_[i] = depth_;
+      peak_time_[i] = time_;
+      peak_profile_[i] = layer_top_profile(i);
+    }
+    if (!layer_breaks(i, f.total_N, first_intact)) continue;
+    open_crack(i);
+    record_puncture(i, f.total_N);
+  }
+}
+
+// Has the tip reached layer i's (displaced) top? (The skin: at first contact.)
+bool AxisymmetricInsertionRun::tip_reached_top(std::size_t i) const {
+  const auto u = solver_.displacement_at(mesh_.crack_radius_m, -scene_.layer_top_depth_m(i));
+  return i == 0 || depth_ >= scene_.layer_top_depth_m(i) - u[1] - 1e-9;
+}
+
+// Layer i's puncture criterion: its cohesive crack open through its top
+// (fracture energy), or the critical force / stretch (first intact layer only).
+bool AxisymmetricInsertionRun::layer_breaks(std::size_t i, double force_N, bool first_intact) const {
+  const PunctureCriterion& c = scene_.layers[i].puncture;
+  if (c.kind == PunctureCriterion::Kind::FractureEnergy) return crack_through_top(i);
+  if (!first_intact) return false;
+  const bool by_force = c.kind == PunctureCriterion::Kind::CriticalForce;
+  const double value =
+      by_force ? force_N
+               : solver_.max_principal_stretch(static_cast<int>(i), 2.0 * a_, -depth_ - 2.0 * a_, -depth_ + 2.0 * a_);
+  return value >= (by_force ? c.critical_force_N : c.critical_stretch);
+}
+
+// Opens layer i's crack: a cohesive crack has opened itself; a crack tied
+// until the force/stretch criterion is met is released now (cutting tips only).
+void AxisymmetricInsertionRun::open_crack(std::size_t i) {
+  if (scene_.layers[i].puncture.kind == PunctureCriterion::Kind::FractureEnergy) return;
+  if (!cutting_)
+    throw std::runtime_error("the puncture criterion of layer '" + scene_.layers[i].name +
+                             "' is met, but a blunt (flat) punch cannot cut in the axisymmetric reference: "
+                             "use needle tip bevel or hollow, or fem.geometry 3d");
+  solver_.break_layer(static_cast<int>(i));
+}
+
+// Records layer i's puncture: the event (at its peak force), the surface
+// before (at the peak) and now, a log line and a frame.
+void AxisymmetricInsertionRun::record_puncture(std::size_t i, double force_after_N) {
+  states_[i] = LayerState::punctured;
+  PunctureEvent e;
+  e.layer = static_cast<int>(i);
+  e.layer_name = scene_.layers[i].name;
+  e.depth_m = peak_depth_[i];
+  e.force_N = peak_force_[i];
+  e.force_after_N = force_after_N;
+  e.time_s = peak_time_[i];
+  summary_.punctures.push_back(e);
+  records_.add_recovery_profile(i, "before", peak_depth_[i], peak_profile_[i]);
+  records_.add_recovery_profile(i, "after", depth_, layer_top_profile(i));
+  std::ostringstream m;
+  m << "fem: " << e.layer_name << " punctured: peak " << e.force_N << " N at " << e.depth_m * 1e3 << " mm, "
+    << e.force_after_N << " N at " << depth_ * 1e3 << " mm";
+  log(m.str());
+  write_frame(time_);
+}
+
+// Records a converged step: its row, every other step the pressed layer's
+// surface, a frame every frame_every steps, progress every 10 steps.
+void AxisymmetricInsertionRun::record_step(const std::string& phase, const StepAdvance& step) {
+  const double t0 = step.t0_s, t1 = time_;
+  const double velocity = phase == "dwell" ? 0.0 : (t1 > t0 ? step.advance_m / (t1 - t0) : 0.0);
+  record(phase, velocity, step.cutting_N);
+  const int p = pressed_layer();
+  if (p >= 0 && states_[p] == LayerState::pressed && step_index_ % 2 == 0)
+    records_.add_surface_profile(step_index_, depth_, layer_top_profile(p), scene_.layers[p].name);
+  if (step_index_ % frame_every_ == 0) write_frame(time_);
+  if (options_.verbose && step_index_ % 10 == 0) {
+    std::ostringstream m;
+    m << "  step " << step_index_ << "  " << phase << "  depth " << std::fixed << std::setprecision(3)
+      << depth_ * 1e3 << " mm  force " << std::setprecision(4) << rows_.back().force_N << " N (friction "
+      << rows_.back().friction_N << " N)  newton " << step.newton_iterations;
+    log(m.str());
+  }
+}
+
+// One row of the force-depth curve (CSV and summary): the needle force split
+// into tip, cutting and friction, the tip stretch, the layer states.
+void AxisymmetricInsertionRun::record(const std::string& phase, double velocity, double cutting_N) {
+  const NeedleForce f = solver_.needle_force();
+  const int p = pressed_layer();
+  double stretch = 1.0;
+  if (p >= 0 && f.nodes_in_contact > 0)
+    stretch = solver_.max_principal_stretch(p, 2.0 * a_, -depth_ - 2.0 * a_, -depth_ + 2.0 * a_);
+  const double total = f.nodes_in_contact > 0 ? f.total_N : 0.0;
+  const double friction = f.nodes_in_contact > 0 ? f.friction_N : 0.0;
+  rows_.push_back({time_, depth_, velocity, total, total - friction - cutting_N, cutting_N, friction, stretch, phase,
+                   states_});
+  summary_.time_s.push_back(time_);
+  summary_.depth_m.push_back(depth_);
+  summary_.force_N.push_back(total);
+  summary_.tip_force_N.push_back(total - friction - cutting_N);
+  summary_.cutting_force_N.push_back(cutting_N);
+  summary_.friction_force_N.push_back(friction);
+  summary_.phase.push_back(phase);
+  if (total > summary_.peak_force_N) {
+    summary_.peak_force_N = total;
+    summary_.peak_force_depth_m = depth_;
+  }
+}
+
+// Energies of the run: crack, stabilisation, and the needle's work over the
+// insertion (trapezoid rule on force x depth).
+void AxisymmetricInsertionRun::add_energy_totals() {
+  summary_.cohesive_dissipation_J = solver_.cohesive_dissipation_J();
+  summary_.stabilization_dissipation_J = solver_.stabilization_dissipation_J();
+  for (std::size_t k = 1; k < rows_.size(); ++k)
+    if (rows_[k].phase == "insertion")
+      summary_.needle_work_J +=
+          0.5 * (rows_[k].force_N + rows_[k - 1].force_N) * (rows_[k].depth_m - rows_[k - 1].depth_m);
+}
+
+// Puts the needle (a cutting needle or the flat punch) at tip depth `depth`.
+void AxisymmetricInsertionRun::place_needle(double depth) {
+  if (cutting_) {
+    RigidNeedle n;
+    n.edge_radius_m = mesh_.crack_radius_m;
+    n.shaft_radius_m = a_;
+    n.flank_angle_rad = scene_.needle.tip_angle_deg * kPi / 180.0;
+    n.z_tip_m = -depth;
+    solver_.set_cutting_needle(n);
+  } else {
+    solver_.set_flat_punch(a_, -depth);
+  }
+}
+
+// The first layer not punctured (-1: all are).
+int AxisymmetricInsertionRun::pressed_layer() const {
+  for (std::size_t i = 0; i < n_layers_; ++i)
+    if (states_[i] != LayerState::punctured) return static_cast<int>(i);
+  return -1;
+}
+
+// Layer i is punctured once its crack is fully open a little below its top.
+bool AxisymmetricInsertionRun::crack_through_top(std::size_t i) const {
+  const double top = scene_.layer_top_depth_m(i);
+  const double margin = std::min(0.25 * scene_.layers[i].thickness_m, a_);
+  return solver_.crack_front_depth_m(static_cast<int>(i)) >= top + margin - 1e-12;
+}
+
+// u_z(r) along the reference top of a layer.
+insertion::SurfaceProfile AxisymmetricInsertionRun::layer_top_profile(std::size_t layer) const {
+  return solver_.vertical_displacement_along(-scene_.layer_top_depth_m(layer));
+}
+
+// Writes one VTU frame of the meridian plane (if VTU output is asked for).
+void AxisymmetricInsertionRun::write_frame(double time) {
+  if (!options_.write_files || !options_.write_vtu) return;
+  std::ostringstream name;
+  name << "fem_fields_" << std::setw(4) << std::setfill('0') << frames_.size() << ".vtu";
+  const std::filesystem::path tmp = out_dir_ / (name.str() + ".part");
+  solver_.write_vtu(tmp.string());
+  std::filesystem::rename(tmp, out_dir_ / name.str());
+  frames_.emplace_back(time, name.str());
+  summary_.files_written.push_back(name.str());
+}
+
+// Writes the outputs (wall time first, so the summary reports it).
+void AxisymmetricInsertionRun::write_outputs() {
+  summary_.wall_time_s = insertion::seconds_since(wall_start_);
+  if (!options_.write_files) return;
+  insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
+  write_pvd();
+  insertion::list_text_outputs(summary_.files_written);
+  write_file_atomically(out_dir_ / "fem_summary.json", summary_json().dump(2) + "\n");
+}
+
+// fem_force_depth.csv: one line per recorded row.
+std::string AxisymmetricInsertionRun::force_depth_csv() const {
+  std::ostringstream csv;
+  csv << insertion::force_depth_header(
+      "time_s,depth_mm,velocity_mm_per_s,force_N,tip_force_N,cutting_force_N,friction_force_N,tip_stretch,phase",
+      scene_);
+  for (const Row& r : rows_) {
+    csv << format_double(r.time_s) << "," << format_double(r.depth_m * 1e3) << ","
+        << format_double(r.velocity_m_per_s * 1e3) << "," << format_double(r.force_N) << ","
+        << format_double(r.tip_N) << "," << format_double(r.cutting_N) << "," << format_double(r.friction_N) << ","
+        << format_double(r.tip_stretch) << "," << r.phase;
+    insertion::append_layer_states(csv, r.states);
+    csv << "\n";
+  }
+  return csv.str();
+}
+
+// fem_fields.pvd: the collection of the VTU frames (if any were written).
+void AxisymmetricInsertionRun::write_pvd() const {
+  if (frames_.empty()) return;
+  std::ostringstream pvd;
+  pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
+  for (const auto& [t, name] : frames_)
+    pvd << "    <DataSet timestep=\"" << format_double(t) << "\" part=\"0\" file=\"" << name << "\"/>\n";
+  pvd << "  </Collection>\n</VTKFile>\n";
+  write_file_atomically(out_dir_ / "fem_fields.pvd", pvd.str());
+  summary_.files_written.push_back("fem_fields.pvd");
+}
+
+// fem_summary.json: the model, the peak, the energies, the counts, the
+// timings, the punctures and the files.
+nlohmann::json AxisymmetricInsertionRun::summary_json() const {
+  nlohmann::json j;
+  j["status"] = "ok";
+  j["scene"] = scene_.name;
+  j["geometry"] = "axisymmetric";
+  j["n_dofs"] = summary_.n_dofs;
+  j["n_cells"] = summary_.n_cells;
+  j["n_ranks_used"] = 1;
+  j["element_degree"] = degree_;
+  j["refinement"] = refinement_;
+  j["tip_element_size_mm"] = mesh_.tip_element_size_m * 1e3;
+  j["crack_radius_mm"] = mesh_.crack_radius_m * 1e3;
+  j["elements_through_layer"] = mesh_.elements_through_layer;
+  j["load_step_mm"] = scene_.fem.load_step_m * 1e3;
+  j["peak_force_N"] = summary_.peak_force_N;
+  j["peak_force_depth_mm"] = summary_.peak_force_depth_m * 1e3;
+  j["cohesive_dissipation_J"] = summary_.cohesive_dissipation_J;
+  j["stabilization_dissipation_J"] = summary_.stabilization_dissipation_J;
+  j["needle_work_insertion_J"] = summary_.needle_work_J;
+  j["load_steps"] = summary_.load_steps;
+  j["step_cuts"] = summary_.step_cuts;
+  j["newton_iterations"] = summary_.newton_iterations;
+  j["wall_time_s"] = summary_.wall_time_s;
+  j["solve_time_s"] = summary_.solve_time_s;
+  j["warnings"] = summary_.warnings;
+  j["punctures"] = insertion::punctures_json(summary_.punctures, /*with_stretch=*/false);
+  j["files"] = summary_.files_written;
+  return j;
+}
+
+// What rank 0 sends the other ranks: the error (empty if none) and the curve.
+nlohmann::json outcome_to_json(const std::string& error, const FemRunSummary& summary) {
+  nlohmann::json j;
+  j["error"] = error;
+  j["time_s"] = summary.time_s;
+  j["depth_m"] = summary.depth_m;
+  j["force_N"] = summary.force_N;
+  j["peak_force_N"] = summary.peak_force_N;
+  j["n_dofs"] = summary.n_dofs;
+  j["wall_time_s"] = summary.wall_time_s;
+  nlohmann::json ev = nlohmann::json::array();
+  for (const auto& e : summary.punctures)
+    ev.push_back({e.layer, e.layer_name, e.depth_m, e.force_N, e.force_after_N, e.time_s});
+  j["punctures"] = ev;
+  return j;
+}
+
+// The other ranks' copy of rank 0's outcome.
+void outcome_from_json(const nlohmann::json& j, std::string& error, FemRunSummary& summary) {
+  error = j["error"].get<std::string>();
+  summary.geometry = "axisymmetric";
+  summary.time_s = j["time_s"].get<std::vector<double>>();
+  summary.depth_m = j["depth_m"].get<std::vector<double>>();
+  summary.force_N = j["force_N"].get<std::vector<double>>();
+  summary.peak_force_N = j["peak_force_N"].get<double>();
+  summary.n_dofs = j["n_dofs"].get<std::size_t>();
+  summary.wall_time_s = j["wall_time_s"].get<double>();
+  for (const auto& e : j["punctures"]) {
+    PunctureEvent p;
+    p.layer = e[0].get<int>();
+    p.layer_name = e[1].get<std::string>();
+    p.depth_m = e[2].get<double>();
+    p.force_N = e[3].get<double>();
+    p.force_after_N = e[4].get<double>();
+    p.time_s = e[5].get<double>();
+    summary.punctures.push_back(p);
+  }
+}
+
+// Rank 0 computed; the others learn the outcome (and the curve) from it.
+void share_outcome(MPI_Comm comm, std::string& error, FemRunSummary& summary) {
+  if (dealii::Utilities::MPI::n_mpi_processes(comm) == 1) return;
+  const bool root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
+  const std::string text =
+      dealii::Utilities::MPI::broadcast(comm, root ? outcome_to_json(error, summary).dump() : std::string(), 0);
+  if (!root) outcome_from_json(nlohmann::json::parse(text), error, summary);
+}
+
 }  // namespace
 
 FemRunSummary run_axisymmetric_insertion(const Scene& scene, const FemRunOptions& options, MPI_Comm comm) {
-  using dealii::Utilities::MPI::this_mpi_process;
-  const bool root = this_mpi_process(comm) == 0;
   FemRunSummary summary;
   std::string error;
-  if (root) {
+  if (dealii::Utilities::MPI::this_mpi_process(comm) == 0) {
     try {
-      const auto wall_start = std::chrono::steady_clock::now();
-      auto log = [&](const std::string& s) {
-        if (options.verbose) std::cout << s << std::endl;
-      };
-
-      // ---- 0. What the scene asks for --------------------------------------------
-      if (scene.layers.empty()) throw std::invalid_argument("fem: the scene has no layers");
-      if (scene.insertion.angle_deg != 0.0)
-        throw std::invalid_argument("fem: only insertions along the sample axis (angle_deg = 0) are modelled");
-      if (!(scene.insertion.speed_m_per_s > 0.0)) throw std::invalid_argument("fem: insertion speed must be > 0");
-      const int degree = options.degree_override > 0 ? options.degree_override : scene.fem.element_degree;
-      const int refinement = options.refinement_override >= 0 ? options.refinement_override : scene.fem.refinement;
-      if (degree != 1 && degree != 2) throw std::invalid_argument("fem: element degree must be 1 or 2");
-      const bool cutting = scene.needle.tip != "blunt";
-      const std::size_t n_layers = scene.layers.size();
-      const double a = scene.needle.radius_m;
-
-      // ---- 1. Mesh and solver ----------------------------------------------------
-      const meshing::AxisymmetricSlabMesh mesh = meshing::build_axisymmetric_slab_mesh(scene, refinement);
-      LayerLaws laws = layer_laws(scene, mesh.crack_radius_m);
-      AxisymmetricSettings settings;
-      settings.degree = static_cast<unsigned>(degree);
-      settings.max_newton_iterations = scene.fem.max_newton_iterations;
-      settings.newton_tolerance = scene.fem.newton_tolerance;
-      settings.verbose = std::getenv("PUNCTURE_FEM_DEBUG") != nullptr;
-      settings.stabilization_time_s = scene.fem.stabilization_time_s;
-      AxisymmetricSolver solver(mesh, laws.materials, laws.cracks, laws.friction, settings);
-      solver.setup(0.5 * scene.sample.diameter_m, scene.total_thickness_m());
-      summary.geometry = "axisymmetric";
-      summary.n_dofs = solver.n_dofs();
-      summary.n_cells = solver.n_cells();
-      summary.n_ranks = static_cast<int>(dealii::Utilities::MPI::n_mpi_processes(comm));
-      summary.degree = degree;
-      summary.refinement = refinement;
-      summary.tip_element_size_m = mesh.tip_element_size_m;
-      summary.elements_through_layer = mesh.elements_through_layer;
-      // Resolution the mesh-convergence study found within 3 % of the converged
-      // indentation force (results/fem_mesh_convergence.md).
-      const double per_radius = a / mesh.tip_element_size_m;
-      const double needed = degree == 1 ? 8.0 : 4.0;
-      if (per_radius < needed - 1e-9)
-        summary.warnings.push_back("mesh: " + fmt(per_radius, 3) + " elements per needle radius with Q" +
-                                   std::to_string(degree) + "; at least " + fmt(needed, 2) +
-                                   " are needed for the indentation force to be within 3 % of its converged value");
-      for (std::size_t i = 0; i < n_layers; ++i)
-        if (mesh.elements_through_layer[i] < 4)
-          summary.warnings.push_back("mesh: layer '" + scene.layers[i].name + "' has only " +
-                                     std::to_string(mesh.elements_through_layer[i]) + " elements through its thickness");
-      {
-        std::ostringstream s;
-        s << "fem: scene '" << scene.name << "', axisymmetric, " << summary.n_cells << " cells, Q" << degree << " ("
-          << summary.n_dofs << " dofs), tip element " << mesh.tip_element_size_m * 1e3 << " mm, needle tip '"
-          << scene.needle.tip << "', crack radius " << mesh.crack_radius_m * 1e3 << " mm";
-        log(s.str());
-        for (const auto& w : summary.warnings) std::cerr << "warning: " << w << std::endl;
-      }
-
-      // The needle at a given tip depth.
-      const double flank = scene.needle.tip_angle_deg * kPi / 180.0;
-      auto place_needle = [&](double depth) {
-        if (cutting) {
-          RigidNeedle n;
-          n.edge_radius_m = mesh.crack_radius_m;
-          n.shaft_radius_m = a;
-          n.flank_angle_rad = flank;
-          n.z_tip_m = -depth;
-          solver.set_cutting_needle(n);
-        } else {
-          solver.set_flat_punch(a, -depth);
-        }
-      };
-
-      // ---- 2. Outputs being collected ---------------------------------------------
-      const std::filesystem::path out_dir = options.output_dir;
-      if (options.write_files) std::filesystem::create_directories(out_dir);
-      std::vector<Row> rows;
-      std::ostringstream newton_log, profile_csv, recovery_csv;
-      profile_csv << "step,depth_mm,r_mm,uz_mm,surface\n";
-      recovery_csv << "layer,phase,depth_mm,r_mm,uz_mm\n";
-      std::vector<std::pair<double, std::string>> frames;
-      const auto plan = trajectory(scene, options.stop_depth_m);
-      const int frame_every = std::max<int>(1, static_cast<int>(plan.size()) / std::max(1, options.max_vtu_frames));
-      auto write_frame = [&](double time) {
-        if (!options.write_files || !options.write_vtu) return;
-        std::ostringstream name;
-        name << "fem_fields_" << std::setw(4) << std::setfill('0') << frames.size() << ".vtu";
-        const std::filesystem::path tmp = out_dir / (name.str() + ".part");
-        solver.write_vtu(tmp.string());
-        std::filesystem::rename(tmp, out_dir / name.str());
-        frames.emplace_back(time, name.str());
-        summary.files_written.push_back(name.str());
-      };
-      auto layer_top_profile = [&](std::size_t layer) {
-        return solver.vertical_displacement_along(-scene.layer_top_depth_m(layer));
-      };
-
-      // ---- 3. State of the layers --------------------------------------------------
-      std::vector<LayerState> states(n_layers, LayerState::untouched);
-      std::vector<double> peak_force(n_layers, 0.0), peak_depth(n_layers, 0.0), peak_time(n_layers, 0.0);
-      std::vector<std::vector<std::pair<double, double>>> peak_profile(n_layers);
-      auto pressed_layer = [&]() -> int {
-        for (std::size_t i = 0; i < n_layers; ++i)
-          if (states[i] != LayerState::punctured) return static_cast<int>(i);
-        return -1;
-      };
-      // Layer i is punctured once its crack is fully open a little below its top.
-      auto crack_through_top = [&](std::size_t i) {
-        const double top = scene.layer_top_depth_m(i);
-        const double margin = std::min(0.25 * scene.layers[i].thickness_m, a);
-        return solver.crack_front_depth_m(static_cast<int>(i)) >= top + margin - 1e-12;
-      };
-
-      // ---- 4. Walk the trajectory ---------------------------------------------------
-      double depth = -scene.insertion.start_height_m, time = 0.0;
-      double dissipated_before = 0.0;
-      auto record = [&](const std::string& phase, double velocity, double cutting_N) {
-        const NeedleForce f = solver.needle_force();
-        const int p = pressed_layer();
-        double stretch = 1.0;
-        if (p >= 0 && f.nodes_in_contact > 0)
-          stretch = solver.max_principal_stretch(p, 2.0 * a, -depth - 2.0 * a, -depth + 2.0 * a);
-        const double total = f.nodes_in_contact > 0 ? f.total_N : 0.0;
-        const double friction = f.nodes_in_contact > 0 ? f.friction_N : 0.0;
-        rows.push_back({time, depth, velocity, total, total - friction - cutting_N, cutting_N, friction, stretch, phase,
-                        states});
-        summary.time_s.push_back(time);
-        summary.depth_m.push_back(depth);
-        summary.force_N.push_back(total);
-        summary.tip_force_N.push_back(total - friction - cutting_N);
-        summary.cutting_force_N.push_back(cutting_N);
-        summary.friction_force_N.push_back(friction);
-        summary.phase.push_back(phase);
-        if (total > summary.peak_force_N) {
-          summary.peak_force_N = total;
-          summary.peak_force_depth_m = depth;
-        }
-      };
-      record("approach", scene.insertion.speed_m_per_s, 0.0);
-      write_frame(time);
-
-      const double min_fraction = 1.0 / 256.0;
-      double fraction = 1.0;  // of the planned step, grows back after cuts
-      int step_index = 0;
-      double last_advance = 0.0;  // depth change of the last converged step (for the predictor)
-      for (std::size_t k = 0; k < plan.size(); ++k) {
-        const TrajectoryPoint& goal = plan[k];
-        const std::string phase = goal.phase;
-        if (phase == "approach") {  // nothing touches the tissue above its surface
-          depth = goal.depth_m;
-          time = goal.time_s;
-          record(phase, scene.insertion.speed_m_per_s, 0.0);
-          continue;
-        }
-        while (time < goal.time_s - 1e-12 * std::max(1.0, goal.time_s)) {
-          const double t0 = time, d0 = depth;
-          double t1 = std::min(goal.time_s, t0 + fraction * (goal.time_s - plan[k - 1].time_s));
-          // Sub-steps of a planned step follow the trajectory linearly.
-          const double s = (t1 - plan[k - 1].time_s) / (goal.time_s - plan[k - 1].time_s);
-          double d1 = plan[k - 1].depth_m + s * (goal.depth_m - plan[k - 1].depth_m);
-          place_needle(d1);
-          solver.set_time_step(t1 - t0);
-          const double advance = d1 - d0;
-          const double predictor = (last_advance != 0.0 && advance * last_advance > 0.0) ? advance / last_advance : 0.0;
-          const auto snapshot_dissipation = solver.cohesive_dissipation_J();
-          const auto t_solve = std::chrono::steady_clock::now();
-          const AxisymmetricNewtonReport report = solver.solve_step(predictor);
-          summary.solve_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_solve).count();
-          summary.newton_iterations += report.iterations;
-          newton_log << "step " << step_index << "  " << phase << "  depth " << d1 * 1e3 << " mm  t " << t1 << " s\n";
-          for (const auto& line : report.table) newton_log << line << "\n";
-          if (!report.converged) {
-            ++summary.step_cuts;
-            newton_log << "  -> " << report.failure << "; step cut\n";
-            fraction *= 0.5;
-            if (fraction < min_fraction) {
-              std::ostringstream m;
-              m << "no convergence at tip depth " << d1 * 1e3 << " mm (" << phase << ") even with 1/256 of the load step: "
-                << report.failure;
-              throw std::runtime_error(m.str());
-            }
-            place_needle(d0);
-            continue;
-          }
-          ++step_index;
-          ++summary.load_steps;
-          time = t1;
-          depth = d1;
-          last_advance = advance;
-          fraction = std::min(1.0, 2.0 * fraction);
-          const double dissipated = solver.cohesive_dissipation_J();
-          const double cutting_N = advance > 0.0 ? (dissipated - snapshot_dissipation) / advance : 0.0;
-          (void)dissipated_before;
-
-          // ---- detect punctures and layer states
-          const NeedleForce f = solver.needle_force();
-          for (std::size_t i = 0; i < n_layers; ++i) {
-            if (states[i] == LayerState::punctured) continue;
-            const bool first_intact = static_cast<int>(i) == pressed_layer();
-            if (states[i] == LayerState::untouched && first_intact && f.nodes_in_contact > 0) {
-              const auto u = solver.displacement_at(mesh.crack_radius_m, -scene.layer_top_depth_m(i));
-              if (i == 0 || depth >= scene.layer_top_depth_m(i) - u[1] - 1e-9) states[i] = LayerState::pressed;
-            }
-            if (states[i] != LayerState::pressed) continue;
-            if (f.total_N > peak_force[i]) {
-              peak_force[i] = f.total_N;
-              peak_depth[i] = depth;
-              peak_time[i] = time;
-              peak_profile[i] = layer_top_profile(i);
-            }
-            bool broken = false;
-            const PunctureCriterion& c = scene.layers[i].puncture;
-            if (c.kind == PunctureCriterion::Kind::FractureEnergy) {
-              broken = crack_through_top(i);
-            } else if (first_intact) {
-              const double value =
-                  c.kind == PunctureCriterion::Kind::CriticalForce
-                      ? f.total_N
-                      : solver.max_principal_stretch(static_cast<int>(i), 2.0 * a, -depth - 2.0 * a, -depth + 2.0 * a);
-              broken = value >= (c.kind == PunctureCriterion::Kind::CriticalForce ? c.critical_force_N : c.critical_stretch);
-              if (broken && !cutting)
-                throw std::runtime_error("the puncture criterion of layer '" + scene.layers[i].name +
-                                         "' is met, but a blunt (flat) punch cannot cut in the axisymmetric reference: "
-                                         "use needle tip bevel or hollow, or fem.geometry 3d");
-              if (broken) solver.break_layer(static_cast<int>(i));
-            }
-            if (!broken) continue;
-            states[i] = LayerState::punctured;
-            PunctureEvent e;
-            e.layer = static_cast<int>(i);
-            e.layer_name = scene.layers[i].name;
-            e.depth_m = peak_depth[i];
-            e.force_N = peak_force[i];
-            e.force_after_N = f.total_N;
-            e.time_s = peak_time[i];
-            summary.punctures.push_back(e);
-            for (const auto& [r, uz] : peak_profile[i])
-              recovery_csv << i << ",before," << fmt(peak_depth[i] * 1e3) << "," << fmt(r * 1e3) << ","
-                           << fmt(uz * 1e3) << "\n";
-            for (const auto& [r, uz] : layer_top_profile(i))
-              recovery_csv << i << ",after," << fmt(depth * 1e3) << "," << fmt(r * 1e3) << ","
-                           << fmt(uz * 1e3) << "\n";
-            std::ostringstream m;
-            m << "fem: " << e.layer_name << " punctured: peak " << e.force_N << " N at " << e.depth_m * 1e3
-              << " mm, " << e.force_after_N << " N at " << depth * 1e3 << " mm";
-            log(m.str());
-            write_frame(time);
-          }
-
-          const double velocity = phase == "dwell" ? 0.0 : (t1 > t0 ? advance / (t1 - t0) : 0.0);
-          record(phase, velocity, cutting_N);
-          const int p = pressed_layer();
-          if (p >= 0 && states[p] == LayerState::pressed && step_index % 2 == 0)
-            for (const auto& [r, uz] : layer_top_profile(p))
-              profile_csv << step_index << "," << fmt(depth * 1e3) << "," << fmt(r * 1e3) << "," << fmt(uz * 1e3) << ","
-                          << scene.layers[p].name << "\n";
-          if (step_index % frame_every == 0) write_frame(time);
-          if (options.verbose && step_index % 10 == 0) {
-            std::ostringstream m;
-            m << "  step " << step_index << "  " << phase << "  depth " << std::fixed << std::setprecision(3)
-              << depth * 1e3 << " mm  force " << std::setprecision(4) << rows.back().force_N << " N (friction "
-              << rows.back().friction_N << " N)  newton " << report.iterations;
-            log(m.str());
-          }
-        }
-      }
-      summary.cohesive_dissipation_J = solver.cohesive_dissipation_J();
-      summary.stabilization_dissipation_J = solver.stabilization_dissipation_J();
-      // Needle work over the insertion (trapezoid rule on force x depth).
-      for (std::size_t k = 1; k < rows.size(); ++k)
-        if (rows[k].phase == "insertion")
-          summary.needle_work_J += 0.5 * (rows[k].force_N + rows[k - 1].force_N) * (rows[k].depth_m - rows[k - 1].depth_m);
-
-      // ---- 5. Write ---------------------------------------------------------------------
-      summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-      if (options.write_files) {
-        std::ostringstream csv;
-        csv << "time_s,depth_mm,velocity_mm_per_s,force_N,tip_force_N,cutting_force_N,friction_force_N,tip_stretch,phase";
-        for (const auto& layer : scene.layers) csv << "," << layer.name << "_state";
-        csv << "\n";
-        for (const Row& r : rows) {
-          csv << fmt(r.time_s) << "," << fmt(r.depth_m * 1e3) << "," << fmt(r.velocity_m_per_s * 1e3) << ","
-              << fmt(r.force_N) << "," << fmt(r.tip_N) << "," << fmt(r.cutting_N) << "," << fmt(r.friction_N) << ","
-              << fmt(r.tip_stretch) << "," << r.phase;
-          for (const auto st : r.states) csv << "," << to_string(st);
-          csv << "\n";
-        }
-        write_file_atomically(out_dir / "fem_force_depth.csv", csv.str());
-        write_file_atomically(out_dir / "fem_surface_profile.csv", profile_csv.str());
-        write_file_atomically(out_dir / "fem_recovery_profile.csv", recovery_csv.str());
-        write_file_atomically(out_dir / "fem_newton_log.txt", newton_log.str());
-        if (!frames.empty()) {
-          std::ostringstream pvd;
-          pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
-          for (const auto& [t, name] : frames)
-            pvd << "    <DataSet timestep=\"" << fmt(t) << "\" part=\"0\" file=\"" << name << "\"/>\n";
-          pvd << "  </Collection>\n</VTKFile>\n";
-          write_file_atomically(out_dir / "fem_fields.pvd", pvd.str());
-          summary.files_written.push_back("fem_fields.pvd");
-        }
-        for (const char* f : {"fem_force_depth.csv", "fem_surface_profile.csv", "fem_recovery_profile.csv",
-                              "fem_newton_log.txt", "fem_summary.json"})
-          summary.files_written.push_back(f);
-        nlohmann::json j;
-        j["status"] = "ok";
-        j["scene"] = scene.name;
-        j["geometry"] = "axisymmetric";
-        j["n_dofs"] = summary.n_dofs;
-        j["n_cells"] = summary.n_cells;
-        j["n_ranks_used"] = 1;
-        j["element_degree"] = degree;
-        j["refinement"] = refinement;
-        j["tip_element_size_mm"] = mesh.tip_element_size_m * 1e3;
-        j["crack_radius_mm"] = mesh.crack_radius_m * 1e3;
-        j["elements_through_layer"] = mesh.elements_through_layer;
-        j["load_step_mm"] = scene.fem.load_step_m * 1e3;
-        j["peak_force_N"] = summary.peak_force_N;
-        j["peak_force_depth_mm"] = summary.peak_force_depth_m * 1e3;
-        j["cohesive_dissipation_J"] = summary.cohesive_dissipation_J;
-        j["stabilization_dissipation_J"] = summary.stabilization_dissipation_J;
-        j["needle_work_insertion_J"] = summary.needle_work_J;
-        j["load_steps"] = summary.load_steps;
-        j["step_cuts"] = summary.step_cuts;
-        j["newton_iterations"] = summary.newton_iterations;
-        j["wall_time_s"] = summary.wall_time_s;
-        j["solve_time_s"] = summary.solve_time_s;
-        j["warnings"] = summary.warnings;
-        j["punctures"] = nlohmann::json::array();
-        for (const auto& e : summary.punctures)
-          j["punctures"].push_back({{"layer", e.layer}, {"name", e.layer_name}, {"depth_mm", e.depth_m * 1e3},
-                                    {"force_N", e.force_N}, {"force_after_N", e.force_after_N}, {"time_s", e.time_s}});
-        j["files"] = summary.files_written;
-        write_file_atomically(out_dir / "fem_summary.json", j.dump(2) + "\n");
-      }
+      AxisymmetricInsertionRun run(scene, options, comm, summary);  // mesh and solver
+      run.walk_trajectory();  // per step: advance, detect punctures, record
+      run.write_outputs();
     } catch (const std::exception& e) {
       error = e.what();
       if (error.empty()) error = "unknown error";
     }
   }
-  // Rank 0 computed; the others learn the outcome (and the curve) from it.
-  if (dealii::Utilities::MPI::n_mpi_processes(comm) > 1) {
-    nlohmann::json j;
-    if (root) {
-      j["error"] = error;
-      j["time_s"] = summary.time_s;
-      j["depth_m"] = summary.depth_m;
-      j["force_N"] = summary.force_N;
-      j["peak_force_N"] = summary.peak_force_N;
-      j["n_dofs"] = summary.n_dofs;
-      j["wall_time_s"] = summary.wall_time_s;
-      nlohmann::json ev = nlohmann::json::array();
-      for (const auto& e : summary.punctures)
-        ev.push_back({e.layer, e.layer_name, e.depth_m, e.force_N, e.force_after_N, e.time_s});
-      j["punctures"] = ev;
-    }
-    const std::string text = dealii::Utilities::MPI::broadcast(comm, root ? j.dump() : std::string(), 0);
-    if (!root) {
-      j = nlohmann::json::parse(text);
-      error = j["error"].get<std::string>();
-      summary.geometry = "axisymmetric";
-      summary.time_s = j["time_s"].get<std::vector<double>>();
-      summary.depth_m = j["depth_m"].get<std::vector<double>>();
-      summary.force_N = j["force_N"].get<std::vector<double>>();
-      summary.peak_force_N = j["peak_force_N"].get<double>();
-      summary.n_dofs = j["n_dofs"].get<std::size_t>();
-      summary.wall_time_s = j["wall_time_s"].get<double>();
-      for (const auto& e : j["punctures"]) {
-        PunctureEvent p;
-        p.layer = e[0].get<int>();
-        p.layer_name = e[1].get<std::string>();
-        p.depth_m = e[2].get<double>();
-        p.force_N = e[3].get<double>();
-        p.force_after_N = e[4].get<double>();
-        p.time_s = e[5].get<double>();
-        summary.punctures.push_back(p);
-      }
-    }
-  }
+  share_outcome(comm, error, summary);
   if (!error.empty()) throw std::runtime_error(error);
   return summary;
 }

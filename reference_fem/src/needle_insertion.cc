@@ -1,7 +1,9 @@
 // needle_insertion.cc: the needle-insertion problem on the layered slab (see
-// needle_insertion.hpp). Reads top-down as the algorithm: build the slab, set
-// up the solver, then for every load step advance the tip, solve, check the
-// puncture criterion, record.
+// needle_insertion.hpp). run_needle_insertion dispatches on the geometry; the
+// 3D reference (SlabInsertionRun) reads top-down as the algorithm: build the
+// slab and the solver, then for every load step advance the tip (cutting a
+// sub-step that fails, bisecting toward a puncture), detect the puncture,
+// open the hole and release the needle (spring-back), record; then write.
 #include <puncture/fem/needle_insertion.hpp>
 
 #include <deal.II/base/mpi.h>
@@ -18,6 +20,7 @@
 #include <iostream>
 #include <limits>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -25,23 +28,18 @@
 #include <puncture/fem/field_output.hpp>
 #include <puncture/fem/finite_strain_solver.hpp>
 
+#include "insertion_common.hpp"
+
 namespace puncture::fem {
 
 using namespace dealii;
 
 namespace {
 
-constexpr types::boundary_id kTop = 0, kBase = 1, kLateral = 2;
+using insertion::format_double;
+using insertion::LayerState;
 
-enum class LayerState { untouched, pressed, punctured };
-const char* to_string(LayerState s) {
-  switch (s) {
-    case LayerState::untouched: return "untouched";
-    case LayerState::pressed: return "pressed";
-    case LayerState::punctured: return "punctured";
-  }
-  return "?";
-}
+constexpr types::boundary_id kTop = 0, kBase = 1, kLateral = 2;
 
 /// A node (support point) with its three displacement dofs.
 struct Node {
@@ -72,12 +70,6 @@ struct Row {
   double tip_stretch;  ///< max principal stretch at the tip in the pressed layer (1: no contact)
   std::vector<LayerState> states;
 };
-
-std::string format_double(double v, int precision = 9) {
-  std::ostringstream s;
-  s << std::setprecision(precision) << v;
-  return s.str();
-}
 
 }  // namespace
 
@@ -115,64 +107,61 @@ void build_slab_triangulation(const Scene& scene, const meshing::SlabMeshOptions
 }
 
 namespace {
-FemRunSummary run_needle_insertion_3d(const Scene& scene, const FemRunOptions& options, MPI_Comm comm);
-}  // namespace
 
-FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& options, MPI_Comm comm) {
-  std::string geometry = scene.fem.geometry;
-  if (geometry == "auto") geometry = scene.needle.tip == "blunt" ? "3d" : "axisymmetric";
-  if (geometry == "axisymmetric") return run_axisymmetric_insertion(scene, options, comm);
-  if (scene.needle.tip != "blunt")
-    throw std::invalid_argument("fem: the 3d reference models a flat (blunt) punch only; needle tip '" +
-                                scene.needle.tip + "' needs geometry axisymmetric");
-  for (const Layer& l : scene.layers)
-    if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy)
-      throw std::invalid_argument("fem: the 3d reference has no fracture_energy criterion (layer '" + l.name +
-                                  "'); use geometry axisymmetric");
-  return run_needle_insertion_3d(scene, options, comm);
-}
+using Tria = parallel::distributed::Triangulation<3>;
 
-namespace {
-FemRunSummary run_needle_insertion_3d(const Scene& scene, const FemRunOptions& options, MPI_Comm comm) {
-  const auto wall_start = std::chrono::steady_clock::now();
-  const bool root = Utilities::MPI::this_mpi_process(comm) == 0;
-  auto log = [&](const std::string& s) {
-    if (root && options.verbose) std::cout << s << std::endl;
-  };
+/// Element degree and global refinements of the 3D reference.
+struct SlabDiscretisation {
+  int degree;
+  int refinement;
+};
 
-  // ---- 0. What the scene asks for -------------------------------------------------
-  if (scene.layers.empty()) throw std::invalid_argument("fem: the scene has no layers");
-  if (scene.insertion.angle_deg != 0.0)
-    throw std::invalid_argument("fem: only insertions along the sample axis (angle_deg = 0) are modelled");
-  if (!(scene.insertion.speed_m_per_s > 0.0))
-    throw std::invalid_argument("fem: insertion speed must be > 0");
+/// The scene checks of the 3D reference; returns its discretisation.
+SlabDiscretisation checked_discretisation(const Scene& scene, const FemRunOptions& options) {
+  insertion::check_axial_insertion(scene);
   if (!(scene.fem.load_step_m > 0.0)) throw std::invalid_argument("fem: load_step_m must be > 0");
   if (options.spring_back_stages < 1) throw std::invalid_argument("fem: spring_back_stages must be >= 1");
-  const int degree = options.degree_override > 0 ? options.degree_override : scene.fem.element_degree;
-  const int refinement = options.refinement_override >= 0 ? options.refinement_override : scene.fem.refinement;
-  if (degree != 1 && degree != 2) throw std::invalid_argument("fem: element degree must be 1 or 2");
-  if (refinement < 0 || refinement > 4) throw std::invalid_argument("fem: refinement must lie in 0..4");
-  const std::size_t n_layers = scene.layers.size();
-  const double needle_radius = scene.needle.radius_m;
-  const double thickness = scene.total_thickness_m();
-  const double tol = 1e-9 * std::max(thickness, scene.sample.diameter_m);
-  const double speed = scene.insertion.speed_m_per_s;
-  const double start_height = scene.insertion.start_height_m;
-  double final_depth = std::min(scene.insertion.target_depth_m, thickness);
+  const SlabDiscretisation d{insertion::element_degree(scene, options), insertion::refinement_level(scene, options)};
+  if (d.degree != 1 && d.degree != 2) throw std::invalid_argument("fem: element degree must be 1 or 2");
+  if (d.refinement < 0 || d.refinement > 4) throw std::invalid_argument("fem: refinement must lie in 0..4");
+  return d;
+}
+
+/// The deepest tip position: the target depth, within the slab, or the option's stop depth.
+double final_tip_depth(const Scene& scene, const FemRunOptions& options) {
+  double final_depth = std::min(scene.insertion.target_depth_m, scene.total_thickness_m());
   if (options.stop_depth_m > 0.0) final_depth = std::min(final_depth, options.stop_depth_m);
+  return final_depth;
+}
+
+/// The output directory, created (by rank 0) if files are to be written.
+std::filesystem::path prepared_output_dir(const FemRunOptions& options, bool root, MPI_Comm comm) {
   const std::filesystem::path out_dir(options.output_dir);
   if (options.write_files) {
     if (options.output_dir.empty()) throw std::invalid_argument("fem: output_dir is empty");
     if (root) std::filesystem::create_directories(out_dir);
     MPI_Barrier(comm);
   }
+  return out_dir;
+}
 
-  // ---- 1. Geometry and material from the same scene --------------------------------
-  parallel::distributed::Triangulation<3> tria(comm);
-  build_slab_triangulation(scene, options.mesh, refinement, tria);
+/// The scene's slab, distributed over `comm`.
+std::unique_ptr<Tria> slab_triangulation(const Scene& scene, const FemRunOptions& options, int refinement,
+                                         MPI_Comm comm) {
+  auto tria = std::make_unique<Tria>(comm);
+  build_slab_triangulation(scene, options.mesh, refinement, *tria);
+  return tria;
+}
+
+std::vector<LayerMaterial> layer_materials(const Scene& scene) {
   std::vector<LayerMaterial> materials;
   for (const auto& layer : scene.layers) materials.emplace_back(layer.material);
+  return materials;
+}
 
+/// Solver settings from the options: formulation, Newton, linear solver
+/// (sparse direct up to direct_solver_max_dofs with "auto").
+SolverSettings solver_settings(const Scene& scene, const FemRunOptions& options, int degree, const Tria& tria) {
   SolverSettings settings;
   settings.degree = degree;
   settings.formulation = options.formulation == "one_field" ? VolumetricFormulation::one_field
@@ -189,417 +178,628 @@ FemRunSummary run_needle_insertion_3d(const Scene& scene, const FemRunOptions& o
   settings.direct_linear_solver =
       options.linear_solver == "direct" ||
       (options.linear_solver == "auto" && approx_dofs <= options.direct_solver_max_dofs);
-  FiniteStrainSolver solver(tria, materials, settings);
-  solver.setup();
+  return settings;
+}
 
-  FemRunSummary summary;
-  summary.n_dofs = solver.n_dofs();
-  summary.n_cells = tria.n_global_active_cells();
-  summary.n_ranks = Utilities::MPI::n_mpi_processes(comm);
-  summary.degree = degree;
-  summary.refinement = refinement;
-  {
-    std::ostringstream s;
-    s << "fem: scene '" << scene.name << "', " << summary.n_cells << " cells, Q" << degree << " ("
-       << options.formulation << "), " << summary.n_dofs << " dofs, "
-      << (settings.direct_linear_solver ? "MUMPS" : "CG+AMG") << ", " << summary.n_ranks << " rank(s)";
-    log(s.str());
+/// What a sub-step started from: restored when it is undone to bisect toward
+/// a puncture (the contact set also when its solve fails).
+struct SubStepStart {
+  double depth_m;
+  double last_advance_m;
+  bool predictor_valid;
+  std::map<std::size_t, std::array<double, 2>> contact;
+  std::vector<LayerState> states;
+  FiniteStrainSolver::Snapshot snapshot;
+};
+
+/// The pressed layer's puncture criterion after a sub-step.
+struct PunctureCheck {
+  double force_N;
+  double stretch;
+  bool breaks;
+};
+
+/// The 3D insertion (flat punch, removal of a layer column at puncture): the
+/// slab and the solver, the contact set and the layer states, what is
+/// recorded, and the steps of the algorithm. Every rank runs it.
+class SlabInsertionRun {
+ public:
+  /// Checks the scene, creates the output directory, builds the slab, the
+  /// solver, the boundary conditions and the node sets.
+  SlabInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm);
+  /// Runs the insertion and writes the outputs (also when it fails).
+  FemRunSummary run();
+
+ private:
+  void advance_to(double step_target);
+  double next_trial_depth(double step_target, double increment) const;
+  SubStepStart sub_step_start() const;
+  double cut_sub_step(const SubStepStart& start, double trial_depth, double advance, const NewtonReport& report);
+  bool accept_sub_step(double trial_depth, double advance);
+  PunctureCheck check_puncture();
+  void undo_for_bisection(const SubStepStart& start);
+  void puncture_current_layer(double force, double stretch);
+  PunctureEvent record_before_puncture(std::size_t layer, double force, double stretch);
+  void open_hole(std::size_t layer);
+  void release_needle(std::size_t layer, double force);
+  void spring_back(const std::string& layer_name);
+  void record_after_puncture(std::size_t layer, PunctureEvent event);
+  void record_load_step(int step);
+  bool solve_at(double depth, NewtonReport& report, double predictor_scale);
+  void find_node_sets();
+  void describe_model();
+  double u_of(const Node& n, unsigned c) const { return solver_.displacement(n.dof[c]); }
+  bool any_contact() const;
+  void apply_targets(double z_tip);
+  bool join_reached_nodes(double z_tip);
+  double needle_force() const;
+  double tip_stretch(std::size_t layer) const;
+  insertion::SurfaceProfile surface_profile(std::size_t layer) const;
+  void record_row(double depth, double force, double stretch);
+  void write_frame(double depth);
+  void write_outputs(const std::string& status, const std::string& error);
+  std::string force_depth_csv() const;
+  nlohmann::json summary_json(const std::string& status, const std::string& error) const;
+  void log(const std::string& s) const {
+    if (root_ && options_.verbose) std::cout << s << std::endl;
   }
 
-  // ---- 2. Boundary conditions and the node sets ------------------------------------
-  std::map<types::global_dof_index, double> fixed;
-  VectorTools::interpolate_boundary_values(solver.dof_handler(), kBase, Functions::ZeroFunction<3>(3), fixed);
-  VectorTools::interpolate_boundary_values(solver.dof_handler(), kLateral, Functions::ZeroFunction<3>(3), fixed);
-
-  const std::vector<Node> nodes = group_nodes(solver.locally_relevant_dof_points(), thickness);
-  std::vector<double> interface_z(n_layers);
-  for (std::size_t i = 0; i < n_layers; ++i) interface_z[i] = -scene.layer_top_depth_m(i);
+  // What the scene asks for.
+  const std::chrono::steady_clock::time_point wall_start_ = std::chrono::steady_clock::now();
+  const Scene& scene_;
+  const FemRunOptions& options_;
+  const MPI_Comm comm_;
+  const bool root_;
+  const SlabDiscretisation disc_;
+  const std::size_t n_layers_;
+  const double needle_radius_;
+  const double thickness_;
+  const double tol_;  // position tolerance (m)
+  const double speed_;
+  const double start_height_;
+  const double final_depth_;
+  const std::filesystem::path out_dir_;
+  // Slab and solver.
+  const std::unique_ptr<Tria> tria_;
+  const SolverSettings settings_;
+  FiniteStrainSolver solver_;
+  FemRunSummary summary_;
+  // Boundary conditions and node sets.
+  std::map<types::global_dof_index, double> fixed_;
+  std::vector<Node> nodes_;
+  std::vector<double> interface_z_;
   // Per layer: every node of its top interface (profiles) and those under the needle.
-  std::vector<std::vector<std::size_t>> interface_nodes(n_layers), tip_nodes(n_layers);
-  for (std::size_t n = 0; n < nodes.size(); ++n)
-    for (std::size_t i = 0; i < n_layers; ++i)
-      if (std::abs(nodes[n].X[2] - interface_z[i]) < tol) {
-        interface_nodes[i].push_back(n);
-        if (nodes[n].r() <= needle_radius * (1.0 + 1e-6)) tip_nodes[i].push_back(n);
-      }
-
-  // Contact state: joined node -> held lateral displacement.
-  std::map<std::size_t, std::array<double, 2>> contact;
-  std::vector<LayerState> states(n_layers, LayerState::untouched);
-  std::size_t current_layer = 0;  // first layer not punctured
-
-  auto u_of = [&](const Node& n, unsigned c) { return solver.displacement(n.dof[c]); };
-  // Collective: does any rank hold contact nodes? (A rank may own none of them.)
-  auto any_contact = [&]() { return Utilities::MPI::max(contact.empty() ? 0 : 1, comm) == 1; };
-
-  auto apply_targets = [&](double z_tip) {
-    std::map<types::global_dof_index, double> targets = fixed;
-    for (const auto& [n, hold] : contact) {
-      targets[nodes[n].dof[0]] = hold[0];
-      targets[nodes[n].dof[1]] = hold[1];
-      targets[nodes[n].dof[2]] = z_tip - nodes[n].X[2];
-    }
-    solver.set_prescribed_displacements(std::move(targets));
-  };
-  // Nodes of the current interface the tip has reached (current z >= z_tip).
-  auto join_reached_nodes = [&](double z_tip) {
-    bool joined = false;
-    if (current_layer >= n_layers) return false;
-    for (const std::size_t n : tip_nodes[current_layer]) {
-      if (contact.count(n)) continue;
-      if (nodes[n].X[2] + u_of(nodes[n], 2) >= z_tip - tol) {
-        contact[n] = {u_of(nodes[n], 0), u_of(nodes[n], 1)};
-        joined = true;
-      }
-    }
-    return Utilities::MPI::max(joined ? 1 : 0, comm) == 1;
-  };
-  auto needle_force = [&]() {
-    std::vector<types::global_dof_index> dofs;
-    for (const auto& [n, hold] : contact) dofs.push_back(nodes[n].dof[2]);
-    // The z reaction is what the needle applies to the tissue; the tissue
-    // pushes back on the needle with the opposite force (upward, > 0).
-    const double force = -solver.sum_of_residual(dofs);
-    return force == 0.0 ? 0.0 : force;  // no "-0" in the CSV
-  };
-  auto tip_stretch = [&](std::size_t layer) {
-    return solver.max_principal_stretch([&](const FiniteStrainSolver::CellIterator& cell) {
-      if (cell->material_id() != layer) return false;
-      for (unsigned v = 0; v < 8; ++v) {
-        const Point<3>& p = cell->vertex(v);
-        if (std::abs(p[2] - interface_z[layer]) < tol &&
-            std::hypot(p[0], p[1]) <= needle_radius * (1.0 + 1e-6))
-          return true;
-      }
-      return false;
-    });
-  };
-
-  std::ostringstream newton_log;
-  bool solution_is_stale = true;  // the state differs from the last solved one
-  // Solves at tip depth `depth`, joining reached nodes until none is left.
-  // predictor_scale: start the first pass from u + scale x the last increment.
-  auto solve_at = [&](double depth, NewtonReport& report, double predictor_scale) {
-    const double z_tip = -depth;
-    for (int pass = 0; pass < 8; ++pass) {
-      const bool joined = join_reached_nodes(z_tip);
-      if (!joined && !solution_is_stale && !any_contact()) return true;  // nothing to do
-      apply_targets(z_tip);
-      const auto t0 = std::chrono::steady_clock::now();
-      report = solver.solve_step(pass == 0 && !joined ? predictor_scale : 0.0);
-      summary.solve_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      summary.newton_iterations += report.iterations;
-      summary.linear_iterations += report.linear_iterations;
-      newton_log << "depth " << format_double(depth * 1e3, 6) << " mm, contact nodes " << contact.size()
-                 << (solver.has_anchor_springs() ? ", spring-back stage" : "")
-                 << (report.converged ? "" : ", FAILED: " + report.failure) << "\n";
-      for (const auto& line : report.table) {
-        newton_log << "  " << line << "\n";
-        log("      " + line);
-      }
-      if (!report.converged) return false;
-      solution_is_stale = false;
-      bool more = false;
-      if (current_layer < n_layers)
-        for (const std::size_t n : tip_nodes[current_layer])
-          if (!contact.count(n) && nodes[n].X[2] + u_of(nodes[n], 2) >= z_tip - tol) more = true;
-      if (Utilities::MPI::max(more ? 1 : 0, comm) == 0) return true;
-    }
-    return true;
-  };
-
-  // ---- 3. Records ----------------------------------------------------------------
-  std::vector<Row> rows;
-  std::ostringstream profile_csv, recovery_csv;
-  profile_csv << "step,depth_mm,r_mm,uz_mm,surface\n";
-  recovery_csv << "layer,phase,depth_mm,r_mm,uz_mm\n";
-  // u_z(r) of a layer's top interface, averaged over nodes at the same r (rank 0 gets it).
-  auto surface_profile = [&](std::size_t layer) {
-    std::vector<std::pair<double, double>> local;
-    const IndexSet owned = solver.dof_handler().locally_owned_dofs();
-    for (const std::size_t n : interface_nodes[layer])
-      if (owned.is_element(nodes[n].dof[2])) local.emplace_back(nodes[n].r(), u_of(nodes[n], 2));
-    const auto all = Utilities::MPI::gather(comm, local, 0);
-    std::map<long long, std::pair<double, int>> by_r;
-    std::map<long long, double> r_of;
-    for (const auto& part : all)
-      for (const auto& [r, uz] : part) {
-        const long long key = std::llround(r / (1e-7 * thickness));
-        auto& acc = by_r[key];
-        acc.first += uz;
-        acc.second += 1;
-        r_of[key] = r;
-      }
-    std::vector<std::pair<double, double>> profile;
-    for (const auto& [key, acc] : by_r) profile.emplace_back(r_of[key], acc.first / acc.second);
-    return profile;
-  };
-  auto record_row = [&](double depth, double force, double stretch) {
-    const double time = (depth + start_height) / speed;
-    rows.push_back({time, depth, speed, force, stretch, states});
-    summary.time_s.push_back(time);
-    summary.depth_m.push_back(depth);
-    summary.force_N.push_back(force);
-    if (force > summary.peak_force_N) {
-      summary.peak_force_N = force;
-      summary.peak_force_depth_m = depth;
-    }
-  };
-
-  std::unique_ptr<FieldOutputSeries> fields;
-  if (options.write_files && options.write_vtu)
-    fields = std::make_unique<FieldOutputSeries>(out_dir, "fem_fields", comm);
-  const double load_step = scene.fem.load_step_m;
-  // Puncture depths are located by bisection to within `resolution`: a step
+  std::vector<std::vector<std::size_t>> interface_nodes_, tip_nodes_;
+  // Contact and layer state.
+  std::map<std::size_t, std::array<double, 2>> contact_;  // joined node -> held lateral displacement
+  std::vector<LayerState> states_;
+  std::size_t current_layer_ = 0;  // first layer not punctured
+  bool solution_is_stale_ = true;  // the state differs from the last solved one
+  // Records.
+  insertion::InsertionRecords records_;
+  std::vector<Row> rows_;
+  std::unique_ptr<FieldOutputSeries> fields_;
+  // Load stepping.
+  const double load_step_;
+  // Puncture depths are located by bisection to within `resolution_`: a step
   // after which the criterion holds is undone and halved until it is short.
-  const double resolution =
-      options.puncture_depth_resolution_m > 0.0 ? options.puncture_depth_resolution_m : load_step / 4.0;
-  const int n_steps = std::max(1, int(std::ceil((final_depth + start_height) / load_step - 1e-9)));
-  const int vtu_stride = std::max(1, n_steps / std::max(1, options.max_vtu_frames));
-  auto write_frame = [&](double depth) {
-    if (!fields) return;
-    const auto names = fields->write_frame(solver, (depth + start_height) / speed);
-    if (root) summary.files_written.insert(summary.files_written.end(), names.begin(), names.end());
-  };
+  const double resolution_;
+  const int n_steps_;
+  const int vtu_stride_;
+  double depth_;
+  int record_index_ = 0;
+  double last_advance_ = 0.0;     // depth change of the last converged step in contact
+  bool predictor_valid_ = false;  // that step pressed the current layer like the next one will
+  double crossing_upper_ = std::numeric_limits<double>::infinity();  // criterion known to hold here
+};
 
-  auto write_outputs = [&](const std::string& status, const std::string& error) {
-    if (!options.write_files) return;
-    if (fields && root) summary.files_written.push_back(fields->write_collection());
-    else if (fields) fields->write_collection();
-    if (!root) return;
-    std::ostringstream csv;
-    csv << "time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch";
-    for (const auto& layer : scene.layers) csv << "," << layer.name << "_state";
-    csv << "\n";
-    for (const auto& r : rows) {
-      csv << format_double(r.time_s) << "," << format_double(r.depth_m * 1e3) << ","
-          << format_double(r.velocity_m_per_s * 1e3) << "," << format_double(r.force_N) << ","
-          << format_double(r.tip_stretch, 6);
-      for (const auto s : r.states) csv << "," << to_string(s);
-      csv << "\n";
-    }
-    write_file_atomically(out_dir / "fem_force_depth.csv", csv.str());
-    write_file_atomically(out_dir / "fem_surface_profile.csv", profile_csv.str());
-    write_file_atomically(out_dir / "fem_recovery_profile.csv", recovery_csv.str());
-    write_file_atomically(out_dir / "fem_newton_log.txt", newton_log.str());
-    for (const char* f : {"fem_force_depth.csv", "fem_surface_profile.csv", "fem_recovery_profile.csv",
-                          "fem_newton_log.txt", "fem_summary.json"})
-      summary.files_written.push_back(f);
-    summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-    nlohmann::json j;
-    j["status"] = status;
-    if (!error.empty()) j["error"] = error;
-    j["scene"] = scene.name;
-    j["n_dofs"] = summary.n_dofs;
-    j["n_cells"] = summary.n_cells;
-    j["n_ranks"] = summary.n_ranks;
-    j["element_degree"] = degree;
-    j["refinement"] = refinement;
-    j["formulation"] = options.formulation;
-    j["load_step_mm"] = load_step * 1e3;
-    j["final_depth_mm"] = final_depth * 1e3;
-    j["note"] = "quasi-static; the FEM stops at the target depth (no dwell, no withdrawal)";
-    j["peak_force_N"] = summary.peak_force_N;
-    j["peak_force_depth_mm"] = summary.peak_force_depth_m * 1e3;
-    j["load_steps"] = summary.load_steps;
-    j["step_cuts"] = summary.step_cuts;
-    j["puncture_bisections"] = summary.bisections;
-    j["spring_back_stages"] = summary.spring_back_stages;
-    j["puncture_depth_resolution_mm"] = resolution * 1e3;
-    j["newton_iterations"] = summary.newton_iterations;
-    j["linear_iterations"] = summary.linear_iterations;
-    j["wall_time_s"] = summary.wall_time_s;
-    j["solve_time_s"] = summary.solve_time_s;
-    j["punctures"] = nlohmann::json::array();
-    for (const auto& e : summary.punctures)
-      j["punctures"].push_back({{"layer", e.layer}, {"name", e.layer_name}, {"depth_mm", e.depth_m * 1e3},
-                                {"force_N", e.force_N}, {"force_after_N", e.force_after_N},
-                                {"max_stretch", e.max_stretch}, {"time_s", e.time_s}});
-    j["files"] = summary.files_written;
-    write_file_atomically(out_dir / "fem_summary.json", j.dump(2) + "\n");
-  };
+SlabInsertionRun::SlabInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm)
+    : scene_(scene),
+      options_(options),
+      comm_(comm),
+      root_(Utilities::MPI::this_mpi_process(comm) == 0),
+      disc_(checked_discretisation(scene, options)),
+      n_layers_(scene.layers.size()),
+      needle_radius_(scene.needle.radius_m),
+      thickness_(scene.total_thickness_m()),
+      tol_(1e-9 * std::max(thickness_, scene.sample.diameter_m)),
+      speed_(scene.insertion.speed_m_per_s),
+      start_height_(scene.insertion.start_height_m),
+      final_depth_(final_tip_depth(scene, options)),
+      out_dir_(prepared_output_dir(options, root_, comm)),
+      tria_(slab_triangulation(scene, options, disc_.refinement, comm)),
+      settings_(solver_settings(scene, options, disc_.degree, *tria_)),
+      solver_(*tria_, layer_materials(scene), settings_),
+      states_(n_layers_, LayerState::untouched),
+      load_step_(scene.fem.load_step_m),
+      resolution_(options.puncture_depth_resolution_m > 0.0 ? options.puncture_depth_resolution_m
+                                                             : load_step_ / 4.0),
+      n_steps_(std::max(1, int(std::ceil((final_depth_ + start_height_) / load_step_ - 1e-9)))),
+      vtu_stride_(std::max(1, n_steps_ / std::max(1, options.max_vtu_frames))),
+      depth_(-start_height_) {
+  solver_.setup();
+  describe_model();
+  find_node_sets();
+  if (options.write_files && options.write_vtu)
+    fields_ = std::make_unique<FieldOutputSeries>(out_dir_, "fem_fields", comm);
+}
 
-  // ---- 4. Load stepping ------------------------------------------------------------
-  double depth = -start_height;
-  record_row(depth, 0.0, 1.0);
-  write_frame(depth);
-  int record_index = 0;
-  double last_advance = 0.0;     // depth change of the last converged step in contact
-  bool predictor_valid = false;  // that step pressed the current layer like the next one will
-  double crossing_upper = std::numeric_limits<double>::infinity();  // criterion known to hold here
-  try {
-    for (int step = 1; step <= n_steps; ++step) {
-      const double step_target = std::min(-start_height + step * load_step, final_depth);
-      double increment = step_target - depth;
-      while (depth < step_target - 1e-12 * load_step) {
-        double trial_depth = std::min(depth + increment, step_target);
-        if (std::isfinite(crossing_upper)) {
-          // Bisecting toward a known crossing (the last part is taken whole).
-          const double remaining = crossing_upper - depth;
-          trial_depth = std::min(trial_depth, remaining <= resolution * (1.0 + 1e-9)
-                                                  ? crossing_upper
-                                                  : depth + 0.5 * remaining);
-        }
-        const double advance = trial_depth - depth;
-        const auto contact_before = contact;
-        const auto states_before = states;
-        const FiniteStrainSolver::Snapshot snapshot = solver.snapshot();
-        const double predictor_scale =
-            predictor_valid && last_advance > 0.0 ? std::min(2.0, advance / last_advance) : 0.0;
-        NewtonReport report;
-        if (!solve_at(trial_depth, report, predictor_scale)) {
-          contact = contact_before;
-          solution_is_stale = true;
-          increment = 0.5 * advance;
-          ++summary.step_cuts;
-          log("  step cut at depth " + format_double(trial_depth * 1e3, 6) + " mm: " + report.failure);
-          if (increment < load_step / 256.0)
-            throw std::runtime_error("fem: cannot continue at depth " + format_double(depth * 1e3, 6) +
-                                     " mm: " + report.failure + " even with load step " +
-                                     format_double(increment * 1e3, 4) + " mm");
-          continue;
-        }
-        const double depth_before = depth;
-        const double last_advance_before = last_advance;
-        const bool predictor_valid_before = predictor_valid;
-        depth = trial_depth;
-        ++summary.load_steps;
-        increment = std::min(2.0 * advance, load_step);
-        if (trial_depth == crossing_upper) crossing_upper = std::numeric_limits<double>::infinity();
-        const bool in_contact = any_contact();
-        if (current_layer < n_layers && in_contact) states[current_layer] = LayerState::pressed;
-        predictor_valid = in_contact;
-        last_advance = advance;
+// Fills the model part of the summary and logs it.
+void SlabInsertionRun::describe_model() {
+  summary_.n_dofs = solver_.n_dofs();
+  summary_.n_cells = tria_->n_global_active_cells();
+  summary_.n_ranks = Utilities::MPI::n_mpi_processes(comm_);
+  summary_.degree = disc_.degree;
+  summary_.refinement = disc_.refinement;
+  std::ostringstream s;
+  s << "fem: scene '" << scene_.name << "', " << summary_.n_cells << " cells, Q" << disc_.degree << " ("
+    << options_.formulation << "), " << summary_.n_dofs << " dofs, "
+    << (settings_.direct_linear_solver ? "MUMPS" : "CG+AMG") << ", " << summary_.n_ranks << " rank(s)";
+  log(s.str());
+}
 
-        // Puncture criterion of the pressed layer.
-        if (current_layer < n_layers && in_contact) {
-          const auto& crit = scene.layers[current_layer].puncture;
-          const double force = needle_force();
-          const double stretch = tip_stretch(current_layer);
-          const bool breaks = crit.kind == PunctureCriterion::Kind::CriticalForce
-                                  ? force >= crit.critical_force_N
-                                  : stretch >= crit.critical_stretch;
-          if (breaks && advance > resolution * (1.0 + 1e-9)) {
-            // Undo the step and bisect toward the crossing.
-            crossing_upper = depth;
-            solver.restore(snapshot);
-            contact = contact_before;
-            states = states_before;
-            depth = depth_before;
-            last_advance = last_advance_before;
-            predictor_valid = predictor_valid_before;
-            solution_is_stale = false;
-            ++summary.bisections;
-            continue;
-          }
-          if (breaks) {
-            crossing_upper = std::numeric_limits<double>::infinity();
-            predictor_valid = false;
-            const std::size_t layer = current_layer;
-            PunctureEvent event;
-            event.layer = int(layer);
-            event.layer_name = scene.layers[layer].name;
-            event.depth_m = depth;
-            event.force_N = force;
-            event.max_stretch = stretch;
-            event.time_s = (depth + start_height) / speed;
-            record_row(depth, force, stretch);
-            for (const auto& [r, uz] : surface_profile(layer))
-              recovery_csv << layer << ",before," << format_double(depth * 1e3) << ","
-                           << format_double(r * 1e3) << "," << format_double(uz * 1e3) << "\n";
-            // Remove the layer's material along the needle path, release the tip.
-            // The spring-back is a homotopy in lambda = 1 -> 0 (see the header):
-            // the removed cells' frozen load is lambda x its value and the
-            // released contact nodes hang on anchor springs of lambda^2 x
-            // 100x the contact patch stiffness per node.
-            solver.remove_cells(
-                [&](const FiniteStrainSolver::CellIterator& cell) {
-                  const Point<3> c = cell->center();
-                  return cell->material_id() == layer && std::hypot(c[0], c[1]) < needle_radius;
-                },
-                /*release_gradually=*/true);
-            states[layer] = LayerState::punctured;
-            const double indentation = std::max(depth - scene.layer_top_depth_m(layer), 1e-3 * needle_radius);
-            const std::size_t n_released = Utilities::MPI::sum(contact.size(), comm);
-            const double k0 = 100.0 * std::abs(force) / (indentation * std::max<std::size_t>(1, n_released));
-            std::map<types::global_dof_index, double> springs;
-            for (const auto& [n, hold] : contact)
-              for (unsigned c = 0; c < 3; ++c) springs[nodes[n].dof[c]] = k0;
-            contact.clear();
-            current_layer = layer + 1;
-            solver.set_anchor_springs(springs);
-            double lambda = 1.0;  // last converged stage
-            double d_lambda = 1.0 / options.spring_back_stages;
-            while (lambda > 0.0) {
-              const double next = lambda - d_lambda < 1e-3 ? 0.0 : lambda - d_lambda;
-              solver.set_released_force_fraction(next);
-              solver.set_anchor_spring_scale(next * next);
-              const auto stage_snapshot = solver.snapshot();
-              const auto stage_contact = contact;
-              solution_is_stale = true;
-              NewtonReport spring_back;
-              const bool ok = solve_at(depth, spring_back, 0.0);
-              ++summary.spring_back_stages;
-              if (!ok) {
-                solver.restore(stage_snapshot);
-                contact = stage_contact;
-                d_lambda *= 0.5;
-                if (d_lambda < 1.0 / (64.0 * options.spring_back_stages))
-                  throw std::runtime_error("fem: spring-back after the puncture of " + event.layer_name +
-                                           " did not converge: " + spring_back.failure);
-                continue;
-              }
-              lambda = next;
-            }
-            solver.set_anchor_springs({});
-            const bool touching = any_contact();
-            event.force_after_N = touching ? needle_force() : 0.0;
-            if (current_layer < n_layers && touching) states[current_layer] = LayerState::pressed;
-            for (const auto& [r, uz] : surface_profile(layer))
-              recovery_csv << layer << ",after," << format_double(depth * 1e3) << ","
-                           << format_double(r * 1e3) << "," << format_double(uz * 1e3) << "\n";
-            summary.punctures.push_back(event);
-            log("  PUNCTURE of " + event.layer_name + " at depth " + format_double(depth * 1e3, 5) +
-                " mm, force " + format_double(force, 5) + " N -> " + format_double(event.force_after_N, 5) +
-                " N");
-            const double stretch_after =
-                current_layer < n_layers && touching ? tip_stretch(current_layer) : 1.0;
-            record_row(depth, event.force_after_N, stretch_after);
-            write_frame(depth);
-          }
-        }
+// Base and lateral surface held (u = 0); the nodes of each layer's top
+// interface, and those of them under the needle.
+void SlabInsertionRun::find_node_sets() {
+  VectorTools::interpolate_boundary_values(solver_.dof_handler(), kBase, Functions::ZeroFunction<3>(3), fixed_);
+  VectorTools::interpolate_boundary_values(solver_.dof_handler(), kLateral, Functions::ZeroFunction<3>(3), fixed_);
+  nodes_ = group_nodes(solver_.locally_relevant_dof_points(), thickness_);
+  interface_z_.resize(n_layers_);
+  for (std::size_t i = 0; i < n_layers_; ++i) interface_z_[i] = -scene_.layer_top_depth_m(i);
+  interface_nodes_.resize(n_layers_);
+  tip_nodes_.resize(n_layers_);
+  for (std::size_t n = 0; n < nodes_.size(); ++n)
+    for (std::size_t i = 0; i < n_layers_; ++i)
+      if (std::abs(nodes_[n].X[2] - interface_z_[i]) < tol_) {
+        interface_nodes_[i].push_back(n);
+        if (nodes_[n].r() <= needle_radius_ * (1.0 + 1e-6)) tip_nodes_[i].push_back(n);
       }
-      const bool touching = any_contact();
-      const double force = touching ? needle_force() : 0.0;
-      const double stretch = touching && current_layer < n_layers ? tip_stretch(current_layer) : 1.0;
-      if (!std::isfinite(force)) throw std::runtime_error("fem: non-finite needle force");
-      // (A puncture at the end of the step already recorded this depth.)
-      if (!(rows.back().depth_m == depth && rows.back().force_N == force)) record_row(depth, force, stretch);
-      ++record_index;
-      if (current_layer < n_layers)
-        for (const auto& [r, uz] : surface_profile(current_layer))
-          profile_csv << record_index << "," << format_double(depth * 1e3) << "," << format_double(r * 1e3)
-                      << "," << format_double(uz * 1e3) << "," << scene.layers[current_layer].name << "\n";
-      if (step % vtu_stride == 0 || step == n_steps) write_frame(depth);
-      std::ostringstream s;
-      s << "  step " << std::setw(4) << step << "/" << n_steps << "  depth " << std::fixed << std::setprecision(3)
-        << depth * 1e3 << " mm  force " << std::setprecision(5) << force << " N  tip stretch "
-        << std::setprecision(4) << stretch << "  contact " << contact.size()
-        << "  newton(total) " << summary.newton_iterations;
-      log(s.str());
+}
+
+// The algorithm: from the start height to the final depth, load step by load
+// step, advance the tip (with punctures on the way), then record the step.
+// The outputs are written also when the run fails.
+FemRunSummary SlabInsertionRun::run() {
+  record_row(depth_, 0.0, 1.0);
+  write_frame(depth_);
+  try {
+    for (int step = 1; step <= n_steps_; ++step) {
+      advance_to(std::min(-start_height_ + step * load_step_, final_depth_));
+      record_load_step(step);
     }
   } catch (const std::exception& e) {
     write_outputs("failed", e.what());
     throw std::runtime_error(e.what());
   }
   write_outputs("completed", "");
-  summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  log("fem: done in " + format_double(summary.wall_time_s, 4) + " s, " + std::to_string(summary.load_steps) +
-      " load steps, " + std::to_string(summary.newton_iterations) + " Newton iterations, peak force " +
-      format_double(summary.peak_force_N, 5) + " N");
-  return summary;
+  summary_.wall_time_s = insertion::seconds_since(wall_start_);
+  log("fem: done in " + format_double(summary_.wall_time_s, 4) + " s, " + std::to_string(summary_.load_steps) +
+      " load steps, " + std::to_string(summary_.newton_iterations) + " Newton iterations, peak force " +
+      format_double(summary_.peak_force_N, 5) + " N");
+  return summary_;
+}
+
+// Advances the tip to `step_target` in sub-steps: a sub-step whose solve
+// fails is halved; one after which the pressed layer's criterion holds is
+// undone and bisected until the crossing is within the resolution; there the
+// layer is punctured.
+void SlabInsertionRun::advance_to(double step_target) {
+  double increment = step_target - depth_;
+  while (depth_ < step_target - 1e-12 * load_step_) {
+    const double trial_depth = next_trial_depth(step_target, increment);
+    const double advance = trial_depth - depth_;
+    const SubStepStart start = sub_step_start();
+    const double predictor_scale =
+        predictor_valid_ && last_advance_ > 0.0 ? std::min(2.0, advance / last_advance_) : 0.0;
+    NewtonReport report;
+    if (!solve_at(trial_depth, report, predictor_scale)) {
+      increment = cut_sub_step(start, trial_depth, advance, report);
+      continue;
+    }
+    increment = std::min(2.0 * advance, load_step_);
+    const bool in_contact = accept_sub_step(trial_depth, advance);
+    if (current_layer_ >= n_layers_ || !in_contact) continue;
+    const PunctureCheck check = check_puncture();
+    if (!check.breaks) continue;
+    if (advance > resolution_ * (1.0 + 1e-9)) {
+      undo_for_bisection(start);
+      continue;
+    }
+    puncture_current_layer(check.force_N, check.stretch);
+  }
+}
+
+// The next sub-step's depth: `increment` further (at most to the step's
+// target), or half-way toward a known crossing (the last part taken whole).
+double SlabInsertionRun::next_trial_depth(double step_target, double increment) const {
+  double trial_depth = std::min(depth_ + increment, step_target);
+  if (std::isfinite(crossing_upper_)) {
+    const double remaining = crossing_upper_ - depth_;
+    trial_depth = std::min(trial_depth, remaining <= resolution_ * (1.0 + 1e-9) ? crossing_upper_
+                                                                                : depth_ + 0.5 * remaining);
+  }
+  return trial_depth;
+}
+
+// The state a sub-step starts from.
+SubStepStart SlabInsertionRun::sub_step_start() const {
+  return {depth_, last_advance_, predictor_valid_, contact_, states_, solver_.snapshot()};
+}
+
+// A failed solve: back to the contact set before it, half the sub-step
+// (returned); stops with an error below 1/256 of the load step.
+double SlabInsertionRun::cut_sub_step(const SubStepStart& start, double trial_depth, double advance,
+                                      const NewtonReport& report) {
+  contact_ = start.contact;
+  solution_is_stale_ = true;
+  const double increment = 0.5 * advance;
+  ++summary_.step_cuts;
+  log("  step cut at depth " + format_double(trial_depth * 1e3, 6) + " mm: " + report.failure);
+  if (increment < load_step_ / 256.0)
+    throw std::runtime_error("fem: cannot continue at depth " + format_double(depth_ * 1e3, 6) + " mm: " +
+                             report.failure + " even with load step " + format_double(increment * 1e3, 4) + " mm");
+  return increment;
+}
+
+// A converged sub-step: the tip is at `trial_depth`; the layer it touches is
+// pressed. Returns whether the needle touches the tissue.
+bool SlabInsertionRun::accept_sub_step(double trial_depth, double advance) {
+  depth_ = trial_depth;
+  ++summary_.load_steps;
+  if (trial_depth == crossing_upper_) crossing_upper_ = std::numeric_limits<double>::infinity();
+  const bool in_contact = any_contact();
+  if (current_layer_ < n_layers_ && in_contact) states_[current_layer_] = LayerState::pressed;
+  predictor_valid_ = in_contact;
+  last_advance_ = advance;
+  return in_contact;
+}
+
+// The pressed layer's puncture criterion: critical needle force or critical
+// maximum principal stretch at the tip.
+PunctureCheck SlabInsertionRun::check_puncture() {
+  const auto& crit = scene_.layers[current_layer_].puncture;
+  const double force = needle_force();
+  const double stretch = tip_stretch(current_layer_);
+  const bool breaks = crit.kind == PunctureCriterion::Kind::CriticalForce ? force >= crit.critical_force_N
+                                                                           : stretch >= crit.critical_stretch;
+  return {force, stretch, breaks};
+}
+
+// The criterion holds after a sub-step longer than the resolution: undo it
+// and bisect toward the crossing.
+void SlabInsertionRun::undo_for_bisection(const SubStepStart& start) {
+  crossing_upper_ = depth_;
+  solver_.restore(start.snapshot);
+  contact_ = start.contact;
+  states_ = start.states;
+  depth_ = start.depth_m;
+  last_advance_ = start.last_advance_m;
+  predictor_valid_ = start.predictor_valid;
+  solution_is_stale_ = false;
+  ++summary_.bisections;
+}
+
+// Punctures the current layer at this depth: record the state before, open
+// the hole along the needle path, release the needle and let the tissue
+// spring back, record the state after.
+void SlabInsertionRun::puncture_current_layer(double force, double stretch) {
+  crossing_upper_ = std::numeric_limits<double>::infinity();
+  predictor_valid_ = false;
+  const std::size_t layer = current_layer_;
+  PunctureEvent event = record_before_puncture(layer, force, stretch);
+  open_hole(layer);
+  release_needle(layer, force);
+  spring_back(event.layer_name);
+  record_after_puncture(layer, std::move(event));
+}
+
+// The puncture event at its peak, its row and the surface before breakthrough.
+PunctureEvent SlabInsertionRun::record_before_puncture(std::size_t layer, double force, double stretch) {
+  PunctureEvent event;
+  event.layer = int(layer);
+  event.layer_name = scene_.layers[layer].name;
+  event.depth_m = depth_;
+  event.force_N = force;
+  event.max_stretch = stretch;
+  event.time_s = (depth_ + start_height_) / speed_;
+  record_row(depth_, force, stretch);
+  records_.add_recovery_profile(layer, "before", depth_, surface_profile(layer));
+  return event;
+}
+
+// Removes the layer's material along the needle path (cells with centre
+// inside the needle radius become void; their internal force is kept as a
+// frozen load for the spring-back homotopy).
+void SlabInsertionRun::open_hole(std::size_t layer) {
+  solver_.remove_cells(
+      [&](const FiniteStrainSolver::CellIterator& cell) {
+        const Point<3> c = cell->center();
+        return cell->material_id() == layer && std::hypot(c[0], c[1]) < needle_radius_;
+      },
+      /*release_gradually=*/true);
+  states_[layer] = LayerState::punctured;
+}
+
+// Releases the contact set: its nodes hang on anchor springs of 100x the
+// contact patch stiffness per node; the tip goes on to the next layer.
+void SlabInsertionRun::release_needle(std::size_t layer, double force) {
+  const double indentation = std::max(depth_ - scene_.layer_top_depth_m(layer), 1e-3 * needle_radius_);
+  const std::size_t n_released = Utilities::MPI::sum(contact_.size(), comm_);
+  const double k0 = 100.0 * std::abs(force) / (indentation * std::max<std::size_t>(1, n_released));
+  std::map<types::global_dof_index, double> springs;
+  for (const auto& [n, hold] : contact_)
+    for (unsigned c = 0; c < 3; ++c) springs[nodes_[n].dof[c]] = k0;
+  contact_.clear();
+  current_layer_ = layer + 1;
+  solver_.set_anchor_springs(springs);
+}
+
+// The spring-back as a homotopy in lambda = 1 -> 0 (see the header): the
+// removed cells' frozen load is lambda x its value, the anchor springs
+// lambda^2 x theirs; a failed stage is retried with half the lambda step.
+void SlabInsertionRun::spring_back(const std::string& layer_name) {
+  double lambda = 1.0;  // last converged stage
+  double d_lambda = 1.0 / options_.spring_back_stages;
+  while (lambda > 0.0) {
+    const double next = lambda - d_lambda < 1e-3 ? 0.0 : lambda - d_lambda;
+    solver_.set_released_force_fraction(next);
+    solver_.set_anchor_spring_scale(next * next);
+    const auto stage_snapshot = solver_.snapshot();
+    const auto stage_contact = contact_;
+    solution_is_stale_ = true;
+    NewtonReport report;
+    const bool ok = solve_at(depth_, report, 0.0);
+    ++summary_.spring_back_stages;
+    if (!ok) {
+      solver_.restore(stage_snapshot);
+      contact_ = stage_contact;
+      d_lambda *= 0.5;
+      if (d_lambda < 1.0 / (64.0 * options_.spring_back_stages))
+        throw std::runtime_error("fem: spring-back after the puncture of " + layer_name +
+                                 " did not converge: " + report.failure);
+      continue;
+    }
+    lambda = next;
+  }
+  solver_.set_anchor_springs({});
+}
+
+// After the spring-back: the force on the next layer (if touched), the
+// surface after breakthrough, the event, its row and a frame.
+void SlabInsertionRun::record_after_puncture(std::size_t layer, PunctureEvent event) {
+  const bool touching = any_contact();
+  event.force_after_N = touching ? needle_force() : 0.0;
+  if (current_layer_ < n_layers_ && touching) states_[current_layer_] = LayerState::pressed;
+  records_.add_recovery_profile(layer, "after", depth_, surface_profile(layer));
+  summary_.punctures.push_back(event);
+  log("  PUNCTURE of " + event.layer_name + " at depth " + format_double(depth_ * 1e3, 5) + " mm, force " +
+      format_double(event.force_N, 5) + " N -> " + format_double(event.force_after_N, 5) + " N");
+  const double stretch_after = current_layer_ < n_layers_ && touching ? tip_stretch(current_layer_) : 1.0;
+  record_row(depth_, event.force_after_N, stretch_after);
+  write_frame(depth_);
+}
+
+// The end of a load step: its row, the pressed surface, a frame every
+// vtu_stride steps (and the last), a progress line.
+void SlabInsertionRun::record_load_step(int step) {
+  const bool touching = any_contact();
+  const double force = touching ? needle_force() : 0.0;
+  const double stretch = touching && current_layer_ < n_layers_ ? tip_stretch(current_layer_) : 1.0;
+  if (!std::isfinite(force)) throw std::runtime_error("fem: non-finite needle force");
+  // (A puncture at the end of the step already recorded this depth.)
+  if (!(rows_.back().depth_m == depth_ && rows_.back().force_N == force)) record_row(depth_, force, stretch);
+  ++record_index_;
+  if (current_layer_ < n_layers_)
+    records_.add_surface_profile(record_index_, depth_, surface_profile(current_layer_),
+                                 scene_.layers[current_layer_].name);
+  if (step % vtu_stride_ == 0 || step == n_steps_) write_frame(depth_);
+  std::ostringstream s;
+  s << "  step " << std::setw(4) << step << "/" << n_steps_ << "  depth " << std::fixed << std::setprecision(3)
+    << depth_ * 1e3 << " mm  force " << std::setprecision(5) << force << " N  tip stretch "
+    << std::setprecision(4) << stretch << "  contact " << contact_.size() << "  newton(total) "
+    << summary_.newton_iterations;
+  log(s.str());
+}
+
+// Solves at tip depth `depth`, joining reached nodes until none is left.
+// predictor_scale: start the first pass from u + scale x the last increment.
+bool SlabInsertionRun::solve_at(double depth, NewtonReport& report, double predictor_scale) {
+  const double z_tip = -depth;
+  for (int pass = 0; pass < 8; ++pass) {
+    const bool joined = join_reached_nodes(z_tip);
+    if (!joined && !solution_is_stale_ && !any_contact()) return true;  // nothing to do
+    apply_targets(z_tip);
+    const auto t0 = std::chrono::steady_clock::now();
+    report = solver_.solve_step(pass == 0 && !joined ? predictor_scale : 0.0);
+    summary_.solve_time_s += insertion::seconds_since(t0);
+    summary_.newton_iterations += report.iterations;
+    summary_.linear_iterations += report.linear_iterations;
+    records_.newton_log << "depth " << format_double(depth * 1e3, 6) << " mm, contact nodes " << contact_.size()
+                        << (solver_.has_anchor_springs() ? ", spring-back stage" : "")
+                        << (report.converged ? "" : ", FAILED: " + report.failure) << "\n";
+    for (const auto& line : report.table) {
+      records_.newton_log << "  " << line << "\n";
+      log("      " + line);
+    }
+    if (!report.converged) return false;
+    solution_is_stale_ = false;
+    bool more = false;
+    if (current_layer_ < n_layers_)
+      for (const std::size_t n : tip_nodes_[current_layer_])
+        if (!contact_.count(n) && nodes_[n].X[2] + u_of(nodes_[n], 2) >= z_tip - tol_) more = true;
+    if (Utilities::MPI::max(more ? 1 : 0, comm_) == 0) return true;
+  }
+  return true;
+}
+
+// Collective: does any rank hold contact nodes? (A rank may own none of them.)
+bool SlabInsertionRun::any_contact() const { return Utilities::MPI::max(contact_.empty() ? 0 : 1, comm_) == 1; }
+
+// Prescribes the held boundary and the contact nodes: on the tip in z, held laterally.
+void SlabInsertionRun::apply_targets(double z_tip) {
+  std::map<types::global_dof_index, double> targets = fixed_;
+  for (const auto& [n, hold] : contact_) {
+    targets[nodes_[n].dof[0]] = hold[0];
+    targets[nodes_[n].dof[1]] = hold[1];
+    targets[nodes_[n].dof[2]] = z_tip - nodes_[n].X[2];
+  }
+  solver_.set_prescribed_displacements(std::move(targets));
+}
+
+// Nodes of the current interface the tip has reached (current z >= z_tip)
+// join the contact set; collective: did any join?
+bool SlabInsertionRun::join_reached_nodes(double z_tip) {
+  bool joined = false;
+  if (current_layer_ >= n_layers_) return false;
+  for (const std::size_t n : tip_nodes_[current_layer_]) {
+    if (contact_.count(n)) continue;
+    if (nodes_[n].X[2] + u_of(nodes_[n], 2) >= z_tip - tol_) {
+      contact_[n] = {u_of(nodes_[n], 0), u_of(nodes_[n], 1)};
+      joined = true;
+    }
+  }
+  return Utilities::MPI::max(joined ? 1 : 0, comm_) == 1;
+}
+
+// The needle force (N, > 0 resisting the insertion).
+double SlabInsertionRun::needle_force() const {
+  std::vector<types::global_dof_index> dofs;
+  for (const auto& [n, hold] : contact_) dofs.push_back(nodes_[n].dof[2]);
+  // The z reaction is what the needle applies to the tissue; the tissue
+  // pushes back on the needle with the opposite force (upward, > 0).
+  const double force = -solver_.sum_of_residual(dofs);
+  return force == 0.0 ? 0.0 : force;  // no "-0" in the CSV
+}
+
+// Maximum principal stretch in the layer's cells touching the needle's patch of its top.
+double SlabInsertionRun::tip_stretch(std::size_t layer) const {
+  return solver_.max_principal_stretch([&](const FiniteStrainSolver::CellIterator& cell) {
+    if (cell->material_id() != layer) return false;
+    for (unsigned v = 0; v < 8; ++v) {
+      const Point<3>& p = cell->vertex(v);
+      if (std::abs(p[2] - interface_z_[layer]) < tol_ && std::hypot(p[0], p[1]) <= needle_radius_ * (1.0 + 1e-6))
+        return true;
+    }
+    return false;
+  });
+}
+
+// u_z(r) of a layer's top interface, averaged over nodes at the same r (rank 0 gets it).
+insertion::SurfaceProfile SlabInsertionRun::surface_profile(std::size_t layer) const {
+  std::vector<std::pair<double, double>> local;
+  const IndexSet owned = solver_.dof_handler().locally_owned_dofs();
+  for (const std::size_t n : interface_nodes_[layer])
+    if (owned.is_element(nodes_[n].dof[2])) local.emplace_back(nodes_[n].r(), u_of(nodes_[n], 2));
+  const auto all = Utilities::MPI::gather(comm_, local, 0);
+  std::map<long long, std::pair<double, int>> by_r;
+  std::map<long long, double> r_of;
+  for (const auto& part : all)
+    for (const auto& [r, uz] : part) {
+      const long long key = std::llround(r / (1e-7 * thickness_));
+      auto& acc = by_r[key];
+      acc.first += uz;
+      acc.second += 1;
+      r_of[key] = r;
+    }
+  insertion::SurfaceProfile profile;
+  for (const auto& [key, acc] : by_r) profile.emplace_back(r_of[key], acc.first / acc.second);
+  return profile;
+}
+
+// One row of the force-depth curve (CSV and summary).
+void SlabInsertionRun::record_row(double depth, double force, double stretch) {
+  const double time = (depth + start_height_) / speed_;
+  rows_.push_back({time, depth, speed_, force, stretch, states_});
+  summary_.time_s.push_back(time);
+  summary_.depth_m.push_back(depth);
+  summary_.force_N.push_back(force);
+  if (force > summary_.peak_force_N) {
+    summary_.peak_force_N = force;
+    summary_.peak_force_depth_m = depth;
+  }
+}
+
+// Writes one frame of the fields (collective; if VTU output is asked for).
+void SlabInsertionRun::write_frame(double depth) {
+  if (!fields_) return;
+  const auto names = fields_->write_frame(solver_, (depth + start_height_) / speed_);
+  if (root_) summary_.files_written.insert(summary_.files_written.end(), names.begin(), names.end());
+}
+
+// Writes the PVD collection, then (rank 0) the CSV files, the Newton log and
+// the summary with `status` ("completed" or "failed") and `error`.
+void SlabInsertionRun::write_outputs(const std::string& status, const std::string& error) {
+  if (!options_.write_files) return;
+  if (fields_ && root_) summary_.files_written.push_back(fields_->write_collection());
+  else if (fields_) fields_->write_collection();
+  if (!root_) return;
+  insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
+  insertion::list_text_outputs(summary_.files_written);
+  summary_.wall_time_s = insertion::seconds_since(wall_start_);
+  write_file_atomically(out_dir_ / "fem_summary.json", summary_json(status, error).dump(2) + "\n");
+}
+
+// fem_force_depth.csv: one line per recorded row.
+std::string SlabInsertionRun::force_depth_csv() const {
+  std::ostringstream csv;
+  csv << insertion::force_depth_header("time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch", scene_);
+  for (const auto& r : rows_) {
+    csv << format_double(r.time_s) << "," << format_double(r.depth_m * 1e3) << ","
+        << format_double(r.velocity_m_per_s * 1e3) << "," << format_double(r.force_N) << ","
+        << format_double(r.tip_stretch, 6);
+    insertion::append_layer_states(csv, r.states);
+    csv << "\n";
+  }
+  return csv.str();
+}
+
+// fem_summary.json: the model, the peak, the counts, the timings, the
+// punctures and the files.
+nlohmann::json SlabInsertionRun::summary_json(const std::string& status, const std::string& error) const {
+  nlohmann::json j;
+  j["status"] = status;
+  if (!error.empty()) j["error"] = error;
+  j["scene"] = scene_.name;
+  j["n_dofs"] = summary_.n_dofs;
+  j["n_cells"] = summary_.n_cells;
+  j["n_ranks"] = summary_.n_ranks;
+  j["element_degree"] = disc_.degree;
+  j["refinement"] = disc_.refinement;
+  j["formulation"] = options_.formulation;
+  j["load_step_mm"] = load_step_ * 1e3;
+  j["final_depth_mm"] = final_depth_ * 1e3;
+  j["note"] = "quasi-static; the FEM stops at the target depth (no dwell, no withdrawal)";
+  j["peak_force_N"] = summary_.peak_force_N;
+  j["peak_force_depth_mm"] = summary_.peak_force_depth_m * 1e3;
+  j["load_steps"] = summary_.load_steps;
+  j["step_cuts"] = summary_.step_cuts;
+  j["puncture_bisections"] = summary_.bisections;
+  j["spring_back_stages"] = summary_.spring_back_stages;
+  j["puncture_depth_resolution_mm"] = resolution_ * 1e3;
+  j["newton_iterations"] = summary_.newton_iterations;
+  j["linear_iterations"] = summary_.linear_iterations;
+  j["wall_time_s"] = summary_.wall_time_s;
+  j["solve_time_s"] = summary_.solve_time_s;
+  j["punctures"] = insertion::punctures_json(summary_.punctures, /*with_stretch=*/true);
+  j["files"] = summary_.files_written;
+  return j;
 }
 
 }  // namespace
+
+FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& options, MPI_Comm comm) {
+  std::string geometry = scene.fem.geometry;
+  if (geometry == "auto") geometry = scene.needle.tip == "blunt" ? "3d" : "axisymmetric";
+  if (geometry == "axisymmetric") return run_axisymmetric_insertion(scene, options, comm);
+  if (scene.needle.tip != "blunt")
+    throw std::invalid_argument("fem: the 3d reference models a flat (blunt) punch only; needle tip '" +
+                                scene.needle.tip + "' needs geometry axisymmetric");
+  for (const Layer& l : scene.layers)
+    if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy)
+      throw std::invalid_argument("fem: the 3d reference has no fracture_energy criterion (layer '" + l.name +
+                                  "'); use geometry axisymmetric");
+  SlabInsertionRun run(scene, options, comm);  // slab, solver, node sets
+  return run.run();  // per load step: advance, detect puncture, open the hole, release, record; write
+}
 
 }  // namespace puncture::fem

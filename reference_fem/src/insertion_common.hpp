@@ -1,0 +1,144 @@
+// insertion_common.hpp: what the two insertion drivers share
+// (axisymmetric_insertion.cc, needle_insertion.cc): the state of a layer, the
+// number format of the CSV files, the rows of the surface and recovery
+// profiles, the force-depth CSV's layer-state columns, the checks of the
+// scene both drivers make, the text outputs and the puncture events of the
+// summary. Internal to reference_fem/src (not part of the public headers).
+//
+// Units: depths, radii and displacements in m in, mm in the CSV files;
+// forces in N; times in s.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <filesystem>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <puncture/fem/field_output.hpp>
+#include <puncture/fem/needle_insertion.hpp>
+#include <puncture/scene.hpp>
+
+namespace puncture::fem::insertion {
+
+/// What the needle has done to a layer so far.
+enum class LayerState { untouched, pressed, punctured };
+
+inline const char* to_string(LayerState s) {
+  switch (s) {
+    case LayerState::untouched: return "untouched";
+    case LayerState::pressed: return "pressed";
+    case LayerState::punctured: return "punctured";
+  }
+  return "?";
+}
+
+/// `v` with `precision` significant digits (the number format of every CSV).
+inline std::string format_double(double v, int precision = 9) {
+  std::ostringstream s;
+  s << std::setprecision(precision) << v;
+  return s.str();
+}
+
+/// Seconds of wall time since `start`.
+inline double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// u_z(r) of a surface: pairs (r, u_z), both in m.
+using SurfaceProfile = std::vector<std::pair<double, double>>;
+
+/// The three text records a run collects while it walks: the Newton tables,
+/// the surface profile of the pressed layer, the spring-back of punctured
+/// surfaces (CSV headers already in place).
+struct InsertionRecords {
+  std::ostringstream newton_log, profile_csv, recovery_csv;
+  InsertionRecords() {
+    profile_csv << "step,depth_mm,r_mm,uz_mm,surface\n";
+    recovery_csv << "layer,phase,depth_mm,r_mm,uz_mm\n";
+  }
+
+  /// Rows `step,depth_mm,r_mm,uz_mm,surface` of fem_surface_profile.csv.
+  void add_surface_profile(int step, double depth_m, const SurfaceProfile& profile, const std::string& surface) {
+    for (const auto& [r, uz] : profile)
+      profile_csv << step << "," << format_double(depth_m * 1e3) << "," << format_double(r * 1e3) << ","
+                  << format_double(uz * 1e3) << "," << surface << "\n";
+  }
+
+  /// Rows `layer,phase,depth_mm,r_mm,uz_mm` of fem_recovery_profile.csv
+  /// (phase "before" or "after" the breakthrough).
+  void add_recovery_profile(std::size_t layer, const char* phase, double depth_m, const SurfaceProfile& profile) {
+    for (const auto& [r, uz] : profile)
+      recovery_csv << layer << "," << phase << "," << format_double(depth_m * 1e3) << ","
+                   << format_double(r * 1e3) << "," << format_double(uz * 1e3) << "\n";
+  }
+};
+
+/// Header line of fem_force_depth.csv: `columns`, then `<layer>_state` per layer.
+inline std::string force_depth_header(const std::string& columns, const Scene& scene) {
+  std::string header = columns;
+  for (const auto& layer : scene.layers) header += "," + layer.name + "_state";
+  return header + "\n";
+}
+
+/// The `<layer>_state` columns of one row of fem_force_depth.csv.
+inline void append_layer_states(std::ostream& csv, const std::vector<LayerState>& states) {
+  for (const auto s : states) csv << "," << to_string(s);
+}
+
+/// The checks of the scene both references make (layers, an axial insertion
+/// at positive speed); throws std::invalid_argument.
+inline void check_axial_insertion(const Scene& scene) {
+  if (scene.layers.empty()) throw std::invalid_argument("fem: the scene has no layers");
+  if (scene.insertion.angle_deg != 0.0)
+    throw std::invalid_argument("fem: only insertions along the sample axis (angle_deg = 0) are modelled");
+  if (!(scene.insertion.speed_m_per_s > 0.0)) throw std::invalid_argument("fem: insertion speed must be > 0");
+}
+
+/// Element degree: the option's override, else the scene's.
+inline int element_degree(const Scene& scene, const FemRunOptions& options) {
+  return options.degree_override > 0 ? options.degree_override : scene.fem.element_degree;
+}
+
+/// Global refinements: the option's override, else the scene's.
+inline int refinement_level(const Scene& scene, const FemRunOptions& options) {
+  return options.refinement_override >= 0 ? options.refinement_override : scene.fem.refinement;
+}
+
+/// Writes fem_force_depth.csv (`force_depth_csv`), the two profiles and the
+/// Newton log into `out_dir`, each atomically.
+inline void write_text_outputs(const std::filesystem::path& out_dir, const std::string& force_depth_csv,
+                               const InsertionRecords& records) {
+  write_file_atomically(out_dir / "fem_force_depth.csv", force_depth_csv);
+  write_file_atomically(out_dir / "fem_surface_profile.csv", records.profile_csv.str());
+  write_file_atomically(out_dir / "fem_recovery_profile.csv", records.recovery_csv.str());
+  write_file_atomically(out_dir / "fem_newton_log.txt", records.newton_log.str());
+}
+
+/// Appends the names of the text outputs and of fem_summary.json to `files`.
+inline void list_text_outputs(std::vector<std::string>& files) {
+  for (const char* f : {"fem_force_depth.csv", "fem_surface_profile.csv", "fem_recovery_profile.csv",
+                        "fem_newton_log.txt", "fem_summary.json"})
+    files.push_back(f);
+}
+
+/// The summary's "punctures" array (depths in mm; `max_stretch` when
+/// `with_stretch`, as the 3D reference reports it).
+inline nlohmann::json punctures_json(const std::vector<PunctureEvent>& events, bool with_stretch) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& e : events) {
+    nlohmann::json j = {{"layer", e.layer},     {"name", e.layer_name},           {"depth_mm", e.depth_m * 1e3},
+                        {"force_N", e.force_N}, {"force_after_N", e.force_after_N}, {"time_s", e.time_s}};
+    if (with_stretch) j["max_stretch"] = e.max_stretch;
+    out.push_back(j);
+  }
+  return out;
+}
+
+}  // namespace puncture::fem::insertion
