@@ -323,6 +323,7 @@ std::optional<StepAdvance> AxisymmetricInsertionRun::advance_needle(std::size_t 
   }
   ++step_index_;
   ++summary_.load_steps;
+  if (report.accepted_at_stall) ++summary_.steps_accepted_at_stall;
   time_ = t1;
   depth_ = d1;
   last_advance_ = advance;
@@ -583,6 +584,7 @@ nlohmann::json AxisymmetricInsertionRun::summary_json() const {
   j["needle_work_insertion_J"] = summary_.needle_work_J;
   j["load_steps"] = summary_.load_steps;
   j["step_cuts"] = summary_.step_cuts;
+  j["steps_accepted_at_stall"] = summary_.steps_accepted_at_stall;
   j["newton_iterations"] = summary_.newton_iterations;
   j["wall_time_s"] = summary_.wall_time_s;
   j["solve_time_s"] = summary_.solve_time_s;

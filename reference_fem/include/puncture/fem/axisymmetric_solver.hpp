@@ -66,6 +66,19 @@ struct AxisymmetricSettings {
   double newton_tolerance = 1e-6;
   double absolute_residual_floor_N = 1e-10;
   int max_line_search_halvings = 6;
+  /// Stall detection: a step whose best free residual has not fallen below
+  /// stall_factor x its best before the last stall_window iterations is given
+  /// up (and cut by the driver) instead of cycling up to max_newton_iterations
+  /// (Newton can cycle at the kinks of contact and full damage). Slow but
+  /// steady progress (the damped iterations through the skin's snap) is not a
+  /// stall. stall_window 0: off.
+  int stall_window = 10;
+  double stall_factor = 0.9;
+  /// A stalled step whose free residual is already below this fraction of the
+  /// force scale is accepted (and reported as such) rather than cut: Newton
+  /// cycling at 1e-5 of the needle force is a kink, not a wrong equilibrium.
+  /// (For comparison, Abaqus' default accepts 5e-3 of the average force.)
+  double stall_acceptance_tolerance = 1e-4;
   double contact_penalty = 1e2;   ///< k_n / (diagonal of the bulk tangent at the node)
   double friction_penalty = 0.5;  ///< k_t / k_n
   double contact_rounding = 0.02; ///< eps of the C1 penalty, in tip element sizes
@@ -109,6 +122,8 @@ struct LayerCrack {
 /// Convergence record of one step.
 struct AxisymmetricNewtonReport {
   bool converged = false;
+  /// Converged to stall_acceptance_tolerance only (Newton stalled below it).
+  bool accepted_at_stall = false;
   int iterations = 0;
   double residual_N = 0.0;
   double force_scale_N = 0.0;

@@ -102,6 +102,10 @@ struct FemRunSummary {
   double peak_force_depth_m = 0.0;
   int load_steps = 0;         ///< converged (sub)steps solved
   int step_cuts = 0;          ///< halvings of the load step after a failed solve
+  /// Axisymmetric: steps accepted at a Newton stall below the acceptance
+  /// tolerance (AxisymmetricSettings::stall_acceptance_tolerance) rather than
+  /// at the Newton tolerance.
+  int steps_accepted_at_stall = 0;
   int bisections = 0;         ///< steps undone to locate a puncture depth
   int spring_back_stages = 0; ///< solves of the spring-back homotopies
   int newton_iterations = 0;  ///< total
