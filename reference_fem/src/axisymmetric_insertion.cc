@@ -21,6 +21,7 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include <puncture/fem/axisymmetric_solver.hpp>
 #include <puncture/fem/field_output.hpp>
@@ -117,6 +118,10 @@ AxisymmetricSettings solver_settings(const Scene& scene, int degree) {
   settings.newton_tolerance = scene.fem.newton_tolerance;
   settings.verbose = std::getenv("PUNCTURE_FEM_DEBUG") != nullptr;
   settings.stabilization_time_s = scene.fem.stabilization_time_s;
+  // Rank 0 solves while the other ranks sleep (share_outcome), so its cell
+  // loop may use every core; PUNCTURE_FEM_THREADS overrides.
+  settings.assembly_threads = std::max(1u, std::thread::hardware_concurrency());
+  if (const char* t = std::getenv("PUNCTURE_FEM_THREADS")) settings.assembly_threads = std::max(1, std::atoi(t));
   return settings;
 }
 
@@ -245,6 +250,7 @@ AxisymmetricInsertionRun::AxisymmetricInsertionRun(const Scene& scene, const Fem
 void AxisymmetricInsertionRun::describe_model(MPI_Comm comm) {
   summary_.geometry = "axisymmetric";
   summary_.n_dofs = solver_.n_dofs();
+  summary_.assembly_threads = static_cast<int>(solver_.settings().assembly_threads);
   summary_.n_cells = solver_.n_cells();
   summary_.n_ranks = static_cast<int>(dealii::Utilities::MPI::n_mpi_processes(comm));
   summary_.degree = degree_;
@@ -266,7 +272,8 @@ void AxisymmetricInsertionRun::describe_model(MPI_Comm comm) {
   std::ostringstream s;
   s << "fem: scene '" << scene_.name << "', axisymmetric, " << summary_.n_cells << " cells, Q" << degree_ << " ("
     << summary_.n_dofs << " dofs), tip element " << mesh_.tip_element_size_m * 1e3 << " mm, needle tip '"
-    << scene_.needle.tip << "', crack radius " << mesh_.crack_radius_m * 1e3 << " mm";
+    << scene_.needle.tip << "', crack radius " << mesh_.crack_radius_m * 1e3 << " mm, "
+    << summary_.assembly_threads << " assembly thread(s)";
   log(s.str());
   for (const auto& w : summary_.warnings) std::cerr << "warning: " << w << std::endl;
 }
@@ -569,6 +576,7 @@ nlohmann::json AxisymmetricInsertionRun::summary_json() const {
   j["scene"] = scene_.name;
   j["geometry"] = "axisymmetric";
   j["n_dofs"] = summary_.n_dofs;
+  j["assembly_threads"] = summary_.assembly_threads;
   j["n_cells"] = summary_.n_cells;
   j["n_ranks_used"] = 1;
   j["element_degree"] = degree_;
@@ -637,6 +645,14 @@ void outcome_from_json(const nlohmann::json& j, std::string& error, FemRunSummar
 void share_outcome(MPI_Comm comm, std::string& error, FemRunSummary& summary) {
   if (dealii::Utilities::MPI::n_mpi_processes(comm) == 1) return;
   const bool root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
+  // The other ranks wait asleep (a blocking collective would spin a core
+  // that rank 0's assembly threads use).
+  MPI_Request ready;
+  MPI_Ibarrier(comm, &ready);
+  for (int done = 0; !done;) {
+    MPI_Test(&ready, &done, MPI_STATUS_IGNORE);
+    if (!done) std::this_thread::sleep_for(std::chrono::milliseconds(root ? 0 : 5));
+  }
   const std::string text =
       dealii::Utilities::MPI::broadcast(comm, root ? outcome_to_json(error, summary).dump() : std::string(), 0);
   if (!root) outcome_from_json(nlohmann::json::parse(text), error, summary);

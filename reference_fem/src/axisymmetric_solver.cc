@@ -20,7 +20,9 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <exception>
 #include <iostream>
+#include <thread>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -235,6 +237,10 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
           cell->center()[0] < r_c && cell->center()[1] > -mesh_.path_depth_m ? 1 : 0;
 
   dof_handler_.distribute_dofs(fe_);
+  cells_.clear();
+  for (const auto& cell : dof_handler_.active_cell_iterators()) cells_.push_back(cell);
+  cell_work_.assign(cells_.size(), CellContribution{FullMatrix<double>(fe_.n_dofs_per_cell(), fe_.n_dofs_per_cell()),
+                                                    Vector<double>(fe_.n_dofs_per_cell()), 0.0});
   const unsigned n = dof_handler_.n_dofs();
   std::vector<Point<2>> support(n);
   DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
@@ -468,14 +474,12 @@ void AxisymmetricSolver::make_constraints(const Vector<double>& u, AffineConstra
   c.close();
 }
 
-bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
+bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, const Vector<double>& u, bool with_matrix) {
   const unsigned degree = settings_.degree;
   const QGauss<2> quadrature(degree + 1);
   FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_JxW_values | update_quadrature_points);
   const unsigned dpc = fe_.n_dofs_per_cell(), nq = quadrature.size(), np = n_pressure_modes(degree);
-  FullMatrix<double> Ke(dpc, dpc), B(np, dpc), G(np, np), tmp(np, np), GB(np, dpc);
-  Vector<double> Re(dpc);
-  std::vector<types::global_dof_index> dofs(dpc);
+  FullMatrix<double> B(np, dpc), G(np, np), tmp(np, np), GB(np, dpc);
   std::vector<Tensor<2, 3>> H(nq), gradN(dpc);
   std::vector<SymTensor2> dE(dpc), CC_dE(dpc);
   std::vector<unsigned> comp(dpc);
@@ -491,14 +495,13 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
   // initial shear modulus.
   const bool stabilize = settings_.stabilization_time_s > 0.0 && dt_s_ > 0.0 && step_start_.size() == u.size();
   const double stab_ratio = stabilize ? settings_.stabilization_time_s / dt_s_ : 0.0;
-  stabilization_trial_J_ = stabilization_J_;
 
-  if (with_matrix) {
-    tangent_ = 0.0;
-    bulk_diagonal_ = 0.0;
-  }
-  residual_ = 0.0;
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
+  for (std::size_t k = begin; k < end; ++k) {
+    const auto& cell = cells_[k];
+    CellContribution& out = cell_work_[k];
+    FullMatrix<double>& Ke = out.Ke;
+    Vector<double>& Re = out.Re;
+    out.stabilization_J = 0.0;
     fev.reinit(cell);
     fev[ur].get_function_gradients(u, g_ur);
     fev[uz].get_function_gradients(u, g_uz);
@@ -527,7 +530,7 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
       if (stabilize) {
         const Tensor<2, 3> dH = H[q] - displacement_gradient(g0_ur[q], g0_uz[q], v0_ur[q], R);
         const Tensor<2, 3> eps = 0.5 * (dH + transpose(dH));
-        stabilization_trial_J_ += two_mu_v * scalar_product(eps, eps) * st.dV[q];
+        out.stabilization_J += two_mu_v * scalar_product(eps, eps) * st.dV[q];
         for (unsigned i = 0; i < dpc; ++i) {
           const Tensor<2, 3> ei = 0.5 * (gradN[i] + transpose(gradN[i]));
           Re(i) += two_mu_v * scalar_product(ei, eps) * st.dV[q];
@@ -560,12 +563,52 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
       for (unsigned i = 0; i < dpc; ++i)
         for (unsigned j = i + 1; j < dpc; ++j) Ke(i, j) = Ke(j, i);
     }
-    cell->get_dof_indices(dofs);
-    for (unsigned i = 0; i < dpc; ++i) {
-      residual_(dofs[i]) += Re(i);
-      if (with_matrix) bulk_diagonal_(dofs[i]) += Ke(i, i);
+  }
+  return true;
+}
+
+bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
+  // Cells: computed in parallel (each thread its own range and scratch), added
+  // to the global system in cell order, so the result does not depend on the
+  // number of threads.
+  const std::size_t n_cells = cells_.size();
+  const std::size_t n_threads = std::max<std::size_t>(1, std::min<std::size_t>(settings_.assembly_threads, n_cells));
+  std::vector<char> ok(n_threads, 1);
+  std::vector<std::exception_ptr> errors(n_threads);
+  auto run_range = [&](std::size_t t) {
+    try {
+      ok[t] = assemble_cells(t * n_cells / n_threads, (t + 1) * n_cells / n_threads, u, with_matrix) ? 1 : 0;
+    } catch (...) {
+      errors[t] = std::current_exception();
     }
-    if (with_matrix) tangent_.add(dofs, Ke, false);
+  };
+  {
+    std::vector<std::thread> pool;
+    for (std::size_t t = 1; t < n_threads; ++t) pool.emplace_back(run_range, t);
+    run_range(0);
+    for (auto& th : pool) th.join();
+  }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+  for (const char o : ok)
+    if (!o) return false;
+
+  stabilization_trial_J_ = stabilization_J_;
+  if (with_matrix) {
+    tangent_ = 0.0;
+    bulk_diagonal_ = 0.0;
+  }
+  residual_ = 0.0;
+  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
+  for (std::size_t k = 0; k < n_cells; ++k) {
+    const CellContribution& c = cell_work_[k];
+    cells_[k]->get_dof_indices(dofs);
+    stabilization_trial_J_ += c.stabilization_J;
+    for (unsigned i = 0; i < dofs.size(); ++i) {
+      residual_(dofs[i]) += c.Re(i);
+      if (with_matrix) bulk_diagonal_(dofs[i]) += c.Ke(i, i);
+    }
+    if (with_matrix) tangent_.add(dofs, c.Ke, false);
   }
 
   // Cohesive points: R_outer += A t, R_core -= A t.

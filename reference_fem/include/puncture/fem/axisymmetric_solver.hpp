@@ -42,6 +42,7 @@
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/grid/tria.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/vector.h>
@@ -79,6 +80,9 @@ struct AxisymmetricSettings {
   /// cycling at 1e-5 of the needle force is a kink, not a wrong equilibrium.
   /// (For comparison, Abaqus' default accepts 5e-3 of the average force.)
   double stall_acceptance_tolerance = 1e-4;
+  /// Threads that compute the cells' stiffness and forces (the system is
+  /// added up in cell order, so results do not depend on this number).
+  unsigned int assembly_threads = 1;
   double contact_penalty = 1e2;   ///< k_n / (diagonal of the bulk tangent at the node)
   double friction_penalty = 0.5;  ///< k_t / k_n
   double contact_rounding = 0.02; ///< eps of the C1 penalty, in tip element sizes
@@ -150,6 +154,7 @@ class AxisymmetricSolver {
 
   /// Distributes the dofs, finds the crack pairs and the contact nodes, u = 0.
   void setup(double sample_radius_m, double total_thickness_m);
+  const AxisymmetricSettings& settings() const { return settings_; }
 
   std::size_t n_dofs() const { return dof_handler_.n_dofs(); }
   std::size_t n_cells() const { return triangulation_.n_active_cells(); }
@@ -250,6 +255,17 @@ class AxisymmetricSolver {
   dealii::SparsityPattern sparsity_;
   dealii::SparseMatrix<double> tangent_, system_matrix_;
   dealii::Vector<double> residual_, rhs_, solution_, last_increment_, bulk_diagonal_;
+  /// One cell's stiffness, forces and stabilisation energy of an assembly.
+  struct CellContribution {
+    dealii::FullMatrix<double> Ke;
+    dealii::Vector<double> Re;
+    double stabilization_J = 0.0;
+  };
+  std::vector<dealii::DoFHandler<2>::active_cell_iterator> cells_;
+  std::vector<CellContribution> cell_work_;
+  /// Cells [begin, end) of cells_ into cell_work_; false on an inverted or
+  /// non-finite state.
+  bool assemble_cells(std::size_t begin, std::size_t end, const dealii::Vector<double>& u, bool with_matrix);
 
   std::vector<ContactNode> contact_nodes_;
   std::vector<CohesivePoint> cohesive_points_;

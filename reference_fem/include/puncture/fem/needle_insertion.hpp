@@ -115,6 +115,7 @@ struct FemRunSummary {
   std::size_t n_dofs = 0;
   std::size_t n_cells = 0;
   int n_ranks = 1;
+  int assembly_threads = 1;  ///< axisymmetric: threads of rank 0's cell loop
   int degree = 1;
   int refinement = 0;
   std::vector<double> time_s, depth_m, force_N;  ///< the rows of the force-depth CSV
