@@ -13,8 +13,9 @@ scripts/fem_axisymmetric_convergence.sh) and writes two tables:
      time of one tangent assembly and one sparse direct solve.
 A run given as LABEL=DIR is shown under LABEL (e.g. the same scene before and
 after a solver change); the table says nothing about a run it was not given.
+Each --note TEXT is printed under the tables as given (what a run changed).
 
-Usage: scripts/fem_axisymmetric_timing.py OUT_MD [LABEL=]RUN_DIR...
+Usage: scripts/fem_axisymmetric_timing.py OUT_MD [--note TEXT]... [LABEL=]RUN_DIR...
 """
 import datetime
 import json
@@ -59,7 +60,14 @@ def newton_stats(log_path):
 def main():
     if len(sys.argv) < 3:
         sys.exit(__doc__)
-    out, args = sys.argv[1], sys.argv[2:]
+    out, rest = sys.argv[1], sys.argv[2:]
+    notes, args = [], []
+    while rest:
+        a = rest.pop(0)
+        if a == "--note" and rest:
+            notes.append(rest.pop(0))
+        else:
+            args.append(a)
     runs = []
     for a in args:
         label, path = a.split("=", 1) if "=" in a and not os.path.exists(a) else (None, a)
@@ -81,7 +89,8 @@ def main():
     except OSError:
         pass
     L = ["# Axisymmetric FEM: time per run, per load step and per Newton iteration\n",
-         f"Command: `scripts/fem_axisymmetric_timing.py {out} {' '.join(args)}`, git {rev}.  ",
+         f"Command: `scripts/fem_axisymmetric_timing.py {out} "
+         f"{' '.join(['--note ' + repr(n) for n in notes] + args)}`, git {rev}.  ",
          f"Machine: {platform.system()} {platform.release()}, {os.cpu_count()} cores ({cpu}); the runs were made on this "
          "shared machine, some while other builds and tests ran, so the wall times are upper bounds.  ",
          f"Date: {datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M')} UTC.\n",
@@ -121,6 +130,8 @@ def main():
           "consistency; iterations in cut attempts measure the work thrown away where Newton fails (the skin's "
           "snap-through, kinks of contact and full damage) before the step is cut; the median assembly and "
           "solve times measure the cost of one iteration."]
+    if notes:
+        L += ["", "## Notes on the runs\n"] + [f"- {n}" for n in notes]
     tmp = out + ".part"
     open(tmp, "w").write("\n".join(L) + "\n")
     os.replace(tmp, out)
