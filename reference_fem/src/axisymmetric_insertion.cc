@@ -23,6 +23,11 @@
 #include <stdexcept>
 #include <thread>
 
+#ifdef __linux__
+#include <sched.h>
+#include <unistd.h>
+#endif
+
 #include <puncture/fem/axisymmetric_solver.hpp>
 #include <puncture/fem/field_output.hpp>
 #include <puncture/fem/needle_insertion.hpp>
@@ -108,6 +113,20 @@ LayerLaws layer_laws(const Scene& scene, double crack_radius_m) {
     laws.friction.push_back({l.shaft_friction.dynamic_coefficient, l.shaft_friction.static_coefficient});
   }
   return laws;
+}
+
+/// Rank 0 solves while the other ranks sleep (share_outcome): let its
+/// assembly threads use every online core even where mpirun bound the rank to
+/// one (OpenMPI binds each rank to a core by default). Best effort: where the
+/// system refuses, the binding stays and the threads share that core.
+void widen_cpu_affinity() {
+#ifdef __linux__
+  const long n = ::sysconf(_SC_NPROCESSORS_ONLN);
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (long c = 0; c < n && c < CPU_SETSIZE; ++c) CPU_SET(static_cast<int>(c), &set);
+  (void)::sched_setaffinity(0, sizeof set, &set);
+#endif
 }
 
 /// Newton settings of the axisymmetric solver from the scene.
@@ -665,6 +684,7 @@ FemRunSummary run_axisymmetric_insertion(const Scene& scene, const FemRunOptions
   std::string error;
   if (dealii::Utilities::MPI::this_mpi_process(comm) == 0) {
     try {
+      widen_cpu_affinity();
       AxisymmetricInsertionRun run(scene, options, comm, summary);  // mesh and solver
       run.walk_trajectory();  // per step: advance, detect punctures, record
       run.write_outputs();
