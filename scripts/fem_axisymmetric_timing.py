@@ -90,7 +90,8 @@ def main():
         pass
     L = ["# Axisymmetric FEM: time per run, per load step and per Newton iteration\n",
          f"Command: `scripts/fem_axisymmetric_timing.py {out} "
-         f"{' '.join(['--note ' + repr(n) for n in notes] + args)}`, git {rev}.  ",
+         f"{' '.join((['--note TEXT'] * len(notes)) + args)}` (the TEXTs: the notes at the end, in order), "
+         f"git {rev}.  ",
          f"Machine: {platform.system()} {platform.release()}, {os.cpu_count()} cores ({cpu}); the runs were made on this "
          "shared machine, some while other builds and tests ran, so the wall times are upper bounds.  ",
          f"Date: {datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M')} UTC.\n",
