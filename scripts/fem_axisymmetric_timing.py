@@ -17,14 +17,13 @@ Each --note TEXT is printed under the tables as given (what a run changed).
 
 Usage: scripts/fem_axisymmetric_timing.py OUT_MD [--note TEXT]... [LABEL=]RUN_DIR...
 """
-import datetime
 import json
 import os
-import platform
 import re
 import statistics
-import subprocess
 import sys
+
+import provenance  # scripts/provenance.py (the script's own folder is on sys.path)
 
 
 def newton_stats(log_path):
@@ -74,27 +73,14 @@ def main():
         if os.path.isfile(path):
             path = os.path.dirname(path)
         runs.append((label, path))
-    rev = "unknown"
-    try:
-        rev = subprocess.check_output(["git", "-C", os.path.dirname(os.path.abspath(__file__)), "rev-parse", "--short",
-                                       "HEAD"], text=True).strip()
-    except Exception:
-        pass
-    cpu = "unknown"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
+    rev = provenance.git_revision()
     L = ["# Axisymmetric FEM: time per run, per load step and per Newton iteration\n",
          f"Command: `scripts/fem_axisymmetric_timing.py {out} "
          f"{' '.join((['--note TEXT'] * len(notes)) + args)}` (the TEXTs: the notes at the end, in order), "
          f"git {rev}.  ",
-         f"Machine: {platform.system()} {platform.release()}, {os.cpu_count()} cores ({cpu}); the runs were made on this "
+         f"Machine: {provenance.machine()}; the runs were made on this "
          "shared machine, some while other builds and tests ran, so the wall times are upper bounds.  ",
-         f"Date: {datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M')} UTC.\n",
+         f"Date: {provenance.utc_now()} UTC.\n",
          "## Runs\n",
          "| run | element | cells | DoFs | load steps | step cuts | Newton iterations | per step | "
          "wall (s) | s per Newton iteration |",

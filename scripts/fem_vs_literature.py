@@ -9,12 +9,11 @@ beside that measurement and its source (../shared/LITERATURE.md).
 Usage: scripts/fem_vs_literature.py FEM_DIR SCENE_JSON OUT_MD
 """
 import csv
-import datetime
 import json
 import os
-import platform
-import subprocess
 import sys
+
+import provenance  # scripts/provenance.py (the script's own folder is on sys.path)
 
 
 def main():
@@ -36,22 +35,11 @@ def main():
     wd = [r for r in rows if r["phase"] == "withdrawal"]
     L = []
     L.append("# FEM reference against measurements\n")
-    try:
-        rev = subprocess.check_output(["git", "-C", os.path.dirname(os.path.abspath(__file__)), "rev-parse", "--short", "HEAD"], text=True).strip()
-    except Exception:
-        rev = "unknown"
-    cpu = "unknown"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
+    rev = provenance.git_revision()
     L.append(f"Command: `scripts/fem_vs_literature.py {fem_dir} {scene_path} {out}` on the FEM run in `{fem_dir}` "
              f"(scene `{scene_path}`), git {rev}.  ")
-    L.append(f"Machine: {platform.system()} {platform.release()}, {os.cpu_count()} cores ({cpu}).  ")
-    L.append(f"Date: {datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M')} UTC.\n")
+    L.append(f"Machine: {provenance.machine()}.  ")
+    L.append(f"Date: {provenance.utc_now()} UTC.\n")
     L.append(f"Needle: {scene['needle']['tip']} tip, {scene['needle'].get('tip_angle_deg', '')} degrees, radius "
              f"{a_mm} mm (18 G). Sample {scene['sample']['diameter_mm']} mm wide; layers "
              + ", ".join(f"{l['name']} {l['thickness_mm']} mm" for l in layers) + ".\n")
