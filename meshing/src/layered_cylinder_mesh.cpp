@@ -1,5 +1,6 @@
 #include <puncture/meshing/layered_cylinder_mesh.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -153,14 +154,20 @@ HexMesh build_layered_cylinder_mesh(const Scene& scene, const SlabMeshOptions& o
   // Node planes, top (z = 0) to base; element layer e lies between planes e and e+1.
   std::vector<double> plane_z{0.0};
   std::vector<int> element_layer_material;
-  const double skin_element_height_m =
-      scene.layers.front().thickness_m / options.elements_through_skin;
+  // The element height at every layer top follows the skin and the needle: at
+  // most t_skin / elements_through_skin and at most the needle radius, so a
+  // thick first layer is graded from the surface (where the punch loads it)
+  // instead of getting elements_through_skin slabs of its whole thickness.
+  const double t_skin = scene.layers.front().thickness_m;
+  const double skin_element_height_m = std::min(t_skin / options.elements_through_skin, a);
   double layer_top_z = 0.0;
   for (std::size_t l = 0; l < scene.layers.size(); ++l) {
     const double t = scene.layers[l].thickness_m;
+    const bool uniform_skin = l == 0 && t_skin / options.elements_through_skin <= a;
     const std::vector<double> heights =
-        l == 0 ? geometric_intervals(t, options.elements_through_skin, 1.0)
-               : graded_divisions(t, skin_element_height_m, options.thickness_grading, 1);
+        uniform_skin ? geometric_intervals(t, options.elements_through_skin, 1.0)
+                     : graded_divisions(t, skin_element_height_m, options.thickness_grading,
+                                        l == 0 ? options.elements_through_skin : 1);
     double z = layer_top_z;
     for (std::size_t e = 0; e < heights.size(); ++e) {
       // The interface below the layer is placed exactly (no accumulated round-off).

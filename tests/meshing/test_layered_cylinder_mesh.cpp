@@ -135,6 +135,26 @@ TEST(LayeredCylinderMesh, MaterialIdIsTheLayerContainingTheCellCentre) {
   }
 }
 
+TEST(LayeredCylinderMesh, OneThickLayerIsGradedFromTheNeedleRadiusNotSplitInTwo) {
+  // A one-layer block 20 mm thick: two 10 mm elements through it would make
+  // the indentation force far too stiff. The top element is no taller than the
+  // needle radius (to within the grading) and the heights grow by the thickness grading, so the count
+  // follows the thickness: about log(1 + (g - 1) t / a) / log(g) elements.
+  Scene scene = default_scene();
+  scene.layers.resize(1);
+  scene.layers[0].thickness_m = 20e-3;
+  const SlabMeshOptions opt;
+  const HexMesh mesh = build_layered_cylinder_mesh(scene, opt);
+  std::set<double> planes;
+  for (const auto& v : mesh.vertices) planes.insert(v.z());
+  std::vector<double> z(planes.rbegin(), planes.rend());
+  const double a = scene.needle.radius_m, g = opt.thickness_grading, t = 20e-3;
+  const double expected = std::log(1 + (g - 1) * t / a) / std::log(g);
+  EXPECT_NEAR(static_cast<double>(z.size() - 1), expected, 1.0);
+  EXPECT_LE(z[0] - z[1], a * g);  // the count whose first size is closest to a
+  for (std::size_t k = 2; k < z.size(); ++k) EXPECT_GE(z[k - 1] - z[k], (z[k - 2] - z[k - 1]) * (1 - 1e-12));
+}
+
 TEST(LayeredCylinderMesh, SkinHasAtLeastTheRequestedElementsAndHeightsGrowDownward) {
   const Scene scene = default_scene();
   for (int n_skin : {1, 2, 3}) {

@@ -18,9 +18,12 @@
 //     radial size starting near the needle radius and growing geometrically
 //     by `radial_grading`. The outer boundary is the polygon of `sectors`
 //     straight edges inscribed in the circle of the sample radius.
-// Through the thickness: every layer interface is a node plane; the skin
-// (layer 0) gets `elements_through_skin` equal elements; every other layer
-// starts with elements of about the skin element height at its top surface
+// Through the thickness: every layer interface is a node plane; the element
+// height at a layer top is h0 = min(skin thickness / elements_through_skin,
+// needle radius). The skin (layer 0) gets `elements_through_skin` equal
+// elements when they are no taller than the needle radius, else (a thick
+// first layer, e.g. a one-layer block) it is graded from h0 like the others;
+// every other layer starts with elements of about h0 at its top surface
 // (where the needle meets it) and grows them geometrically by
 // `thickness_grading` downward (thin layers end up uniform).
 #pragma once
