@@ -138,3 +138,31 @@ TEST(AxisymmetricInsertion, HardCasesConvergeOrStopWithAClearErrorAndNeverNaN) {
     }
   }
 }
+
+TEST(AxisymmetricInsertion, WarnsWhenTheMeshIsTooCoarseForTheAccuracyTarget) {
+  // results/fem_axisymmetric_convergence.md: Q1 needs 4 elements per needle
+  // radius and every layer a few elements through its thickness. The scene's
+  // own resolution gets no mesh warning; 2 per radius, or a layer with 2
+  // elements through its thickness, does. Only the first millimetre is run (warnings come first).
+  auto mesh_warnings = [](const Scene& s) {
+    FemRunOptions o = quiet();
+    o.stop_depth_m = 0.4e-3;
+    const FemRunSummary r = run_needle_insertion(s, o, MPI_COMM_WORLD);
+    std::string all;
+    for (const auto& w : r.warnings)
+      if (w.rfind("mesh:", 0) == 0) all += w + "\n";
+    return all;
+  };
+  Scene s = small_default_scene();
+  s.insertion.start_height_m = 0.0;
+  EXPECT_EQ(mesh_warnings(s), "");
+  Scene coarse = s;
+  coarse.fem.mesh.elements_per_needle_radius = 2;
+  EXPECT_NE(mesh_warnings(coarse).find("elements per needle radius"), std::string::npos);
+  Scene thin = s;
+  thin.fem.mesh.elements_per_needle_radius = 2;  // first element 0.32 mm at each layer top
+  thin.fem.mesh.min_elements_per_layer = 2;
+  thin.fem.mesh.path_element_size_mm = 2.0;
+  thin.layers[1].thickness_m = 0.8e-3;  // fat: 0.32 mm, then 0.38 mm, then the rest
+  EXPECT_NE(mesh_warnings(thin).find("elements through its thickness"), std::string::npos) << mesh_warnings(thin);
+}
