@@ -1,7 +1,7 @@
 // `puncture sweep`: what accuracy costs in time.
 //
-// The real-time force compared is the total minus the damping force d h v
-// (the FEM is quasi-static and frictionless; as in validate and calibrate).
+// The real-time force compared is the whole force, the damping force d h v
+// included (as in validate and calibrate).
 //
 // Algorithm (top-down):
 //   1. load the scene;

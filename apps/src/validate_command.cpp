@@ -41,6 +41,7 @@
 #include "puncture/io/output_session.hpp"
 #include "puncture/io/pvd.hpp"
 #include "puncture/model/realtime_model.hpp"
+#include "puncture/validation/acceptance.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/metrics.hpp"
 #include "run_outputs.hpp"
@@ -136,12 +137,17 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
       on_progress = [&](double f) { out << "[validate] real-time " << std::lround(100 * f) << " %\n" << std::flush; };
     const ScriptedRunResult run = run_scripted_insertion(model, every_tick, on_tick, on_progress);
 
-    // 3. Force-depth metrics.
-    // The FEM is quasi-static and frictionless: the damping force d h v has no
-    // counterpart there and is left out of the compared force (as in calibrate).
+    // 3. Force-depth metrics: the model's whole force (d h v included, as it
+    // renders) against the FEM's, per layer on the insertion, then over the
+    // whole trajectory (dwell and withdrawal) with the acceptance per layer.
     const validation::InsertionCurve realtime_curve =
-        validation::curve_from_run(scene, run, "realtime", /*include_damping=*/false);
+        validation::curve_from_run(scene, run, "realtime", /*include_damping=*/true);
     const validation::CurveComparison cmp = validation::compare_curves(realtime_curve, fem.curve);
+    const std::vector<validation::LayerGeometry> geometry = validation::layer_geometry(scene);
+    const validation::ReferenceEvents fem_events = validation::reference_events(fem.curve, geometry);
+    const validation::TrajectoryComparison trajectory =
+        validation::compare_trajectory(realtime_curve, fem.curve, fem_events, geometry);
+    const std::vector<validation::LayerAcceptance> acceptance = validation::layer_acceptance(geometry, trajectory);
 
     // 4-5. Deflection before breakthrough and recovery after it.
     std::vector<LayerDeflectionComparison> defl(scene.layers.size());
@@ -180,6 +186,28 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
                           {"compared_to_depth_mm", cmp.compared_to_depth_m / kMm}};
     const nlohmann::json layers = layer_metrics_json(scene, cmp, defl);
     metrics["layers"] = layers;
+    nlohmann::json acc = nlohmann::json::array();
+    for (const auto& a : acceptance) {
+      auto check = [](const validation::AcceptanceCheck& c) {
+        nlohmann::json j = {{"available", c.available}, {"met", c.met}, {"limit", c.limit}, {"note", c.note}};
+        if (c.available) j["value"] = c.value;
+        return j;
+      };
+      acc.push_back({{"layer", a.layer},
+                     {"accepted", a.accepted()},
+                     {"force_rmse_relative", check(a.force_rmse)},
+                     {"puncture_depth_error_m", check(a.puncture_depth)},
+                     {"puncture_force_error_relative", check(a.puncture_force)}});
+    }
+    metrics["acceptance"] = acc;
+    nlohmann::json terms = nlohmann::json::array();
+    for (const auto& t : trajectory.terms) {
+      nlohmann::json j = {{"term", t.name}, {"layer", t.layer}, {"available", t.available},
+                          {"samples", t.samples}, {"note", t.note}};
+      if (t.available) j["value"] = t.value, j["error"] = t.raw;
+      terms.push_back(j);
+    }
+    metrics["trajectory_terms"] = terms;
     session.write_text("validation_metrics.json", metrics.dump(2) + "\n");
 
     if (vtk) {
@@ -214,13 +242,17 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
     io::OutputSession summary_session(dir);
     summary_session.write_text("validation_summary.md",
                                validation_summary_markdown(scene, provenance, {reference.hash, reference.from_cache},
-                                                           fem, cmp, layers, plots, vtk && !fem.frames.empty()));
+                                                           fem, cmp, layers, plots, vtk && !fem.frames.empty(),
+                                                           validation::acceptance_markdown(acceptance, trajectory)));
     summary_session.commit();
 
     out << "\nValidation of " << scene.name << " (FEM reference " << reference.hash.substr(0, 12)
         << (reference.from_cache ? ", from cache" : ", computed") << ")\n";
     out << "  force RMSE over the insertion: " << fmt(cmp.force_rmse_N, 4) << " N (" << fmt(100 * cmp.force_rmse_relative, 3)
         << " % of the FEM peak " << fmt(cmp.reference_peak_force_N, 4) << " N)\n";
+    for (const auto& a : acceptance)
+      out << "  acceptance " << std::left << std::setw(8) << a.layer << std::right << (a.accepted() ? "met" : "not met")
+          << '\n';
     for (const auto& j : layers) {
       out << "  " << std::left << std::setw(8) << j["layer"].get<std::string>() << std::right;
       if (j.contains("force_rmse_N")) out << " force RMSE " << fmt(j["force_rmse_N"].get<double>(), 4) << " N";

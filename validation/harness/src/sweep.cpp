@@ -62,7 +62,7 @@ SweepRow sweep_realtime_variant(const Scene& scene, const std::string& knob, con
     row.time_per_step_s = cost.contact_mean_s;
     row.time_p99_s = cost.contact_p99_s;
     // Against the quasi-static, frictionless FEM: without the damping force.
-    fill_sweep_errors(row, curve_from_run(scene, run, "realtime", /*include_damping=*/false), reference);
+    fill_sweep_errors(row, curve_from_run(scene, run, "realtime", /*include_damping=*/true), reference);
   } catch (const std::exception& e) {
     row.status = std::string("failed: ") + e.what();
   }

@@ -13,7 +13,7 @@
 //   deformation threshold, the critical force or the critical energy, by the
 //   layer's criterion) always; the cutting force, the dynamic shaft friction
 //   (the static level keeps its ratio to it) and the tip stiffening
-//   coefficient (a2 of the polynomial law, k_e of the exponential one) when
+//   coefficients (a2 and a3 of the polynomial law, k_e of the exponential one) when
 //   their effects are on in the scene; k_s, L and w on request; d with rate
 //   information (DampingPolicy).
 // Bounds with physical meaning (parameter_bounds): every parameter stays
@@ -56,8 +56,8 @@
 //   options.integrator, no frames, the reference's trajectory (its insertion
 //   speed: metadata "speed_mm_per_s", else the scene's; its deepest depth;
 //   its dwell in the joint stage and the report; its withdrawal speed, or a
-//   fast withdrawal when it has none), the damping effect off when the
-//   reference is quasi-static (reference_is_quasi_static: the FEM), and a
+//   fast withdrawal when it has none), every effect of the scene (the
+//   damping force d h v included: the model is compared as it renders), and a
 //   haptic rate raised so that one tick moves the needle at most
 //   objective_depth_step_m (sharper breakthrough depths). The SH layer
 //   surfaces depend only on geometry and degree: they are fitted once per
@@ -207,8 +207,8 @@ struct ReferenceCurve {
   std::string kind = "fem";
 };
 /// True for the FEM reference (kind "fem") or a curve whose metadata says
-/// "quasi_static: true" (or yes / 1): no rate dependence and no friction, so
-/// the model runs compared with it leave the damping force d h v out.
+/// "quasi_static: true" (or yes / 1): no rate dependence, so d cannot be
+/// identified from it (the model runs still include d h v).
 bool reference_is_quasi_static(const ReferenceCurve& reference);
 /// True if the curve's metadata says "rate_dependent: true" (or yes / 1).
 bool reference_is_rate_dependent(const InsertionCurve& curve);

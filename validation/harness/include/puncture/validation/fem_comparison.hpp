@@ -113,10 +113,12 @@ LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size
 std::vector<std::string> run_plot_script(const std::string& script, const std::filesystem::path& dir,
                                          std::ostream& out, std::ostream& err);
 
+/// acceptance_section: markdown (acceptance.hpp) placed after the force table.
 std::string validation_summary_markdown(const Scene& scene, const io::Provenance& provenance,
                                         const FemReferenceInfo& reference, const FemResultFiles& fem,
                                         const CurveComparison& cmp, const nlohmann::json& layers,
-                                        const std::vector<std::string>& plots, bool has_vtk);
+                                        const std::vector<std::string>& plots, bool has_vtk,
+                                        const std::string& acceptance_section = "");
 
 /// layer_metrics.csv: per-layer force, puncture and deflection metrics.
 std::string layer_metrics_csv(const Scene& scene, const CurveComparison& cmp,

@@ -9,8 +9,8 @@
 // missed_punctures); cost = mean and 99th percentile of the haptic-tick wall
 // time over the ticks with contact (real-time; tick_cost in realtime_model.hpp:
 // where the work is, not the median over all ticks, which is a tick without
-// contact) or FEM wall time per load step. The real-time force compared is the total minus
-// the damping force d h v (the FEM is quasi-static and frictionless).
+// contact) or FEM wall time per load step. The real-time force compared is the whole
+// force, the damping force d h v included (as validate and calibrate).
 #pragma once
 
 #include <functional>

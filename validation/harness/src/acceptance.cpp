@@ -1,0 +1,101 @@
+#include "puncture/validation/acceptance.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace puncture::validation {
+namespace {
+
+std::string fmt(double v, int digits = 3) {
+  std::ostringstream s;
+  s << std::setprecision(digits) << v;
+  return s.str();
+}
+
+}  // namespace
+
+std::vector<LayerAcceptance> layer_acceptance(const std::vector<LayerGeometry>& layers,
+                                              const TrajectoryComparison& comparison,
+                                              const AcceptanceCriteria& criteria) {
+  std::vector<LayerAcceptance> out;
+  for (const LayerGeometry& g : layers) {
+    LayerAcceptance a;
+    a.layer = g.name;
+    // Force RMSE over the layer's pressing and cut.
+    double sum = 0.0;
+    std::string missing;
+    for (const char* name : {"pressing", "after_puncture"}) {
+      const ObjectiveTerm* t = comparison.term(name, g.name);
+      if (t && t->available && t->samples > 0) {
+        sum += static_cast<double>(t->samples) * t->value * t->value;
+        a.rmse_samples += t->samples;
+      } else {
+        missing += std::string(missing.empty() ? "" : ", ") + name + (t ? ": " + t->note : ": no term");
+      }
+    }
+    a.force_rmse.limit = criteria.max_rmse_relative;
+    if (a.rmse_samples > 0) {
+      a.force_rmse.available = true;
+      a.force_rmse.value = std::sqrt(sum / static_cast<double>(a.rmse_samples));
+      a.force_rmse.met = a.force_rmse.value <= criteria.max_rmse_relative;
+      a.force_rmse.note = std::to_string(a.rmse_samples) + " samples" + (missing.empty() ? "" : " (n/a: " + missing + ")");
+    } else {
+      a.force_rmse.note = "n/a: " + missing;
+    }
+    // Puncture depth within L.
+    const ObjectiveTerm* depth = comparison.term("puncture_depth", g.name);
+    a.puncture_depth.limit = g.spacing_L_m;
+    if (depth && depth->available) {
+      a.puncture_depth.available = true;
+      a.puncture_depth.value = depth->raw;
+      a.puncture_depth.met = std::abs(depth->raw) <= g.spacing_L_m;
+      a.puncture_depth.note = depth->note;
+    } else {
+      a.puncture_depth.note = "n/a: " + (depth ? depth->note : std::string("no term"));
+    }
+    // Puncture force within 10 %.
+    const ObjectiveTerm* force = comparison.term("puncture_force", g.name);
+    a.puncture_force.limit = criteria.max_force_error_relative;
+    if (force && force->available) {
+      a.puncture_force.available = true;
+      a.puncture_force.value = force->value;
+      a.puncture_force.met = std::abs(force->value) <= criteria.max_force_error_relative;
+      a.puncture_force.note = force->note;
+    } else {
+      a.puncture_force.note = "n/a: " + (force ? force->note : std::string("no term"));
+    }
+    out.push_back(a);
+  }
+  return out;
+}
+
+std::string acceptance_markdown(const std::vector<LayerAcceptance>& acceptance, const TrajectoryComparison& comparison,
+                                const AcceptanceCriteria& criteria) {
+  std::ostringstream md;
+  md << "| layer | force RMSE / peak (limit " << fmt(100 * criteria.max_rmse_relative) << " %) | puncture depth error "
+     << "(limit L) | puncture force error (limit " << fmt(100 * criteria.max_force_error_relative)
+     << " %) | accepted |\n|---|---|---|---|---|\n";
+  auto cell = [](const AcceptanceCheck& c, const std::string& value) {
+    if (!c.available) return c.note;
+    return value + (c.met ? " (met)" : " (**not met**)");
+  };
+  for (const LayerAcceptance& a : acceptance) {
+    md << "| " << a.layer << " | "
+       << cell(a.force_rmse, fmt(100 * a.force_rmse.value) + " % over " + std::to_string(a.rmse_samples) + " samples")
+       << " | "
+       << cell(a.puncture_depth, fmt(a.puncture_depth.value * 1e3) + " mm (L = " + fmt(a.puncture_depth.limit * 1e3) + " mm)")
+       << " | " << cell(a.puncture_force, fmt(100 * a.puncture_force.value) + " %") << " | "
+       << (a.accepted() ? "yes" : "**no**") << " |\n";
+  }
+  md << "\nWhole trajectory (RMSE over the reference's samples, relative to its insertion peak "
+     << fmt(comparison.reference_peak_force_N) << " N):\n\n| term | value | error | samples | note |\n|---|---|---|---|---|\n";
+  for (const ObjectiveTerm& t : comparison.terms) {
+    if (!t.layer.empty()) continue;
+    md << "| " << t.label() << " | " << (t.available ? fmt(100 * t.value) + " %" : "n/a") << " | "
+       << (t.available ? fmt(t.raw) + " N" : "n/a") << " | " << t.samples << " | " << t.note << " |\n";
+  }
+  return md.str();
+}
+
+}  // namespace puncture::validation
