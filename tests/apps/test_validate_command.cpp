@@ -292,6 +292,17 @@ TEST(ValidateCommand, ReportOfASmallSceneAndSecondRunFromCache) {
   EXPECT_FALSE(metrics.at("fem_reference").at("from_cache").get<bool>());
   EXPECT_TRUE(metrics.at("layers").at(0).at("fem_punctured").get<bool>());
   EXPECT_TRUE(metrics.at("layers").at(0).contains("deflection"));
+  // The acceptance per layer and the whole-trajectory terms, in both files.
+  EXPECT_NE(md.str().find("Acceptance per layer"), std::string::npos);
+  ASSERT_EQ(metrics.at("acceptance").size(), metrics.at("layers").size());
+  const auto& skin = metrics["acceptance"][0];
+  EXPECT_EQ(skin.at("layer"), "skin");
+  EXPECT_EQ(skin.at("accepted").get<bool>(), skin["force_rmse_relative"]["met"].get<bool>() &&
+                                                 skin["puncture_depth_error_m"]["met"].get<bool>() &&
+                                                 skin["puncture_force_error_relative"]["met"].get<bool>());
+  bool has_overall = false;
+  for (const auto& t : metrics.at("trajectory_terms")) has_overall |= t.at("term") == "overall";
+  EXPECT_TRUE(has_overall);
 
   // Second validation of a retuned scene: the FEM comes from the cache.
   Scene retuned = small_scene();
