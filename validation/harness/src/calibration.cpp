@@ -747,8 +747,12 @@ Scene scaled_start(const Scene& candidate, std::size_t k, const ReferenceCurve& 
 std::string bound_name(const Parameter& p, double x) {
   const double span = p.upper - p.lower;
   if (!(span > 0.0)) return "lower";
-  if (x <= p.lower + 1e-3 * span) return "lower";
-  if (x >= p.upper - 1e-3 * span) return "upper";
+  // Within 0.1 % of the span, but never farther than 0.1 % of the value's own
+  // size: a linear-space parameter with a wide physical range (stiffening
+  // 0..1000 N/mm^3) is not "at its bound" at 0.004 N/mm^3.
+  const double tol = 1e-3 * std::min(span, std::max(1.0, std::abs(x)));
+  if (x <= p.lower + tol) return "lower";
+  if (x >= p.upper - tol) return "upper";
   return "";
 }
 
