@@ -3,7 +3,9 @@
 #   results/validation_default/  puncture validate: the default (Table 2) real-time
 #                                model against the FEM reference
 #   results/fem_vs_literature.md the FEM reference's numbers beside the measurements
-#   results/tuned_preset/        puncture calibrate: tuned preset of the Table 2 slab,
+#   results/tuned_preset/        puncture calibrate: tuned preset of the Table 2 slab
+#                                with the physical force law (scenes/default_force_law.json:
+#                                critical-force breakthrough, stiffening, cutting, friction),
 #                                provenance, before/after plot, wall time
 #   results/validation_tuned/    puncture validate of the tuned preset
 #   results/accuracy_cost/       puncture sweep of the tuned preset (real-time knobs
@@ -23,7 +25,7 @@ mpi=(mpirun --oversubscribe -np "$ranks")
 # The FEM reference beside the measurements (from the cached FEM run just used).
 fem_dir="$(ls -td out/.fem_cache/*/ | head -1)"
 "${PYTHON:-$(command -v /usr/bin/python3 || command -v python3)}" scripts/fem_vs_literature.py "${fem_dir%/}" scenes/default.json results/fem_vs_literature.md
-"$build/apps/puncture" calibrate scenes/default.json -o results/tuned_preset --name default_tuned --also-tune surface_stiffness
+"$build/apps/puncture" calibrate scenes/default_force_law.json -o results/tuned_preset --name default_tuned --depth-weight 1 --integrator implicit
 "${mpi[@]}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json -o results/validation_tuned
 "$build/apps/puncture" sweep results/tuned_preset/default_tuned.json --no-fem-knobs -o results/accuracy_cost
 echo "results in results/validation_default, results/tuned_preset, results/validation_tuned, results/accuracy_cost"
