@@ -227,6 +227,7 @@ ShaftFrictionLaw read_friction(ObjectReader r) {
   f.dynamic_N_per_m = r.number("dynamic_N_per_mm") / kMm;
   f.static_N_per_m = r.number("static_N_per_mm", f.dynamic_N_per_m * kMm) / kMm;
   f.velocity_band_m_per_s = r.number("velocity_band_mm_per_s", f.velocity_band_m_per_s / kMm) * kMm;
+  f.presliding_m = r.number("presliding_mm", 0.0) * kMm;
   r.reject_unknown_keys();
   return f;
 }
@@ -455,6 +456,7 @@ void validate_force_law(const ForceLaw& law, const std::string& file, const std:
           ">= dynamic_N_per_mm (the shaft cannot stick with less force than it slides with)", f.static_N_per_m * kMm);
   require(f.velocity_band_m_per_s > 0, file, p + "/friction/velocity_band_mm_per_s", "> 0",
           f.velocity_band_m_per_s / kMm);
+  require(f.presliding_m >= 0, file, p + "/friction/presliding_mm", ">= 0", f.presliding_m / kMm);
 }
 
 }  // namespace
@@ -723,7 +725,8 @@ json force_law_json(const ForceLaw& law) {
   j["cutting_release_mm"] = law.cutting_release_m / kMm;
   j["friction"] = {{"static_N_per_mm", law.friction.static_N_per_m * kMm},
                    {"dynamic_N_per_mm", law.friction.dynamic_N_per_m * kMm},
-                   {"velocity_band_mm_per_s", law.friction.velocity_band_m_per_s / kMm}};
+                   {"velocity_band_mm_per_s", law.friction.velocity_band_m_per_s / kMm},
+                   {"presliding_mm", law.friction.presliding_m / kMm}};
   return j;
 }
 

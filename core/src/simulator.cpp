@@ -341,7 +341,8 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
     out.state = LayerState::Punctured;
     if (!damping_on_ && !layer.friction) continue;
     out.shaft_length_m = shaft_length_in_layer_m(result_.depth_m, layer.top_depth_m, layer.thickness_m);
-    if (layer.friction) out.friction_force_N = layer.friction->update(needle.axial_velocity_m_per_s) * out.shaft_length_m;
+    if (layer.friction)
+      out.friction_force_N = layer.friction->update(needle.axial_velocity_m_per_s, result_.depth_m) * out.shaft_length_m;
     if (damping_on_)
       out.damping_force_N =
           puncture_damping_force_N(layer.damping_N_s_per_m2, out.shaft_length_m, needle.axial_velocity_m_per_s);

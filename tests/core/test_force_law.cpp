@@ -295,6 +295,39 @@ TEST(KarnoppFriction, SlidesHoldsAndReverses) {
   EXPECT_THROW(KarnoppFriction{bad}, std::invalid_argument);
 }
 
+TEST(KarnoppFriction, PreslidingBuildsAndReversesLinearlyOverTheTravel) {
+  // f_d = 10 N/m, delta = 1 mm, steps of 0.1 mm: the elastic-plastic
+  // interface gives phi = min(f_d x / delta, f_d) sliding in from 0, keeps it
+  // through a dwell, and on withdrawal falls by f_d / delta per metre of travel,
+  // reaching -f_d after 2 delta (closed form of the law, step by step).
+  ShaftFrictionLaw law;
+  law.static_N_per_m = 15.0;
+  law.dynamic_N_per_m = 10.0;
+  law.velocity_band_m_per_s = 1e-4;
+  law.presliding_m = 1e-3;
+  KarnoppFriction f(law);
+  double depth = 5e-3;
+  EXPECT_EQ(f.update(0.01, depth), 0.0);  // first update: no travel yet
+  for (int n = 1; n <= 15; ++n) {
+    depth += 0.1e-3;
+    EXPECT_NEAR(f.update(0.01, depth), std::min(10.0 * n * 0.1e-3 / 1e-3, 10.0), 1e-9) << "step " << n;
+  }
+  EXPECT_NEAR(f.update(0.0, depth), 10.0, 1e-9);  // dwell: stuck, kept
+  EXPECT_TRUE(f.sticking());
+  for (int n = 1; n <= 25; ++n) {
+    depth -= 0.1e-3;
+    EXPECT_NEAR(f.update(-0.01, depth), std::max(10.0 - 10.0 * n * 0.1e-3 / 1e-3, -10.0), 1e-9) << "withdrawal " << n;
+  }
+  // Without presliding the depth changes nothing: Karnopp's instant reversal.
+  law.presliding_m = 0.0;
+  KarnoppFriction k(law);
+  EXPECT_EQ(k.update(0.01, 1e-3), 10.0);
+  EXPECT_EQ(k.update(-0.01, 0.9e-3), -10.0);
+  ShaftFrictionLaw bad = law;
+  bad.presliding_m = -1e-3;
+  EXPECT_THROW(KarnoppFriction{bad}, std::invalid_argument);
+}
+
 TEST(CuttingForce, ConstantAtTheFrontAndReleasedOverTheReleaseDistance) {
   EXPECT_EQ(cutting_force_N(1.4, 1e-4, 5e-3, 5e-3), 1.4);
   EXPECT_EQ(cutting_force_N(1.4, 1e-4, 5e-3, 6e-3), 1.4);

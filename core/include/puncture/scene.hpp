@@ -124,6 +124,11 @@ struct ShaftFrictionLaw {
   double static_N_per_m = 0.0;          ///< f_s: largest friction per metre of shaft while the shaft sticks
   double dynamic_N_per_m = 0.0;         ///< f_d: friction per metre of shaft while it slides (<= f_s)
   double velocity_band_m_per_s = 1e-4;  ///< Karnopp's band: |v| below it counts as sticking
+  /// delta (>= 0): shaft travel over which the friction builds up and reverses
+  /// (the tissue around the shaft is dragged along elastically before it
+  /// slips: an elastic-plastic "presliding" interface of stiffness f_d / delta
+  /// per metre of shaft). 0: Karnopp's instant reversal.
+  double presliding_m = 0.0;
 };
 
 struct ForceLaw {

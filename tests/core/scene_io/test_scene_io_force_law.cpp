@@ -25,7 +25,8 @@ json with_force_law() {
       {"stiffening", {{"law", "polynomial"}, {"quadratic_N_per_mm2", 0.2}, {"cubic_N_per_mm3", 0.03}}},
       {"cutting_force_N", 1.44},
       {"cutting_release_mm", 0.05},
-      {"friction", {{"static_N_per_mm", 0.015}, {"dynamic_N_per_mm", 0.01}, {"velocity_band_mm_per_s", 0.2}}}};
+      {"friction", {{"static_N_per_mm", 0.015}, {"dynamic_N_per_mm", 0.01}, {"velocity_band_mm_per_s", 0.2},
+                    {"presliding_mm", 2.5}}}};
   j["layers"][1]["force_law"] = {{"breakthrough", {{"criterion", "critical_energy"}, {"critical_energy_mJ", 2.5}}},
                                  {"stiffening", {{"law", "exponential"}, {"stiffness_N_per_mm", 0.3}, {"strain_scale_mm", 1.5}}}};
   j["layers"][2]["force_law"] = {{"breakthrough", {{"criterion", "critical_force"}, {"critical_force_N", 2.0}}},
@@ -56,6 +57,7 @@ TEST(SceneIoForceLaw, KeysAreReadInSiUnits) {
   EXPECT_NEAR(skin.cutting_release_m, 0.05e-3, 1e-18);
   EXPECT_NEAR(skin.friction.static_N_per_m, 15.0, 1e-12);  // N/mm -> N/m
   EXPECT_NEAR(skin.friction.dynamic_N_per_m, 10.0, 1e-12);
+  EXPECT_NEAR(skin.friction.presliding_m, 2.5e-3, 1e-15);
   EXPECT_NEAR(skin.friction.velocity_band_m_per_s, 0.2e-3, 1e-18);
   const ForceLaw& fat = s.layers[1].force_law;
   EXPECT_EQ(fat.breakthrough.kind, BreakthroughCriterion::Kind::CriticalEnergy);
@@ -130,6 +132,8 @@ const BadForceLaw kBad[] = {
      "/layers/0/force_law/friction/static_N_per_mm"},
     {"zero_band", [](json& j) { j["layers"][0]["force_law"]["friction"]["velocity_band_mm_per_s"] = 0.0; },
      "/layers/0/force_law/friction/velocity_band_mm_per_s"},
+    {"negative_presliding", [](json& j) { j["layers"][0]["force_law"]["friction"]["presliding_mm"] = -1.0; },
+     "/layers/0/force_law/friction/presliding_mm"},
     {"negative_quadratic", [](json& j) { j["layers"][0]["force_law"]["stiffening"]["quadratic_N_per_mm2"] = -0.1; },
      "/layers/0/force_law/stiffening/quadratic_N_per_mm2"},
     {"exponential_without_scale", [](json& j) { j["layers"][1]["force_law"]["stiffening"].erase("strain_scale_mm"); },
