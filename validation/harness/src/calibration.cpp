@@ -146,7 +146,8 @@ enum class ParamKind {
   Friction,
   StiffeningQuadratic,
   StiffeningCubic,
-  StiffeningExponential
+  StiffeningExponential,
+  Presliding
 };
 
 struct ParamInfo {
@@ -171,6 +172,7 @@ ParamInfo info(ParamKind k) {
     case ParamKind::StiffeningQuadratic: return {"stiffening_quadratic", "N/mm^2", kMm * kMm, false, 1e4};
     case ParamKind::StiffeningCubic: return {"stiffening_cubic", "N/mm^3", kMm * kMm * kMm, false, 1e6};
     case ParamKind::StiffeningExponential: return {"stiffening_exponential", "N/mm", kMm, false, 10.0};
+    case ParamKind::Presliding: return {"friction_presliding", "mm", 1.0 / kMm, false, 1e-3};
   }
   throw std::logic_error("info");
 }
@@ -190,6 +192,7 @@ double& param_ref(Scene& s, std::size_t layer, ParamKind k) {
     case ParamKind::StiffeningQuadratic: return l.force_law.stiffening.quadratic_N_per_m2;
     case ParamKind::StiffeningCubic: return l.force_law.stiffening.cubic_N_per_m3;
     case ParamKind::StiffeningExponential: return l.force_law.stiffening.exponential_stiffness_N_per_m;
+    case ParamKind::Presliding: return l.force_law.friction.presliding_m;
   }
   throw std::logic_error("param_ref");
 }
@@ -215,6 +218,7 @@ void physical_range(const Scene& s, std::size_t layer, ParamKind k, double& lo, 
     case ParamKind::StiffeningQuadratic: lo = 0.0, hi = 1e9; return;               // 0 .. 1000 N/mm^2
     case ParamKind::StiffeningCubic: lo = 0.0, hi = 1e12; return;                  // 0 .. 1000 N/mm^3
     case ParamKind::StiffeningExponential: lo = 0.0, hi = 1e6; return;
+    case ParamKind::Presliding: lo = 0.0, hi = 0.05; return;                       // 0 .. 50 mm of shaft travel
   }
 }
 
@@ -291,7 +295,12 @@ std::vector<ParamKind> layer_kinds(const Scene& scene, std::size_t k, const Tune
     }
   }
   if (t.cutting && scene.effects.cutting) kinds.push_back(ParamKind::Cutting);
-  if (t.friction && scene.effects.friction) kinds.push_back(ParamKind::Friction);
+  if (t.friction && scene.effects.friction) {
+    kinds.push_back(ParamKind::Friction);
+    // Presliding is tuned when the scene uses it (a start > 0): the
+    // withdrawal's reversal over the shaft travel identifies it.
+    if (l.force_law.friction.presliding_m > 0.0) kinds.push_back(ParamKind::Presliding);
+  }
   return kinds;
 }
 

@@ -14,7 +14,8 @@
 //   layer's criterion) always; the cutting force, the dynamic shaft friction
 //   (the static level keeps its ratio to it) and the tip stiffening
 //   coefficients (a2 and a3 of the polynomial law, k_e of the exponential one) when
-//   their effects are on in the scene; k_s, L and w on request; d with rate
+//   their effects are on in the scene; the friction's presliding travel when
+//   the scene's start value is > 0; k_s, L and w on request; d with rate
 //   information (DampingPolicy).
 // Bounds with physical meaning (parameter_bounds): every parameter stays
 //   inside an absolute physical range (e.g. a ring threshold between 1 um,
