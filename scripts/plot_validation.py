@@ -3,7 +3,7 @@
 
 In:  DIR with force_depth_aligned.csv, realtime_curve.csv, fem_force_depth.csv,
      deflection_profiles.csv, layer_metrics.csv (written by puncture validate).
-Out: DIR/force_depth.png        force against depth, both models (insertion phase)
+Out: DIR/force_depth.png        force against depth, both models (insertion and withdrawal)
      DIR/deflection_profiles.png deflection against distance from the needle per layer,
                                  before and after breakthrough, both models
      DIR/layer_errors.png        per-layer force RMSE, puncture depth and force errors
@@ -41,16 +41,30 @@ def insertion(rows):
     return [r for i, r in enumerate(rows[: deepest + 1]) if num(r["velocity_mm_per_s"]) > 0]
 
 
+def withdrawal(rows):
+    """Rows after the deepest sample with velocity < 0 (the withdrawal)."""
+    depth = [num(r["depth_mm"]) for r in rows]
+    if not depth:
+        return []
+    deepest = max(range(len(depth)), key=lambda i: depth[i])
+    return [r for r in rows[deepest:] if num(r["velocity_mm_per_s"]) < 0]
+
+
 def plot_force_depth(d):
-    rt = insertion(read_rows(os.path.join(d, "realtime_curve.csv")))
+    rt_all = read_rows(os.path.join(d, "realtime_curve.csv"))
+    rt, rt_out = insertion(rt_all), withdrawal(rt_all)
     fem = read_rows(os.path.join(d, "fem_force_depth.csv"))
     fig, ax = plt.subplots(figsize=(7, 4.2))
-    ax.plot([num(r["depth_mm"]) for r in rt], [num(r["force_N"]) for r in rt], lw=1.2, label="real-time (SHF + MSM)")
-    ax.plot([num(r["depth_mm"]) for r in fem], [num(r["force_N"]) for r in fem], "o-", ms=2.5, lw=1.0,
-            label="FEM reference")
+    ax.plot([num(r["depth_mm"]) for r in rt], [num(r["force_N"]) for r in rt], lw=1.2, color="C0",
+            label="real-time (SHF + MSM), insertion")
+    if rt_out:
+        ax.plot([num(r["depth_mm"]) for r in rt_out], [num(r["force_N"]) for r in rt_out], "--", lw=1.2, color="C0",
+                label="real-time, withdrawal")
+    ax.plot([num(r["depth_mm"]) for r in fem], [num(r["force_N"]) for r in fem], "o-", ms=2.5, lw=1.0, color="C1",
+            label="FEM reference (insertion, then withdrawal)")
     ax.set_xlabel("needle tip depth (mm)")
     ax.set_ylabel("needle force (N)")
-    ax.set_title("Force against depth (insertion)")
+    ax.set_title("Force against depth (insertion and withdrawal)")
     ax.grid(alpha=0.3)
     ax.legend()
     fig.tight_layout()
