@@ -104,7 +104,8 @@ def main():
             continue
         if parts[0] != "BM_comparison_step":
             continue
-        rows.append({"model": parts[1], "resolution": parts[2], "dofs": int(b["dofs"]), "mean_us": b["real_time"],
+        rows.append({"model": parts[1], "resolution": parts[2], "dofs": int(b["dofs"]), "nodes": int(b["nodes"]),
+                     "mean_us": b["real_time"],
                      "cpu_us": b["cpu_time"], "median_us": b["step_median_us"], "memory_MB": b["memory_MB"],
                      "pressed": b["skin_pressed_fraction"]})
     # Factorisations of the volumetric runs (integrator_report.txt, one line per
@@ -123,7 +124,8 @@ def main():
     # (the FEM: its mean time per load step).
     slopes = {}
     for m in ORDER:
-        r = [x for x in rows if x["model"] == m]
+        # Only windows that measured the same phase (skin pressed throughout).
+        r = [x for x in rows if x["model"] == m and (x["pressed"] is None or x["pressed"] >= 0.99)]
         if len(r) < 2:
             continue
         t = [x["median_us"] if x["median_us"] is not None else x["mean_us"] for x in r]
@@ -160,6 +162,7 @@ def main():
                       f"{x.get('factorisations', 'n/a')} | "
                       f"{'%.3g' % x['s_per_factorisation'] if 's_per_factorisation' in x else 'n/a'} |")
     md += ["", "## Growth order (slope of log time against log DoFs, least squares)", "",
+           "Fitted over the rows with `pressed` = 1 only (a window in which the skin broke measured another phase).", "",
            "| model | resolution knob | slope of the median | slope of the mean | slope of the mean CPU time |",
            "|---|---|---|---|---|"]
     for m in ORDER:
@@ -170,8 +173,8 @@ def main():
         md.append(f"| {m} | {KNOB.get(m, 'FEM mesh (elements per needle radius)')} | {f(s_med)} | {f(s_mean)} | "
                   f"{'n/a' if m == 'fem' else f(s_cpu)} |")
     md += ["", "Volumetric models, one sparse LDL^T factorisation of the Newton matrix (wall time, from "
-           "`integrator_report.txt`): slope of log(s per factorisation) against log DoFs: " +
-           ", ".join(f"{m} {fit_slope([x['dofs'] for x in rows if x['model'] == m and 's_per_factorisation' in x], [x['s_per_factorisation'] for x in rows if x['model'] == m and 's_per_factorisation' in x]) or float('nan'):.2f}"
+           "`integrator_report.txt`, every factorisation of the run; the matrix is 3 x nodes square for every law): slope of log(s per factorisation) against log(3 x nodes): " +
+           ", ".join(f"{m} {fit_slope([3 * x['nodes'] for x in rows if x['model'] == m and 's_per_factorisation' in x], [x['s_per_factorisation'] for x in rows if x['model'] == m and 's_per_factorisation' in x]) or float('nan'):.2f}"
                      for m in ("msm", "mass_tensor", "nonlinear_mass_tensor", "viscoelastic_mass_tensor")
                      if len([x for x in rows if x['model'] == m and 's_per_factorisation' in x]) >= 2) + "."]
     if meshes:
