@@ -209,6 +209,36 @@ TEST(VolumetricModels, ApproachBeforeContactIsTheRestState) {
     EXPECT_NEAR(rb.force_N[i + shift], ra.force_N[i], 0.01 * scale) << "step " << i;
 }
 
+TEST(VolumetricModels, PersistentIntegrationFailureStopsWithAMessageAfterOneRestart) {
+  // Tolerances no integrator can meet: the first failure is answered by one
+  // restart from the last haptic step, the second stops the run with the
+  // integrator's message (nothing non-finite is returned).
+  Scene scene = testing::small_slab_scene();
+  scene.layers[0].force_mesh.deformed_threshold_m = 1.0;
+  const auto mesh = mesh_of(scene);
+  VolumetricSettings settings = volumetric_settings(scene);
+  settings.relative_tolerance = 1e-300;
+  settings.absolute_tolerance_m = 1e-300;
+  VolumetricNeedleModel model(scene, mesh, std::make_unique<LinearTensorMass>(*mesh, layer_elasticity(scene)), settings,
+                              "unreachable tolerances");
+  const ScriptedTrajectory trajectory(scene.insertion);
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  bool threw = false;
+  for (long i = 0; i < 200 && !threw; ++i) {
+    try {
+      const double force = model.step(trajectory.sample(i * dt));
+      EXPECT_TRUE(std::isfinite(force));
+    } catch (const std::runtime_error& e) {
+      threw = true;
+      EXPECT_NE(std::string(e.what()).find("time integration"), std::string::npos) << e.what();
+    }
+  }
+  ASSERT_TRUE(threw);
+  EXPECT_NE(model.integrator_report().find("1 of them after an integration failure"), std::string::npos)
+      << model.integrator_report();
+  EXPECT_GE(model.recovered_steps(), 1);
+}
+
 TEST(VolumetricModels, BadInputIsRejected) {
   const Scene scene = testing::small_slab_scene();
   EXPECT_THROW(make_comparison_model("msm", scene, nullptr), std::invalid_argument);
