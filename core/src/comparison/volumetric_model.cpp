@@ -238,7 +238,14 @@ int VolumetricNeedleModel::preconditioner_setup(double, const double* yp, bool j
       omega_squared_bound_ = std::max(omega_squared_bound_, row / mass_[j]);
     }
     have_tangent_ = true;
-    have_factor_ = false;
+    // Lagged preconditioner: CVODE asks for fresh Jacobian data after every
+    // restart (each contact change) and every 50 steps; the factorisation made
+    // with an older tangent or contact set stays a good preconditioner (GMRES
+    // absorbs the difference), so it is kept until a Newton iteration fails
+    // to converge with it. Factorisations dominate the cost of a step.
+    if (!settings_.lag_preconditioner || !integrator_ ||
+        integrator_->stats().convergence_failures != factor_convergence_failures_)
+      have_factor_ = false;
     updated = true;
   }
   const double alpha = settings_.mass_damping_per_s, beta = settings_.stiffness_damping_s;
@@ -286,6 +293,7 @@ int VolumetricNeedleModel::preconditioner_setup(double, const double* yp, bool j
   }
   have_factor_ = true;
   factor_gamma_ = gamma;
+  factor_convergence_failures_ = integrator_ ? integrator_->stats().convergence_failures : 0;
   return 0;
 }
 
@@ -492,6 +500,9 @@ void VolumetricNeedleModel::puncture_active_layer() {
 }
 
 double VolumetricNeedleModel::contact_force_N() {
+  // Without contact nodes the force is zero: no internal force evaluation
+  // (a sweep over every element) on the steps before and between contacts.
+  if (std::none_of(dof_.begin(), dof_.end(), [](Dof d) { return d == Dof::Contact; })) return 0.0;
   compute_forces(y_, work_f_);
   double force = 0.0;
   for (int a = 0; a < nodes_; ++a)
@@ -536,7 +547,13 @@ double VolumetricNeedleModel::step(const NeedleState& needle) {
     integrator_ = std::make_unique<SundialsIntegrator>(static_cast<OdeSystem&>(*this), integration, time_, y_);
     return contact_force_N();
   }
-  if (t > time_) {
+  const bool touched = std::any_of(layers_.begin(), layers_.end(), [](const LayerRuntime& l) { return l.contact_started; });
+  if (t > time_ && !touched) {
+    // Before the needle first touches the tissue the mesh rests unloaded
+    // (y' = 0 exactly: no contact, no body forces): nothing to integrate. The
+    // integrator restarts from this state at the first contact.
+    time_ = t;
+  } else if (t > time_) {
     // The contact nodes follow the needle with its mean velocity over this step.
     double z_contact = 0.0;
     bool any_contact = false;
@@ -556,13 +573,28 @@ double VolumetricNeedleModel::step(const NeedleState& needle) {
       integrator_->reinit(time_, y_);
     }
     needle_velocity_z_ = step_velocity;
-    integrator_->advance(t, y_);
+    try {
+      integrator_->advance(t, y_);
+    } catch (const std::runtime_error&) {
+      // Recovery: the BDF history can lead the error test to fail over and
+      // over (h collapsing to ~1e-7 s) on a smooth stretch of the insertion;
+      // restart from the last accepted haptic state (order 1, new history,
+      // fresh tangent and factorisation) and try once more. A second failure
+      // stops the run with the integrator's message.
+      ++failure_restarts_;
+      have_tangent_ = false;
+      have_factor_ = false;
+      integrator_->reinit(time_, y_);
+      integrator_->advance(t, y_);
+    }
     time_ = t;
     for (int a = 0; a < nodes_; ++a)
       if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * a + 2] = z_tip;
   }
   if (update_contacts(z_tip, velocity_z, needle.axial_velocity_m_per_s < 0.0)) {
-    have_factor_ = false;  // the prescribed dofs changed
+    // The prescribed dofs changed: the factorisation is kept as a lagged
+    // preconditioner (see preconditioner_setup); a puncture drops it.
+    if (!settings_.lag_preconditioner) have_factor_ = false;
     needle_velocity_z_ = velocity_z;
     integrator_->reinit(time_, y_);
   }
@@ -663,14 +695,15 @@ std::string VolumetricNeedleModel::integrator_report() const {
       << " convergence failures; " << factorisations_ << " sparse LDL^T factorisations (" << factorisation_seconds_
       << " s), " << mass_only_setups_ << " diagonal preconditioners; " << relaxations_
       << " static relaxations after a contact jump (" << relaxation_factorisations_ << " factorisations); "
-      << s.reinitialisations << " restarts (contact, puncture, speed changes)";
+      << s.reinitialisations << " restarts (contact, puncture, speed changes), " << failure_restarts_
+      << " of them after an integration failure";
   return out.str();
 }
 
 long VolumetricNeedleModel::recovered_steps() const {
   if (!integrator_) return 0;
   const IntegratorStats s = integrator_->stats();
-  return s.error_test_failures + s.convergence_failures;
+  return s.error_test_failures + s.convergence_failures + failure_restarts_;
 }
 
 }  // namespace puncture::comparison

@@ -153,6 +153,92 @@ TEST(VolumetricModels, ExplicitIntegrationAgreesWithImplicit) {
   EXPECT_NE(explicit_model->integrator_report().find("ERK"), std::string::npos);
 }
 
+TEST(VolumetricModels, LaggedPreconditionerGivesTheSameForces) {
+  // The factorisation kept across contact changes and new tangents is only a
+  // preconditioner: the forces must agree with refactorising at every
+  // Jacobian update, within the integrator's tolerance.
+  Scene scene = testing::small_slab_scene();
+  scene.insertion.target_depth_m = 0.6e-3;  // press the skin, contact nodes joining
+  scene.layers[0].force_mesh.deformed_threshold_m = 1.0;  // never break it
+  const auto mesh = mesh_of(scene);
+  const double until = (scene.insertion.start_height_m + scene.insertion.target_depth_m) / scene.insertion.speed_m_per_s;
+  for (const char* law : {"mass_tensor", "msm"}) {
+    SCOPED_TRACE(law);
+    auto lagged = make_comparison_model(law, scene, mesh);
+    const RunRecord lagged_run = run(*lagged, scene, until);
+    VolumetricSettings fresh_settings = volumetric_settings(scene);
+    fresh_settings.lag_preconditioner = false;
+    std::unique_ptr<InternalForceLaw> force_law;
+    if (std::string(law) == "msm")
+      force_law = std::make_unique<MassSpringLaw>(*mesh, layer_elasticity(scene), std::vector<double>{});
+    else
+      force_law = std::make_unique<LinearTensorMass>(*mesh, layer_elasticity(scene));
+    VolumetricNeedleModel fresh(scene, mesh, std::move(force_law), fresh_settings, "fresh factorisations");
+    const RunRecord fresh_run = run(fresh, scene, until);
+    ASSERT_EQ(lagged_run.force_N.size(), fresh_run.force_N.size());
+    const double scale = fresh_run.force_N.back();
+    ASSERT_GT(scale, 1e-4);
+    for (std::size_t i = 0; i < fresh_run.force_N.size(); ++i)
+      EXPECT_NEAR(lagged_run.force_N[i], fresh_run.force_N[i], 0.01 * scale) << "step " << i;
+  }
+}
+
+TEST(VolumetricModels, ApproachBeforeContactIsTheRestState) {
+  // Nothing is integrated before the first contact: starting 0.5 mm above
+  // the skin must give the same forces, shifted in time, as starting on it.
+  Scene on_skin = testing::small_slab_scene();
+  on_skin.insertion.start_height_m = 0.0;
+  on_skin.insertion.target_depth_m = 0.3e-3;
+  on_skin.layers[0].force_mesh.deformed_threshold_m = 1.0;
+  Scene above = on_skin;
+  above.insertion.start_height_m = 0.5e-3;
+  const auto mesh = mesh_of(on_skin);
+  auto a = make_comparison_model("mass_tensor", on_skin, mesh);
+  auto b = make_comparison_model("mass_tensor", above, mesh);
+  const RunRecord ra = run(*a, on_skin, on_skin.insertion.target_depth_m / on_skin.insertion.speed_m_per_s);
+  const RunRecord rb = run(*b, above, (above.insertion.start_height_m + above.insertion.target_depth_m) / above.insertion.speed_m_per_s);
+  const std::size_t shift = rb.force_N.size() - ra.force_N.size();
+  ASSERT_EQ(shift, 50u);  // 0.5 mm at 10 mm/s and 1 kHz
+  for (std::size_t i = 0; i < shift; ++i) EXPECT_EQ(rb.force_N[i], 0.0) << "step " << i;
+  const double scale = ra.force_N.back();
+  ASSERT_GT(scale, 1e-4);
+  // From the step after the contact: at t = 0 the trajectory gives the needle
+  // no speed yet, so the first contact step of `on_skin` lacks the damping
+  // force of the nodes put onto the moving tip.
+  for (std::size_t i = 1; i < ra.force_N.size(); ++i)
+    EXPECT_NEAR(rb.force_N[i + shift], ra.force_N[i], 0.01 * scale) << "step " << i;
+}
+
+TEST(VolumetricModels, PersistentIntegrationFailureStopsWithAMessageAfterOneRestart) {
+  // Tolerances no integrator can meet: the first failure is answered by one
+  // restart from the last haptic step, the second stops the run with the
+  // integrator's message (nothing non-finite is returned).
+  Scene scene = testing::small_slab_scene();
+  scene.layers[0].force_mesh.deformed_threshold_m = 1.0;
+  const auto mesh = mesh_of(scene);
+  VolumetricSettings settings = volumetric_settings(scene);
+  settings.relative_tolerance = 1e-300;
+  settings.absolute_tolerance_m = 1e-300;
+  VolumetricNeedleModel model(scene, mesh, std::make_unique<LinearTensorMass>(*mesh, layer_elasticity(scene)), settings,
+                              "unreachable tolerances");
+  const ScriptedTrajectory trajectory(scene.insertion);
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  bool threw = false;
+  for (long i = 0; i < 200 && !threw; ++i) {
+    try {
+      const double force = model.step(trajectory.sample(i * dt));
+      EXPECT_TRUE(std::isfinite(force));
+    } catch (const std::runtime_error& e) {
+      threw = true;
+      EXPECT_NE(std::string(e.what()).find("time integration"), std::string::npos) << e.what();
+    }
+  }
+  ASSERT_TRUE(threw);
+  EXPECT_NE(model.integrator_report().find("1 of them after an integration failure"), std::string::npos)
+      << model.integrator_report();
+  EXPECT_GE(model.recovered_steps(), 1);
+}
+
 TEST(VolumetricModels, BadInputIsRejected) {
   const Scene scene = testing::small_slab_scene();
   EXPECT_THROW(make_comparison_model("msm", scene, nullptr), std::invalid_argument);

@@ -34,7 +34,10 @@
 //     than 20 um), the free nodes are brought to static equilibrium at once
 //     (as the FEM reference does), instead of a dynamic impulse.
 // Every state change (contact, release, puncture, a change of needle speed)
-// re-initialises the integrator at that time.
+// re-initialises the integrator at that time; so does a failed integration
+// (error or convergence test failing repeatedly), once, from the last
+// haptic step, before the failure is reported. Before the needle first touches
+// the tissue nothing is integrated (the mesh rests, y' = 0).
 //
 // Implicit integration: CVODE BDF of order at most 2 (the A-stable ones: the
 // lightly damped oscillations of an elastic mesh make BDF3-5 unstable and
@@ -44,7 +47,10 @@
 // with the law's tangent K at the last setup (prescribed and fixed degrees of
 // freedom eliminated), factorised by a sparse LDL^T (Eigen); laws with an exact
 // tangent also give the Jacobian-vector product from it. The factorisation is
-// reused while gamma stays within a factor 5 of the one it was made with;
+// reused while gamma stays within a factor 5 of the one it was made with and
+// no Newton iteration has failed to converge since it was made, across new
+// tangents and contact changes (a lagged preconditioner; a puncture, which
+// removes elements, drops it);
 // the visco-elastic law's internal variables q (q' = g dS_e/dt - q / tau) are
 // eliminated too: their residual enters the velocity equation through their
 // nodal forces, and q's correction follows from the velocity one;
@@ -79,6 +85,10 @@ struct VolumetricSettings {
   /// the contact set is unchanged and Newton converges). Used by the
   /// mass-spring identification against the quasi-static FEM.
   bool quasi_static = false;
+  /// Keep the Newton matrix's factorisation across new tangents and contact
+  /// changes while Newton converges with it (false: refactorise at every
+  /// Jacobian update and contact change, as before; for tests).
+  bool lag_preconditioner = true;
 };
 VolumetricSettings volumetric_settings(const Scene& scene);
 
@@ -191,6 +201,8 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   bool have_factor_ = false;
   bool mass_only_ = false;          ///< the last setup chose the diagonal preconditioner
   double factor_gamma_ = 0.0;
+  long factor_convergence_failures_ = 0;
+  long failure_restarts_ = 0;  ///< restarts after the integrator failed (step())  ///< integrator's convergence failures when the factor was made
   double omega_squared_bound_ = 0.0;
   Eigen::VectorXd diagonal_;
   long factorisations_ = 0;
