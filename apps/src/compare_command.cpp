@@ -478,7 +478,7 @@ int compare_command(const CompareOptions& options, std::ostream& out, std::ostre
        << "FEM reference: cache key `" << reference.hash << "` (" << (reference.from_cache ? "from the cache" : "computed now")
        << "), " << fem.summary.value("n_dofs", 0L) << " dofs, " << fem.summary.value("load_steps", 0L)
        << " load steps in " << shown(fem.summary.value("wall_time_s", kNaN), 4) << " s. "
-       << (ref.has_shaft_forces ? "Its curve has cutting/friction columns: the models' force includes Table 1's d h v."
+       << (ref.has_shaft_forces ? "Its curve has cutting/friction columns: every model's force includes the same shaft forces (cutting, Karnopp friction and Table 1's d h v)."
                                 : "Its curve is quasi-static and frictionless (no cutting/friction columns): the "
                                   "models' contact force is compared, without Table 1's post-puncture d h v.")
        << "\n\n";
