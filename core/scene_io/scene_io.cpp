@@ -209,8 +209,10 @@ StiffeningLaw read_stiffening(ObjectReader r) {
   const std::string law = r.string("law");
   if (law == "polynomial") {
     st.kind = StiffeningLaw::Kind::Polynomial;
-    st.quadratic_N_per_m2 = r.number("quadratic_N_per_mm2", 0.0) / (kMm * kMm);
-    st.cubic_N_per_m3 = r.number("cubic_N_per_mm3", 0.0) / (kMm * kMm * kMm);
+    // One operation with an exact constant each way (1e6, 1e9), so a value
+    // written and read back stays the same text (kMm * kMm rounds twice).
+    st.quadratic_N_per_m2 = r.number("quadratic_N_per_mm2", 0.0) * 1e6;
+    st.cubic_N_per_m3 = r.number("cubic_N_per_mm3", 0.0) * 1e9;
   } else if (law == "exponential") {
     st.kind = StiffeningLaw::Kind::Exponential;
     st.exponential_stiffness_N_per_m = r.number("stiffness_N_per_mm") / kMm;
@@ -715,8 +717,8 @@ json force_law_json(const ForceLaw& law) {
   const StiffeningLaw& st = law.stiffening;
   if (st.kind == StiffeningLaw::Kind::Polynomial)
     j["stiffening"] = {{"law", "polynomial"},
-                       {"quadratic_N_per_mm2", st.quadratic_N_per_m2 * kMm * kMm},
-                       {"cubic_N_per_mm3", st.cubic_N_per_m3 * kMm * kMm * kMm}};
+                       {"quadratic_N_per_mm2", st.quadratic_N_per_m2 / 1e6},
+                       {"cubic_N_per_mm3", st.cubic_N_per_m3 / 1e9}};
   else
     j["stiffening"] = {{"law", "exponential"},
                        {"stiffness_N_per_mm", st.exponential_stiffness_N_per_m * kMm},

@@ -192,8 +192,15 @@ TEST(PunctureApp, TunedPresetOpensAndRunsItsOwnParameters) {
   RealtimeModel tuned_model = build_realtime_model(tuned);
   const ScriptedRunResult offline = run_scripted_insertion(tuned_model, tuned);
   const json& events = s.at("puncture_events");
-  ASSERT_EQ(events.size(), offline.events.size());
-  ASSERT_FALSE(offline.events.empty());
+  // The app ran 2 s of the scripted trajectory, the offline model all of it:
+  // the app's events are the offline events of those 2 s (a layer that breaks
+  // later, e.g. the tuned muscle at about 18 mm = 2.02 s, is not among them).
+  const double duration_s = 2.0;
+  std::size_t within = 0;
+  for (const auto& e : offline.events) within += e.time_s < duration_s - 0.01 ? 1 : 0;
+  ASSERT_GE(events.size(), within);
+  ASSERT_LE(events.size(), offline.events.size());
+  ASSERT_FALSE(events.empty());
   for (std::size_t i = 0; i < events.size(); ++i) {
     EXPECT_EQ(events[i].at("layer").get<std::string>(), tuned.layers[offline.events[i].layer].name);
     EXPECT_EQ(events[i].at("depth_mm").get<double>(), offline.events[i].depth_m * 1e3);
