@@ -22,14 +22,10 @@ double KarnoppFriction::update(double v, double depth_m) {
   const double dx = has_depth_ ? depth_m - last_depth_m_ : 0.0;
   has_depth_ = true;
   last_depth_m_ = depth_m;
-  if (!(law_.presliding_m > 0.0)) return update(v);
-  if (std::abs(v) > law_.velocity_band_m_per_s) {
-    phi_ = std::clamp(phi_ + law_.dynamic_N_per_m / law_.presliding_m * dx, -law_.dynamic_N_per_m, law_.dynamic_N_per_m);
-    sticking_ = false;
-  } else {
-    phi_ = std::clamp(phi_, -law_.static_N_per_m, law_.static_N_per_m);
-    sticking_ = true;
-  }
+  // Without presliding, or inside the band (sticking), Karnopp's rule.
+  if (!(law_.presliding_m > 0.0) || std::abs(v) <= law_.velocity_band_m_per_s) return update(v);
+  phi_ = std::clamp(phi_ + law_.dynamic_N_per_m / law_.presliding_m * dx, -law_.dynamic_N_per_m, law_.dynamic_N_per_m);
+  sticking_ = false;
   return phi_;
 }
 

@@ -13,6 +13,21 @@ std::string fmt(double v, int digits = 3) {
   return s.str();
 }
 
+/// |value| <= limit for one objective term: its relative value or its raw error.
+AcceptanceCheck term_check(const ObjectiveTerm* t, bool relative, double limit) {
+  AcceptanceCheck c;
+  c.limit = limit;
+  if (!t || !t->available) {
+    c.note = "n/a: " + (t ? t->note : std::string("no term"));
+    return c;
+  }
+  c.available = true;
+  c.value = relative ? t->value : t->raw;
+  c.met = std::abs(c.value) <= limit;
+  c.note = t->note;
+  return c;
+}
+
 }  // namespace
 
 std::vector<LayerAcceptance> layer_acceptance(const std::vector<LayerGeometry>& layers,
@@ -43,28 +58,9 @@ std::vector<LayerAcceptance> layer_acceptance(const std::vector<LayerGeometry>& 
     } else {
       a.force_rmse.note = "n/a: " + missing;
     }
-    // Puncture depth within L.
-    const ObjectiveTerm* depth = comparison.term("puncture_depth", g.name);
-    a.puncture_depth.limit = g.spacing_L_m;
-    if (depth && depth->available) {
-      a.puncture_depth.available = true;
-      a.puncture_depth.value = depth->raw;
-      a.puncture_depth.met = std::abs(depth->raw) <= g.spacing_L_m;
-      a.puncture_depth.note = depth->note;
-    } else {
-      a.puncture_depth.note = "n/a: " + (depth ? depth->note : std::string("no term"));
-    }
-    // Puncture force within 10 %.
-    const ObjectiveTerm* force = comparison.term("puncture_force", g.name);
-    a.puncture_force.limit = criteria.max_force_error_relative;
-    if (force && force->available) {
-      a.puncture_force.available = true;
-      a.puncture_force.value = force->value;
-      a.puncture_force.met = std::abs(force->value) <= criteria.max_force_error_relative;
-      a.puncture_force.note = force->note;
-    } else {
-      a.puncture_force.note = "n/a: " + (force ? force->note : std::string("no term"));
-    }
+    // Puncture depth within L (the term's error in m), force within 10 % (its relative error).
+    a.puncture_depth = term_check(comparison.term("puncture_depth", g.name), false, g.spacing_L_m);
+    a.puncture_force = term_check(comparison.term("puncture_force", g.name), true, criteria.max_force_error_relative);
     out.push_back(a);
   }
   return out;

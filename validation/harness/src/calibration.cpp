@@ -12,10 +12,10 @@
 #include <stdexcept>
 
 #include "puncture/io/output_session.hpp"
-#include "puncture/stiffening.hpp"
-#include "puncture/validation/pressing_polynomial.hpp"
 #include "puncture/io/provenance.hpp"
 #include "puncture/scene_io.hpp"
+#include "puncture/stiffening.hpp"
+#include "puncture/validation/pressing_polynomial.hpp"
 
 
 namespace puncture::validation {
