@@ -133,8 +133,8 @@ bool PunctureSimulator::try_contact(const NeedleState& needle) {
   layer.contact = hit;
   layer.contact_at_tip = false;
   if (!interaction_ && penetration > 0.0 && std::isfinite(layer.tip_contact_from_m)) {
-    // Reached with the tip already below the rest surface (see the header):
-    // pressed from where the tip is, once it cut through the layer above.
+    // Reached with the tip already below the rest surface, as the layer
+    // above broke (see the header): pressed from where the tip is.
     if (needle.tip_position_m.dot(needle.direction) < layer.tip_contact_from_m) return false;
     layer.contact.position = tip;
     layer.contact_at_tip = true;
@@ -258,11 +258,10 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
         needle.tip_position_m - needle.direction * (contact_search_height_m_ + std::abs(needle.tip_position_m.z()));
     if (next.surface->intersect_ray(origin, needle.direction, s, hit) &&
         hit.normal.dot(hit.position - needle.tip_position_m) > 0.0) {
-      // The tip is already below the next rest surface. Where the broken
-      // layer's top surface was on the axis at the break: at the tip when a
-      // force mesh carried it down, at the rest surface without one.
-      const double top_axial = layer.mesh ? tip_axial : tip_axial - result_.layers[active_ - 1].contact_deflection_m;
-      next.tip_contact_from_m = top_axial + layer.thickness_m;
+      // The tip is already below the next rest surface, which does not move
+      // without layer interaction: the broken layer left between them is
+      // squeezed to nothing, so the next layer is pressed from the tip on.
+      next.tip_contact_from_m = tip_axial;
     }
   }
 }

@@ -31,12 +31,13 @@
 //      axis' crossings with their surfaces when they are at rest). A contact
 //      is released when the tip is back above the rest surface, so the next
 //      touch lays the mesh where it happens.
-//      Without layer interaction the layer below does not move, so a thin
-//      layer pressed deeper than its own thickness (the skin) leaves the tip
-//      below the next layer's rest surface when it breaks. The tip then first
-//      cuts through the broken layer's thickness (from where its top surface
-//      was at the break) and the next layer's contact is made at the tip
-//      there (its deflection counts from that point);
+//      Without layer interaction the layer below does not move, so a layer
+//      pressed deeper than its own thickness (the skin, or the fat pressed
+//      onto the muscle) leaves the tip below the next layer's rest surface
+//      when it breaks. The broken layer left between the tip and that fixed
+//      surface is then squeezed to nothing: the next layer's contact is made
+//      at the tip in the same tick (its deflection counts from there), as the
+//      FEM's soft layers are compressed ahead of the tip rather than carried;
 //   3. the tip's penetration D past the contact point along the contact
 //      normal drives the chain (displacement-driven: one common force F,
 //      deflections summing to D; without interaction the chain is the needle
@@ -180,7 +181,8 @@ class PunctureSimulator {
     bool contact_at_tip = false;  ///< contact below the rest surface (no layer interaction)
     /// Without layer interaction: from this position of the tip along the
     /// needle axis on, a contact below the rest surface is made at the tip
-    /// (+inf: only at the surface crossing). See try_contact.
+    /// (+inf: only at the surface crossing; the tip at the break of the layer
+    /// above when it broke below this layer's rest surface). See try_contact.
     double tip_contact_from_m = 0.0;
     SurfacePoint contact;
     double deflection_m = 0.0;    ///< committed deflection of the contact node relative to the layer below

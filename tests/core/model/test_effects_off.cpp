@@ -196,9 +196,12 @@ TEST(EffectsOff, CuttingAndFrictionOffGiveExactlyZeroAndBuildNoFriction) {
     const ScriptedRunResult run = run_scripted_insertion(m, s);
     ASSERT_EQ(run.events.size(), 3u);
     double max_cutting = 0.0, min_friction = 0.0, max_friction = 0.0;
+    std::vector<double> layer_cutting(s.layers.size(), 0.0);
     for (const TickResult& t : run.ticks) {
       double friction = 0.0, cutting = 0.0;
       for (const LayerTickResult& l : t.layers) friction += l.friction_force_N, cutting += l.cutting_force_N;
+      for (std::size_t k = 0; k < s.layers.size(); ++k)
+        layer_cutting[k] = std::max(layer_cutting[k], t.layers[k].cutting_force_N);
       EXPECT_EQ(t.cutting_force_N, cutting);
       max_cutting = std::max(max_cutting, cutting);
       min_friction = std::min(min_friction, friction);
@@ -209,7 +212,15 @@ TEST(EffectsOff, CuttingAndFrictionOffGiveExactlyZeroAndBuildNoFriction) {
       EXPECT_NEAR(t.total_force_N, parts, 1e-12);
     }
     if (on) {
-      EXPECT_NEAR(max_cutting, 1.44, 1e-12);  // the skin's cutting force of the scene
+      // The skin breaks below the fat's rest surface, and the fat is then
+      // pressed from the tip at once: no cut through the skin. The fat breaks
+      // above the muscle and the muscle is cut into: each cuts with its
+      // scene value.
+      EXPECT_GT(run.events[0].depth_m, s.layer_top_depth_m(1));
+      EXPECT_LT(run.events[1].depth_m, s.layer_top_depth_m(2));
+      EXPECT_EQ(layer_cutting[0], 0.0);
+      for (std::size_t k : {1u, 2u}) EXPECT_NEAR(layer_cutting[k], s.layers[k].force_law.cutting_force_N, 1e-12);
+      EXPECT_NEAR(max_cutting, s.layers[2].force_law.cutting_force_N, 1e-12);
       // Friction at the deepest point: f_d x shaft length in tissue (30 mm at 0.01 N/mm).
       EXPECT_NEAR(max_friction, 0.01e3 * s.insertion.target_depth_m, 1e-9);
       EXPECT_NEAR(min_friction, -max_friction, 1e-5);  // reversed on withdrawal
