@@ -74,6 +74,9 @@ int main(int argc, char** argv) {
                             "Integrator of the model runs: quasi_static, explicit or implicit; default: the scene's");
   calibrate_cmd->add_option("--depth-weight", calibrate.depth_weight,
                             "Weight of the puncture-depth term (error in units of min(L, thickness)); default 0.1");
+  calibrate_cmd->add_option("--force-weight", calibrate.force_weight,
+                            "Weight of the puncture-force term (relative error, like the RMSE terms of weight 1); "
+                            "default 1");
   calibrate_cmd->add_option("--bound-factor", calibrate.bound_factor,
                             "Each tuned scale parameter stays within [start / f, start * f] (and its physical "
                             "range); default 1000");

@@ -32,7 +32,8 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
   c << " -o " << dir.string() << " --name " << name << " --method " << options.method;
   for (std::size_t i = 0; i < options.also_tune.size(); ++i) c << (i ? "," : " --also-tune ") << options.also_tune[i];
   for (const std::string& layer : options.layers) c << " --layers " << layer;
-  c << " --bound-factor " << options.bound_factor << " --depth-weight " << options.depth_weight << " --integrator "
+  c << " --bound-factor " << options.bound_factor << " --depth-weight " << options.depth_weight
+    << " --force-weight " << options.force_weight << " --integrator "
     << integrator;
   for (std::size_t i = 0; i < options.puncture_depths_mm.size(); ++i)
     c << (i ? "," : " --puncture-depths ") << options.puncture_depths_mm[i];
@@ -79,6 +80,9 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
     if (!(options.depth_weight >= 0.0) || !std::isfinite(options.depth_weight))
       throw UsageError("--depth-weight must be a finite number >= 0");
     calibration.weights.puncture_depth = options.depth_weight;
+    if (!(options.force_weight >= 0.0) || !std::isfinite(options.force_weight))
+      throw UsageError("--force-weight must be a finite number >= 0");
+    calibration.weights.puncture_force = options.force_weight;
     for (const std::string& name : options.also_tune) {
       if (name == "surface_stiffness")
         calibration.parameters.surface_stiffness = true;

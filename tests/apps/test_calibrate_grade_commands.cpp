@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -140,17 +141,19 @@ TEST(CalibrateCommand, BadKeepOrPunctureDepthsAreErrorsWithNoOutput) {
   const fs::path ref_dir = fresh_dir("calibrate_bad_keep_reference");
   fs::create_directories(ref_dir);
   std::ofstream(ref_dir / "curve.csv") << "depth_mm,force_N\n0,0\n1,0.5\n2,1.0\n";
-  for (int which = 0; which < 2; ++which) {
+  const char* names[] = {"--keep", "--puncture-depths", "--force-weight", "--force-weight"};
+  for (int which = 0; which < 4; ++which) {
     CalibrateOptions options;
     options.scene = kSourceDir / "scenes" / "default.json";
     options.reference = ref_dir / "curve.csv";
     options.output_dir = dir;
     options.quiet = true;
     if (which == 0) options.keep = {"everything"};
-    else options.puncture_depths_mm = {-1.0};
+    else if (which == 1) options.puncture_depths_mm = {-1.0};
+    else options.force_weight = which == 2 ? -1.0 : std::numeric_limits<double>::quiet_NaN();
     std::ostringstream out, err;
-    EXPECT_NE(calibrate_command(options, out, err), 0);
-    EXPECT_NE(err.str().find(which == 0 ? "--keep" : "--puncture-depths"), std::string::npos) << err.str();
+    EXPECT_EQ(calibrate_command(options, out, err), 2) << names[which];
+    EXPECT_NE(err.str().find(names[which]), std::string::npos) << err.str();
     EXPECT_FALSE(fs::exists(dir));
   }
   fs::remove_all(ref_dir);

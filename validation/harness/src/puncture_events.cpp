@@ -142,16 +142,22 @@ ReferenceEvents reference_events(const InsertionCurve& reference, const std::vec
     for (std::size_t k = 0; k < layers.size(); ++k) {
       if (!ev.punctures[k].found) continue;
       bool after = false;
+      double last_free_m = 0.0;  // deepest sample of the cut with the tip force at 0
       for (std::size_t i : phase) {
         if (reference.depth_m[i] < ev.punctures[k].depth_m) continue;
+        const bool free_tip = reference.tip_force_N[i] <= 1e-12 * std::max(1.0, peak);
         if (!after) {  // skip the samples up to the drop itself
-          after = reference.tip_force_N[i] <= 1e-12 * std::max(1.0, peak);
+          after = free_tip;
+          if (after) last_free_m = reference.depth_m[i];
           continue;
         }
-        if (reference.tip_force_N[i] > 1e-12 * std::max(1.0, peak)) {
-          ev.cut_end_m[k] = reference.depth_m[i];
+        if (!free_tip) {
+          // The tip force back above 0 right after the drop sample: the next
+          // layer was met at the break (no cut through this one).
+          ev.cut_end_m[k] = last_free_m > ev.punctures[k].depth_m ? reference.depth_m[i] : ev.punctures[k].depth_m;
           break;
         }
+        last_free_m = reference.depth_m[i];
       }
     }
 

@@ -80,6 +80,11 @@ struct CalibrateOptions {
   /// one L weighs like a force RMSE of 32 % of the peak. With weight 1 the fat
   /// of the default scene trades 20 % force RMSE for a 0.1 mm better depth.
   double depth_weight = 0.1;
+  /// Weight of each layer's puncture-force term (relative error); 1 weighs a
+  /// 10 % force error like a 10 % RMSE. Raise it when the puncture forces
+  /// matter more than the fit after them (the acceptance of validate asks
+  /// for them within 10 %).
+  double force_weight = 1.0;
   /// Puncture depths of the reference (mm), one per layer from the top; empty:
   /// from its state columns, else from its force drops.
   std::vector<double> puncture_depths_mm;

@@ -90,7 +90,9 @@ struct ReferenceEvents {
   std::vector<ForceDrop> drops;                 ///< every candidate drop found (ForceDrops source)
   /// Per layer: where the cut through it ends (the first insertion sample
   /// after its puncture whose tip force is > 0: the tip presses the next
-  /// layer); NaN when the curve has no part columns or the tip never does.
+  /// layer; the puncture depth itself when only the drop's own sample has
+  /// the tip force at 0, i.e. the next layer was met at the break); NaN
+  /// when the curve has no part columns or the tip never does.
   std::vector<double> cut_end_m;
   std::string note;                             ///< how they were found, for reports
 };
