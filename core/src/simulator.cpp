@@ -289,9 +289,12 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   if (first_tick_) layers_[0].tip_contact_from_m = std::numeric_limits<double>::infinity();
   first_tick_ = false;
 
-  // Cutting force of the punctured layer the tip is in (the next layer has no contact yet).
+  // Cutting force of the punctured layer the tip is in: until the next layer
+  // is touched, or, when that layer was met at the break (contact at the
+  // tip, the broken layer squeezed between them), while the tip presses it.
   auto cutting = [&]() {
-    if (!cutting_on_ || active_ == 0 || (active_ < n && layers_[active_].contact_set)) return 0.0;
+    if (!cutting_on_ || active_ == 0) return 0.0;
+    if (active_ < n && layers_[active_].contact_set && !layers_[active_].contact_at_tip) return 0.0;
     LayerModel& p = layers_[active_ - 1];
     const double f = cutting_force_N(p.law.cutting_force_N, p.law.cutting_release_m, p.front_m, tip_axial_m);
     p.front_m = std::max(p.front_m, tip_axial_m);

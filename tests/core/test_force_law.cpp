@@ -383,6 +383,60 @@ TEST(ForceLaw, CuttingPlusFrictionAfterThePunctureReversingOnWithdrawal) {
   });
 }
 
+TEST(ForceLaw, ALayerBrokenBelowTheNextSurfaceIsCutWhileTheNextIsPressed) {
+  // A 1 mm layer that breaks at 1 N with the tip about 1.5 mm deep, below the rest
+  // surface of the 20 mm layer under it (no layer interaction: that surface
+  // does not move). The broken layer between them is squeezed to nothing:
+  // the lower layer is pressed from the tip at the break (its force is its
+  // static stiffness times the travel since the break), and the tip keeps
+  // cutting the broken layer meanwhile (C on top of that force). Then the
+  // same two layers with the upper one 8 mm thick: it breaks above the lower
+  // surface, is cut alone until the tip touches it, and no longer after.
+  for (double upper_m : {1e-3, 8e-3}) {
+    Scene scene = single_layer_scene(upper_m);
+    scene.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 4, 1e-3, 100.0, 1.0, 0.05));
+    scene.layers[1].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+    scene.layers[1].force_law.breakthrough.critical_force_N = 1e3;
+    scene.effects.cutting = true;
+    scene.layers[0].force_law.breakthrough.critical_force_N = 1.0;
+    scene.layers[0].force_law.cutting_force_N = 0.8;
+    PunctureSimulator sim(scene, test::plane_surfaces(scene));
+    double t = 0.0;
+    double break_depth = -1.0;
+    int pressed_while_cut = 0, cut_alone = 0, pressed_alone = 0;
+    drive(sim, t, -0.2e-3, 10e-3, 0.01, [&](const TickResult& r) {
+      if (break_depth < 0.0 && !sim.puncture_events().empty()) break_depth = sim.puncture_events()[0].depth_m;
+      if (break_depth < 0.0) {
+        EXPECT_EQ(r.cutting_force_N, 0.0);
+        return;
+      }
+      EXPECT_NEAR(r.total_force_N, r.tip_force_N + r.cutting_force_N, 1e-12);
+      const double below_next_m = r.depth_m - upper_m;  // the tip's depth below b's rest surface
+      if (upper_m < break_depth) {
+        // Met at the break: b pressed from the tip there, a cut meanwhile.
+        EXPECT_NEAR(r.cutting_force_N, 0.8, 1e-12);
+        EXPECT_NEAR(r.tip_force_N, sim.force_mesh(1)->static_stiffness_N_per_m() * (r.depth_m - break_depth), 1e-9);
+        if (r.tip_force_N > 0.0) ++pressed_while_cut;
+      } else if (below_next_m <= 0.0) {
+        EXPECT_NEAR(r.cutting_force_N, 0.8, 1e-12);  // cut alone, b not touched
+        EXPECT_EQ(r.tip_force_N, 0.0);
+        ++cut_alone;
+      } else {
+        EXPECT_EQ(r.cutting_force_N, 0.0);  // b touched from above: the cut through a is over
+        EXPECT_NEAR(r.tip_force_N, sim.force_mesh(1)->static_stiffness_N_per_m() * below_next_m, 1e-9);
+        ++pressed_alone;
+      }
+    });
+    ASSERT_EQ(sim.puncture_events().size(), 1u);
+    if (upper_m < break_depth) {
+      EXPECT_GT(pressed_while_cut, 100);
+    } else {
+      EXPECT_GT(cut_alone, 10);
+      EXPECT_GT(pressed_alone, 100);
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------
 // Breakthrough criteria
 

@@ -69,6 +69,16 @@ TEST(ComparisonRealtimeModel, ContactPlusShaftForcesIsTheTickTotalOfTheDefaultSc
   expect_same_total(scene);
 }
 
+TEST(ComparisonRealtimeModel, ContactPlusShaftForcesIsTheTickTotalWithPreslidingAndStiffening) {
+  // The physical force law of scenes/default_force_law.json: critical-force
+  // breakthrough, stiffening, presliding friction (phi follows the shaft
+  // travel), every layer broken below the next one's rest surface or cut.
+  Scene scene = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default_force_law.json");
+  ASSERT_GT(scene.layers[0].force_law.friction.presliding_m, 0.0);
+  ASSERT_TRUE(scene.effects.stiffening);
+  expect_same_total(scene);
+}
+
 TEST(ComparisonRealtimeModel, ContactPlusShaftForcesIsTheTickTotalWithoutCutting) {
   Scene scene = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json");
   scene.effects.cutting = false;

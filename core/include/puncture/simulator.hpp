@@ -37,7 +37,8 @@
 //      when it breaks. The broken layer left between the tip and that fixed
 //      surface is then squeezed to nothing: the next layer's contact is made
 //      at the tip in the same tick (its deflection counts from there), as the
-//      FEM's soft layers are compressed ahead of the tip rather than carried;
+//      FEM's soft layers are compressed ahead of the tip rather than carried,
+//      and the tip keeps cutting the squeezed layer while it presses (5.);
 //   3. the tip's penetration D past the contact point along the contact
 //      normal drives the chain (displacement-driven: one common force F,
 //      deflections summing to D; without interaction the chain is the needle
@@ -52,8 +53,11 @@
 //      becomes the needle layer (its contact is checked in the same tick).
 //      Without a force mesh (surface_force off) a layer breaks as soon as the
 //      tip passes its contact point;
-//   5. cutting: the last punctured layer, while the tip is inside it (the
-//      next layer has no contact yet), adds the cutting force (cutting.hpp);
+//   5. cutting: the last punctured layer, while the tip is inside it, adds
+//      the cutting force (cutting.hpp): until the next layer is touched, or,
+//      when the next layer was met at the break (contact at the tip, the
+//      broken layer squeezed between them), while the tip presses it (the
+//      FEM's tip force and cohesive cutting force act together there);
 //   6. every punctured layer adds its shaft friction phi h (shaft_friction.hpp)
 //      and the damping force d h v (Table 1), with h the shaft length inside
 //      the layer's depth range [top, top + thickness] of the scene;

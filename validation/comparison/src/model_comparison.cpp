@@ -50,12 +50,15 @@ ModelRun run_comparison_model(comparison::ComparisonModel& model, const Scene& s
   // Shaft forces of the force law, the same for every model (as the
   // simulator computes them, core/simulator.hpp steps 5-6): per punctured
   // layer Karnopp friction phi h and damping d h v; the cutting force of the
-  // last punctured layer while the next one is untouched, from the crack
-  // front (the deepest tip position since that layer broke).
+  // last punctured layer while the next one is untouched, or while it is
+  // pressed when it was met at the break (the tip below its rest surface
+  // then, without layer interaction), from the crack front (the deepest tip
+  // position since that layer broke).
   std::vector<std::optional<KarnoppFriction>> friction(n_layers);
   if (scene.effects.friction)
     for (std::size_t k = 0; k < n_layers; ++k) friction[k].emplace(scene.layers[k].force_law.friction);
   std::vector<double> front_m(n_layers, 0.0);
+  std::vector<char> met_at_break(n_layers, 0);
   std::size_t punctured_before = 0;
   for (long i = 0; i < n_steps; ++i) {
     const double t = static_cast<double>(i) * dt;
@@ -81,15 +84,19 @@ ModelRun run_comparison_model(comparison::ComparisonModel& model, const Scene& s
       if (states[k] == LayerState::Punctured && punctured == k) ++punctured;
       if (states[k] != LayerState::Punctured) continue;
       const double h = shaft_length_in_layer_m(needle.depth_m(), scene.layer_top_depth_m(k), scene.layers[k].thickness_m);
-      if (friction[k]) post += friction[k]->update(needle.axial_velocity_m_per_s) * h;
+      if (friction[k]) post += friction[k]->update(needle.axial_velocity_m_per_s, needle.depth_m()) * h;
       if (scene.effects.damping)
         post += puncture_damping_force_N(scene.layers[k].damping_N_s_per_m2, h, needle.axial_velocity_m_per_s);
     }
     const double tip_axial_m = needle.tip_position_m.dot(needle.direction);
-    for (std::size_t k = punctured_before; k < punctured; ++k) front_m[k] = tip_axial_m;
+    for (std::size_t k = punctured_before; k < punctured; ++k) {
+      front_m[k] = tip_axial_m;
+      if (k + 1 < n_layers && !scene.effects.layer_interaction && needle.depth_m() > scene.layer_top_depth_m(k + 1))
+        met_at_break[k + 1] = 1;
+    }
     punctured_before = std::max(punctured_before, punctured);
     if (scene.effects.cutting && punctured > 0 &&
-        (punctured == n_layers || states[punctured] == LayerState::Untouched)) {
+        (punctured == n_layers || states[punctured] == LayerState::Untouched || met_at_break[punctured])) {
       const ForceLaw& law = scene.layers[punctured - 1].force_law;
       post += cutting_force_N(law.cutting_force_N, law.cutting_release_m, front_m[punctured - 1], tip_axial_m);
       front_m[punctured - 1] = std::max(front_m[punctured - 1], tip_axial_m);
