@@ -302,12 +302,15 @@ TEST(PunctureEvents, GivenDepthsOverrideDetectionAndBadOnesAreRejected) {
   EXPECT_THROW(pv::reference_events(ref, geometry, {1e-3, 2e-3, 3e-3}), std::invalid_argument);  // three for two layers
 }
 
-TEST(PunctureEvents, TheCutEndsWhereTheTipPressesTheNextLayerOrAtTheBreak) {
+TEST(PunctureEvents, TheCutEndsWhereTheTipPressesTheNextLayerOrWhereItsCuttingEnds) {
   // Skin (0.8 mm) broken at 2 mm. Curve a: the tip cuts with its own force
   // at 0 over two samples, then presses the fat at 2.4 mm: the cut is
   // [2, 2.4). Curve b: the fat is pressed from the sample after the break
   // (met at the break, as the real-time model does without layer
-  // interaction): there is no cut, and the fat's pressing starts at 2 mm.
+  // interaction) with no cutting force: there is no cut, and the fat's
+  // pressing starts at 2 mm. Curve c: met at the break, with the squeezed
+  // skin cut meanwhile (cutting force > 0 while the fat is pressed) until
+  // 2.6 mm: the cut is [2, 2.6), as the parts say.
   const std::string head =
       "time_s,depth_mm,velocity_mm_per_s,force_N,tip_force_N,cutting_force_N,friction_force_N,phase,skin_state,fat_state\n"
       "0.0,0.0,10,0.0,0.0,0,0,insertion,untouched,untouched\n"
@@ -323,6 +326,12 @@ TEST(PunctureEvents, TheCutEndsWhereTheTipPressesTheNextLayerOrAtTheBreak) {
       "0.2,2.0,10,0.0,0.0,0,0,insertion,punctured,pressed\n"
       "0.21,2.1,10,0.11,0.1,0,0.01,insertion,punctured,pressed\n"
       "0.3,3.0,10,1.2,1.0,0,0.1,insertion,punctured,pressed\n";
+  const std::string c = head +
+      "0.2,2.0,10,0.6,0.0,0.6,0,insertion,punctured,pressed\n"
+      "0.21,2.1,10,0.71,0.1,0.6,0.01,insertion,punctured,pressed\n"
+      "0.24,2.4,10,1.04,0.4,0.6,0.04,insertion,punctured,pressed\n"
+      "0.26,2.6,10,0.66,0.6,0,0.06,insertion,punctured,pressed\n"
+      "0.3,3.0,10,1.1,1.0,0,0.1,insertion,punctured,pressed\n";
   const std::vector<pv::LayerGeometry> layers{{"skin", 0.0, 0.8e-3, 2e-3}, {"fat", 0.8e-3, 8.4e-3, 1e-3}};
   const pv::ReferenceEvents ea = pv::reference_events(pv::parse_insertion_curve(a, "a.csv"), layers);
   const pv::ReferenceEvents eb = pv::reference_events(pv::parse_insertion_curve(b, "b.csv"), layers);
@@ -330,6 +339,8 @@ TEST(PunctureEvents, TheCutEndsWhereTheTipPressesTheNextLayerOrAtTheBreak) {
   ASSERT_TRUE(eb.punctures[0].found);
   EXPECT_NEAR(ea.cut_end_m[0], 2.4e-3, 1e-15);
   EXPECT_NEAR(eb.cut_end_m[0], 2.0e-3, 1e-15);
+  const pv::ReferenceEvents ec = pv::reference_events(pv::parse_insertion_curve(c, "c.csv"), layers);
+  EXPECT_NEAR(ec.cut_end_m[0], 2.6e-3, 1e-15);
   const std::vector<pv::LayerSegments> sa = pv::layer_segments(ea, layers);
   const std::vector<pv::LayerSegments> sb = pv::layer_segments(eb, layers);
   EXPECT_TRUE(sa[0].has_after);

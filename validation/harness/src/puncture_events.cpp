@@ -82,6 +82,32 @@ std::vector<ForceDrop> detect_force_drops(const InsertionCurve& curve, const Pun
   return found;
 }
 
+double cut_end_from_parts(const InsertionCurve& curve, const std::vector<std::size_t>& samples,
+                          double puncture_depth_m, double zero_N) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (!curve.has_parts()) return nan;
+  bool after = false, first = true, concurrent = false;
+  for (std::size_t i : samples) {
+    if (curve.depth_m[i] < puncture_depth_m) continue;
+    const bool tip_free = curve.tip_force_N[i] <= zero_N;
+    const bool cutting = curve.cutting_force_N[i] > zero_N;
+    if (!after) {  // skip the samples up to the drop itself
+      after = tip_free;
+      continue;
+    }
+    if (first) {
+      first = false;
+      if (!tip_free) {
+        if (!cutting) return puncture_depth_m;  // the next layer met at the break, no cut
+        concurrent = true;                      // cut while the next layer is pressed
+      }
+      continue;
+    }
+    if (concurrent ? !cutting : !tip_free) return curve.depth_m[i];
+  }
+  return nan;
+}
+
 ReferenceEvents reference_events(const InsertionCurve& reference, const std::vector<LayerGeometry>& layers,
                                  const std::vector<double>& given, const PunctureDetectionOptions& o) {
   ReferenceEvents ev;
@@ -136,30 +162,12 @@ ReferenceEvents reference_events(const InsertionCurve& reference, const std::vec
   }
   ev.note = note.str();
 
-  // Where each cut ends: the tip force back above 0 after the puncture.
+  // Where each cut ends (cut_end_from_parts).
   ev.cut_end_m.assign(layers.size(), std::numeric_limits<double>::quiet_NaN());
   if (reference.has_parts())
-    for (std::size_t k = 0; k < layers.size(); ++k) {
-      if (!ev.punctures[k].found) continue;
-      bool after = false;
-      double last_free_m = 0.0;  // deepest sample of the cut with the tip force at 0
-      for (std::size_t i : phase) {
-        if (reference.depth_m[i] < ev.punctures[k].depth_m) continue;
-        const bool free_tip = reference.tip_force_N[i] <= 1e-12 * std::max(1.0, peak);
-        if (!after) {  // skip the samples up to the drop itself
-          after = free_tip;
-          if (after) last_free_m = reference.depth_m[i];
-          continue;
-        }
-        if (!free_tip) {
-          // The tip force back above 0 right after the drop sample: the next
-          // layer was met at the break (no cut through this one).
-          ev.cut_end_m[k] = last_free_m > ev.punctures[k].depth_m ? reference.depth_m[i] : ev.punctures[k].depth_m;
-          break;
-        }
-        last_free_m = reference.depth_m[i];
-      }
-    }
+    for (std::size_t k = 0; k < layers.size(); ++k)
+      if (ev.punctures[k].found)
+        ev.cut_end_m[k] = cut_end_from_parts(reference, phase, ev.punctures[k].depth_m, 1e-12 * std::max(1.0, peak));
 
   // Contact onset: the top layer first pressed, else the force first above a fraction of the peak.
   const int top = !layers.empty() ? reference.layer_index(layers.front().name) : -1;

@@ -139,24 +139,14 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
   out.model_punctures.resize(layers.size());
   for (std::size_t k = 0; k < layers.size(); ++k) out.model_punctures[k] = puncture_event(model, layers[k].name);
   // A reference without parts does not say where a cut ends: there, the cut
-  // through layer k (and layer k + 1's pressing) ends where the model's tip
-  // meets layer k + 1 (its tip force back above 0), within the segment.
+  // through layer k (and layer k + 1's pressing) ends where the model's cut
+  // ends (cut_end_from_parts: where its tip meets layer k + 1, or at the
+  // puncture when it meets it at the break with no cutting), within the
+  // segment.
   if (!reference.has_parts() && model.has_parts()) {
     for (std::size_t k = 0; k < layers.size(); ++k) {
       if (!seg[k].has_after || !out.model_punctures[k].found) continue;
-      double end = std::numeric_limits<double>::quiet_NaN();
-      bool after = false;
-      for (std::size_t i : mod_in) {
-        if (model.depth_m[i] < out.model_punctures[k].depth_m) continue;
-        if (!after) {
-          after = model.tip_force_N[i] <= 0.0;
-          continue;
-        }
-        if (model.tip_force_N[i] > 0.0) {
-          end = model.depth_m[i];
-          break;
-        }
-      }
+      double end = cut_end_from_parts(model, mod_in, out.model_punctures[k].depth_m, 0.0);
       if (!std::isfinite(end)) continue;
       end = std::clamp(end, seg[k].after_from_m, seg[k].after_to_m);
       seg[k].after_to_m = end;

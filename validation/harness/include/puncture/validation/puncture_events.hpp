@@ -88,14 +88,25 @@ struct ReferenceEvents {
   double contact_onset_m = 0.0;
   double deepest_m = 0.0;                       ///< deepest insertion sample
   std::vector<ForceDrop> drops;                 ///< every candidate drop found (ForceDrops source)
-  /// Per layer: where the cut through it ends (the first insertion sample
-  /// after its puncture whose tip force is > 0: the tip presses the next
-  /// layer; the puncture depth itself when only the drop's own sample has
-  /// the tip force at 0, i.e. the next layer was met at the break); NaN
-  /// when the curve has no part columns or the tip never does.
+  /// Per layer: where the cut through it ends (cut_end_from_parts); NaN when
+  /// the curve has no part columns or does not say.
   std::vector<double> cut_end_m;
   std::string note;                             ///< how they were found, for reports
 };
+
+/// Where the cut through a layer punctured at puncture_depth_m ends, from a
+/// curve's parts (`samples`: its insertion samples in depth order; forces at
+/// or below zero_N count as 0):
+///  - the tip force at 0 after the drop's own sample (the tip cuts alone):
+///    the first later sample with the tip force > 0 (the next layer pressed);
+///  - the tip force > 0 from the sample after the drop on (the next layer met
+///    at the break): with the cutting force at 0 there, no cut (the puncture
+///    depth itself); with it > 0 (the squeezed layer cut while the next one is
+///    pressed), the first sample with the cutting force back at 0;
+/// NaN when the curve does not say (no parts, no sample after the drop, or a
+/// cut that lasts to the end).
+double cut_end_from_parts(const InsertionCurve& curve, const std::vector<std::size_t>& samples,
+                          double puncture_depth_m, double zero_N);
 
 /// given_depths_m: empty, or one depth per layer from the top (fewer: the
 /// layers below are not punctured). Throws std::invalid_argument for given
