@@ -46,6 +46,7 @@
 #include "puncture/validation/comparison_grading.hpp"
 #include "puncture/validation/mass_spring_identification.hpp"
 #include "puncture/validation/model_comparison.hpp"
+#include "puncture/validation/number_format.hpp"
 
 
 namespace puncture::apps {
@@ -58,9 +59,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 std::string fmt(double x, int precision = 6) {
   if (!std::isfinite(x)) return "nan";
-  std::ostringstream s;
-  s << std::setprecision(precision) << x;
-  return s.str();
+  return validation::significant_digits(x, precision);
 }
 std::string shown(double x, int precision = 3) { return std::isfinite(x) ? fmt(x, precision) : "n/a"; }
 

@@ -46,6 +46,7 @@
 #include "puncture/validation/metrics.hpp"
 #include "run_outputs.hpp"
 #include "puncture/validation/fem_comparison.hpp"
+#include "puncture/validation/number_format.hpp"
 
 namespace puncture::apps {
 
@@ -55,9 +56,7 @@ constexpr double kMm = 1e-3;
 
 std::string fmt(double x, int precision = 10) {
   if (!std::isfinite(x)) return "nan";
-  std::ostringstream s;
-  s << std::setprecision(precision) << x;
-  return s.str();
+  return validation::significant_digits(x, precision);
 }
 
 }  // namespace

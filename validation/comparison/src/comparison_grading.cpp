@@ -14,6 +14,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "puncture/validation/number_format.hpp"
+
 namespace puncture::validation {
 
 namespace {
@@ -47,9 +49,7 @@ std::string text(const nlohmann::json& j, const std::string& key, const std::str
 
 std::string format(double v, int precision = 4) {
   if (!std::isfinite(v)) return "n/a";
-  std::ostringstream s;
-  s << std::setprecision(precision) << v;
-  return s.str();
+  return validation::significant_digits(v, precision);
 }
 
 }  // namespace

@@ -1,17 +1,14 @@
 #include "puncture/validation/acceptance.hpp"
 
 #include <cmath>
-#include <iomanip>
 #include <sstream>
+
+#include "puncture/validation/number_format.hpp"
 
 namespace puncture::validation {
 namespace {
 
-std::string fmt(double v, int digits = 3) {
-  std::ostringstream s;
-  s << std::setprecision(digits) << v;
-  return s.str();
-}
+std::string fmt(double v, int digits = 3) { return significant_digits(v, digits); }
 
 /// |value| <= limit for one objective term: its relative value or its raw error.
 AcceptanceCheck term_check(const ObjectiveTerm* t, bool relative, double limit) {

@@ -5,16 +5,13 @@
 #include <sstream>
 
 #include "puncture/io/csv_writer.hpp"
+#include "puncture/validation/number_format.hpp"
 
 namespace puncture::validation {
 
 namespace {
 
-std::string num(double x, int precision = 4) {
-  std::ostringstream s;
-  s << std::setprecision(precision) << x;
-  return s.str();
-}
+std::string num(double x, int precision = 4) { return significant_digits(x, precision); }
 
 }  // namespace
 

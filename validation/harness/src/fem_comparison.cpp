@@ -15,6 +15,7 @@
 #include "puncture/io/atomic_file.hpp"
 #include "puncture/io/csv_reader.hpp"
 #include "puncture/io/csv_writer.hpp"
+#include "puncture/validation/number_format.hpp"
 
 namespace puncture::validation {
 
@@ -255,9 +256,7 @@ std::vector<std::string> run_plot_script(const std::string& script, const std::f
 namespace {
 std::string num(double x, int precision = 4) {
   if (!std::isfinite(x)) return "–";
-  std::ostringstream s;
-  s << std::setprecision(precision) << x;
-  return s.str();
+  return significant_digits(x, precision);
 }
 std::string num(const nlohmann::json& j, const char* key, double scale = 1.0, int precision = 4) {
   if (!j.contains(key) || !j[key].is_number()) return "–";

@@ -9,6 +9,7 @@
 #include "puncture/io/csv_writer.hpp"
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/scene_io.hpp"
+#include "puncture/validation/number_format.hpp"
 
 namespace puncture::validation {
 
@@ -19,9 +20,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string fmt(double x, int precision = 8) {
   if (!std::isfinite(x)) return "nan";
-  std::ostringstream s;
-  s << std::setprecision(precision) << x;
-  return s.str();
+  return significant_digits(x, precision);
 }
 
 void fill_sweep_errors(SweepRow& row, const InsertionCurve& model, const InsertionCurve& reference) {
