@@ -13,7 +13,7 @@
 #include <iostream>
 
 #include "puncture/apps/commands.hpp"
-#include "puncture/apps/fem_reference.hpp"
+#include "puncture/validation/fem_reference.hpp"
 #include "puncture/io/interrupt_cleanup.hpp"
 #include "puncture/io/provenance.hpp"
 
@@ -166,6 +166,6 @@ int main(int argc, char** argv) {
     return kExitFailure;
   };
   const int exit_code = dispatch();
-  finalize_mpi();  // before static destruction (see fem_reference.hpp)
+  validation::finalize_mpi();  // before static destruction (see fem_reference.hpp)
   return exit_code;
 }

@@ -11,7 +11,7 @@
 
 #include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
-#include "puncture/apps/fem_reference.hpp"
+#include "puncture/validation/fem_reference.hpp"
 #include "puncture/io/provenance.hpp"
 #include "puncture/validation/calibration_report.hpp"
 #include "puncture/io/output_session.hpp"
@@ -54,11 +54,11 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
 
     validation::ReferenceCurve reference;
     if (options.reference.empty()) {
-      FemReferenceOptions fem;
+      validation::FemReferenceOptions fem;
       if (!options.cache_dir.empty()) fem.cache_dir = options.cache_dir;
       fem.verbose = !options.quiet;
-      const FemReference ref = obtain_fem_reference(scene, fem, out);
-      if (!is_mpi_root()) return 0;  // the other ranks only help with the FEM
+      const validation::FemReference ref = validation::obtain_fem_reference(scene, fem, out);
+      if (!validation::is_mpi_root()) return 0;  // the other ranks only help with the FEM
       out << "[calibrate] FEM reference " << ref.hash << (ref.from_cache ? " (from cache)" : " (computed)") << '\n';
       reference.curve = validation::read_insertion_curve(ref.dir / "fem_force_depth.csv");
       reference.kind = "fem";

@@ -32,7 +32,7 @@
 
 #include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
-#include "puncture/apps/fem_reference.hpp"
+#include "puncture/validation/fem_reference.hpp"
 #include "puncture/io/provenance.hpp"
 #include "puncture/io/provenance_json.hpp"
 #include "puncture/validation/fem_comparison.hpp"
@@ -205,11 +205,11 @@ int compare_command(const CompareOptions& options, std::ostream& out, std::ostre
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_comparison") : options.output_dir;
 
     // 1. The FEM reference (all MPI ranks help; only rank 0 goes on).
-    FemReferenceOptions fem_options;
+    validation::FemReferenceOptions fem_options;
     if (!options.cache_dir.empty()) fem_options.cache_dir = options.cache_dir;
     fem_options.verbose = !options.quiet;
-    const FemReference reference = obtain_fem_reference(scene, fem_options, out);
-    if (!is_mpi_root()) return 0;
+    const validation::FemReference reference = validation::obtain_fem_reference(scene, fem_options, out);
+    if (!validation::is_mpi_root()) return 0;
     const validation::FemResultFiles fem = validation::read_fem_result(reference.dir, scene);
     validation::ReferenceData ref;
     ref.curve = fem.curve;

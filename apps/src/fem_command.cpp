@@ -4,7 +4,7 @@
 
 #include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
-#include "puncture/apps/fem_reference.hpp"
+#include "puncture/validation/fem_reference.hpp"
 #include "puncture/scene_io.hpp"
 
 #ifdef PUNCTURE_HAVE_FEM
@@ -19,7 +19,7 @@ int fem_command(const FemOptions& options, std::ostream& stdout_stream, std::ost
   NullStream quiet;
   std::ostream& out = options.quiet ? quiet : stdout_stream;
 #ifdef PUNCTURE_HAVE_FEM
-  ensure_mpi();
+  validation::ensure_mpi();
   const bool root = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
   NullStream silent;

@@ -33,7 +33,7 @@
 
 #include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
-#include "puncture/apps/fem_reference.hpp"
+#include "puncture/validation/fem_reference.hpp"
 #include "puncture/io/provenance.hpp"
 #include "puncture/io/provenance_json.hpp"
 #include "puncture/io/output_session.hpp"
@@ -86,25 +86,25 @@ int sweep_command(const SweepOptions& options, std::ostream& stdout_stream, std:
                                                                                        scene.fem.element_degree}};
     struct FemResult {
       FemKnob knob;
-      FemReference ref;
+      validation::FemReference ref;
       validation::InsertionCurve curve;
       nlohmann::json summary;
     };
     std::vector<FemResult> fem_results;
     for (const FemKnob& k : fem_knobs) {
       progress("FEM refinement " + std::to_string(k.refinement) + " Q" + std::to_string(k.degree));
-      FemReferenceOptions fo;
+      validation::FemReferenceOptions fo;
       if (!options.cache_dir.empty()) fo.cache_dir = options.cache_dir;
       fo.refinement = k.refinement;
       fo.degree = k.degree;
       fo.write_vtu = false;
       fo.verbose = !options.quiet;
-      FemResult r{k, obtain_fem_reference(scene, fo, out), {}, {}};
+      FemResult r{k, validation::obtain_fem_reference(scene, fo, out), {}, {}};
       r.curve = validation::read_insertion_curve(r.ref.dir / "fem_force_depth.csv");
       r.summary = nlohmann::json::parse(io::read_text_file(r.ref.dir / "fem_summary.json"));
       fem_results.push_back(std::move(r));
     }
-    if (!is_mpi_root()) return 0;  // the other ranks only help with the FEM
+    if (!validation::is_mpi_root()) return 0;  // the other ranks only help with the FEM
     const auto finest_it = std::max_element(fem_results.begin(), fem_results.end(), [](const auto& a, const auto& b) {
       return a.summary.value("n_dofs", 0.0) < b.summary.value("n_dofs", 0.0);
     });

@@ -34,7 +34,7 @@
 
 #include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
-#include "puncture/apps/fem_reference.hpp"
+#include "puncture/validation/fem_reference.hpp"
 #include "puncture/io/atomic_file.hpp"
 #include "puncture/io/vtk_xml_field_data.hpp"
 #include "puncture/io/provenance_json.hpp"
@@ -84,14 +84,14 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
     progress("scene " + scene_path.string());
 
     // 1. FEM reference.
-    FemReferenceOptions fem_options;
+    validation::FemReferenceOptions fem_options;
     if (!options.cache_dir.empty()) fem_options.cache_dir = options.cache_dir;
     fem_options.refinement = options.refinement;
     fem_options.degree = options.degree;
     fem_options.write_vtu = vtk;
     fem_options.verbose = !options.quiet;
-    const FemReference reference = obtain_fem_reference(scene, fem_options, out);
-    if (!is_mpi_root()) return 0;  // the other ranks only help with the FEM
+    const validation::FemReference reference = validation::obtain_fem_reference(scene, fem_options, out);
+    if (!validation::is_mpi_root()) return 0;  // the other ranks only help with the FEM
     const FemResultFiles fem = read_fem_result(reference.dir, scene);
 
     // 2. Real-time model along the same trajectory.

@@ -2,11 +2,11 @@
 // commands that run the FEM) is finalised before static destruction.
 #include <gtest/gtest.h>
 
-#include "puncture/apps/fem_reference.hpp"
+#include "puncture/validation/fem_reference.hpp"
 
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   const int result = RUN_ALL_TESTS();
-  puncture::apps::finalize_mpi();
+  puncture::validation::finalize_mpi();
   return result;
 }

@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "puncture/apps/commands.hpp"
-#include "puncture/apps/fem_reference.hpp"
+#include "puncture/validation/fem_reference.hpp"
 #include "puncture/scene_io.hpp"
 
 namespace fs = std::filesystem;
@@ -54,9 +54,9 @@ Scene small_scene() {
 /// there; the fat pressed from 1.2 to 2.5 mm at 5 mN/mm, broken; the muscle
 /// pressed from 4 mm (the end). Skin profiles u_z(r) = -delta a / max(r, a).
 void write_synthetic_reference(const Scene& scene, const fs::path& cache) {
-  FemReferenceOptions options;
+  validation::FemReferenceOptions options;
   options.cache_dir = cache;
-  const fs::path dir = cache / fem_reference_hash(scene, options);
+  const fs::path dir = cache / validation::fem_reference_hash(scene, options);
   fs::create_directories(dir);
   std::ofstream curve(dir / "fem_force_depth.csv");
   curve << "time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch,skin_state,fat_state,muscle_state\n";

@@ -13,7 +13,7 @@
 
 #include "csv_header.hpp"
 #include "puncture/apps/commands.hpp"
-#include "puncture/apps/fem_reference.hpp"
+#include "puncture/validation/fem_reference.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/metrics.hpp"
 
@@ -58,8 +58,8 @@ Scene small_scene() {
 }
 
 #ifdef PUNCTURE_HAVE_FEM
-FemReferenceOptions coarse_options(const fs::path& cache) {
-  FemReferenceOptions o;
+validation::FemReferenceOptions coarse_options(const fs::path& cache) {
+  validation::FemReferenceOptions o;
   o.cache_dir = cache;
   o.verbose = false;
   o.write_vtu = false;
@@ -73,8 +73,8 @@ FemReferenceOptions coarse_options(const fs::path& cache) {
 
 TEST(FemReferenceHash, IgnoresRealtimeOnlyFields) {
   const Scene base = small_scene();
-  const FemReferenceOptions options;
-  const std::string h = fem_reference_hash(base, options);
+  const validation::FemReferenceOptions options;
+  const std::string h = validation::fem_reference_hash(base, options);
   EXPECT_EQ(h.size(), 32u);
   std::vector<std::pair<std::string, std::function<void(Scene&)>>> realtime_only{
       {"K", [](Scene& s) { s.layers[0].force_mesh.virtual_stiffness_N_per_m *= 2; }},
@@ -94,14 +94,14 @@ TEST(FemReferenceHash, IgnoresRealtimeOnlyFields) {
   for (const auto& [what, change] : realtime_only) {
     Scene s = base;
     change(s);
-    EXPECT_EQ(fem_reference_hash(s, options), h) << "a change of " << what << " must hit the cache";
+    EXPECT_EQ(validation::fem_reference_hash(s, options), h) << "a change of " << what << " must hit the cache";
   }
 }
 
 TEST(FemReferenceHash, ChangesWithEverythingTheFemSees) {
   const Scene base = small_scene();
-  const FemReferenceOptions options;
-  const std::string h = fem_reference_hash(base, options);
+  const validation::FemReferenceOptions options;
+  const std::string h = validation::fem_reference_hash(base, options);
   std::vector<std::pair<std::string, std::function<void(Scene&)>>> fem_relevant{
       {"E", [](Scene& s) { s.layers[1].material.youngs_modulus_Pa *= 1.0000001; }},
       {"nu", [](Scene& s) { s.layers[2].material.poisson_ratio = 0.49; }},
@@ -122,32 +122,32 @@ TEST(FemReferenceHash, ChangesWithEverythingTheFemSees) {
   for (const auto& [what, change] : fem_relevant) {
     Scene s = base;
     change(s);
-    const std::string changed = fem_reference_hash(s, options);
+    const std::string changed = validation::fem_reference_hash(s, options);
     EXPECT_NE(changed, h) << "a change of " << what << " must change the key";
     EXPECT_TRUE(seen.emplace(changed, what).second) << what << " collides with " << seen[changed];
   }
-  FemReferenceOptions refined = options;
+  validation::FemReferenceOptions refined = options;
   refined.refinement = 1;
-  EXPECT_NE(fem_reference_hash(base, refined), h) << "refinement override";
-  FemReferenceOptions q2 = options;
+  EXPECT_NE(validation::fem_reference_hash(base, refined), h) << "refinement override";
+  validation::FemReferenceOptions q2 = options;
   q2.degree = 2;
-  EXPECT_NE(fem_reference_hash(base, q2), h) << "degree override";
+  EXPECT_NE(validation::fem_reference_hash(base, q2), h) << "degree override";
   // An override equal to the scene's own value is the same FEM.
-  FemReferenceOptions same = options;
+  validation::FemReferenceOptions same = options;
   same.refinement = base.fem.refinement;
   same.degree = base.fem.element_degree;
-  EXPECT_EQ(fem_reference_hash(base, same), h);
+  EXPECT_EQ(validation::fem_reference_hash(base, same), h);
 #ifdef PUNCTURE_HAVE_FEM
-  FemReferenceOptions mesh = options;
+  validation::FemReferenceOptions mesh = options;
   mesh.mesh.sectors = 8;
-  EXPECT_NE(fem_reference_hash(base, mesh), h) << "mesh options";
+  EXPECT_NE(validation::fem_reference_hash(base, mesh), h) << "mesh options";
 #endif
   // Output-only options are not part of the key.
-  FemReferenceOptions other_dir = options;
+  validation::FemReferenceOptions other_dir = options;
   other_dir.cache_dir = "elsewhere";
   other_dir.write_vtu = false;
   other_dir.verbose = false;
-  EXPECT_EQ(fem_reference_hash(base, other_dir), h);
+  EXPECT_EQ(validation::fem_reference_hash(base, other_dir), h);
 }
 
 #ifdef PUNCTURE_HAVE_FEM
@@ -155,7 +155,7 @@ TEST(FemReferenceCache, SecondCallComesFromTheCacheWithoutRunning) {
   const fs::path cache = fresh_dir("fem_cache");
   const Scene scene = small_scene();
   std::ostringstream out;
-  const FemReference first = obtain_fem_reference(scene, coarse_options(cache), out);
+  const validation::FemReference first = validation::obtain_fem_reference(scene, coarse_options(cache), out);
   EXPECT_FALSE(first.from_cache);
   EXPECT_EQ(first.dir, cache / first.hash);
   for (const char* f : {"fem_force_depth.csv", "fem_surface_profile.csv", "fem_recovery_profile.csv",
@@ -192,7 +192,7 @@ TEST(FemReferenceCache, SecondCallComesFromTheCacheWithoutRunning) {
   Scene retuned = scene;
   retuned.layers[0].force_mesh.virtual_stiffness_N_per_m *= 4;
   retuned.realtime.sh_degree = 12;
-  const FemReference second = obtain_fem_reference(retuned, coarse_options(cache), out);
+  const validation::FemReference second = validation::obtain_fem_reference(retuned, coarse_options(cache), out);
   EXPECT_TRUE(second.from_cache);
   EXPECT_EQ(second.dir, first.dir);
   EXPECT_EQ(fs::last_write_time(first.dir / "fem_summary.json"), stamp);

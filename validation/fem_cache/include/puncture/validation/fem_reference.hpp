@@ -1,7 +1,8 @@
 // fem_reference.hpp: the FEM reference of a scene, computed once and cached
-// on disk, keyed by a hash of everything that affects it (the scene's
-// geometry, materials, puncture criteria, needle, insertion and FEM settings,
-// the mesh options, the refinement/degree overrides and the program version).
+// on disk, keyed by everything the FEM reads (fem_reference_key.hpp: the
+// scene's canonical JSON minus its real-time-only fields, the refinement /
+// degree overrides, the mesh options, the program version and a digest of the
+// FEM sources).
 //
 // In:  a Scene, options (cache directory, overrides), a stream for progress.
 // Out: the directory holding fem_force_depth.csv, fem_surface_profile.csv,
@@ -14,12 +15,13 @@
 #include <string>
 
 #include "puncture/scene.hpp"
+#include "puncture/validation/fem_reference_key.hpp"
 
 #ifdef PUNCTURE_HAVE_FEM
 #include <puncture/meshing/layered_cylinder_mesh.hpp>
 #endif
 
-namespace puncture::apps {
+namespace puncture::validation {
 
 struct FemReferenceOptions {
   std::filesystem::path cache_dir = "out/.fem_cache";
@@ -38,8 +40,16 @@ struct FemReference {
   bool from_cache = false;
 };
 
+/// The key text of `scene` with `options` (fem_reference_key_text with this
+/// build's FEM source digest and the options' overrides and mesh).
+std::string fem_reference_key_text(const Scene& scene, const FemReferenceOptions& options);
+
 /// Hash (hex) of everything that affects the FEM result of `scene` with `options`.
 std::string fem_reference_hash(const Scene& scene, const FemReferenceOptions& options);
+
+/// True when `dir` holds fem_reference_key.json with exactly `key_text`
+/// (an entry of another key format, or a colliding hash, does not match).
+bool cached_key_matches(const std::filesystem::path& dir, const std::string& key_text);
 
 /// Returns the cached reference or runs the FEM (in this process, MPI
 /// initialised once per process by ensure_mpi()) and caches it.
@@ -59,4 +69,4 @@ bool is_mpi_root();
 /// races with the destruction of other libraries' statics.
 void finalize_mpi();
 
-}  // namespace puncture::apps
+}  // namespace puncture::validation

@@ -4,18 +4,12 @@
 // plus fem_reference_key.json (the exact text that was hashed, for a human who
 // wonders why two runs did or did not share a reference). A new reference is
 // computed into <cache_dir>/.tmp-<hash>/ and renamed into place only when the
-// FEM succeeded, so the cache never holds a half-written reference.
+// FEM succeeded, so the cache never holds a half-written reference. An entry
+// is reused only when its stored key text equals the current one, so an entry
+// of an older key format (or a hash collision) is recomputed, never reused.
 //
-// The key holds every input that changes the FEM result: sample diameter,
-// needle radius and tip, per layer thickness, density, continuum material and
-// puncture criterion, the insertion start height, speed, target depth and
-// angle (the FEM stops at the target depth: dwell and withdrawal do not enter),
-// the FEM settings (with the refinement/degree overrides applied), the mesh
-// options, and the program version plus a digest of the FEM and mesh sources
-// (PUNCTURE_FEM_SOURCE_DIGEST, computed by apps/CMakeLists.txt). Realtime-only
-// fields (K, d, w, L, surface stiffness, thresholds, resumption rate, SH
-// degree, haptic rate, integrator, effects, names) are not in it.
-#include "puncture/apps/fem_reference.hpp"
+// The key is derived from everything the FEM reads: fem_reference_key.hpp.
+#include "puncture/validation/fem_reference.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -26,7 +20,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "puncture/io/content_hash.hpp"
 #include "puncture/io/interrupt_cleanup.hpp"
 #include "puncture/io/provenance.hpp"
 
@@ -40,66 +33,32 @@
 #define PUNCTURE_FEM_SOURCE_DIGEST "none"
 #endif
 
-namespace puncture::apps {
+namespace puncture::validation {
 
 namespace {
 
-/// Shortest text that reads back to the same double (so equal inputs give equal keys).
-std::string exact(double x) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.17g", x);
-  return buffer;
-}
-
-const char* criterion_name(PunctureCriterion::Kind kind) {
-  return kind == PunctureCriterion::Kind::CriticalForce ? "critical_force" : "critical_stretch";
-}
-
-/// The text that is hashed (JSON, numbers in SI units printed exactly).
-std::string fem_reference_key_text(const Scene& scene, const FemReferenceOptions& options) {
-  nlohmann::ordered_json key;
-  key["program_version"] = io::program_version();
-  key["fem_source_digest"] = PUNCTURE_FEM_SOURCE_DIGEST;
-  key["sample_diameter_m"] = exact(scene.sample.diameter_m);
-  key["needle"] = {{"radius_m", exact(scene.needle.radius_m)}, {"tip", scene.needle.tip}};
-  nlohmann::ordered_json layers = nlohmann::ordered_json::array();
-  for (const Layer& l : scene.layers) {
-    nlohmann::ordered_json j;
-    j["thickness_m"] = exact(l.thickness_m);
-    j["density_kg_per_m3"] = exact(l.density_kg_per_m3);
-    j["material"] = {{"model", l.material.model},
-                     {"youngs_modulus_Pa", exact(l.material.youngs_modulus_Pa)},
-                     {"poisson_ratio", exact(l.material.poisson_ratio)},
-                     {"mooney_rivlin_c01_fraction", exact(l.material.mooney_rivlin_c01_fraction)}};
-    j["puncture"] = {{"criterion", criterion_name(l.puncture.kind)}};
-    if (l.puncture.kind == PunctureCriterion::Kind::CriticalForce)
-      j["puncture"]["critical_force_N"] = exact(l.puncture.critical_force_N);
-    else
-      j["puncture"]["critical_stretch"] = exact(l.puncture.critical_stretch);
-    layers.push_back(j);
-  }
-  key["layers"] = layers;
-  const Insertion& in = scene.insertion;
-  key["insertion"] = {{"start_height_m", exact(in.start_height_m)},
-                      {"speed_m_per_s", exact(in.speed_m_per_s)},
-                      {"target_depth_m", exact(in.target_depth_m)},
-                      {"angle_deg", exact(in.angle_deg)}};
-  key["fem"] = {{"refinement", options.refinement >= 0 ? options.refinement : scene.fem.refinement},
-                {"element_degree", options.degree >= 1 ? options.degree : scene.fem.element_degree},
-                {"load_step_m", exact(scene.fem.load_step_m)},
-                {"max_newton_iterations", scene.fem.max_newton_iterations},
-                {"newton_tolerance", exact(scene.fem.newton_tolerance)}};
+FemKeyOptions key_options(const FemReferenceOptions& options) {
+  FemKeyOptions k;
+  k.refinement = options.refinement;
+  k.degree = options.degree;
 #ifdef PUNCTURE_HAVE_FEM
-  key["mesh"] = {{"elements_through_skin", options.mesh.elements_through_skin},
-                 {"radial_grading", exact(options.mesh.radial_grading)},
-                 {"sectors", options.mesh.sectors},
-                 {"thickness_grading", exact(options.mesh.thickness_grading)}};
+  char buffer[40];
+  const auto exact = [&buffer](double x) {
+    std::snprintf(buffer, sizeof buffer, "%.17g", x);
+    return std::string(buffer);
+  };
+  k.mesh_options = {{"elements_through_skin", std::to_string(options.mesh.elements_through_skin)},
+                    {"radial_grading", exact(options.mesh.radial_grading)},
+                    {"sectors", std::to_string(options.mesh.sectors)},
+                    {"thickness_grading", exact(options.mesh.thickness_grading)}};
 #endif
-  return key.dump(2) + "\n";
+  return k;
 }
 
-/// A complete reference: the summary says it finished and the curve exists.
-bool reference_complete(const std::filesystem::path& dir, bool need_vtu) {
+/// A complete reference of this key: the stored key text is `key_text`, the
+/// summary says it finished and the curve exists.
+bool reference_complete(const std::filesystem::path& dir, bool need_vtu, const std::string& key_text) {
+  if (!cached_key_matches(dir, key_text)) return false;
   const auto summary_path = dir / "fem_summary.json";
   if (!std::filesystem::is_regular_file(summary_path) || !std::filesystem::is_regular_file(dir / "fem_force_depth.csv"))
     return false;
@@ -112,10 +71,20 @@ bool reference_complete(const std::filesystem::path& dir, bool need_vtu) {
 
 }  // namespace
 
+std::string fem_reference_key_text(const Scene& scene, const FemReferenceOptions& options) {
+  return fem_reference_key_text(scene, key_options(options), PUNCTURE_FEM_SOURCE_DIGEST);
+}
+
 std::string fem_reference_hash(const Scene& scene, const FemReferenceOptions& options) {
-  const std::string text = fem_reference_key_text(scene, options);
-  // Two FNV-1a 64 passes with different offset bases: a 128-bit key.
-  return io::fnv1a64_hex(text) + io::fnv1a64_hex(text, 0x84222325cbf29ce4ULL);
+  return fem_reference_key_hash(fem_reference_key_text(scene, options));
+}
+
+bool cached_key_matches(const std::filesystem::path& dir, const std::string& key_text) {
+  std::ifstream in(dir / "fem_reference_key.json", std::ios::binary);
+  if (!in) return false;
+  std::ostringstream stored;
+  stored << in.rdbuf();
+  return stored.str() == key_text;
 }
 
 #ifdef PUNCTURE_HAVE_FEM
@@ -169,9 +138,10 @@ void finalize_mpi() {
 
 FemReference obtain_fem_reference(const Scene& scene, const FemReferenceOptions& options, std::ostream& out) {
   FemReference ref;
-  ref.hash = fem_reference_hash(scene, options);
+  const std::string key_text = fem_reference_key_text(scene, options);
+  ref.hash = fem_reference_key_hash(key_text);
   ref.dir = options.cache_dir / ref.hash;
-  if (reference_complete(ref.dir, options.write_vtu)) {
+  if (reference_complete(ref.dir, options.write_vtu, key_text)) {
     ref.from_cache = true;
     if (options.verbose) out << "[fem] reference from cache " << ref.dir.string() << "\n";
     return ref;
@@ -200,7 +170,7 @@ FemReference obtain_fem_reference(const Scene& scene, const FemReferenceOptions&
     fem::run_needle_insertion(scene, fem_options, MPI_COMM_WORLD);
     if (root) {
       std::ofstream key(staging / "fem_reference_key.json");
-      key << fem_reference_key_text(scene, options);
+      key << key_text;
       if (!key) throw std::runtime_error("cannot write " + (staging / "fem_reference_key.json").string());
     }
   } catch (...) {
@@ -228,4 +198,4 @@ FemReference obtain_fem_reference(const Scene& scene, const FemReferenceOptions&
 #endif
 }
 
-}  // namespace puncture::apps
+}  // namespace puncture::validation
