@@ -18,6 +18,7 @@
 #include <CGAL/Mesh_domain_with_polyline_features_3.h>
 #include <CGAL/Mesh_triangulation_3.h>
 #include <CGAL/Random.h>
+#include <CGAL/exude_mesh_3.h>
 #include <CGAL/make_mesh_3.h>
 
 namespace puncture::meshing {
@@ -92,6 +93,21 @@ std::vector<Point> circle(double radius, double z, double max_segment) {
   return c;
 }
 
+/// CGAL's sliver exudation (same criterion and bound as make_mesh_3's
+/// p::exude(): maximise the smallest dihedral angle) run until it cannot
+/// improve any more. make_mesh_3's own exudation stops at a wall-clock limit,
+/// by default the refinement's wall time, so how many slivers it treated, and
+/// hence the mesh, depended on the machine's load. Without the limit the
+/// exuder's work depends on the triangulation alone: its queues order cells by
+/// quality and break ties by insertion order and by the creation time stamps
+/// of Mesh_3's cells and vertices, not by address.
+void exude_slivers_to_completion(Complex& c3t3) {
+  namespace p = CGAL::parameters;
+  const CGAL::Mesh_optimization_return_code code = CGAL::exude_mesh_3(c3t3, p::time_limit = 0.0, p::sliver_bound = 0.0);
+  if (code == CGAL::TIME_LIMIT_REACHED)
+    throw std::logic_error("build_tet_slab_mesh: sliver exudation stopped at a time limit (none was set)");
+}
+
 void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("build_tet_slab_mesh: " + what);
 }
@@ -148,12 +164,12 @@ comparison::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOpt
   namespace p = CGAL::parameters;
   const Criteria criteria(p::edge_size = size, p::facet_angle = 25.0, p::facet_size = size,
                           p::facet_distance = distance, p::cell_radius_edge_ratio = 3.0, p::cell_size = size);
-  Complex c3t3 = options.exude_slivers
-                     ? CGAL::make_mesh_3<Complex>(domain, criteria, p::no_perturb(), p::exude(), p::no_odt(),
-                                                  p::no_lloyd())
-                     : CGAL::make_mesh_3<Complex>(domain, criteria, p::no_perturb(), p::no_exude(), p::no_odt(),
-                                                  p::no_lloyd());
+  Complex c3t3 =
+      CGAL::make_mesh_3<Complex>(domain, criteria, p::no_perturb(), p::no_exude(), p::no_odt(), p::no_lloyd());
   if (c3t3.number_of_cells_in_complex() == 0) throw std::runtime_error("build_tet_slab_mesh: CGAL returned no cells");
+  const auto refined = std::chrono::steady_clock::now();
+  if (options.exude_slivers) exude_slivers_to_completion(c3t3);
+  const auto exuded = std::chrono::steady_clock::now();
 
   // The finite cells whose centroid lies in the slab and whose vertices do
   // not all lie on one boundary surface (the side r = R or one interface
@@ -223,6 +239,8 @@ comparison::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOpt
 
   if (report) {
     report->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    report->refinement_time_s = std::chrono::duration<double>(refined - start).count();
+    report->exudation_time_s = std::chrono::duration<double>(exuded - refined).count();
     report->vertices = mesh.node_count();
     report->tetrahedra = mesh.tet_count();
     report->quality = comparison::measure_tet_quality(mesh);

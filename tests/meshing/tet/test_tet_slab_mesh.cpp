@@ -1,7 +1,8 @@
 // CGAL tetrahedral mesh of the layered slab: layer volumes against the
 // analytic cylinder volumes, labels against the layer depths and the needle
 // radius, a closed tiling (every interior face shared by two tetrahedra, every
-// boundary face on the sample's outer surface), quality bounds, determinism.
+// boundary face on the sample's outer surface), quality bounds, determinism
+// within one process (across processes: test_tet_slab_mesh_determinism.cpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -141,22 +142,27 @@ TEST_F(DefaultSceneMesh, NodesOnEveryInterfaceInsideTheNeedleDisc) {
 }
 
 TEST(TetSlabMesh, RepeatableAndFinerWithSmallerSizes) {
-  // Delaunay refinement is deterministic (fixed seed); sliver exudation breaks
-  // ties by memory address, so a second mesh may connect a few cells
-  // differently. Without exudation two meshes are identical.
+  // With the production options (sliver exudation on, run to completion) two
+  // meshes in one process are identical; across processes see
+  // test_tet_slab_mesh_determinism.cpp. Exudation only reconnects cells near
+  // slivers, so the layer volumes stay those of the unexuded mesh.
   const Scene scene = testing::small_slab_scene();
   TetSlabMeshOptions options = tet_slab_mesh_options(scene);
-  options.exude_slivers = false;
+  ASSERT_TRUE(options.exude_slivers);
   const comparison::TetMesh a = build_tet_slab_mesh(scene, options);
   const comparison::TetMesh b = build_tet_slab_mesh(scene, options);
   ASSERT_EQ(a.node_count(), b.node_count());
   ASSERT_EQ(a.tets.size(), b.tets.size());
   EXPECT_EQ((a.points_m - b.points_m).cwiseAbs().maxCoeff(), 0.0);
-  options.exude_slivers = true;
+  EXPECT_TRUE(a.tets == b.tets);
+  options.exude_slivers = false;
   const comparison::TetMesh c = build_tet_slab_mesh(scene, options);
   const std::vector<double> va = comparison::layer_volumes_m3(a, 3), vc = comparison::layer_volumes_m3(c, 3);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(vc[k], va[k], 1e-3 * va[k]);
-  options.exude_slivers = false;
+  // Exudation raises the smallest dihedral angle and removes slivers.
+  const comparison::TetQuality qa = comparison::measure_tet_quality(a), qc = comparison::measure_tet_quality(c);
+  EXPECT_GT(qa.min_dihedral_deg, qc.min_dihedral_deg);
+  EXPECT_LT(qa.tets_below_10_deg, qc.tets_below_10_deg);
   options.size_at_axis_m *= 0.6;
   options.size_far_m *= 0.6;
   EXPECT_GT(build_tet_slab_mesh(scene, options).node_count(), a.node_count());

@@ -20,11 +20,15 @@
 // size_at_axis + grading * max(0, r - needle radius)), graded toward the axis.
 // Facet distance (surface approximation): min(0.1 h, 0.005 R), so the side of
 // the sample loses well under 1 % of the volume.
-// Criteria: facet angle >= 25 deg, cell radius-edge ratio <= 3; then sliver
-// exudation. Random choices use a fixed seed, so the vertices are the same
-// from run to run; exudation breaks ties by memory address, so a few cells may
-// be connected differently (about 0.1 % of them; without exudation, which
-// leaves slivers, the mesh is identical).
+// Criteria: facet angle >= 25 deg, cell radius-edge ratio <= 3; then CGAL's
+// sliver exudation, run until it cannot improve any more (no time limit).
+// Deterministic: the same scene and options give the same mesh (vertex
+// coordinates bit for bit, the same tetrahedra in the same order) in every
+// run and every process. Random choices use a fixed seed; CGAL's queues break
+// ties by the creation time stamps of cells and vertices, not by address; the
+// vertex numbering follows the cell order. (make_mesh_3's own exudation,
+// used before, stopped at a wall-clock limit equal to the refinement time,
+// so a few cells depended on the machine's load.)
 // Throws std::invalid_argument for bad options or scene geometry, and
 // std::runtime_error if CGAL returns an empty mesh.
 #pragma once
@@ -40,7 +44,7 @@ struct TetSlabMeshOptions {
   double size_at_axis_m = 1.0e-3;
   double size_far_m = 8e-3;
   double grading = 0.5;
-  bool exude_slivers = true;  ///< CGAL sliver exudation after refinement
+  bool exude_slivers = true;  ///< CGAL sliver exudation after refinement, run to completion
   unsigned random_seed = 0;
 };
 
@@ -48,7 +52,9 @@ struct TetSlabMeshOptions {
 TetSlabMeshOptions tet_slab_mesh_options(const Scene& scene);
 
 struct TetSlabMeshReport {
-  double wall_time_s = 0.0;
+  double wall_time_s = 0.0;        ///< whole call, s
+  double refinement_time_s = 0.0;  ///< Delaunay refinement (make_mesh_3), s
+  double exudation_time_s = 0.0;   ///< sliver exudation (0 when exude_slivers is off), s
   int vertices = 0;
   int tetrahedra = 0;
   comparison::TetQuality quality;
