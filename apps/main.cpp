@@ -11,11 +11,21 @@
 // line), 3 output not writable, 128 + n ended by signal n (apps/README.md).
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <sstream>
 
 #include "puncture/apps/commands.hpp"
 #include "puncture/validation/fem_reference.hpp"
 #include "puncture/io/interrupt_cleanup.hpp"
 #include "puncture/io/provenance.hpp"
+
+namespace {
+/// A default value as the help text shows it (e.g. 1000).
+std::string default_text(double value) {
+  std::ostringstream s;
+  s << value;
+  return s.str();
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace puncture::apps;
@@ -79,7 +89,8 @@ int main(int argc, char** argv) {
                             "default 1");
   calibrate_cmd->add_option("--bound-factor", calibrate.bound_factor,
                             "Each tuned scale parameter stays within [start / f, start * f] (and its physical "
-                            "range); default 1000");
+                            "range); default " +
+                                default_text(puncture::validation::kDefaultCalibrationBoundFactor));
   calibrate_cmd->add_option("--puncture-depths", calibrate.puncture_depths_mm,
                             "Puncture depths of the reference in mm, one per layer from the top (comma separated); "
                             "default: from its state columns, else from its force drops")
@@ -166,6 +177,6 @@ int main(int argc, char** argv) {
     return kExitFailure;
   };
   const int exit_code = dispatch();
-  validation::finalize_mpi();  // before static destruction (see fem_reference.hpp)
+  puncture::validation::finalize_mpi();  // before static destruction (see fem_reference.hpp)
   return exit_code;
 }
