@@ -5,7 +5,9 @@
 //   0  success
 //   1  the run failed (numerical failure, FEM failure, out of memory, ...)
 //   2  bad input: scene file (message names the file and the JSON path),
-//      reference or scores CSV (file, line, column), command-line usage
+//      reference or scores CSV (file, line, column), a reference curve that
+//      cannot be fitted or whose punctures are a guess (file and why:
+//      validation::ReferenceError), command-line usage
 //   3  the output cannot be written (message names the path and the OS reason)
 //   128 + n  ended by signal n (130 Ctrl-C, 143 SIGTERM): staged files removed
 #pragma once
@@ -22,6 +24,7 @@
 #include "puncture/io/output_session.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/metrics.hpp"
+#include "puncture/validation/reference_checks.hpp"
 
 namespace puncture::apps {
 
@@ -52,6 +55,9 @@ int report_errors(std::ostream& err, const std::string& context, Body&& body) {
     err << "error: " << e.what() << '\n';
     return kExitBadInput;
   } catch (const io::CsvFormatError& e) {
+    err << "error: " << e.what() << '\n';
+    return kExitBadInput;
+  } catch (const validation::ReferenceError& e) {
     err << "error: " << e.what() << '\n';
     return kExitBadInput;
   } catch (const InputError& e) {

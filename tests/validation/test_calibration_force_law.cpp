@@ -431,3 +431,32 @@ TEST(CalibrationForceLaw, RecoversThePolynomialStiffeningOfTheSkinAndDoesNotCall
     if (p.layer == "skin" && (p.name == "stiffening_quadratic" || p.name == "stiffening_cubic"))
       EXPECT_TRUE(p.at_bound.empty()) << p.name << " = " << p.tuned << " reported at its " << p.at_bound << " bound";
 }
+
+TEST(CalibrationForceLaw, ParametersTheReferenceCannotIdentifyKeepTheirStartValuesWithAWarning) {
+  // The fat is pressed but never punctured: its critical force, cutting and
+  // friction stay at their start values, one warning each; its K is tuned.
+  Scene truth = truth_scene(false);
+  truth.layers[1].force_law.breakthrough.critical_force_N = 40.0;
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  ASSERT_FALSE(pv::puncture_event(ref, "fat").found);
+  const Scene start = perturbed(truth_scene(false));
+  pv::CalibrationOptions o;
+  o.max_evaluations_per_stage = 20;
+  o.evaluations_per_parameter = 10;
+  o.joint_polish = false;
+  const pv::CalibrationResult r = pv::calibrate(start, ref, o);
+  const auto& fat = r.tuned_scene.layers[1].force_law;
+  EXPECT_EQ(fat.breakthrough.critical_force_N, start.layers[1].force_law.breakthrough.critical_force_N);
+  EXPECT_EQ(fat.cutting_force_N, start.layers[1].force_law.cutting_force_N);
+  EXPECT_EQ(fat.friction.dynamic_N_per_m, start.layers[1].force_law.friction.dynamic_N_per_m);
+  for (const char* name : {"critical_force", "cutting_force", "friction_dynamic"}) {
+    int warnings = 0;
+    for (const std::string& w : r.warnings)
+      if (w.find(std::string("layer fat: ") + name + " kept at its start value") != std::string::npos) ++warnings;
+    EXPECT_EQ(warnings, 1) << name;
+    for (const pv::TunedParameterRecord& p : r.parameters) EXPECT_FALSE(p.layer == "fat" && p.name == name) << name;
+  }
+  bool fat_K_tuned = false;
+  for (const pv::TunedParameterRecord& p : r.parameters) fat_K_tuned = fat_K_tuned || (p.layer == "fat" && p.name == "K");
+  EXPECT_TRUE(fat_K_tuned);
+}

@@ -16,7 +16,7 @@
 #include "puncture/scene_io.hpp"
 #include "puncture/stiffening.hpp"
 #include "puncture/validation/pressing_polynomial.hpp"
-
+#include "puncture/validation/reference_checks.hpp"
 
 namespace puncture::validation {
 
@@ -24,23 +24,6 @@ namespace {
 constexpr double kMm = 1e-3;
 constexpr int kMaxParameters = 32;
 }  // namespace
-
-CalibrationMethod parse_calibration_method(const std::string& name) {
-  if (name == "bobyqa") return CalibrationMethod::Bobyqa;
-  if (name == "nelder_mead") return CalibrationMethod::NelderMead;
-  if (name == "simulated_annealing") return CalibrationMethod::SimulatedAnnealing;
-  throw std::invalid_argument("unknown calibration method '" + name +
-                              "' (expected bobyqa, nelder_mead or simulated_annealing)");
-}
-
-const char* to_string(CalibrationMethod method) {
-  switch (method) {
-    case CalibrationMethod::Bobyqa: return "bobyqa";
-    case CalibrationMethod::NelderMead: return "nelder_mead";
-    case CalibrationMethod::SimulatedAnnealing: return "simulated_annealing";
-  }
-  return "unknown";
-}
 
 std::vector<LayerParameters> layer_parameters(const Scene& scene) {
   std::vector<LayerParameters> out;
@@ -68,21 +51,6 @@ std::vector<LayerParameters> layer_parameters(const Scene& scene) {
     out.push_back(p);
   }
   return out;
-}
-
-bool reference_is_quasi_static(const ReferenceCurve& reference) {
-  if (reference_is_rate_dependent(reference.curve)) return false;
-  if (reference.kind == "fem") return true;
-  const auto it = reference.curve.metadata.find("quasi_static");
-  return it != reference.curve.metadata.end() && (it->second == "true" || it->second == "yes" || it->second == "1");
-}
-
-bool reference_is_rate_dependent(const InsertionCurve& curve) {
-  const auto it = curve.metadata.find("rate_dependent");
-  if (it == curve.metadata.end()) return false;
-  std::string v = it->second;
-  std::transform(v.begin(), v.end(), v.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return v == "true" || v == "yes" || v == "1";
 }
 
 // ---------------------------------------------------------------------------
@@ -271,7 +239,22 @@ Parameter make_parameter(const Scene& start, std::size_t layer, ParamKind kind, 
 }
 
 /// The stage parameters of layer k the options and the scene's effects call for.
-std::vector<ParamKind> layer_kinds(const Scene& scene, std::size_t k, const TunedParameterSet& t) {
+/// Why the references do not identify a parameter (reference_checks.hpp); "" when they do.
+std::string unidentified_reason(const LayerIdentifiability& id, ParamKind kind) {
+  switch (kind) {
+    case ParamKind::DeformedThreshold: case ParamKind::CriticalForce: case ParamKind::CriticalEnergy:
+      return !id.punctured ? "the reference has no puncture of this layer"
+             : id.pressing() ? "" : "the reference has fewer than 3 pressing samples of this layer before its puncture";
+    case ParamKind::Cutting: case ParamKind::Friction: case ParamKind::Presliding:
+      return id.cut() ? "" : "the reference has fewer than 3 samples of the cut through this layer";
+    case ParamKind::Damping: return "";
+    default: return id.pressing() ? "" : "the reference has fewer than 3 pressing samples of this layer";
+  }
+}
+
+/// With `id`: only the parameters the references identify.
+std::vector<ParamKind> layer_kinds(const Scene& scene, std::size_t k, const TunedParameterSet& t,
+                                   const LayerIdentifiability* id = nullptr) {
   std::vector<ParamKind> kinds;
   const Layer& l = scene.layers[k];
   if (t.virtual_stiffness && scene.effects.surface_force) kinds.push_back(ParamKind::VirtualStiffness);
@@ -301,6 +284,8 @@ std::vector<ParamKind> layer_kinds(const Scene& scene, std::size_t k, const Tune
     // withdrawal's reversal over the shaft travel identifies it.
     if (l.force_law.friction.presliding_m > 0.0) kinds.push_back(ParamKind::Presliding);
   }
+  if (id) kinds.erase(std::remove_if(kinds.begin(), kinds.end(), [&](ParamKind kind) {
+    return !unidentified_reason(*id, kind).empty(); }), kinds.end());
   return kinds;
 }
 
@@ -599,11 +584,6 @@ bool pressing_rise(const InsertionCurve& c, const ReferenceEvents& ev, const std
   return deflection_m > 0.0 && force_rise_N > 0.0;
 }
 
-/// Events of a model curve (its own states).
-ReferenceEvents model_events(const InsertionCurve& model, const std::vector<LayerGeometry>& layers) {
-  return reference_events(model, layers);
-}
-
 /// Scaled start of a layer's stage (up to eight passes), against the first
 /// reference: K (and k_s when tuned, keeping K / k_s and so the ring
 /// profile) scaled by the ratio of the reference's pressing slope to the
@@ -661,7 +641,7 @@ Scene scaled_start(const Scene& candidate, std::size_t k, const ReferenceCurve& 
     } catch (const std::exception&) {
       return candidate;
     }
-    const ReferenceEvents mod_ev = model_events(model, layers);
+    const ReferenceEvents mod_ev = reference_events(model, layers);  // its own states
     double z_ref = 0.0, f_ref = 0.0, z_model = 0.0, f_model = 0.0;
     const bool ref_rise = pressing_rise(reference.curve, ref_ev, layers, k, z_ref, f_ref);
     const bool model_rise = pressing_rise(model, mod_ev, layers, k, z_model, f_model);
@@ -800,6 +780,25 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
                                                        r == 0 ? options.puncture_depths_m : std::vector<double>{},
                                                        options.detection));
     result.warnings.push_back(references[r].curve.source + ": " + result.reference_events.back().note);
+    check_reference_fittable(references[r].curve, result.reference_events.back(),
+                             r == 0 && !options.puncture_depths_m.empty(), options.detection);
+  }
+  // What the references identify (reference_checks.hpp); the rest keeps its start values.
+  std::vector<LayerIdentifiability> ident(geometry.size());
+  for (std::size_t r = 0; r < references.size(); ++r) {
+    const auto more = layer_identifiability(references[r].curve, result.reference_events[r], geometry);
+    for (std::size_t k = 0; k < ident.size(); ++k) ident[k] = {std::max(ident[k].pressing_samples, more[k].pressing_samples),
+                                                               std::max(ident[k].cut_samples, more[k].cut_samples), ident[k].punctured || more[k].punctured};
+  }
+  std::size_t n_tuned = 0, n_requested = 0;
+  for (std::size_t k : layers) {
+    n_tuned += layer_kinds(scene, k, options.parameters, &ident[k]).size();
+    n_requested += layer_kinds(scene, k, options.parameters).size();
+    for (ParamKind kind : layer_kinds(scene, k, options.parameters))
+      if (const std::string why = unidentified_reason(ident[k], kind); !why.empty())
+        result.warnings.push_back("layer " + scene.layers[k].name + ": " + info(kind).name + " kept at its start value (" +
+                                  std::to_string(param_value(scene, k, kind) * info(kind).to_unit) + " " +
+                                  info(kind).unit + "): " + why);
   }
 
   bool rate_info = false;
@@ -824,6 +823,7 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
     result.damping_tuned = false;
     result.damping_note = "d kept fixed: the scene's damping effect is off";
   }
+  check_enough_samples(references.front().curve, result.reference_events.front(), n_tuned + (result.damping_tuned ? layers.size() : 0), n_requested);
 
   const SurfaceCache cache(scene);
   int total_evaluations = 0;
@@ -883,7 +883,7 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
       sel.withdrawal_max_depth_m = std::min(end - 0.5e-3, geometry[k].top_depth_m + geometry[k].thickness_m);
       selection.push_back(sel);
     }
-    const std::vector<ParamKind> kinds = layer_kinds(current, k, options.parameters);
+    const std::vector<ParamKind> kinds = layer_kinds(current, k, options.parameters, &ident[k]);
     std::vector<int> ring_candidates{current.layers[k].force_mesh.rings_w};
     if (options.parameters.rings && first_pass)
       for (int dw = 1; dw <= options.rings_search_radius; ++dw)

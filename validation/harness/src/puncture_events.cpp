@@ -1,5 +1,8 @@
 #include "puncture/validation/puncture_events.hpp"
 
+#include "puncture/validation/force_noise.hpp"
+#include "puncture/validation/reference_checks.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -22,64 +25,6 @@ std::vector<LayerGeometry> layer_geometry(const Scene& scene) {
     out.push_back({scene.layers[k].name, scene.layer_top_depth_m(k), scene.layers[k].thickness_m,
                    scene.layers[k].force_mesh.spacing_L_m});
   return out;
-}
-
-namespace {
-
-/// Least-squares slope of force against depth over the insertion samples
-/// from phase[from] going in `direction` (-1 back, +1 forward) over `window`
-/// of depth (at least two samples besides the first); NaN if fewer than
-/// three distinct depths.
-double slope(const InsertionCurve& c, const std::vector<std::size_t>& phase, std::size_t from, int direction,
-             double window) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  int n = 0;
-  const double d0 = c.depth_m[phase[from]];
-  for (long q = static_cast<long>(from); q >= 0 && q < static_cast<long>(phase.size()); q += direction) {
-    const double x = c.depth_m[phase[static_cast<std::size_t>(q)]] - d0;
-    if (std::abs(x) > window && n >= 3) break;
-    const double y = c.force_N[phase[static_cast<std::size_t>(q)]];
-    sx += x, sy += y, sxx += x * x, sxy += x * y, ++n;
-  }
-  const double den = n * sxx - sx * sx;
-  if (n < 3 || !(den > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  return (n * sxy - sx * sy) / den;
-}
-
-}  // namespace
-
-std::vector<ForceDrop> detect_force_drops(const InsertionCurve& curve, const PunctureDetectionOptions& o) {
-  const std::vector<std::size_t> phase = insertion_phase(curve);
-  double peak = 0.0;
-  for (std::size_t i : phase) peak = std::max(peak, std::abs(curve.force_N[i]));
-  std::vector<ForceDrop> found;
-  for (std::size_t p = 0; p + 1 < phase.size(); ++p) {
-    const double f = curve.force_N[phase[p]];
-    if (p > 0 && curve.force_N[phase[p - 1]] > f) continue;  // not a maximum
-    if (!(curve.force_N[phase[p + 1]] < f)) continue;          // no fall right after it
-    // The sample right after the maximum counts whatever the sampling; later
-    // ones while the tip is within the window.
-    double lowest = curve.force_N[phase[p + 1]];
-    std::size_t lowest_at = p + 1;
-    for (std::size_t q = p + 2; q < phase.size(); ++q) {
-      if (curve.depth_m[phase[q]] > curve.depth_m[phase[p + 1]] + o.window_m) break;
-      if (curve.force_N[phase[q]] > f) break;  // rose above the maximum again
-      if (curve.force_N[phase[q]] < lowest) lowest = curve.force_N[phase[q]], lowest_at = q;
-    }
-    const double drop = f - lowest;
-    if (!(drop >= o.min_drop_fraction * std::abs(f) && drop >= o.min_drop_of_peak * peak && drop > 0.0)) continue;
-    // A stiff rise before it, a softer course after it (see the header).
-    const double before = slope(curve, phase, p, -1, o.slope_window_m);
-    const double after = slope(curve, phase, lowest_at, +1, o.slope_window_m);
-    if (std::isfinite(before) && std::isfinite(after) && !(before > after)) continue;
-    const ForceDrop d{phase[p], curve.depth_m[phase[p + 1]], f, drop};
-    if (!found.empty() && d.depth_m - found.back().depth_m <= o.window_m) {
-      if (d.drop_N > found.back().drop_N) found.back() = d;  // one drop seen twice: keep the larger
-      continue;
-    }
-    found.push_back(d);
-  }
-  return found;
 }
 
 double cut_end_from_parts(const InsertionCurve& curve, const std::vector<std::size_t>& samples,
@@ -119,6 +64,7 @@ ReferenceEvents reference_events(const InsertionCurve& reference, const std::vec
     peak = std::max(peak, std::abs(reference.force_N[i]));
     ev.deepest_m = std::max(ev.deepest_m, reference.depth_m[i]);
   }
+  ev.noise_N = force_noise_sigma_N(reference, phase);
   std::ostringstream note;
   if (!given.empty()) {
     ev.source = PunctureSource::GivenDepths;
@@ -155,12 +101,14 @@ ReferenceEvents reference_events(const InsertionCurve& reference, const std::vec
       std::sort(kept.begin(), kept.end(), [](const ForceDrop& a, const ForceDrop& b) { return a.depth_m < b.depth_m; });
     }
     for (std::size_t k = 0; k < kept.size(); ++k) ev.punctures[k] = {true, kept[k].depth_m, kept[k].peak_force_N};
-    note << ev.drops.size() << " force drop(s) found (>= " << 100.0 * o.min_drop_fraction << " % of the force and >= "
-         << 100.0 * o.min_drop_of_peak << " % of the peak within " << o.window_m * 1e3 << " mm)";
+    note << ev.drops.size() << " force drop(s) found (>= " << 100.0 * o.min_drop_fraction << " % of the force, >= "
+         << 100.0 * o.min_drop_of_peak << " % of the peak and >= " << o.min_drop_sigmas << " x the noise "
+         << ev.noise_N << " N within " << o.window_m * 1e3 << " mm)";
     if (ev.drops.size() > kept.size()) note << "; the " << kept.size() << " largest kept";
     note << "; no state columns";
   }
   ev.note = note.str();
+  if (ev.source == PunctureSource::ForceDrops) ev.doubts = detection_doubts(ev, layers);
 
   // Where each cut ends (cut_end_from_parts).
   ev.cut_end_m.assign(layers.size(), std::numeric_limits<double>::quiet_NaN());
@@ -171,14 +119,15 @@ ReferenceEvents reference_events(const InsertionCurve& reference, const std::vec
 
   // Contact onset: the top layer first pressed, else the force first above a fraction of the peak.
   const int top = !layers.empty() ? reference.layer_index(layers.front().name) : -1;
-  for (std::size_t i : phase) {
-    const bool pressed = top >= 0 ? reference.layer_states[static_cast<std::size_t>(top)][i] != LayerState::Untouched
-                                  : std::abs(reference.force_N[i]) > o.onset_fraction * peak;
-    if (pressed) {
-      ev.has_contact_onset = true;
-      ev.contact_onset_m = reference.depth_m[i];
-      break;
-    }
+  if (top >= 0) {
+    for (std::size_t i : phase)
+      if (reference.layer_states[static_cast<std::size_t>(top)][i] != LayerState::Untouched) {
+        ev.has_contact_onset = true;
+        ev.contact_onset_m = reference.depth_m[i];
+        break;
+      }
+  } else {
+    ev.has_contact_onset = contact_onset_from_force(reference, phase, ev.noise_N, o, ev.contact_onset_m);
   }
   return ev;
 }
