@@ -334,14 +334,31 @@ TEST(ProgramContract, ANewRunRemovesStagedFilesOfADeadRun) {
 namespace puncture::apps {
 namespace {
 
-TEST(DocumentedDefaults, CalibrationBoundFactorOfTheCommandAndTheLibrary) {
-  // validation/README.md and apps/README.md: the library keeps each parameter
-  // within [p0 / 3, 3 p0]; `puncture calibrate` widens it to 1000.
-  EXPECT_EQ(CalibrateOptions{}.bound_factor, 1000.0);
-  EXPECT_EQ(validation::CalibrationOptions{}.bound_factor, 3.0);
+/// A file's text with every run of white space made one space (READMEs wrap their lines anywhere).
+std::string collapsed_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::string text, word;
+  while (in >> word) text += (text.empty() ? "" : " ") + word;
+  return text;
+}
+
+TEST(DocumentedDefaults, CalibrationBoundFactorIsOneValueInTheCommandTheLibraryAndTheDocs) {
+  // One default, declared once (validation::kDefaultCalibrationBoundFactor): the command's options, the
+  // library's options, `calibrate --help`, apps/README.md and validation/README.md all say the same number.
+  const double f = validation::kDefaultCalibrationBoundFactor;
+  EXPECT_EQ(CalibrateOptions{}.bound_factor, f);
+  EXPECT_EQ(validation::CalibrationOptions{}.bound_factor, f);
+  std::ostringstream number;
+  number << f;
   const Result help = run_program("calibrate --help");
   EXPECT_EQ(help.exit_code, 0);
-  EXPECT_NE(help.out.find("default 1000"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("range); default " + number.str()), std::string::npos) << help.out;
+  const std::string apps_readme = collapsed_text(kSourceDir / "apps" / "README.md");
+  EXPECT_NE(apps_readme.find("F = " + number.str() + " by default"), std::string::npos) << "apps/README.md";
+  const std::string validation_readme = collapsed_text(kSourceDir / "validation" / "README.md");
+  EXPECT_NE(validation_readme.find("f = `CalibrationOptions::bound_factor`, " + number.str() + " by default"),
+            std::string::npos)
+      << "validation/README.md";
 }
 
 }  // namespace

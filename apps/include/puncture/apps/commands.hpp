@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "puncture/validation/calibration.hpp"
+
 namespace puncture::apps {
 
 /// Exit codes of the `puncture` program (apps/README.md); 128 + n when ended by signal n.
@@ -66,9 +68,8 @@ struct CalibrateOptions {
   std::string method = "nelder_mead"; ///< nelder_mead, bobyqa, simulated_annealing
   std::string preset_name;            ///< empty: <scene name>_tuned
   std::vector<std::string> layers;    ///< empty: all
-  /// Each tuned parameter stays within [start / f, start x f]. Wide by default:
-  /// against the FEM the Table 2 stiffnesses can be two orders of magnitude off.
-  double bound_factor = 1000.0;
+  /// Each tuned parameter stays within [start / f, start x f]; the library's default (1000).
+  double bound_factor = validation::kDefaultCalibrationBoundFactor;
   /// Parameters tuned besides K and the deformation threshold:
   /// "surface_stiffness" (k_s), "rings" (w), "spacing" (L).
   std::vector<std::string> also_tune;

@@ -125,6 +125,10 @@ struct AnnealingSettings {
   bool polish_locally = true;      ///< local Nelder-Mead (with restarts) from the annealing's best point
 };
 
+/// Default of CalibrationOptions::bound_factor and of `puncture calibrate --bound-factor`: against the
+/// FEM the Table 2 values can be two orders of magnitude off, so the box is wide.
+inline constexpr double kDefaultCalibrationBoundFactor = 1000.0;
+
 struct CalibrationOptions {
   /// Nelder-Mead by default: the objective is piecewise smooth with small
   /// steps where a breakthrough moves by one tick, and in our identifiability
@@ -134,7 +138,7 @@ struct CalibrationOptions {
   std::vector<std::string> layers;  ///< layers to calibrate; empty = all (always processed top to bottom)
   TunedParameterSet parameters;
   CalibrationWeights weights;
-  double bound_factor = 3.0;        ///< each continuous parameter stays in [p0 / f, p0 f]
+  double bound_factor = kDefaultCalibrationBoundFactor;  ///< each continuous parameter stays in [p0 / f, p0 f]
   int rings_search_radius = 1;
   int max_evaluations_per_stage = 300;  ///< NLopt evaluation budget per stage and w (shared by restarts) ...
   int evaluations_per_parameter = 250;  ///< ... raised to this many per tuned parameter of the stage
