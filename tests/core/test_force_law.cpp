@@ -479,8 +479,8 @@ TEST(Breakthrough, CriticalEnergyBreaksWhereTheStoredEnergyReachesIt) {
   }
   EXPECT_GE(sim.puncture_events()[0].depth_m, lo - 1e-12);
   EXPECT_LT(sim.puncture_events()[0].depth_m, lo + 1e-5);
-  // Maps to a fracture toughness: E_c = G_c w t (core/README.md): with w = 1.27 mm, t = 5 mm, G_c = 189 J/m^2.
-  EXPECT_NEAR(1.2e-3 / (1.27e-3 * 5e-3), 189.0, 0.1);
+  // (E_c = G_c w t, core/README.md: 1.2 mJ is G_c = 189 J/m^2 for w = 1.27 mm, t = 5 mm; no code maps one to
+  // the other, so nothing here checks that arithmetic.)
 }
 
 // ---------------------------------------------------------------------------
