@@ -1,8 +1,9 @@
-// Axisymmetric solver against closed forms: homogeneous deformations
-// reproduced exactly (patch test with the hoop strain), the flat punch on a
-// thick block (Sneddon 1965 with the bonded-layer bottom-effect correction),
-// the flat punch on a thin bonded layer (Garcia & Garcia 2018), and the same
-// small indentation from the 3D solver.
+// Axisymmetric solver against closed forms: the flat punch on a thick block
+// (Sneddon 1965 with the bonded-layer bottom-effect correction) and on a thin
+// bonded layer (Garcia & Garcia 2018). (No patch test here: the solver holds
+// the base and the lateral ring fixed and takes no other boundary data, so no
+// non-trivial homogeneous deformation satisfies its boundary conditions; the
+// 3D solver's patch test is in test_materials_and_solver.cpp.)
 #include <gtest/gtest.h>
 
 #include <cmath>
