@@ -86,8 +86,8 @@ TEST(FemReferenceHash, IgnoresRealtimeOnlyFields) {
       {"sh_degree", [](Scene& s) { s.realtime.sh_degree = 24; }},
       {"integrator", [](Scene& s) { s.realtime.integrator = "explicit"; }},
       {"haptic rate", [](Scene& s) { s.realtime.haptic_rate_Hz = 2000; }},
-      {"dwell", [](Scene& s) { s.insertion.dwell_s = 3.0; }},
-      {"withdrawal", [](Scene& s) { s.insertion.withdrawal_speed_m_per_s = 0.05; }},
+      {"density", [](Scene& s) { s.layers[2].density_kg_per_m3 = 1500; }},
+      {"real-time force law", [](Scene& s) { s.layers[0].force_law.cutting_force_N = 2.0; }},
       {"effects", [](Scene& s) { s.effects.resumption = false; }},
       {"name", [](Scene& s) { s.name = "renamed"; }},
   };
@@ -117,6 +117,19 @@ TEST(FemReferenceHash, ChangesWithEverythingTheFemSees) {
       {"load step", [](Scene& s) { s.fem.load_step_m = 0.2e-3; }},
       {"scene refinement", [](Scene& s) { s.fem.refinement = 1; }},
       {"newton tolerance", [](Scene& s) { s.fem.newton_tolerance = 1e-9; }},
+      // The axisymmetric reference runs the whole trajectory.
+      {"dwell", [](Scene& s) { s.insertion.dwell_s = 3.0; }},
+      {"withdrawal", [](Scene& s) { s.insertion.withdrawal_speed_m_per_s = 0.05; }},
+      {"fracture energy", [](Scene& s) {
+         s.layers[0].puncture.kind = PunctureCriterion::Kind::FractureEnergy;
+         s.layers[0].puncture.toughness_J_per_m2 = 1000.0;
+       }},
+      {"shaft friction", [](Scene& s) { s.layers[1].shaft_friction.dynamic_coefficient = 0.1; }},
+      {"cohesive viscosity", [](Scene& s) { s.fem.cohesive_viscosity_s = 0.01; }},
+      {"stabilisation time", [](Scene& s) { s.fem.stabilization_time_s = 0.01; }},
+      {"tip angle", [](Scene& s) { s.needle.tip_angle_deg = 30.0; }},
+      {"geometry", [](Scene& s) { s.fem.geometry = "axisymmetric"; }},
+      {"fem mesh", [](Scene& s) { s.fem.mesh.radial_growth = 1.5; }},
   };
   std::map<std::string, std::string> seen{{h, "base"}};
   for (const auto& [what, change] : fem_relevant) {
