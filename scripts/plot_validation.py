@@ -105,7 +105,7 @@ def plot_layer_errors(d):
     if not rows:
         return
     names = [r["layer"] for r in rows]
-    panels = [("force_rmse_N", "force RMSE (N)"), ("puncture_depth_error_mm", "puncture depth error (mm)"),
+    panels = [("pressing_force_rmse_N", "pressing force RMSE (N)"), ("puncture_depth_error_mm", "puncture depth error (mm)"),
               ("puncture_force_error_N", "puncture force error (N)"), ("deflection_rmse_mm", "deflection RMSE (mm)")]
     fig, axes = plt.subplots(1, len(panels), figsize=(3.6 * len(panels), 3.6))
     for ax, (key, label) in zip(axes, panels):

@@ -194,7 +194,7 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
       };
       acc.push_back({{"layer", a.layer},
                      {"accepted", a.accepted()},
-                     {"force_rmse_relative", check(a.force_rmse)},
+                     {"pressing_and_cut_force_rmse_relative", check(a.force_rmse)},
                      {"puncture_depth_error_m", check(a.puncture_depth)},
                      {"puncture_force_error_relative", check(a.puncture_force)}});
     }

@@ -310,9 +310,19 @@ TEST(ValidateCommand, ReportOfASmallSceneAndSecondRunFromCache) {
   ASSERT_EQ(metrics.at("acceptance").size(), metrics.at("layers").size());
   const auto& skin = metrics["acceptance"][0];
   EXPECT_EQ(skin.at("layer"), "skin");
-  EXPECT_EQ(skin.at("accepted").get<bool>(), skin["force_rmse_relative"]["met"].get<bool>() &&
+  EXPECT_EQ(skin.at("accepted").get<bool>(), skin["pressing_and_cut_force_rmse_relative"]["met"].get<bool>() &&
                                                  skin["puncture_depth_error_m"]["met"].get<bool>() &&
                                                  skin["puncture_force_error_relative"]["met"].get<bool>());
+  // One definition per metric name: the per-layer pressing RMSE, the
+  // acceptance's pressing-and-cut RMSE and the whole-insertion RMSE have
+  // names of their own, in the JSON and in the report's table headers.
+  EXPECT_TRUE(metrics["layers"][0].contains("pressing_force_rmse_relative"));
+  EXPECT_FALSE(metrics["layers"][0].contains("force_rmse_relative"));
+  EXPECT_FALSE(skin.contains("force_rmse_relative"));
+  EXPECT_TRUE(metrics["overall"].contains("force_rmse_relative"));
+  EXPECT_NE(md.str().find("| pressing force RMSE (N) | pressing RMSE / FEM peak |"), std::string::npos);
+  EXPECT_NE(md.str().find("| force RMSE over pressing and cut / peak (limit"), std::string::npos);
+  EXPECT_EQ(md.str().find("| force RMSE (N) |"), std::string::npos);
   bool has_overall = false;
   for (const auto& t : metrics.at("trajectory_terms")) has_overall |= t.at("term") == "overall";
   EXPECT_TRUE(has_overall);

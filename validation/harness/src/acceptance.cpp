@@ -66,7 +66,7 @@ std::vector<LayerAcceptance> layer_acceptance(const std::vector<LayerGeometry>& 
 std::string acceptance_markdown(const std::vector<LayerAcceptance>& acceptance, const TrajectoryComparison& comparison,
                                 const AcceptanceCriteria& criteria) {
   std::ostringstream md;
-  md << "| layer | force RMSE / peak (limit " << fmt(100 * criteria.max_rmse_relative) << " %) | puncture depth error "
+  md << "| layer | force RMSE over pressing and cut / peak (limit " << fmt(100 * criteria.max_rmse_relative) << " %) | puncture depth error "
      << "(limit L) | puncture force error (limit " << fmt(100 * criteria.max_force_error_relative)
      << " %) | accepted |\n|---|---|---|---|---|\n";
   auto cell = [](const AcceptanceCheck& c, const std::string& value) {

@@ -295,14 +295,14 @@ std::string validation_summary_markdown(const Scene& scene, const io::Provenance
      << num(cmp.reference_peak_force_N) << " N. The real-time force compared is its whole force, the damping "
         "force d h v of the punctured layers included (as `puncture run` and the app render it; the FEM is "
         "quasi-static, so d h v has no separate counterpart there and is judged with the friction).\n\n";
-  md << "| layer | force RMSE (N) | RMSE / FEM peak | FEM puncture depth (mm) | real-time puncture depth (mm) | "
+  md << "| layer | pressing force RMSE (N) | pressing RMSE / FEM peak | FEM puncture depth (mm) | real-time puncture depth (mm) | "
         "depth error (mm) | force error (N) | deflection RMSE before breakthrough (mm) | max error (mm) | "
         "recovery RMSE (mm) |\n";
   md << "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& j : layers) {
     const std::string name = j["layer"].get<std::string>();
     const LayerMetrics* m = cmp.layer(name);
-    md << "| " << name << " | " << num(j, "force_rmse_N") << " | " << num(j, "force_rmse_relative") << " | "
+    md << "| " << name << " | " << num(j, "pressing_force_rmse_N") << " | " << num(j, "pressing_force_rmse_relative") << " | "
        << (m && m->reference_puncture.found ? num(m->reference_puncture.depth_m / kMm) : "not punctured") << " | "
        << (m && m->model_puncture.found ? num(m->model_puncture.depth_m / kMm) : "not punctured") << " | "
        << num(j, "puncture_depth_error_mm") << " | " << num(j, "puncture_force_error_N") << " | "
@@ -310,14 +310,16 @@ std::string validation_summary_markdown(const Scene& scene, const io::Provenance
        << (j.contains("deflection") ? num(j["deflection"], "max_abs_error_mm") : "–") << " | "
        << (j.contains("recovery") ? num(j["recovery"], "rmse_mm") : "–") << " |\n";
   }
-  md << "\nDepth and force errors are real-time minus FEM. The deflection is compared at the last depth at which "
+  md << "\nThe pressing force RMSE is over the layer's pressed interval (from its contact to its puncture) only; "
+        "the acceptance below judges the pressing and the cut together. Depth and force errors are real-time "
+        "minus FEM. The deflection is compared at the last depth at which "
         "the layer is intact in both models: ring deflections Delta Z_j at r = (j - 1) L against the FEM's -u_z "
         "of the layer's top surface at the same distance from the needle. The recovery compares the FEM's "
         "spring-back (same depth, after the material along the needle path was removed) with the real-time "
         "ring deflections ceil(1 / eta_r) haptic steps after its breakthrough.\n\n";
   if (!acceptance_section.empty()) {
     md << "## Acceptance per layer (whole trajectory)\n\n"
-          "A layer is accepted when its force RMSE over its pressing and its cut is at most 10 % of the FEM peak, "
+          "A layer is accepted when its force RMSE over pressing and cut is at most 10 % of the FEM peak, "
           "its puncture depth within the layer's force-mesh spacing L of the FEM's, and its puncture force within "
           "10 % of the FEM's (the FEM's punctures from its state columns).\n\n"
        << acceptance_section << "\n";
@@ -348,7 +350,8 @@ std::string validation_summary_markdown(const Scene& scene, const io::Provenance
 
 std::string layer_metrics_csv(const Scene& scene, const CurveComparison& cmp,
                               const std::vector<LayerDeflectionComparison>& defl, const io::Provenance& provenance) {
-  io::CsvWriter csv({"layer", "pressed_from_mm", "pressed_to_mm", "n_samples", "force_rmse_N", "force_rmse_relative",
+  io::CsvWriter csv({"layer", "pressed_from_mm", "pressed_to_mm", "n_samples", "pressing_force_rmse_N",
+                     "pressing_force_rmse_relative",
                      "fem_puncture_depth_mm", "realtime_puncture_depth_mm", "puncture_depth_error_mm",
                      "fem_puncture_force_N", "realtime_puncture_force_N", "puncture_force_error_N",
                      "deflection_realtime_depth_mm", "deflection_fem_depth_mm", "deflection_rings", "deflection_rmse_mm",
@@ -447,8 +450,8 @@ nlohmann::json layer_metrics_json(const Scene& scene, const CurveComparison& cmp
     nlohmann::json j;
     j["layer"] = scene.layers[k].name;
     if (const LayerMetrics* m = cmp.layer(scene.layers[k].name)) {
-      j["force_rmse_N"] = m->force_rmse_N;
-      j["force_rmse_relative"] = m->force_rmse_relative;
+      j["pressing_force_rmse_N"] = m->force_rmse_N;
+      j["pressing_force_rmse_relative"] = m->force_rmse_relative;
       j["n_samples"] = m->n_samples;
       j["fem_punctured"] = m->reference_puncture.found;
       j["realtime_punctured"] = m->model_puncture.found;
