@@ -14,6 +14,7 @@
 #include "csv_header.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/validation/fem_reference.hpp"
+#include "puncture/model/realtime_model.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/metrics.hpp"
 
@@ -342,6 +343,58 @@ TEST(ValidateCommand, ReportOfASmallSceneAndSecondRunFromCache) {
 #endif
 
 #ifdef PUNCTURE_HAVE_FEM
+/// The columns of a CSV the program wrote, by header name (the "# ..." lines before the header skipped).
+std::map<std::string, std::vector<std::string>> csv_columns(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line) && !line.empty() && line[0] == '#') {
+  }
+  std::vector<std::string> names;
+  for (std::istringstream h(line); std::getline(h, line, ',');) names.push_back(line);
+  std::map<std::string, std::vector<std::string>> columns;
+  while (std::getline(in, line)) {
+    std::istringstream row(line);
+    for (std::size_t c = 0; c < names.size() && std::getline(row, line, ','); ++c) columns[names[c]].push_back(line);
+  }
+  return columns;
+}
+
+/// The sweep's error of a real-time run against the FEM (sweep.hpp), computed here from the FEM's own CSV
+/// and the run's ticks: at every FEM sample of the insertion (velocity > 0) whose depth is not recorded
+/// twice (a force drop) and lies within the run's insertion, the run's force linearly interpolated at that
+/// depth minus the FEM force; RMSE over those samples, and its ratio to the FEM's insertion peak |force|.
+struct IndependentError {
+  double force_rmse_N = 0.0, relative = 0.0;
+  int samples = 0;
+};
+IndependentError error_against_fem_csv(const ScriptedRunResult& run, const fs::path& fem_csv) {
+  auto columns = csv_columns(fem_csv);
+  std::vector<double> depth, force;  // FEM insertion samples
+  for (std::size_t i = 0; i < columns["force_N"].size(); ++i)
+    if (std::stod(columns["velocity_mm_per_s"].at(i)) > 0.0)
+      depth.push_back(std::stod(columns["depth_mm"][i]) * 1e-3), force.push_back(std::stod(columns["force_N"][i]));
+  std::vector<double> run_depth, run_force;  // the run's insertion ticks (depth strictly rising)
+  for (const TickResult& t : run.ticks)
+    if (t.velocity_m_per_s > 0.0 && (run_depth.empty() || t.depth_m > run_depth.back()))
+      run_depth.push_back(t.depth_m), run_force.push_back(t.total_force_N);
+  IndependentError e;
+  double sum_sq = 0.0, peak = 0.0;
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    peak = std::max(peak, std::abs(force[i]));
+    const bool drop = (i > 0 && depth[i - 1] == depth[i]) || (i + 1 < depth.size() && depth[i + 1] == depth[i]);
+    if (drop || depth[i] < run_depth.front() || depth[i] > run_depth.back()) continue;
+    std::size_t hi = 1;
+    while (hi + 1 < run_depth.size() && run_depth[hi] < depth[i]) ++hi;
+    const double t = (depth[i] - run_depth[hi - 1]) / (run_depth[hi] - run_depth[hi - 1]);
+    const double f = run_force[hi - 1] + t * (run_force[hi] - run_force[hi - 1]);
+    sum_sq += (f - force[i]) * (f - force[i]);
+    ++e.samples;
+  }
+  e.force_rmse_N = std::sqrt(sum_sq / e.samples);
+  e.relative = e.force_rmse_N / peak;
+  return e;
+}
+
 TEST(SweepCommand, TableOfEveryRealtimeKnobAgainstTheFem) {
   const fs::path work = fresh_dir("sweep");
   fs::create_directories(work);
@@ -362,6 +415,7 @@ TEST(SweepCommand, TableOfEveryRealtimeKnobAgainstTheFem) {
   EXPECT_EQ(line.rfind("model,knob,value,baseline,status,force_rmse_N", 0), 0u) << line;
   std::map<std::string, int> variants;
   int baselines = 0;
+  std::vector<std::vector<std::string>> baseline_rows;
   while (std::getline(csv, line)) {
     std::vector<std::string> f;
     std::istringstream s(line);
@@ -369,6 +423,7 @@ TEST(SweepCommand, TableOfEveryRealtimeKnobAgainstTheFem) {
     ASSERT_GE(f.size(), 13u) << line;
     ++variants[f[0] + ":" + f[1]];
     if (f[3] == "1") ++baselines;
+    if (f[3] == "1" && f[0] == "realtime") baseline_rows.push_back(f);
     if (f[0] == "fem") {
       // The only FEM setting is the reference itself: zero error.
       EXPECT_EQ(std::stod(f[5]), 0.0);
@@ -387,6 +442,23 @@ TEST(SweepCommand, TableOfEveryRealtimeKnobAgainstTheFem) {
   EXPECT_EQ(variants["realtime:integrator"], 3);
   EXPECT_EQ(variants["realtime:haptic_rate_Hz"], 5);
   EXPECT_EQ(baselines, 6);  // one per knob
+
+  // Each knob's baseline is the scene itself: the five real-time baseline rows have the same errors
+  // (force RMSE, relative, depth error, punctures compared, missed), and those are the errors computed
+  // here from the FEM's CSV in the cache and a run of the scene (to the 8 digits of the table).
+  ASSERT_EQ(baseline_rows.size(), 5u);
+  for (const auto& row : baseline_rows)
+    for (std::size_t c = 5; c <= 9; ++c) EXPECT_EQ(row[c], baseline_rows[0][c]) << row[1] << " column " << c;
+  fs::path fem_csv;
+  for (const auto& entry : fs::recursive_directory_iterator(options.cache_dir))
+    if (entry.path().filename() == "fem_force_depth.csv") fem_csv = entry.path();
+  ASSERT_FALSE(fem_csv.empty()) << "no FEM curve in " << options.cache_dir;
+  const Scene scene = small_scene();
+  RealtimeModel model = build_realtime_model(scene);
+  const IndependentError expected = error_against_fem_csv(run_scripted_insertion(model, scene), fem_csv);
+  ASSERT_GT(expected.samples, 5);
+  EXPECT_NEAR(std::stod(baseline_rows[0][5]), expected.force_rmse_N, 1e-6 * expected.force_rmse_N);
+  EXPECT_NEAR(std::stod(baseline_rows[0][6]), expected.relative, 1e-6 * expected.relative);
   fs::remove_all(work);
 }
 #endif
