@@ -2,11 +2,11 @@
 // withdrawal) on a small version of the default scene: the default's
 // materials, fracture energies, friction and needle, on a 30 mm wide slab with
 // thinner fat and muscle, coarse mesh. What is checked could each fail:
-// layers break in depth order, the skin punctures at a force of the measured
-// order (1-5 N: LITERATURE.md, median 1.22 N over 24 studies for needles of
-// this size), friction is there after puncture and reverses on withdrawal,
-// the numerical stabilisation dissipates a small share of the needle's work,
-// and nothing is NaN.
+// layers break in depth order, the skin's puncture force and depth are those
+// of the same slab on a twice finer mesh (a convergence check), friction is
+// there after puncture and reverses on withdrawal, the numerical
+// stabilisation dissipates a small share of the needle's work, and nothing is
+// NaN. Hard cases: a brittle skin punctures, a very tough one does not.
 #include <deal.II/base/mpi.h>
 #include <gtest/gtest.h>
 
@@ -64,12 +64,27 @@ TEST(AxisymmetricInsertion, SmallDefaultSlabPuncturesInOrderWithFrictionThatReve
   EXPECT_EQ(r.punctures[0].layer_name, "skin");
   EXPECT_EQ(r.punctures[1].layer_name, "fat");
   for (std::size_t i = 1; i < r.punctures.size(); ++i) EXPECT_GE(r.punctures[i].depth_m, r.punctures[i - 1].depth_m);
-  // Skin puncture force of the measured order (LITERATURE.md: 0.5-3 N for
-  // 18-25 G needles in skin; here a stiff, thin bed under a 30 mm slab).
-  EXPECT_GT(r.punctures[0].force_N, 0.5);
-  EXPECT_LT(r.punctures[0].force_N, 5.0);
   // It punctures after a visible tenting of the surface, not at first touch.
   EXPECT_GT(r.punctures[0].depth_m, 1e-3);
+  // Convergence: the same slab on a mesh twice as fine (tip and path elements
+  // halved), run only until just past the skin puncture, gives the same skin
+  // puncture. Tolerance 2 % of the force, one load step (0.2 mm) of the depth:
+  // on the default slab these two meshes differ by 0.28 % in force and not at
+  // all in depth (results/fem_puncture_mesh_independence.md), on this slab by
+  // 0.4 % (3.094 N against 3.082 N, both at 5.0 mm); 2 % is five times that,
+  // and far below the 10 % the mesh study aims at.
+  {
+    Scene fine = s;
+    fine.fem.mesh.elements_per_needle_radius = 8;
+    fine.fem.mesh.path_element_size_mm = 0.2;
+    FemRunOptions o = quiet();
+    o.stop_depth_m = r.punctures[0].depth_m + 0.6e-3;
+    const FemRunSummary f = run_needle_insertion(fine, o, MPI_COMM_WORLD);
+    ASSERT_GE(f.punctures.size(), 1u) << "the fine mesh's skin punctures by " << o.stop_depth_m * 1e3 << " mm";
+    EXPECT_EQ(f.punctures[0].layer_name, "skin");
+    EXPECT_NEAR(f.punctures[0].force_N, r.punctures[0].force_N, 0.02 * r.punctures[0].force_N);
+    EXPECT_NEAR(f.punctures[0].depth_m, r.punctures[0].depth_m, s.fem.load_step_m + 1e-9);
+  }
 
   // After the skin puncture the force does not fall to zero (cutting and
   // friction), and friction acts on the shaft while inserting.
@@ -110,33 +125,47 @@ TEST(AxisymmetricInsertion, WithoutFrictionTheWithdrawalForceIsNeverNegative) {
   EXPECT_EQ(r.punctures[0].layer_name, "skin");
 }
 
-TEST(AxisymmetricInsertion, HardCasesConvergeOrStopWithAClearErrorAndNeverNaN) {
-  // Very brittle and very tough skin (G_c 1 and 30 000 J/m^2), nearly
-  // incompressible (nu 0.499), on the small slab to 4 mm and back. Either the
-  // run completes with finite values (the brittle skin punctures) or it stops
-  // with an error that says where and why. (With sigma_c fixed, the skin's
-  // puncture force is governed by the cohesive strength more than by G_c: a
-  // brittle skin still needs the traction sigma_c to open.)
-  for (const double gc : {1.0, 30000.0}) {
-    Scene s = small_default_scene();
-    s.layers[0].puncture.toughness_J_per_m2 = gc;
-    for (auto& l : s.layers) l.material.poisson_ratio = 0.499;
-    s.insertion.target_depth_m = 4e-3;
-    try {
-      const FemRunSummary r = run_needle_insertion(s, quiet(), MPI_COMM_WORLD);
-      for (std::size_t k = 0; k < r.force_N.size(); ++k)
-        ASSERT_TRUE(std::isfinite(r.force_N[k]) && std::isfinite(r.friction_force_N[k])) << "G_c " << gc << " row " << k;
-      if (gc == 1.0) {
-        ASSERT_GE(r.punctures.size(), 1u) << "brittle skin punctures";
-        EXPECT_EQ(r.punctures[0].layer_name, "skin");
-      }
-    } catch (const std::runtime_error& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find("no convergence"), std::string::npos) << what;
-      EXPECT_NE(what.find("mm"), std::string::npos) << "names the depth: " << what;
-      EXPECT_NE(gc, 1.0) << "the brittle case should complete: " << what;
-    }
-  }
+/// The small slab with nearly incompressible layers (nu 0.499), to 4 mm and
+/// back, with the skin's fracture energy G_c (J/m^2) set.
+Scene hard_case(double skin_toughness_J_per_m2) {
+  Scene s = small_default_scene();
+  s.layers[0].puncture.toughness_J_per_m2 = skin_toughness_J_per_m2;
+  for (auto& l : s.layers) l.material.poisson_ratio = 0.499;
+  s.insertion.target_depth_m = 4e-3;
+  return s;
+}
+
+void expect_finite_rows(const FemRunSummary& r) {
+  for (std::size_t k = 0; k < r.force_N.size(); ++k)
+    ASSERT_TRUE(std::isfinite(r.force_N[k]) && std::isfinite(r.friction_force_N[k])) << "row " << k;
+}
+
+TEST(AxisymmetricInsertion, HardCaseBrittleSkinConvergesAndPunctures) {
+  // G_c = 1 J/m^2: the cohesive law opens fully within 2 G_c / sigma_c = 1 um
+  // once the traction reaches sigma_c (2 MPa), so the skin cuts as soon as the
+  // tip stretches it that far: the run completes and the skin (only) punctures
+  // within the 4 mm. (With sigma_c fixed, the puncture force is governed by
+  // sigma_c more than by G_c: a brittle skin still needs sigma_c to open.)
+  const FemRunSummary r = run_needle_insertion(hard_case(1.0), quiet(), MPI_COMM_WORLD);
+  expect_finite_rows(r);
+  ASSERT_EQ(r.punctures.size(), 1u);
+  EXPECT_EQ(r.punctures[0].layer_name, "skin");
+  EXPECT_LE(r.punctures[0].depth_m, 4e-3 + 1e-9);
+  EXPECT_GT(r.punctures[0].force_N, 0.0);
+}
+
+TEST(AxisymmetricInsertion, HardCaseVeryToughSkinConvergesAndDoesNotPuncture) {
+  // G_c = 30 000 J/m^2: full separation needs a separation of 2 G_c / sigma_c =
+  // 30 mm, and the bevel can open the law's separation at most to its width
+  // 2a = 1.27 mm (LayerCrack: the ring's radial opening a - r_c times
+  // opening_scale); steady cutting would need G_c x 2a = 38 N. The run
+  // completes with finite forces, no layer punctures, the force stays below 38 N.
+  const FemRunSummary r = run_needle_insertion(hard_case(30000.0), quiet(), MPI_COMM_WORLD);
+  expect_finite_rows(r);
+  EXPECT_TRUE(r.punctures.empty()) << r.punctures.size() << " punctures, the first " << r.punctures[0].layer_name;
+  const double peak = *std::max_element(r.force_N.begin(), r.force_N.end());
+  EXPECT_GT(peak, 0.0);
+  EXPECT_LT(peak, 38.0);
 }
 
 TEST(AxisymmetricInsertion, WarnsWhenTheMeshIsTooCoarseForTheAccuracyTarget) {
