@@ -174,11 +174,34 @@ TEST(UnfittableReference, IsAnErrorNamingTheFileAndWhy) {
       pv::parse_insertion_curve("depth_mm,force_N\n0,0\n0.5,0.2\n1.0,0.4\n1.5,0.6\n1.6,0.2\n", "few.csv"));
   EXPECT_EQ(few.rfind("few.csv: ", 0), 0u) << few;
   EXPECT_NE(few.find("fewer samples after contact (3) than tuned parameters (4)"), std::string::npos) << few;
-  // Five rows, one drop: nothing of any layer identified.
-  const std::string five = calibrate_error(
-      pv::parse_insertion_curve("depth_mm,force_N\n0,0\n1,1\n2,2\n2.5,0.5\n3,0.6\n", "five.csv"));
-  EXPECT_NE(five.find("five.csv: "), std::string::npos) << five;
-  EXPECT_NE(five.find("identifies no parameter"), std::string::npos) << five;
+  // Three rows inside the skin, no drop: two pressing samples identify nothing.
+  const std::string three = calibrate_error(
+      pv::parse_insertion_curve("depth_mm,force_N\n0,0\n0.2,0.1\n0.4,0.2\n", "three.csv"));
+  EXPECT_NE(three.find("three.csv: "), std::string::npos) << three;
+  EXPECT_NE(three.find("identifies no parameter"), std::string::npos) << three;
+}
+
+TEST(UnfittableReference, FiveRowsWithOneDropTuneOnlyTheSkinsCriticalForce) {
+  // The drop at 2 mm after 2 N identifies the skin's critical force (the
+  // puncture's force sets it); two pressing samples and a one-sample cut
+  // identify nothing else, and nothing of the fat and muscle: each of those
+  // parameters keeps its start value with a warning.
+  pv::CalibrationOptions o;
+  const puncture::Scene scene = default_slab();
+  const pv::CalibrationResult r = pv::calibrate(
+      scene, pv::parse_insertion_curve("depth_mm,force_N\n0,0\n1,1\n2,2\n2.5,0.5\n3,0.6\n", "five.csv"), o);
+  ASSERT_EQ(r.parameters.size(), 1u);
+  EXPECT_EQ(r.parameters[0].layer, "skin");
+  EXPECT_EQ(r.parameters[0].name, "critical_force");
+  // Moved from its start (2.75 N) toward the drop's 2 N; K stays at its start,
+  // so the fit trades the puncture's force against its depth.
+  EXPECT_LT(r.parameters[0].tuned, r.parameters[0].start - 0.1);
+  EXPECT_NEAR(r.parameters[0].tuned, 2.0, 0.6);
+  std::size_t kept = 0;
+  for (const std::string& w : r.warnings) kept += w.find("kept at its start value") != std::string::npos;
+  EXPECT_GE(kept, 6u);  // the skin's K, stiffening, cutting, friction at least
+  ASSERT_EQ(r.tuned.size(), scene.layers.size());
+  EXPECT_EQ(r.tuned[1].critical_force_N, r.initial[1].critical_force_N);
 }
 
 TEST(UnfittableReference, UnsureDetectionAsksForPunctureDepths) {

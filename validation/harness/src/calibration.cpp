@@ -242,7 +242,9 @@ Parameter make_parameter(const Scene& start, std::size_t layer, ParamKind kind, 
 /// Why the references do not identify a parameter (reference_checks.hpp); "" when they do.
 std::string unidentified_reason(const LayerIdentifiability& id, ParamKind kind) {
   switch (kind) {
-    case ParamKind::DeformedThreshold: case ParamKind::CriticalForce: case ParamKind::CriticalEnergy:
+    case ParamKind::CriticalForce: case ParamKind::CriticalEnergy:  // the puncture's depth and force set them
+      return id.punctured ? "" : "the reference has no puncture of this layer";
+    case ParamKind::DeformedThreshold:  // a ring deflection: read off the pressing curve
       return !id.punctured ? "the reference has no puncture of this layer"
              : id.pressing() ? "" : "the reference has fewer than 3 pressing samples of this layer before its puncture";
     case ParamKind::Cutting: case ParamKind::Friction: case ParamKind::Presliding:

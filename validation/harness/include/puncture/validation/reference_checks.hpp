@@ -16,10 +16,11 @@
 //   * pressing group (K, k_s, L, w, stiffening): at least
 //     kMinIdentifyingSamples insertion samples in the layer's pressing
 //     segment (layer_segments);
-//   * breakthrough parameter: the reference has a puncture of the layer and
-//     the pressing group is identified (the breakthrough deflection, force
-//     or energy is read off the pressing curve: with K unknown the fit would
-//     only trade one for the other);
+//   * breakthrough parameter: a critical force or energy needs the
+//     reference's puncture of the layer (its depth and force set it, whatever
+//     K is; the default FEM's fat has a puncture but a single pressing
+//     sample); the ring criterion's deformed threshold, a deflection read off
+//     the pressing curve, needs the puncture and the pressing group;
 //   * cut group (cutting force, friction, presliding): at least
 //     kMinIdentifyingSamples insertion samples in the layer's after-puncture
 //     segment.
