@@ -29,8 +29,9 @@
 // vertex numbering follows the cell order. (make_mesh_3's own exudation,
 // used before, stopped at a wall-clock limit equal to the refinement time,
 // so a few cells depended on the machine's load.)
-// Throws std::invalid_argument for bad options or scene geometry, and
-// std::runtime_error if CGAL returns an empty mesh.
+// Throws std::invalid_argument for bad options or scene geometry,
+// std::runtime_error if CGAL returns an empty mesh, and std::logic_error if the
+// exudation reports that it stopped at a time limit (none is set).
 #pragma once
 
 #include <string>
