@@ -1,0 +1,55 @@
+// write_model_comparison: the report of `puncture compare` (see
+// comparison_report.hpp), top-down: the FEM reference's files, the mesh,
+// every model, the identifications, the metrics and grading, the files.
+#include "puncture/validation/comparison_report.hpp"
+
+#include <algorithm>
+
+#include "comparison_runs.hpp"
+#include "comparison_tables.hpp"
+#include "puncture/io/provenance.hpp"
+#include "puncture/io/provenance_json.hpp"
+#include "puncture/io/pvd.hpp"
+
+namespace puncture::validation {
+
+using namespace comparison_report_detail;
+
+ComparisonOutcome write_model_comparison(const Scene& scene, const DelphiWeights& weights,
+                                         const ComparisonFemReference& fem, const ComparisonReportOptions& options,
+                                         std::ostream& out, std::ostream& err) {
+  const ComparisonReference reference = read_comparison_reference(scene, fem.dir);
+  io::OutputSession session(options.output_dir);
+  const nlohmann::json provenance = io::provenance_json(io::make_provenance(options.command_line));
+  const ComparisonMesh mesh = build_comparison_mesh(scene, options, session, out);
+
+  ComparisonRunner runner(scene, options, reference, mesh.mesh, session, out, err);
+  for (const std::string& key : options.models)
+    if (key != "fem") runner.run(key, scene, key);
+  nlohmann::json identification = nlohmann::json::array();
+  for (const std::string& method : options.identify) identification.push_back(runner.identify(method));
+
+  const std::vector<std::unique_ptr<ModelRun>>& runs = runner.runs();
+  const bool with_fem_row = std::find(options.models.begin(), options.models.end(), "fem") != options.models.end();
+  const ComparisonRows rows = comparison_rows(scene, runs, reference, with_fem_row);
+  session.write_text("comparison.csv", comparison_csv(scene, rows));
+  session.write_text("fem_curve.csv", insertion_curve_csv(reference.fem.curve));
+  session.write_text("deflection_profiles.csv", deflection_profiles_csv(reference.data, runs));
+  ComparisonOutcome outcome{rows.metrics, grade_models(rows.metrics, weights), reference.data.has_shaft_forces};
+  session.write_text("ranking.csv", ranking_csv(outcome.grade));
+  const double wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - options.wall_start).count();
+  const ComparisonContent content{scene, options, fem, reference, mesh, provenance,
+                                  runs, identification, rows, outcome.grade, weights, wall_time_s};
+  session.write_text("comparison_summary.json", summary_json(content).dump(2) + "\n");
+  if (!runner.pvd().empty()) io::write_pvd(session, "comparison.pvd", runner.pvd());
+  session.commit();
+
+  const std::vector<std::string> plots = run_plot_script("plot_comparison.py", options.output_dir, out, err);
+  io::OutputSession md_session(options.output_dir);
+  md_session.write_text("comparison.md", comparison_markdown(content, plots));
+  md_session.commit();
+  return outcome;
+}
+
+}  // namespace puncture::validation

@@ -1,0 +1,229 @@
+// The text files of `puncture compare` (see comparison_tables.hpp).
+#include "comparison_tables.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/validation/number_format.hpp"
+
+namespace puncture::validation::comparison_report_detail {
+
+namespace {
+
+constexpr double kMm = 1e-3;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// comparison.md: title, command and machine, the FEM reference, the mesh.
+void markdown_header(std::ostringstream& md, const ComparisonContent& c) {
+  const nlohmann::json& provenance = c.provenance;
+  const FemResultFiles& fem = c.reference.fem;
+  md << "# Model comparison: " << c.scene.name << "\n\n"
+     << "Made by `" << c.options.command_line << "` on " << provenance["machine"].get<std::string>() << ", "
+     << provenance["date_utc"].get<std::string>() << " (puncture " << provenance["program_version"].get<std::string>()
+     << ", git " << provenance["git_revision"].get<std::string>() << "); wall time " << shown(c.wall_time_s, 4)
+     << " s.\n\n"
+     << "FEM reference: cache key `" << c.fem_entry.hash << "` ("
+     << (c.fem_entry.from_cache ? "from the cache" : "computed now") << "), " << fem.summary.value("n_dofs", 0L)
+     << " dofs, " << fem.summary.value("load_steps", 0L) << " load steps in "
+     << shown(fem.summary.value("wall_time_s", kNaN), 4) << " s. "
+     << (c.reference.data.has_shaft_forces
+             ? "Its curve has cutting/friction columns: every model's force includes the same shaft forces (cutting, Karnopp friction and Table 1's d h v)."
+             : "Its curve is quasi-static and frictionless (no cutting/friction columns): the "
+               "models' contact force is compared, without Table 1's post-puncture d h v.")
+     << "\n\n";
+  if (c.mesh.mesh)
+    md << "Tetrahedral mesh (CGAL Mesh_3): " << c.mesh.report.vertices << " vertices, " << c.mesh.report.tetrahedra
+       << " tetrahedra; " << comparison::describe(c.mesh.report.quality) << ".\n\n";
+}
+
+/// comparison.md: one row per model, then the ranking.
+void markdown_metrics(std::ostringstream& md, const ComparisonContent& c) {
+  md << "| model | dofs | memory MB | force RMSE / FEM peak | peak force error | puncture depth error mm | "
+        "skin deflection RMSE / max | step mean ms | step p99 ms |\n|---|---|---|---|---|---|---|---|---|\n";
+  for (const ModelMetrics& m : c.rows.metrics)
+    md << "| " << m.model << " | " << m.dofs << " | " << shown(m.memory_bytes / 1e6) << " | "
+       << shown(m.force_rmse_relative) << " | " << shown(m.peak_force_error_relative) << " | "
+       << shown(m.puncture_depth_error_m / kMm)
+       << (m.puncture_layers_disagreeing
+               ? " (" + std::to_string(m.puncture_layers_disagreeing) + " layer(s) broken by one only)"
+               : "")
+       << " | " << shown(m.deflection_rmse_relative) << " | " << shown(m.step_time_mean_s * 1e3) << " | "
+       << shown(m.step_time_p99_s * 1e3) << " |\n";
+  md << "\nTimes per step are over the steps with the tip in the tissue; the FEM's is its wall time per load step.\n\n"
+     << "## Ranking (seed paper Sec. 3.3)\n\n" << ranking_markdown(c.grade, c.weights) << "\n";
+}
+
+/// comparison.md: one row per identification method (nothing without one).
+void markdown_identification(std::ostringstream& md, const nlohmann::json& identification) {
+  if (identification.empty()) return;
+  md << "## Mass-spring identification\n\n| method | factors before | factors after | objective before | "
+        "objective after | force RMSE before | after | evaluations | wall time s |\n|---|---|---|---|---|---|---|---|---|\n";
+  auto list = [](const nlohmann::json& v) {
+    std::string s;
+    for (const auto& x : v) s += (s.empty() ? "" : ", ") + fmt(x.get<double>(), 3);
+    return s;
+  };
+  for (const auto& j : identification)
+    md << "| " << j["library"].get<std::string>() << " | " << list(j["scale_before"]) << " | " << list(j["scale_after"])
+       << " | " << shown(j["objective_before"].get<double>()) << " | " << shown(j["objective_after"].get<double>())
+       << " | " << shown(j["force_rmse_relative_before"].get<double>()) << " | "
+       << shown(j["force_rmse_relative_after"].get<double>()) << " | " << j["evaluations"].get<int>() << " | "
+       << shown(j["wall_time_s"].get<double>(), 4) << " |\n";
+  md << "\n";
+}
+
+/// comparison.md: the models' descriptions, the plots, the files.
+void markdown_models_and_files(std::ostringstream& md, const ComparisonContent& c,
+                               const std::vector<std::string>& plots) {
+  md << "## Models\n\n";
+  for (std::size_t i = 0; i < c.rows.metrics.size(); ++i)
+    md << "- **" << c.rows.metrics[i].model << "**: " << c.rows.descriptions[i] << "\n";
+  for (const auto& run : c.runs)
+    if (!run->integrator_report.empty()) md << "- " << run->model << " integration: " << run->integrator_report << "\n";
+  md << "\n";
+  for (const std::string& png : plots) md << "![" << png << "](" << png << ")\n\n";
+  md << "Files: `comparison.csv` (one row per model), `ranking.csv`, `curves/<model>.csv` (every step), "
+        "`deflection_profiles.csv`, `fem_curve.csv`, `comparison_summary.json`"
+     << (c.options.write_vtk ? ", `mesh.vtu`, `comparison.pvd` (every model side by side in ParaView, shifted along x)"
+                             : "")
+     << ".\n";
+}
+
+}  // namespace
+
+std::string fmt(double x, int precision) {
+  if (!std::isfinite(x)) return "nan";
+  return significant_digits(x, precision);
+}
+
+std::string shown(double x, int precision) { return std::isfinite(x) ? fmt(x, precision) : "n/a"; }
+
+std::string curve_csv(const Scene& scene, const ModelRun& run, bool with_post) {
+  std::ostringstream csv;
+  csv << "# model: " << run.model << "\n# description: " << run.description << "\n# force: "
+      << (with_post ? "contact + post-puncture (compared with the FEM's total)"
+                    : "contact (compared with the quasi-static FEM)")
+      << "\ntime_s,depth_mm,velocity_mm_per_s,force_N,contact_force_N,post_puncture_force_N,step_wall_time_us";
+  for (const Layer& l : scene.layers) csv << ',' << l.name << "_state";
+  csv << '\n';
+  for (std::size_t i = 0; i < run.steps(); ++i) {
+    const double force = run.contact_force_N[i] + (with_post ? run.post_puncture_force_N[i] : 0.0);
+    csv << fmt(run.time_s[i], 10) << ',' << fmt(run.depth_m[i] / kMm, 10) << ','
+        << fmt(run.velocity_m_per_s[i] / kMm, 10) << ',' << fmt(force, 10) << ',' << fmt(run.contact_force_N[i], 10)
+        << ',' << fmt(run.post_puncture_force_N[i], 10) << ',' << fmt(run.step_wall_time_s[i] * 1e6, 6);
+    for (LayerState s : run.states[i]) csv << ',' << to_string(s);
+    csv << '\n';
+  }
+  return csv.str();
+}
+
+std::string comparison_csv(const Scene& scene, const ComparisonRows& rows) {
+  std::ostringstream csv;
+  csv << "model,dofs,nodes,memory_MB,force_rmse_N,force_rmse_relative,peak_force_N,reference_peak_force_N,"
+         "peak_force_error_relative,puncture_depth_error_mm,puncture_layers_disagreeing";
+  for (const Layer& l : scene.layers) csv << ',' << l.name << "_puncture_mm";
+  csv << ",deflection_rmse_mm,deflection_rmse_relative,deflection_depths,withdrawal_force_rmse_N,"
+         "step_time_mean_ms,step_time_p99_ms,step_time_max_ms,build_s,run_s,completed_fraction,recovered_steps,"
+         "description\n";
+  for (std::size_t i = 0; i < rows.metrics.size(); ++i) {
+    const ModelMetrics& m = rows.metrics[i];
+    const ModelRun* run = rows.runs[i];
+    csv << m.model << ',' << m.dofs << ',' << (run ? std::to_string(run->size.nodes) : "nan") << ','
+        << fmt(m.memory_bytes / 1e6) << ',' << fmt(m.force_rmse_N) << ',' << fmt(m.force_rmse_relative) << ','
+        << fmt(m.model_peak_force_N) << ',' << fmt(m.reference_peak_force_N) << ',' << fmt(m.peak_force_error_relative)
+        << ',' << fmt(m.puncture_depth_error_m / kMm) << ',' << m.puncture_layers_disagreeing;
+    for (const auto& p : m.punctures) csv << ',' << fmt(p.model_depth_m / kMm);
+    csv << ',' << fmt(m.deflection_rmse_m / kMm) << ',' << fmt(m.deflection_rmse_relative) << ',' << m.deflection_depths
+        << ',' << fmt(m.withdrawal_force_rmse_N) << ',' << fmt(m.step_time_mean_s * 1e3) << ','
+        << fmt(m.step_time_p99_s * 1e3) << ',' << fmt(m.step_time_max_s * 1e3) << ','
+        << (run ? fmt(run->build_wall_time_s) : "nan") << ',' << (run ? fmt(run->run_wall_time_s) : "nan") << ','
+        << fmt(m.completed_fraction) << ',' << (run ? std::to_string(run->recovered_steps) : "0") << ",\""
+        << rows.descriptions[i] << "\"\n";
+  }
+  return csv.str();
+}
+
+std::string deflection_profiles_csv(const ReferenceData& reference, const std::vector<std::unique_ptr<ModelRun>>& runs) {
+  std::ostringstream csv;
+  csv << "model,depth_mm,r_mm,deflection_mm\n";
+  for (const RadialProfile& p : reference.skin_profiles)
+    for (std::size_t i = 0; i < p.r_m.size(); ++i)
+      csv << "fem," << fmt(p.depth_m / kMm) << ',' << fmt(p.r_m[i] / kMm) << ',' << fmt(-p.uz_m[i] / kMm) << '\n';
+  for (const auto& run : runs)
+    for (const SurfaceSnapshot& s : run->skin_profiles)
+      for (std::size_t i = 0; i < s.r_m.size(); ++i)
+        csv << run->model << ',' << fmt(s.depth_m / kMm) << ',' << fmt(s.r_m[i] / kMm) << ','
+            << fmt(s.deflection_m[i] / kMm) << '\n';
+  return csv.str();
+}
+
+nlohmann::json identification_record(const std::string& method, const IdentificationResult& r, double step_m) {
+  nlohmann::json j;
+  j["method"] = method;
+  j["library"] = method == "isres" ? "NLopt GN_ISRES (evolution strategy)" : "GSL gsl_siman (simulated annealing)";
+  j["scale_before"] = r.scale_before;
+  j["scale_after"] = r.scale_after;
+  j["objective_before"] = r.before.objective;
+  j["objective_after"] = r.after.objective;
+  j["force_rmse_relative_before"] = r.before.force_rmse_relative;
+  j["force_rmse_relative_after"] = r.after.force_rmse_relative;
+  nlohmann::json punctures = nlohmann::json::array();
+  for (std::size_t k = 0; k < r.punctures_after.size(); ++k)
+    punctures.push_back({{"layer", r.punctures_after[k].layer},
+                         {"reference_mm", fmt(r.punctures_after[k].reference_depth_m / kMm)},
+                         {"before_mm", fmt(r.punctures_before[k].model_depth_m / kMm)},
+                         {"after_mm", fmt(r.punctures_after[k].model_depth_m / kMm)}});
+  j["puncture_depths"] = punctures;
+  j["evaluations"] = r.evaluations;
+  j["wall_time_s"] = r.wall_time_s;
+  j["seconds_per_evaluation"] = r.seconds_per_evaluation;
+  j["model_runs"] = "quasi-static mass-spring on the comparison mesh, steps of " + fmt(step_m / kMm) + " mm";
+  nlohmann::json history = nlohmann::json::array();
+  for (const auto& e : r.history) history.push_back({{"scale", e.scale}, {"objective", e.objective}});
+  j["history"] = history;
+  return j;
+}
+
+nlohmann::json summary_json(const ComparisonContent& c) {
+  const Scene& scene = c.scene;
+  nlohmann::json summary;
+  summary["provenance"] = c.provenance;
+  summary["scene"] = scene.name;
+  summary["fem_reference"] = {{"hash", c.fem_entry.hash},
+                              {"from_cache", c.fem_entry.from_cache},
+                              {"summary", c.reference.fem.summary},
+                              {"has_cutting_or_friction_columns", c.reference.data.has_shaft_forces}};
+  summary["compared_force"] = c.reference.data.has_shaft_forces ? "total (contact + post-puncture)" : "contact force only";
+  if (c.mesh.mesh)
+    summary["mesh"] = {{"vertices", c.mesh.report.vertices},
+                       {"tetrahedra", c.mesh.report.tetrahedra},
+                       {"wall_time_s", c.mesh.report.wall_time_s},
+                       {"min_dihedral_deg", c.mesh.report.quality.min_dihedral_deg},
+                       {"max_radius_edge_ratio", c.mesh.report.quality.max_radius_edge_ratio},
+                       {"options", {{"size_at_axis_mm", scene.comparison.mesh.size_at_axis_m / kMm},
+                                    {"size_far_mm", scene.comparison.mesh.size_far_m / kMm},
+                                    {"grading", scene.comparison.mesh.grading}}}};
+  nlohmann::json integrators = nlohmann::json::object();
+  for (const auto& run : c.runs) {
+    integrators[run->model] = {{"description", run->description}, {"integrator", run->integrator_report}};
+    if (run->failed()) integrators[run->model]["failure"] = run->failure;
+  }
+  summary["models"] = integrators;
+  summary["identification"] = c.identification;
+  summary["weights_file"] = c.options.weights_path.string();
+  summary["wall_time_s"] = c.wall_time_s;
+  return summary;
+}
+
+std::string comparison_markdown(const ComparisonContent& content, const std::vector<std::string>& plots) {
+  std::ostringstream md;
+  markdown_header(md, content);
+  markdown_metrics(md, content);
+  markdown_identification(md, content.identification);
+  markdown_models_and_files(md, content, plots);
+  return md.str();
+}
+
+}  // namespace puncture::validation::comparison_report_detail
