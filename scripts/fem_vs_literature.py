@@ -81,6 +81,26 @@ def main():
         share = 100 * fr / tot if tot > 0 else float("nan")
         L.append(f"| friction share of the force at the target depth | {fr:.3f} of {tot:.3f} N ({share:.0f} %) | "
                  "21 % (tearing 61 %, spreading 18 %) | Barnett, Lee, Moore 2016, J. Manuf. Sci. Eng. 138:011005 |")
+    # Friction per unit length of shaft: least-squares slope of the friction
+    # column against depth from 1 mm below the last puncture to the target
+    # depth (the shaft then slides through every punctured layer).
+    if ins and order:
+        z0 = max(p["depth_mm"] for p in summary["punctures"]) + 1.0
+        pts = [(f(r, "depth_mm"), f(r, "friction_force_N")) for r in ins if f(r, "depth_mm") >= z0]
+        if len(pts) >= 3:
+            n = len(pts)
+            mx = sum(z for z, _ in pts) / n
+            my = sum(v for _, v in pts) / n
+            slope = sum((z - mx) * (v - my) for z, v in pts) / sum((z - mx) ** 2 for z, _ in pts)
+            band = "inside" if 0.013 <= slope <= 0.080 else ("above" if slope > 0.080 else "below")
+            L.append(f"| shaft friction per unit length | {slope:.3f} N/mm (slope of the friction column over "
+                     f"{pts[0][0]:.1f}-{pts[-1][0]:.1f} mm, {n} steps; {band} the measured 0.013-0.080 N/mm) | "
+                     "bovine liver 0.013 N/mm sliding, 0.018 N/mm static (Karnopp fit per metre of contact); "
+                     "PVC phantom 0.034 / 0.059 / 0.080 N/mm at 1 / 3 / 9 mm/s | "
+                     "Okamura, Simone, O'Leary 2004, IEEE TBME 51:1707; DiMaio & Salcudean 2003 (via van Gerwen 2012) |")
+        L.append(f"| friction force at the target depth | {f(ins[-1], 'friction_force_N'):.2f} N | survey of maximum "
+                 "friction forces: median 1.0 N, range 0.15-2.8 N (10 papers) | van Gerwen, Dankelman, "
+                 "van den Dobbelsteen 2012, Med. Eng. Phys. 34:665, Table 2 |")
     if wd:
         mn = min(f(r, "force_N") for r in wd)
         mf = min(f(r, "friction_force_N") for r in wd)
