@@ -174,12 +174,10 @@ TEST(CompareCommand, TableRankingCurvesAndSeriesOnASmallSlab) {
   std::ostringstream out, err;
   ASSERT_EQ(compare_command(options, out, err), 0) << err.str();
   // The synthetic entry was used, not replaced by a FEM run.
-  const validation::FemReference ref = [&] {
-    validation::FemReferenceOptions o;
-    o.cache_dir = options.cache_dir;
-    return validation::FemReference{o.cache_dir / validation::fem_reference_hash(load_scene(scene_file), o), "", false};
-  }();
-  std::ifstream summary(ref.dir / "fem_summary.json");
+  validation::FemReferenceOptions fem_options;
+  fem_options.cache_dir = options.cache_dir;
+  std::ifstream summary(fem_options.cache_dir / validation::fem_reference_hash(load_scene(scene_file), fem_options) /
+                        "fem_summary.json");
   std::stringstream summary_text;
   summary_text << summary.rdbuf();
   EXPECT_NE(summary_text.str().find("\"n_dofs\": 1234"), std::string::npos) << "the cached synthetic reference was replaced";

@@ -241,16 +241,17 @@ Parameter make_parameter(const Scene& start, std::size_t layer, ParamKind kind, 
 /// The stage parameters of layer k the options and the scene's effects call for.
 /// Why the references do not identify a parameter (reference_checks.hpp); "" when they do.
 std::string unidentified_reason(const LayerIdentifiability& id, ParamKind kind) {
+  const std::string fewer = "the reference has fewer than " + std::to_string(kMinIdentifyingSamples);
   switch (kind) {
     case ParamKind::CriticalForce: case ParamKind::CriticalEnergy:  // the puncture's depth and force set them
       return id.punctured ? "" : "the reference has no puncture of this layer";
     case ParamKind::DeformedThreshold:  // a ring deflection: read off the pressing curve
       return !id.punctured ? "the reference has no puncture of this layer"
-             : id.pressing() ? "" : "the reference has fewer than 3 pressing samples of this layer before its puncture";
+             : id.pressing() ? "" : fewer + " pressing samples of this layer before its puncture";
     case ParamKind::Cutting: case ParamKind::Friction: case ParamKind::Presliding:
-      return id.cut() ? "" : "the reference has fewer than 3 samples of the cut through this layer";
+      return id.cut() ? "" : fewer + " samples of the cut through this layer";
     case ParamKind::Damping: return "";
-    default: return id.pressing() ? "" : "the reference has fewer than 3 pressing samples of this layer";
+    default: return id.pressing() ? "" : fewer + " pressing samples of this layer";
   }
 }
 
@@ -789,18 +790,26 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
   std::vector<LayerIdentifiability> ident(geometry.size());
   for (std::size_t r = 0; r < references.size(); ++r) {
     const auto more = layer_identifiability(references[r].curve, result.reference_events[r], geometry);
-    for (std::size_t k = 0; k < ident.size(); ++k) ident[k] = {std::max(ident[k].pressing_samples, more[k].pressing_samples),
-                                                               std::max(ident[k].cut_samples, more[k].cut_samples), ident[k].punctured || more[k].punctured};
+    for (std::size_t k = 0; k < ident.size(); ++k) {  // any reference counts
+      ident[k].pressing_samples = std::max(ident[k].pressing_samples, more[k].pressing_samples);
+      ident[k].cut_samples = std::max(ident[k].cut_samples, more[k].cut_samples);
+      ident[k].punctured = ident[k].punctured || more[k].punctured;
+    }
   }
   std::size_t n_tuned = 0, n_requested = 0;
   for (std::size_t k : layers) {
-    n_tuned += layer_kinds(scene, k, options.parameters, &ident[k]).size();
-    n_requested += layer_kinds(scene, k, options.parameters).size();
-    for (ParamKind kind : layer_kinds(scene, k, options.parameters))
-      if (const std::string why = unidentified_reason(ident[k], kind); !why.empty())
-        result.warnings.push_back("layer " + scene.layers[k].name + ": " + info(kind).name + " kept at its start value (" +
-                                  std::to_string(param_value(scene, k, kind) * info(kind).to_unit) + " " +
-                                  info(kind).unit + "): " + why);
+    const std::vector<ParamKind> requested = layer_kinds(scene, k, options.parameters);
+    n_requested += requested.size();
+    for (ParamKind kind : requested) {
+      const std::string why = unidentified_reason(ident[k], kind);
+      if (why.empty()) {
+        ++n_tuned;
+        continue;
+      }
+      result.warnings.push_back("layer " + scene.layers[k].name + ": " + info(kind).name + " kept at its start value (" +
+                                std::to_string(param_value(scene, k, kind) * info(kind).to_unit) + " " +
+                                info(kind).unit + "): " + why);
+    }
   }
 
   bool rate_info = false;
@@ -825,7 +834,8 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
     result.damping_tuned = false;
     result.damping_note = "d kept fixed: the scene's damping effect is off";
   }
-  check_enough_samples(references.front().curve, result.reference_events.front(), n_tuned + (result.damping_tuned ? layers.size() : 0), n_requested);
+  check_enough_samples(references.front().curve, result.reference_events.front(),
+                       n_tuned + (result.damping_tuned ? layers.size() : 0), n_requested);
 
   const SurfaceCache cache(scene);
   int total_evaluations = 0;

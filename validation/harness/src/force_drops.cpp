@@ -58,8 +58,12 @@ SlopeFit slope_before(const InsertionCurve& c, const std::vector<std::size_t>& p
 }  // namespace
 
 std::vector<ForceDrop> detect_force_drops(const InsertionCurve& curve, const PunctureDetectionOptions& o) {
+  return detect_force_drops(curve, force_noise_sigma_N(curve, insertion_phase(curve)), o);
+}
+
+std::vector<ForceDrop> detect_force_drops(const InsertionCurve& curve, double sigma,
+                                          const PunctureDetectionOptions& o) {
   const std::vector<std::size_t> phase = insertion_phase(curve);
-  const double sigma = force_noise_sigma_N(curve, phase);
   const double band = o.noise_band_sigmas * sigma;
   double peak = 0.0;
   for (std::size_t i : phase) peak = std::max(peak, std::abs(curve.force_N[i]));

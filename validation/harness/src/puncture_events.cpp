@@ -93,7 +93,7 @@ ReferenceEvents reference_events(const InsertionCurve& reference, const std::vec
     note << "punctures from the <layer>_state columns";
   } else {
     ev.source = PunctureSource::ForceDrops;
-    ev.drops = detect_force_drops(reference, o);
+    ev.drops = detect_force_drops(reference, ev.noise_N, o);
     std::vector<ForceDrop> kept = ev.drops;
     if (kept.size() > layers.size()) {
       std::sort(kept.begin(), kept.end(), [](const ForceDrop& a, const ForceDrop& b) { return a.drop_N > b.drop_N; });

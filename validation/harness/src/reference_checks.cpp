@@ -4,15 +4,12 @@
 #include <cmath>
 #include <sstream>
 
+#include "puncture/validation/number_format.hpp"
+
 namespace puncture::validation {
 
 namespace {
-std::string mm(double m) {
-  std::ostringstream s;
-  s.precision(4);
-  s << m * 1e3 << " mm";
-  return s.str();
-}
+std::string mm(double m) { return significant_digits(m * 1e3, 4) + " mm"; }
 }  // namespace
 
 std::vector<std::string> detection_doubts(const ReferenceEvents& ev, const std::vector<LayerGeometry>& layers) {
@@ -23,11 +20,9 @@ std::vector<std::string> detection_doubts(const ReferenceEvents& ev, const std::
       ++clear;
       continue;
     }
-    std::ostringstream s;
-    s.precision(3);
-    s << "the drop at " << mm(d.depth_m) << " (" << d.drop_N << " N) is only " << d.noise_sigmas
-      << " x the noise (" << ev.noise_N << " N)";
-    doubts.push_back(s.str());
+    doubts.push_back("the drop at " + mm(d.depth_m) + " (" + significant_digits(d.drop_N, 3) + " N) is only " +
+                     significant_digits(d.noise_sigmas, 3) + " x the noise (" + significant_digits(ev.noise_N, 3) +
+                     " N)");
   }
   if (clear > layers.size())
     doubts.push_back(std::to_string(clear) + " clear force drops for " + std::to_string(layers.size()) + " layers");

@@ -100,6 +100,9 @@ struct ForceDrop {
 
 /// Every force drop of the insertion phase that passes the thresholds, in depth order.
 std::vector<ForceDrop> detect_force_drops(const InsertionCurve& curve, const PunctureDetectionOptions& options = {});
+/// The same with the insertion force's noise sigma (N) already estimated (force_noise.hpp).
+std::vector<ForceDrop> detect_force_drops(const InsertionCurve& curve, double noise_sigma_N,
+                                          const PunctureDetectionOptions& options);
 
 /// Contact onset from the force alone (see the header): depth (m) of the
 /// first insertion sample (`phase`) above the threshold that holds; false if none.
