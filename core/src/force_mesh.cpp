@@ -133,11 +133,17 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
     if (ldlt.info() != Eigen::Success)
       throw std::runtime_error("force mesh: implicit system matrix could not be factorised");
     // Copy the factors into plain arrays so that a step is allocation-free.
+    // Strictly below the (unit) diagonal, column by column in row order.
     SparseMatrix Lm = ldlt.matrixL();
     Lm.makeCompressed();
-    l_col_start_.assign(Lm.outerIndexPtr(), Lm.outerIndexPtr() + nf + 1);
-    l_row_.assign(Lm.innerIndexPtr(), Lm.innerIndexPtr() + Lm.nonZeros());
-    l_val_.assign(Lm.valuePtr(), Lm.valuePtr() + Lm.nonZeros());
+    l_col_start_.assign(1, 0);
+    l_row_.clear();
+    l_val_.clear();
+    for (int j = 0; j < nf; ++j) {
+      for (SparseMatrix::InnerIterator it(Lm, j); it; ++it)
+        if (it.row() > j) l_row_.push_back(static_cast<int>(it.row())), l_val_.push_back(it.value());
+      l_col_start_.push_back(static_cast<int>(l_row_.size()));
+    }
     d_inv_ = ldlt.vectorD().cwiseInverse();
     perm_.resize(nf);
     for (int k = 0; k < nf; ++k) perm_[k] = ldlt.permutationP().indices()[k];
@@ -191,6 +197,15 @@ void ForceMesh::layout(const ContactSurface& surface, const SurfacePoint& contac
   for (int i = 1; i < lattice_.node_count(); ++i) project_node(i);
   next_projection_ = lattice_.node_count();
   positions_ = rest_;
+  positions_stale_ = false;
+}
+
+const Eigen::Matrix3Xd& ForceMesh::positions() const {
+  if (positions_stale_) {
+    for (int i = 0; i < lattice_.node_count(); ++i) positions_.col(i) = rest_.col(i) - z_[i] * normals_.col(i);
+    positions_stale_ = false;
+  }
+  return positions_;
 }
 
 void ForceMesh::relayout(const ContactSurface& surface, const SurfacePoint& contact) {
@@ -250,14 +265,12 @@ void ForceMesh::implicit_solve() {
   for (int k = 0; k < nf; ++k) work_[perm_[k]] = rhs_[k];
   for (int j = 0; j < nf; ++j) {
     const double yj = work_[j];
-    for (int p = l_col_start_[j]; p < l_col_start_[j + 1]; ++p)
-      if (l_row_[p] > j) work_[l_row_[p]] -= l_val_[p] * yj;
+    for (int p = l_col_start_[j]; p < l_col_start_[j + 1]; ++p) work_[l_row_[p]] -= l_val_[p] * yj;
   }
   for (int j = 0; j < nf; ++j) work_[j] *= d_inv_[j];
   for (int j = nf - 1; j >= 0; --j) {
     double s = work_[j];
-    for (int p = l_col_start_[j]; p < l_col_start_[j + 1]; ++p)
-      if (l_row_[p] > j) s -= l_val_[p] * work_[l_row_[p]];
+    for (int p = l_col_start_[j]; p < l_col_start_[j + 1]; ++p) s -= l_val_[p] * work_[l_row_[p]];
     work_[j] = s;
   }
 }
@@ -334,10 +347,8 @@ void ForceMesh::advance(double contact_deflection_m) {
 void ForceMesh::update_derived() {
   const int n = lattice_.node_count();
   ring_mean_m_.setZero();
-  for (int i = 0; i < n; ++i) {
-    ring_mean_m_[lattice_.ring[i] - 1] += z_[i];
-    positions_.col(i) = rest_.col(i) - z_[i] * normals_.col(i);
-  }
+  for (int i = 0; i < n; ++i) ring_mean_m_[lattice_.ring[i] - 1] += z_[i];
+  positions_stale_ = true;
   ring_mean_m_.array() /= ring_size_.array();
   max_abs_deflection_m_ = z_.cwiseAbs().maxCoeff();
   max_abs_velocity_m_per_s_ = v_.cwiseAbs().maxCoeff();

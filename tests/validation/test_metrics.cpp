@@ -6,7 +6,10 @@
 #include <filesystem>
 #include <fstream>
 
+#include "puncture/model/realtime_model.hpp"
+#include "puncture/scene_io.hpp"
 #include "puncture/validation/metrics.hpp"
+#include "puncture/validation/puncture_events.hpp"
 
 namespace pv = puncture::validation;
 using puncture::LayerState;
@@ -305,5 +308,31 @@ TEST(Metrics, SurfaceProfilesCsv) {
   } catch (const pv::CurveFormatError& e) {
     EXPECT_NE(std::string(e.what()).find("p.csv:3"), std::string::npos) << e.what();
     EXPECT_EQ(e.column(), "r_mm");
+  }
+}
+
+TEST(Metrics, CurveRecordedTickByTickEqualsTheCurveOfTheStoredRun) {
+  // simulate_curve (calibration's model runs) must give exactly what
+  // curve_from_run of a stored scripted run gives, with and without damping.
+  const puncture::Scene scene = puncture::load_scene(std::filesystem::path(PUNCTURE_SOURCE_DIR) / "scenes/default_force_law.json");
+  puncture::Scene short_run = scene;
+  short_run.insertion.target_depth_m = 12e-3;  // through skin and fat, into muscle
+  short_run.insertion.dwell_s = 0.1;
+  for (bool damping : {true, false}) {
+    puncture::RealtimeModel a = puncture::build_realtime_model(short_run);
+    puncture::RealtimeModel b = puncture::build_realtime_model(short_run);
+    const pv::InsertionCurve stored = pv::curve_from_run(short_run, puncture::run_scripted_insertion(a, short_run), "x", damping);
+    const pv::InsertionCurve streamed = pv::simulate_curve(b, short_run, "x", damping);
+    ASSERT_EQ(stored.size(), streamed.size());
+    EXPECT_EQ(stored.time_s, streamed.time_s);
+    EXPECT_EQ(stored.depth_m, streamed.depth_m);
+    EXPECT_EQ(stored.force_N, streamed.force_N);
+    EXPECT_EQ(stored.tip_force_N, streamed.tip_force_N);
+    EXPECT_EQ(stored.cutting_force_N, streamed.cutting_force_N);
+    EXPECT_EQ(stored.friction_force_N, streamed.friction_force_N);
+    EXPECT_EQ(stored.layer_states, streamed.layer_states);
+    EXPECT_EQ(stored.phase, streamed.phase);
+    EXPECT_EQ(stored.metadata, streamed.metadata);
+    EXPECT_TRUE(pv::puncture_event(streamed, "skin").found);
   }
 }

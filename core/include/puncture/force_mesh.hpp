@@ -167,7 +167,8 @@ class ForceMesh {
   // --- geometry (3 x N, m) ---
   const Eigen::Matrix3Xd& rest_positions() const { return rest_; }
   const Eigen::Matrix3Xd& normals() const { return normals_; }
-  const Eigen::Matrix3Xd& positions() const { return positions_; }
+  /// rest - z normals, computed when asked after a step (the haptic tick does not need it).
+  const Eigen::Matrix3Xd& positions() const;
   const HexLattice& lattice() const { return lattice_; }
   const std::vector<int>& node_rings() const { return lattice_.ring; }
 
@@ -212,7 +213,9 @@ class ForceMesh {
   bool explicit_fallback_ = false;
   bool use_implicit_ = false;
 
-  Eigen::Matrix3Xd rest_, normals_, positions_;
+  Eigen::Matrix3Xd rest_, normals_;
+  mutable Eigen::Matrix3Xd positions_;
+  mutable bool positions_stale_ = false;  ///< z_ changed since positions_ was computed
   // Layout frame: contact point, normal and in-plane axes; nodes >= next_projection_ are
   // still in the tangent plane (relayout) and wait for their projection onto *layout_surface_.
   const ContactSurface* layout_surface_ = nullptr;

@@ -73,13 +73,18 @@ TickCost tick_cost(const ScriptedRunResult& run) {
   return c;
 }
 
+long scripted_tick_count(const Scene& scene) {
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  const double duration = ScriptedTrajectory(scene.insertion).duration();
+  return static_cast<long>(std::ceil(duration / dt - 1e-9)) + 1;
+}
+
 ScriptedRunResult run_scripted_insertion(RealtimeModel& model, const Scene& scene, const FrameCallback& on_frame,
                                          const ProgressCallback& on_progress) {
   if (!model.simulator) throw std::invalid_argument("run_scripted_insertion: model has no simulator");
   ScriptedNeedleDevice device(scene.insertion);
   const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
-  const double duration = device.trajectory().duration();
-  const long n_ticks = static_cast<long>(std::ceil(duration / dt - 1e-9)) + 1;
+  const long n_ticks = scripted_tick_count(scene);
   const double frame_interval_s = 1.0 / scene.realtime.frame_rate_Hz;
 
   ScriptedRunResult run;

@@ -205,41 +205,58 @@ InsertionCurve read_insertion_curve(const std::filesystem::path& path) {
   return c;
 }
 
-InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, const std::string& source,
-                              bool include_damping) {
+namespace {
+
+InsertionCurve empty_run_curve(const Scene& scene, const std::string& source, bool include_damping, std::size_t n) {
   InsertionCurve c;
   c.source = source;
   if (!include_damping) c.metadata["force"] = "without damping (total minus d h v of every layer)";
   for (const Layer& l : scene.layers) c.layer_names.push_back(l.name);
   c.layer_states.resize(scene.layers.size());
-  const std::size_t n = run.ticks.size();
   c.time_s.reserve(n), c.depth_m.reserve(n), c.velocity_m_per_s.reserve(n), c.force_N.reserve(n);
+  c.tip_force_N.reserve(n), c.cutting_force_N.reserve(n), c.friction_force_N.reserve(n), c.phase.reserve(n);
   for (auto& s : c.layer_states) s.reserve(n);
-  for (const TickResult& t : run.ticks) {
-    c.time_s.push_back(t.time_s);
-    c.depth_m.push_back(t.depth_m);
-    c.velocity_m_per_s.push_back(t.velocity_m_per_s);
-    double force = t.total_force_N;
-    if (!include_damping)
-      for (const auto& layer : t.layers) force -= layer.damping_force_N;
-    c.force_N.push_back(force);
-    for (std::size_t k = 0; k < c.layer_states.size() && k < t.layers.size(); ++k)
-      c.layer_states[k].push_back(t.layers[k].state);
-    double damping = 0.0;
-    if (!include_damping)
-      for (const auto& layer : t.layers) damping += layer.damping_force_N;
-    c.tip_force_N.push_back(t.tip_force_N);
-    c.cutting_force_N.push_back(t.cutting_force_N);
-    c.friction_force_N.push_back(t.friction_force_N - damping);
-  }
-  // Phases from the scripted trajectory of the run.
-  const ScriptedTrajectory trajectory(scene.insertion);
-  c.phase.reserve(n);
-  for (const TickResult& t : run.ticks)
-    c.phase.push_back(t.time_s < trajectory.insertion_end_s()      ? CurvePhase::Insertion
-                      : t.time_s < trajectory.withdrawal_start_s() ? CurvePhase::Dwell
-                                                                   : CurvePhase::Withdrawal);
   c.phase_from_column = true;
+  return c;
+}
+
+/// Appends one tick; its phase from the scripted trajectory of the run.
+void append_tick(InsertionCurve& c, const TickResult& t, const ScriptedTrajectory& trajectory, bool include_damping) {
+  double force = t.total_force_N, damping = 0.0;
+  if (!include_damping)
+    for (const auto& layer : t.layers) force -= layer.damping_force_N, damping += layer.damping_force_N;
+  c.time_s.push_back(t.time_s);
+  c.depth_m.push_back(t.depth_m);
+  c.velocity_m_per_s.push_back(t.velocity_m_per_s);
+  c.force_N.push_back(force);
+  for (std::size_t k = 0; k < c.layer_states.size() && k < t.layers.size(); ++k) c.layer_states[k].push_back(t.layers[k].state);
+  c.tip_force_N.push_back(t.tip_force_N);
+  c.cutting_force_N.push_back(t.cutting_force_N);
+  c.friction_force_N.push_back(t.friction_force_N - damping);
+  c.phase.push_back(t.time_s < trajectory.insertion_end_s()      ? CurvePhase::Insertion
+                    : t.time_s < trajectory.withdrawal_start_s() ? CurvePhase::Dwell
+                                                                 : CurvePhase::Withdrawal);
+}
+
+}  // namespace
+
+InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, const std::string& source,
+                              bool include_damping) {
+  InsertionCurve c = empty_run_curve(scene, source, include_damping, run.ticks.size());
+  const ScriptedTrajectory trajectory(scene.insertion);
+  for (const TickResult& t : run.ticks) append_tick(c, t, trajectory, include_damping);
+  return c;
+}
+
+InsertionCurve simulate_curve(RealtimeModel& model, const Scene& scene, const std::string& source,
+                              bool include_damping) {
+  if (!model.simulator) throw std::invalid_argument("simulate_curve: model has no simulator");
+  ScriptedNeedleDevice device(scene.insertion);
+  const long n_ticks = scripted_tick_count(scene);
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  InsertionCurve c = empty_run_curve(scene, source, include_damping, static_cast<std::size_t>(n_ticks));
+  for (long i = 0; i < n_ticks; ++i)
+    append_tick(c, model.simulator->tick(device.read(static_cast<double>(i) * dt)), device.trajectory(), include_damping);
   return c;
 }
 

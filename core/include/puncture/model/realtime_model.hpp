@@ -83,6 +83,9 @@ TickCost tick_cost(const ScriptedRunResult& run);
 using FrameCallback = std::function<void(const PunctureSimulator&, const TickResult&, int frame_index)>;
 using ProgressCallback = std::function<void(double fraction_done)>;
 
+/// Ticks of the scene's scripted run: t = 0, dt, ... up to the end of the trajectory.
+long scripted_tick_count(const Scene& scene);
+
 ScriptedRunResult run_scripted_insertion(RealtimeModel& model, const Scene& scene,
                                          const FrameCallback& on_frame = {},
                                          const ProgressCallback& on_progress = {});

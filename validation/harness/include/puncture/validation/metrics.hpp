@@ -109,6 +109,10 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
 /// with); the curve's metadata then says "force: without damping".
 InsertionCurve curve_from_run(const Scene& scene, const ScriptedRunResult& run, const std::string& source = "realtime",
                               bool include_damping = true);
+/// The same curve as curve_from_run(scene, run_scripted_insertion(model, scene), ...),
+/// recorded tick by tick: no tick results kept, no tick timed (what calibration runs need).
+InsertionCurve simulate_curve(RealtimeModel& model, const Scene& scene, const std::string& source = "realtime",
+                              bool include_damping = true);
 /// CSV text in the reader's schema (depth and velocity in mm, states): the
 /// provenance lines (when given), the curve's metadata, then the table.
 std::string insertion_curve_csv(const InsertionCurve& curve, const io::Provenance* provenance = nullptr);
