@@ -73,8 +73,16 @@ int main(int argc, char** argv) {
                             "validation/README.md); default: the scene's FEM reference (cached)");
   calibrate_cmd->add_option("-o,--output", output, "Output directory; default: out/<scene name>_calibration");
   calibrate_cmd->add_option("--cache", cache, "FEM cache directory; default: out/.fem_cache");
-  calibrate_cmd->add_option("--method", calibrate.method, "nelder_mead (default), bobyqa or simulated_annealing")
-      ->check(CLI::IsMember({"nelder_mead", "bobyqa", "simulated_annealing"}));
+  calibrate_cmd->add_option("--method", calibrate.method,
+                            "levenberg_marquardt (default), nelder_mead, bobyqa or simulated_annealing")
+      ->check(CLI::IsMember({"levenberg_marquardt", "nelder_mead", "bobyqa", "simulated_annealing"}));
+  calibrate_cmd->add_option("--threads", calibrate.threads, "Model runs at once; default 0: every core")
+      ->check(CLI::Range(0, 256));
+  calibrate_cmd->add_option("--stage-turn-margin", calibrate.stage_turn_margin_mm,
+                            "Per-layer stages run the model this far (mm) past their compared depth range and "
+                            "turn; 0: every run the whole trajectory; default " +
+                                default_text(puncture::validation::CalibrationOptions{}.stage_turn_margin_m * 1e3))
+      ->check(CLI::Range(0.0, 1e3));
   calibrate_cmd->add_option("--name", calibrate.preset_name, "Preset name; default: <scene name>_tuned");
   calibrate_cmd->add_option("--layers", calibrate.layers, "Layers to calibrate; default: all");
   calibrate_cmd->add_option("--also-tune", calibrate.also_tune,

@@ -32,6 +32,8 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
   c << " -o " << dir.string() << " --name " << name << " --method " << options.method;
   for (std::size_t i = 0; i < options.also_tune.size(); ++i) c << (i ? "," : " --also-tune ") << options.also_tune[i];
   for (const std::string& layer : options.layers) c << " --layers " << layer;
+  if (options.threads > 0) c << " --threads " << options.threads;
+  c << " --stage-turn-margin " << options.stage_turn_margin_mm;
   c << " --bound-factor " << options.bound_factor << " --depth-weight " << options.depth_weight
     << " --force-weight " << options.force_weight << " --integrator "
     << integrator;
@@ -70,6 +72,8 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
     validation::CalibrationOptions calibration;
     calibration.method = validation::parse_calibration_method(options.method);
     calibration.layers = options.layers;
+    calibration.threads = options.threads;
+    calibration.stage_turn_margin_m = options.stage_turn_margin_mm * 1e-3;
     if (!(options.bound_factor > 1.0) || !std::isfinite(options.bound_factor))
       throw UsageError("--bound-factor must be a finite number > 1");
     calibration.bound_factor = options.bound_factor;
@@ -133,14 +137,18 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
     std::ostringstream md;
     md << "# Calibration of " << scene.name << "\n\nMade by `" << command << "` on " << provenance.machine << ", " << provenance.date_utc << " (program " << provenance.program_version
        << ", git " << provenance.git_revision << ").\n\nReference: " << reference.kind << " ("
-       << reference.curve.source << "). Method: " << options.method << ", " << result.evaluations
+       << reference.curve.source << "). Method: " << options.method << " on "
+       << (options.threads > 0 ? std::to_string(options.threads) : std::string("every")) << " thread(s), "
+       << result.evaluations
        << " model runs in " << std::setprecision(4) << calibration_s
        << " s (wall, reference already available). Objective " << result.objective_before << " -> "
        << result.objective_after << ".\n\n"
        << "## Objective, term by term\n\n" << validation::calibration_terms_table(result) << "\n## Punctures\n\n"
        << validation::calibration_punctures_table(result, scene) << "\n## Tuned parameters\n\n"
-       << validation::calibration_parameters_table(result) << "\nTuned preset: `" << name
-       << ".json` (a scene `puncture run` accepts), provenance: `" << name << ".provenance.json`.\n";
+       << validation::calibration_parameters_table(result) << "\n## Identifiability\n\n"
+       << validation::calibration_identifiability_table(result) << "\nTuned preset: `" << name
+       << ".json` (a scene `puncture run` accepts), provenance: `" << name << ".provenance.json`, identifiability: `"
+       << name << ".identifiability.md`.\n";
     if (!result.damping_note.empty()) md << "\nDamping d: " << result.damping_note << "\n";
     if (!result.warnings.empty()) {
       md << "\n## Warnings\n\n";

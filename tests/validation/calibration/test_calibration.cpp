@@ -132,7 +132,9 @@ TEST(Calibration, RecoversPerturbedSkinStiffnessAndThreshold) {
   EXPECT_EQ(prov.at("references").at(0).at("kind"), "synthetic");
   EXPECT_TRUE(prov.at("references").at(0).contains("metrics_before"));
   EXPECT_TRUE(prov.at("references").at(0).contains("metrics_after"));
-  EXPECT_EQ(prov.at("optimiser").at("method"), "nelder_mead");
+  EXPECT_EQ(prov.at("optimiser").at("method"), "levenberg_marquardt");
+  EXPECT_TRUE(prov.contains("identifiability"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "skin_tuned.identifiability.md"));
   EXPECT_FALSE(prov.at("damping").at("tuned").get<bool>());
   EXPECT_TRUE(prov.contains("date_utc"));
   EXPECT_TRUE(prov.contains("project_version"));
@@ -303,4 +305,47 @@ TEST(Calibration, ModelRunsKeepTheDampingForceForEveryReference) {
   }
   EXPECT_GT(max_difference, 0.0);  // the truth scene does have damping after a breakthrough
   EXPECT_EQ(without.metadata.count("force"), 1u);
+}
+
+TEST(Calibration, IdentifiabilityReportNamesWhatTheReferenceCannotDetermine) {
+  // Known answers: with the quasi-static force mesh the ring spacing L does
+  // not enter the force at all (each node follows influence_i z0, and the
+  // force is S(K, k_s, w) z0: calibration.hpp), so a force curve cannot
+  // identify it; d cannot be identified from a reference without rate
+  // information. K and the ring threshold set the pressing slope and the
+  // puncture and are identified.
+  const Scene truth = truth_scene();
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  Scene start = truth;
+  start.layers[0].force_mesh.virtual_stiffness_N_per_m *= 1.3;
+  start.layers[0].force_mesh.spacing_L_m *= 1.2;
+  pv::CalibrationOptions options;
+  options.layers = {"skin"};
+  options.parameters.spacing = true;
+  const pv::CalibrationResult r = pv::calibrate(start, std::vector<pv::ReferenceCurve>{{ref, "fem"}}, options);
+  auto find = [&](const std::string& layer, const std::string& name) -> const pv::ParameterIdentifiability* {
+    for (const pv::ParameterIdentifiability& p : r.identifiability.parameters)
+      if (p.layer == layer && p.name == name) return &p;
+    return nullptr;
+  };
+  const pv::ParameterIdentifiability* K = find("skin", "K");
+  const pv::ParameterIdentifiability* L = find("skin", "L");
+  const pv::ParameterIdentifiability* threshold = find("skin", "deformed_threshold");
+  const pv::ParameterIdentifiability* d = find("skin", "d");
+  ASSERT_TRUE(K && L && threshold && d);
+  EXPECT_EQ(K->status, "identified");
+  EXPECT_EQ(threshold->status, "identified");
+  EXPECT_GT(K->sensitivity, 0.0);
+  EXPECT_LT(K->standard_error, 0.1 * K->value);  // a few % at most
+  EXPECT_EQ(L->status, "not identifiable");
+  EXPECT_EQ(L->sensitivity, 0.0);
+  EXPECT_NE(L->reason.find("does not change"), std::string::npos);
+  EXPECT_EQ(d->status, "not identifiable");
+  EXPECT_NE(d->reason.find("rate information"), std::string::npos);
+  // The unidentifiable L keeps its start value; K is recovered.
+  EXPECT_EQ(r.tuned_scene.layers[0].force_mesh.spacing_L_m, start.layers[0].force_mesh.spacing_L_m);
+  EXPECT_NEAR(r.tuned_scene.layers[0].force_mesh.virtual_stiffness_N_per_m /
+                  truth.layers[0].force_mesh.virtual_stiffness_N_per_m,
+              1.0, 0.03);
+  EXPECT_EQ(r.identifiability.correlation.rows(), 3);  // K, threshold, L
 }

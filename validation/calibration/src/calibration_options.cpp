@@ -9,15 +9,17 @@
 namespace puncture::validation {
 
 CalibrationMethod parse_calibration_method(const std::string& name) {
+  if (name == "levenberg_marquardt") return CalibrationMethod::LevenbergMarquardt;
   if (name == "bobyqa") return CalibrationMethod::Bobyqa;
   if (name == "nelder_mead") return CalibrationMethod::NelderMead;
   if (name == "simulated_annealing") return CalibrationMethod::SimulatedAnnealing;
   throw std::invalid_argument("unknown calibration method '" + name +
-                              "' (expected bobyqa, nelder_mead or simulated_annealing)");
+                              "' (expected levenberg_marquardt, bobyqa, nelder_mead or simulated_annealing)");
 }
 
 const char* to_string(CalibrationMethod method) {
   switch (method) {
+    case CalibrationMethod::LevenbergMarquardt: return "levenberg_marquardt";
     case CalibrationMethod::Bobyqa: return "bobyqa";
     case CalibrationMethod::NelderMead: return "nelder_mead";
     case CalibrationMethod::SimulatedAnnealing: return "simulated_annealing";

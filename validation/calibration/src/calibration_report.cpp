@@ -1,6 +1,7 @@
 // calibration_report.cpp: see calibration_report.hpp.
 #include "puncture/validation/calibration_report.hpp"
 
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -64,6 +65,53 @@ std::string calibration_punctures_table(const CalibrationResult& r, const Scene&
       << (p.found ? num(p.force_N) : "n/a") << " | " << (m_found ? num(model[k].depth_m * 1e3) : "n/a") << " | "
       << (m_found ? num(model[k].force_N) : "n/a") << " |\n";
   }
+  return s.str();
+}
+
+std::string calibration_identifiability_table(const CalibrationResult& r) {
+  const IdentifiabilityReport& rep = r.identifiability;
+  std::ostringstream s;
+  s << "| layer | parameter | value | sensitivity | standard error | status | reason |\n|---|---|---|---|---|---|---|\n";
+  for (const ParameterIdentifiability& p : rep.parameters) {
+    const bool tuned = p.status != "not identifiable" || p.reason.find("kept at its start value") == std::string::npos;
+    s << "| " << p.layer << " | " << p.name << " (" << p.unit << ") | " << num(p.value) << " | "
+      << (tuned ? num(p.sensitivity, 3) : "-") << " | "
+      << (std::isfinite(p.standard_error) ? num(p.standard_error, 2) : (tuned ? "not determined" : "-")) << " | "
+      << (p.status == "identified" ? p.status : "**" + p.status + "**") << " | " << p.reason << " |\n";
+  }
+  if (!rep.note.empty()) s << "\n" << rep.note << "; residual variance " << num(rep.residual_variance, 3) << ".\n";
+  s << "\nCorrelated pairs (|r| > 0.95): ";
+  if (rep.correlated_names.empty()) s << "none.\n";
+  for (std::size_t i = 0; i < rep.correlated_names.size(); ++i)
+    s << (i ? "; " : "") << rep.correlated_names[i].first << " and " << rep.correlated_names[i].second << " ("
+      << num(rep.correlated_values[i], 3) << ")" << (i + 1 == rep.correlated_names.size() ? ".\n" : "");
+  if (rep.correlation.rows() > 0) {
+    s << "\nCorrelation matrix (tuned parameters in the order above):\n\n";
+    for (Eigen::Index i = 0; i < rep.correlation.rows(); ++i) {
+      s << "    ";
+      for (Eigen::Index k = 0; k < rep.correlation.cols(); ++k) {
+        const double c = rep.correlation(i, k);
+        std::ostringstream cell;
+        cell << std::fixed << std::setprecision(2) << c;
+        s << std::setw(6) << (std::isfinite(c) ? cell.str() : "n/a");
+      }
+      s << "\n";
+    }
+  }
+  return s.str();
+}
+
+std::string calibration_identifiability_report(const CalibrationResult& r, const std::string& name) {
+  std::ostringstream s;
+  s << "# Identifiability of " << name << "\n\n"
+    << "What the reference determines of each parameter of `" << name << ".json`: the Jacobian of the calibration's "
+    << "residuals at the tuned values gives each parameter's sensitivity (|d r / d x|, x = ln p for scale "
+    << "parameters, so per relative change) and approximate standard error (Gauss-Newton covariance "
+    << "sigma^2 (J^T J)^-1, in the parameter's unit); a parameter is identified when it is inside its bounds, "
+    << "the objective changes with it, and its standard error is below its value (scale). Parameters the "
+    << "reference cannot identify before any fit (no puncture of the layer, too few samples, d without rate "
+    << "information) keep their start values.\n\n"
+    << calibration_identifiability_table(r);
   return s.str();
 }
 

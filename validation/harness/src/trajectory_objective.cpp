@@ -56,11 +56,24 @@ ObjectiveTerm make_term(const std::string& name, const std::string& layer) {
   return t;
 }
 
+/// RMSE over reference samples; keeps each sample's error (NaN where the
+/// model curve does not reach it) for the term's residuals.
 struct Rmse {
   double sum_sq = 0.0;
   std::size_t n = 0;
-  void add(double e) { sum_sq += e * e, ++n; }
+  std::vector<double> errors;
+  void add(double e) { sum_sq += e * e, ++n, errors.push_back(e); }
+  void miss() { errors.push_back(std::numeric_limits<double>::quiet_NaN()); }
   double value() const { return n ? std::sqrt(sum_sq / static_cast<double>(n)) : 0.0; }
+  /// sqrt(weight / n) x error / P per sample, 0 where missed.
+  std::vector<double> residuals(double weight, double P) const {
+    std::vector<double> r(errors.size(), 0.0);
+    if (n == 0) return r;
+    const double s = std::sqrt(weight / static_cast<double>(n)) / P;
+    for (std::size_t i = 0; i < errors.size(); ++i)
+      if (std::isfinite(errors[i])) r[i] = s * errors[i];
+    return r;
+  }
 };
 
 }  // namespace
@@ -69,6 +82,12 @@ const ObjectiveTerm* TrajectoryComparison::term(const std::string& name, const s
   for (const ObjectiveTerm& t : terms)
     if (t.name == name && t.layer == layer) return &t;
   return nullptr;
+}
+
+std::vector<double> TrajectoryComparison::residuals() const {
+  std::vector<double> r;
+  for (const ObjectiveTerm& t : terms) r.insert(r.end(), t.residuals.begin(), t.residuals.end());
+  return r;
 }
 
 TrajectoryComparison compare_trajectory(const InsertionCurve& model, const InsertionCurve& reference,
@@ -82,11 +101,16 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
   const double P = out.reference_peak_force_N > 0.0 ? out.reference_peak_force_N : 1.0;
   const Branch model_in = branch(model, mod_in, model.force_N, false);
 
-  auto add_term = [&](ObjectiveTerm t) {
+  // A single-value term has one residual, an RMSE term (force_term) one per
+  // reference sample it covers.
+  auto add_term = [&](ObjectiveTerm t, bool single_value = true) {
     if (t.available && !std::isfinite(t.value)) t.available = false, t.note = "not finite";
+    if (single_value) t.residuals = {t.available ? std::sqrt(t.weight) * t.value : 0.0};
+    if (!t.available) std::fill(t.residuals.begin(), t.residuals.end(), 0.0);
     out.objective += t.contribution();
     out.terms.push_back(std::move(t));
   };
+  auto add_rmse_term = [&](ObjectiveTerm t) { add_term(std::move(t), false); };
   // RMSE of model - reference over the reference insertion samples with depth in [from, to).
   auto insertion_rmse = [&](double from, double to, bool inclusive_end, const std::vector<double>& ref_values,
                             const Branch& model_branch) {
@@ -95,8 +119,8 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
       const double d = reference.depth_m[i];
       if (d < from || d > sel.max_depth_m || (inclusive_end ? d > to : d >= to)) continue;
       double f = 0.0;
-      if (!interpolate_linear(model_branch.x, model_branch.y, d, f)) continue;
-      r.add(f - ref_values[i]);
+      if (interpolate_linear(model_branch.x, model_branch.y, d, f)) r.add(f - ref_values[i]);
+      else r.miss();
     }
     return r;
   };
@@ -109,13 +133,14 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
     t.raw = r.value();
     t.value = t.raw / P;
     t.note = r.n > 0 ? where : "no reference samples " + where;
+    t.residuals = r.residuals(weight, P);
     return t;
   };
 
   // --- whole insertion ---
   if (sel.whole_curve_terms) {
     const double inf = std::numeric_limits<double>::infinity();
-    add_term(force_term("overall", "", w.overall_rmse, insertion_rmse(-inf, inf, true, reference.force_N, model_in),
+    add_rmse_term(force_term("overall", "", w.overall_rmse, insertion_rmse(-inf, inf, true, reference.force_N, model_in),
                         "over the insertion"));
     const char* part_names[] = {"tip_force", "cutting_force", "friction_force"};
     const std::vector<double>* ref_parts[] = {&reference.tip_force_N, &reference.cutting_force_N, &reference.friction_force_N};
@@ -128,7 +153,7 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
         add_term(t);
         continue;
       }
-      add_term(force_term(part_names[p], "", w.parts,
+      add_rmse_term(force_term(part_names[p], "", w.parts,
                           insertion_rmse(-inf, inf, true, *ref_parts[p], branch(model, mod_in, *mod_parts[p], false)),
                           "over the insertion"));
     }
@@ -161,7 +186,7 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
     const std::string& name = layers[k].name;
     const LayerSegments& s = seg[k];
     if (s.has_pressing) {
-      add_term(force_term("pressing", name, w.pressing,
+      add_rmse_term(force_term("pressing", name, w.pressing,
                           insertion_rmse(s.pressing_from_m, s.pressing_to_m, !ev.punctures[k].found, reference.force_N, model_in),
                           "over " + mm(s.pressing_from_m) + " - " + mm(s.pressing_to_m)));
     } else {
@@ -209,7 +234,7 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
     add_term(depth);
     add_term(missing);
     if (s.has_after) {
-      add_term(force_term("after_puncture", name, w.after_puncture,
+      add_rmse_term(force_term("after_puncture", name, w.after_puncture,
                           insertion_rmse(s.after_from_m, s.after_to_m, false, reference.force_N, model_in),
                           "over " + mm(s.after_from_m) + " - " + mm(s.after_to_m)));
     } else {
@@ -240,8 +265,9 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
         if (d > sel.withdrawal_max_depth_m) continue;
         double f = 0.0;
         if (interpolate_linear(mb.x, mb.y, d, f)) r.add(f - reference.force_N[i]);
+        else r.miss();
       }
-      add_term(force_term("withdrawal", "", w.withdrawal, r, "over the withdrawal"));
+      add_rmse_term(force_term("withdrawal", "", w.withdrawal, r, "over the withdrawal"));
     }
   }
 
@@ -273,8 +299,9 @@ TrajectoryComparison compare_trajectory(const InsertionCurve& model, const Inser
         double f = 0.0;
         if (mt.size() == 1 && tr == 0.0) f = mf.front(), r.add(f - reference.force_N[i]);
         else if (interpolate_linear(mt, mf, tr, f)) r.add(f - reference.force_N[i]);
+        else r.miss();
       }
-      add_term(force_term("dwell", "", w.dwell, r, "over the dwell"));
+      add_rmse_term(force_term("dwell", "", w.dwell, r, "over the dwell"));
     }
   }
 

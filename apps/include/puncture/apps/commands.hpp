@@ -65,9 +65,12 @@ struct CalibrateOptions {
   std::filesystem::path reference;    ///< measured curve CSV; empty: FEM reference of the scene (cached)
   std::filesystem::path output_dir;   ///< empty: out/<scene name>_calibration
   std::filesystem::path cache_dir;    ///< empty: out/.fem_cache
-  std::string method = "nelder_mead"; ///< nelder_mead, bobyqa, simulated_annealing
+  std::string method = "levenberg_marquardt"; ///< levenberg_marquardt, nelder_mead, bobyqa, simulated_annealing
   std::string preset_name;            ///< empty: <scene name>_tuned
   std::vector<std::string> layers;    ///< empty: all
+  int threads = 0;                    ///< model runs at once; 0: every core
+  /// Per-layer stages turn this far past their compared depth range (mm); 0: whole runs.
+  double stage_turn_margin_mm = validation::CalibrationOptions{}.stage_turn_margin_m * 1e3;
   /// Each tuned parameter stays within [start / f, start x f]; the library's default (1000).
   double bound_factor = validation::kDefaultCalibrationBoundFactor;
   /// Parameters tuned besides K and the deformation threshold:

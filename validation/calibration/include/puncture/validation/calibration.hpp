@@ -5,8 +5,9 @@
 //      or more reference InsertionCurves (FEM, measured, or synthetic) and
 //      CalibrationOptions.
 // Out: CalibrationResult: the tuned Scene, parameters and metrics before and
-//      after, the optimiser's record; write_tuned_preset() writes it as a
-//      scene file plus a provenance file.
+//      after, the optimiser's record and the identifiability report;
+//      write_tuned_preset() writes it as a scene file, a provenance file and
+//      an identifiability page.
 //
 // What is tuned (per layer, switchable in CalibrationOptions::parameters):
 //   K (virtual stiffness) and the layer's breakthrough parameter (the ring
@@ -45,14 +46,29 @@
 //   (trajectory_objective.hpp: its pressing, its puncture force and depth,
 //   its cut (cutting and friction) and the overall and part terms) over the
 //   reference insertion down to the end of the cut through layer k, plus the
-//   withdrawal above that depth. The model itself runs the whole insertion,
-//   so that its breakthrough of layer k is found even when a start value
-//   moves it far beyond the reference's. When d is tuned, a stage tunes the
+//   withdrawal above that depth. The model runs down to that end plus
+//   stage_turn_margin_m (2 mm) and turns there (the skin's stage runs a
+//   third of the insertion); a run that has not broken through a layer the
+//   reference breaks within the compared depths is repeated over the whole
+//   trajectory, so a breakthrough far beyond the reference's still gives a
+//   depth error, not a missing puncture.
+//   When d is tuned, a stage tunes the
 //   d of all calibrated layers together; a final joint stage (joint_polish)
 //   refines every tuned parameter of every calibrated layer on the whole
 //   objective (every term, dwell included).
 // Objective of a stage, summed over the references: sum of weight x value^2
-//   of the selected terms (the header of trajectory_objective.hpp).
+//   of the selected terms (the header of trajectory_objective.hpp), which is
+//   the sum of squares of their residuals (one per compared reference sample
+//   and per puncture term): Levenberg-Marquardt (the default) minimises it
+//   as least squares (levenberg_marquardt.hpp), the NLopt and GSL methods as
+//   a scalar.
+// Identifiability report: at the tuned values, the forward-difference
+//   Jacobian of the whole objective's residuals over every tuned parameter
+//   gives sensitivities, standard errors and correlations
+//   (identifiability.hpp); each parameter is identified, at a bound or not
+//   identifiable (with the reason), and the parameters withheld before the
+//   fit are listed with theirs. A tuned parameter the objective does not
+//   change with goes back to its start value (keep_unidentifiable_at_start).
 // Model runs: a copy of the scene with realtime.integrator =
 //   options.integrator, no frames, the reference's trajectory (its insertion
 //   speed: metadata "speed_mm_per_s", else the scene's; its deepest depth;
@@ -62,7 +78,8 @@
 //   haptic rate raised so that one tick moves the needle at most
 //   objective_depth_step_m (sharper breakthrough depths). The SH layer
 //   surfaces depend only on geometry and degree: they are fitted once per
-//   calibrate() call (SurfaceCache).
+//   calibrate() call (SurfaceCache). Runs are independent: the Jacobian's
+//   columns and the trial points go to `threads` threads at once.
 // A candidate whose run throws (e.g. a non-finite force) gets the objective
 //   kFailedObjective; it is counted, never returned as a result.
 #pragma once
@@ -75,6 +92,7 @@
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/scene.hpp"
 #include "puncture/sh/layer_surface.hpp"
+#include "puncture/validation/identifiability.hpp"
 #include "puncture/validation/metrics.hpp"
 #include "puncture/validation/puncture_events.hpp"
 #include "puncture/validation/trajectory_objective.hpp"
@@ -87,8 +105,8 @@ namespace puncture::validation {
 
 constexpr double kFailedObjective = 1e6;
 
-enum class CalibrationMethod { Bobyqa, NelderMead, SimulatedAnnealing };
-/// "bobyqa", "nelder_mead", "simulated_annealing" (std::invalid_argument otherwise).
+enum class CalibrationMethod { LevenbergMarquardt, Bobyqa, NelderMead, SimulatedAnnealing };
+/// "levenberg_marquardt", "bobyqa", "nelder_mead", "simulated_annealing" (std::invalid_argument otherwise).
 CalibrationMethod parse_calibration_method(const std::string& name);
 const char* to_string(CalibrationMethod method);
 
@@ -130,11 +148,29 @@ struct AnnealingSettings {
 inline constexpr double kDefaultCalibrationBoundFactor = 1000.0;
 
 struct CalibrationOptions {
-  /// Nelder-Mead by default: the objective is piecewise smooth with small
-  /// steps where a breakthrough moves by one tick, and in our identifiability
-  /// tests BOBYQA's quadratic models stalled in the K-threshold valley (a few
-  /// % off) where Nelder-Mead reached the known values.
-  CalibrationMethod method = CalibrationMethod::NelderMead;
+  /// Levenberg-Marquardt by default: least squares on the objective's
+  /// residual vector (one residual per compared reference sample and per
+  /// puncture term), finite-difference Jacobians on `threads` threads; the
+  /// derivative-free methods evaluate the scalar objective one run at a time
+  /// (Nelder-Mead needed about 7,000 runs on the default slab where
+  /// Levenberg-Marquardt needs a few hundred: results/calibration_speed).
+  CalibrationMethod method = CalibrationMethod::LevenbergMarquardt;
+  int threads = 0;                  ///< model runs at once (Jacobian columns, trial points); 0: all cores
+  int lm_max_iterations = 100;      ///< Levenberg-Marquardt iterations per stage
+  /// Finite-difference step in x (5 % of a scale parameter): wide enough to
+  /// step over the objective's small steps where a breakthrough moves by one
+  /// tick or a reference sample changes sides of it (1 % stalled the default
+  /// slab's skin stage at 0.0017 against 0.0014).
+  double lm_difference_step = 5e-2;
+  double lm_difference_step_min = 1e-4;  ///< refined down to this on a stall (levenberg_marquardt.hpp)
+  /// A tuned parameter the whole objective does not change with at the
+  /// optimum (identifiability report) goes back to its start value; false:
+  /// it keeps wherever the optimiser left it.
+  bool keep_unidentifiable_at_start = true;
+  /// Per-layer stages run the model down to the end of their compared depth
+  /// range plus this margin and turn there (not to the reference's deepest
+  /// sample); the joint stage runs the whole trajectory. <= 0: always whole.
+  double stage_turn_margin_m = 2e-3;
   std::vector<std::string> layers;  ///< layers to calibrate; empty = all (always processed top to bottom)
   TunedParameterSet parameters;
   CalibrationWeights weights;
@@ -246,6 +282,10 @@ struct CalibrationResult {
   std::string damping_note;
   std::vector<CalibrationStageRecord> stages;
   std::vector<std::string> calibrated_layers;
+  /// At the tuned values, on the whole objective (every term, every
+  /// reference): each tuned parameter's sensitivity, standard error,
+  /// correlations and status, and the parameters withheld with the reason.
+  IdentifiabilityReport identifiability;
 };
 
 /// SH layer surfaces of a scene, fitted once; build() assembles a real-time
@@ -283,10 +323,11 @@ CalibrationResult calibrate(const Scene& scene, const InsertionCurve& reference,
                             const CalibrationProgressCallback& progress = {});
 
 /// Writes <name>.json (a scene file `puncture run` accepts: the tuned scene,
-/// renamed to `name`) and <name>.provenance.json (references with kind,
+/// renamed to `name`), <name>.provenance.json (references with kind,
 /// source and FNV-1a 64 content hash, trajectory, metrics before and after,
-/// optimiser and settings, parameters before and after, UTC date, project
-/// version and git revision) into the session; the caller commits.
+/// optimiser and settings, parameters before and after, identifiability, UTC
+/// date, project version and git revision) and <name>.identifiability.md
+/// into the session; the caller commits.
 void write_tuned_preset(io::OutputSession& session, const std::string& name, const CalibrationResult& result,
                         const std::vector<ReferenceCurve>& references, const CalibrationOptions& options);
 /// Provenance JSON text as written by write_tuned_preset.

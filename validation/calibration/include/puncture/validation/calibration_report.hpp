@@ -10,6 +10,11 @@
 //   calibrated model's; empty when there is no reference event.
 // calibration_parameters_table(result): every tuned parameter with its start,
 //   tuned value, physical bounds and whether it ended at one.
+// calibration_identifiability_table(result): per parameter (tuned, then
+//   withheld) its value, sensitivity, standard error, status and reason, then
+//   the correlated pairs (|r| > 0.95) and the correlation matrix.
+// calibration_identifiability_report(result, name): that table as the page
+//   <name>.identifiability.md written beside every tuned preset.
 // calibration_curves_csv(curves, provenance): curve,time_s,depth_mm,force_N,phase
 //   rows of the whole trajectory of each named curve (reference, before,
 //   after; phase insertion, dwell or withdrawal), with the provenance header;
@@ -32,6 +37,10 @@ std::string calibration_terms_table(const CalibrationResult& result);
 std::string calibration_punctures_table(const CalibrationResult& result, const Scene& scene);
 
 std::string calibration_parameters_table(const CalibrationResult& result);
+
+std::string calibration_identifiability_table(const CalibrationResult& result);
+
+std::string calibration_identifiability_report(const CalibrationResult& result, const std::string& preset_name);
 
 std::string calibration_curves_csv(const std::vector<std::pair<std::string, const InsertionCurve*>>& curves,
                                    const io::Provenance& provenance);

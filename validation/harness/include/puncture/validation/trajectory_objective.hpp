@@ -58,6 +58,13 @@ struct ObjectiveTerm {
   std::size_t samples = 0;   ///< reference samples compared
   double weight = 0.0;
   std::string note;
+  /// Weighted residuals, sum of squares = contribution(): sqrt(weight) x
+  /// value for a single-value term; for an RMSE term one per reference
+  /// sample in its range, sqrt(weight / n) x error / P (0 where the model
+  /// curve does not reach the sample). All 0 when unavailable. Their number
+  /// depends on the reference and the selection only, so least-squares
+  /// calibration sees a residual vector of fixed size.
+  std::vector<double> residuals;
   double contribution() const { return available ? weight * value * value : 0.0; }
   std::string label() const { return layer.empty() ? name : name + " " + layer; }
 };
@@ -80,6 +87,8 @@ struct TrajectoryComparison {
   std::vector<std::string> warnings;
   /// The term, or nullptr.
   const ObjectiveTerm* term(const std::string& name, const std::string& layer = "") const;
+  /// Every term's residuals in term order: sum of squares = objective.
+  std::vector<double> residuals() const;
 };
 
 TrajectoryComparison compare_trajectory(const InsertionCurve& model, const InsertionCurve& reference,

@@ -1,0 +1,149 @@
+// Levenberg-Marquardt (levenberg_marquardt.hpp) against problems with known
+// solutions, and its finite-difference Jacobian against analytic derivatives.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+#include "puncture/validation/levenberg_marquardt.hpp"
+
+namespace pv = puncture::validation;
+
+namespace {
+
+/// y = a exp(-b t) sampled at t = 0, 0.1, ..., 2 with a = 2.5, b = 1.3.
+std::vector<double> exponential_times() {
+  std::vector<double> t;
+  for (int i = 0; i <= 20; ++i) t.push_back(0.1 * i);
+  return t;
+}
+
+pv::ResidualFunction exponential_fit(double a_true, double b_true) {
+  return [a_true, b_true](const std::vector<double>& x, std::vector<double>& r) {
+    r.clear();
+    for (double t : exponential_times()) r.push_back(x[0] * std::exp(-x[1] * t) - a_true * std::exp(-b_true * t));
+    return true;
+  };
+}
+
+/// Rosenbrock as least squares: r = (10 (y - x^2), 1 - x); minimum (1, 1), cost 0.
+bool rosenbrock(const std::vector<double>& x, std::vector<double>& r) {
+  r = {10.0 * (x[1] - x[0] * x[0]), 1.0 - x[0]};
+  return true;
+}
+
+}  // namespace
+
+TEST(LevenbergMarquardt, RecoversExponentialDecayParameters) {
+  const auto r = exponential_fit(2.5, 1.3);
+  const pv::LevenbergMarquardtResult res = pv::levenberg_marquardt(r, {1.0, 0.5}, {0.0, 0.0}, {10.0, 10.0});
+  EXPECT_NEAR(res.x[0], 2.5, 1e-5);
+  EXPECT_NEAR(res.x[1], 1.3, 1e-5);
+  EXPECT_LT(res.cost, 1e-10);
+  EXPECT_GT(res.initial_cost, 1.0);
+}
+
+TEST(LevenbergMarquardt, SolvesRosenbrockValley) {
+  pv::LevenbergMarquardtOptions o;
+  o.max_iterations = 200;
+  o.fd_step = 1e-6;
+  o.fd_step_min = 1e-6;
+  o.cost_tolerance = 1e-12;
+  o.step_tolerance = 1e-12;
+  const pv::LevenbergMarquardtResult res = pv::levenberg_marquardt(rosenbrock, {-1.2, 1.0}, {-5.0, -5.0}, {5.0, 5.0}, o);
+  EXPECT_NEAR(res.x[0], 1.0, 1e-4);
+  EXPECT_NEAR(res.x[1], 1.0, 1e-4);
+  EXPECT_LT(res.cost, 1e-8);
+}
+
+TEST(LevenbergMarquardt, StopsAtTheBoundWhenTheMinimumLiesOutside) {
+  // min (x - 3)^2 + (y - 1)^2 with x <= 2: the constrained minimum is (2, 1), cost 1.
+  const pv::ResidualFunction r = [](const std::vector<double>& x, std::vector<double>& out) {
+    out = {x[0] - 3.0, x[1] - 1.0};
+    return true;
+  };
+  const pv::LevenbergMarquardtResult res = pv::levenberg_marquardt(r, {0.0, 0.0}, {-10.0, -10.0}, {2.0, 10.0});
+  EXPECT_DOUBLE_EQ(res.x[0], 2.0);
+  EXPECT_NEAR(res.x[1], 1.0, 1e-6);
+  EXPECT_NEAR(res.cost, 1.0, 1e-9);
+}
+
+TEST(LevenbergMarquardt, NeverAcceptsAPointThatCannotBeEvaluated) {
+  // r fails for x > 1.5 (e.g. a simulation that throws); the unconstrained minimum is at 3.
+  std::atomic<int> failures{0};
+  const pv::ResidualFunction r = [&failures](const std::vector<double>& x, std::vector<double>& out) {
+    if (x[0] > 1.5) {
+      ++failures;
+      throw std::runtime_error("cannot run");
+    }
+    out = {x[0] - 3.0};
+    return true;
+  };
+  const pv::LevenbergMarquardtResult res = pv::levenberg_marquardt(r, {0.0}, {-10.0}, {10.0});
+  EXPECT_LE(res.x[0], 1.5);
+  EXPECT_LT(res.cost, 9.0);  // it did move towards the minimum
+  EXPECT_GT(failures.load(), 0);
+  EXPECT_THROW(pv::levenberg_marquardt(r, {2.0}, {-10.0}, {10.0}), std::invalid_argument);
+}
+
+TEST(LevenbergMarquardt, RejectsMismatchedBoxes) {
+  EXPECT_THROW(pv::levenberg_marquardt(rosenbrock, {0.0, 0.0}, {0.0}, {1.0, 1.0}), std::invalid_argument);
+  EXPECT_THROW(pv::levenberg_marquardt(rosenbrock, {0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}), std::invalid_argument);
+}
+
+TEST(FiniteDifferenceJacobian, MatchesAnalyticDerivativesAndIsTheSameOnAnyThreadCount) {
+  const auto r = exponential_fit(2.5, 1.3);
+  const std::vector<double> x{2.0, 1.0};
+  std::vector<double> r0;
+  ASSERT_TRUE(r(x, r0));
+  int evaluations = 0;
+  const Eigen::MatrixXd J1 = pv::finite_difference_jacobian(r, x, r0, {0.0, 0.0}, {10.0, 10.0}, 1e-7, 1, &evaluations);
+  const Eigen::MatrixXd J2 = pv::finite_difference_jacobian(r, x, r0, {0.0, 0.0}, {10.0, 10.0}, 1e-7, 2);
+  EXPECT_EQ(evaluations, 2);
+  const std::vector<double> ts = exponential_times();
+  for (std::size_t i = 0; i < ts.size(); ++i) {
+    const double e = std::exp(-x[1] * ts[i]);
+    EXPECT_NEAR(J1(static_cast<Eigen::Index>(i), 0), e, 1e-6);                   // d/da a e^{-bt}
+    EXPECT_NEAR(J1(static_cast<Eigen::Index>(i), 1), -x[0] * ts[i] * e, 1e-6);   // d/db
+  }
+  EXPECT_EQ((J1 - J2).cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(FiniteDifferenceJacobian, StepsBackwardAtTheUpperBoundAndZeroesFailedColumns) {
+  const pv::ResidualFunction r = [](const std::vector<double>& x, std::vector<double>& out) {
+    if (x[1] != 0.5) return false;  // any move of the second coordinate fails
+    out = {x[0] * x[0]};
+    return true;
+  };
+  const std::vector<double> x{1.0, 0.5};
+  const std::vector<double> r0{1.0};
+  // x[0] sits at its upper bound: a forward step would leave the box.
+  const Eigen::MatrixXd J = pv::finite_difference_jacobian(r, x, r0, {0.0, 0.0}, {1.0, 1.0}, 1e-6, 2);
+  EXPECT_NEAR(J(0, 0), 2.0, 1e-5);
+  EXPECT_EQ(J(0, 1), 0.0);
+}
+
+TEST(EvaluateResidualsParallel, UsesSeveralThreadsWhenAsked) {
+  std::atomic<int> concurrent{0}, most{0};
+  const pv::ResidualFunction r = [&](const std::vector<double>& x, std::vector<double>& out) {
+    const int now = ++concurrent;
+    int seen = most.load();
+    while (now > seen && !most.compare_exchange_weak(seen, now)) {
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    --concurrent;
+    out = {x[0]};
+    return true;
+  };
+  std::vector<std::vector<double>> points{{1.0}, {2.0}, {3.0}, {4.0}};
+  std::vector<std::vector<double>> rs;
+  std::vector<char> ok;
+  pv::evaluate_residuals_parallel(r, points, rs, ok, 2);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    EXPECT_TRUE(ok[i]);
+    EXPECT_EQ(rs[i], points[i]);
+  }
+  EXPECT_EQ(most.load(), 2);
+}

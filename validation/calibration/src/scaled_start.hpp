@@ -1,0 +1,29 @@
+// scaled_start.hpp (internal to puncture_calibration): the start point of a
+// layer's stage, scaled to the first reference.
+//
+// Scaled start of a layer's stage (up to eight passes), against the first
+// reference: K (and k_s when tuned, keeping K / k_s and so the ring
+// profile) scaled by the ratio of the reference's pressing slope to the
+// model's; the breakthrough parameter scaled to the reference's puncture
+// (threshold by the ratio of the breakthrough deflections, critical force
+// set to the reference's puncture force minus the model's friction and
+// cutting there, critical energy by the squared deflection ratio); then
+// cutting and friction from a least-squares fit of the force difference on
+// the layer's cut (level and slope with the shaft length) and, with a
+// withdrawal, of the withdrawal force inside the layer (friction only).
+// Values stay inside the bounds.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "calibration_parameters.hpp"
+#include "puncture/validation/calibration.hpp"
+
+namespace puncture::validation::calibration_detail {
+
+Scene scaled_start(const Scene& candidate, std::size_t k, const ReferenceCurve& reference, const ReferenceEvents& ref_ev,
+                   const std::vector<LayerGeometry>& layers, const CalibrationOptions& options, const SurfaceCache& cache,
+                   const std::vector<Parameter>& parameters);
+
+}  // namespace puncture::validation::calibration_detail
