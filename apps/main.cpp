@@ -99,6 +99,9 @@ int main(int argc, char** argv) {
                             "Each tuned scale parameter stays within [start / f, start * f] (and its physical "
                             "range); default " +
                                 default_text(puncture::validation::kDefaultCalibrationBoundFactor));
+  calibrate_cmd->add_option("--reference-depth-offset", calibrate.reference_depth_offset_mm,
+                            "Subtracted from the measured curve's depths (mm): a trace that starts above the tissue "
+                            "surface (e.g. 9.5 for the Okamura liver trace); default 0");
   calibrate_cmd->add_option("--puncture-depths", calibrate.puncture_depths_mm,
                             "Puncture depths of the reference in mm, one per layer from the top (comma separated); "
                             "default: from its state columns, else from its force drops")

@@ -29,6 +29,7 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
   std::ostringstream c;
   c << "puncture calibrate " << scene_path.string();
   if (!options.reference.empty()) c << " --reference " << options.reference.string();
+  if (options.reference_depth_offset_mm != 0.0) c << " --reference-depth-offset " << options.reference_depth_offset_mm;
   c << " -o " << dir.string() << " --name " << name << " --method " << options.method;
   for (std::size_t i = 0; i < options.also_tune.size(); ++i) c << (i ? "," : " --also-tune ") << options.also_tune[i];
   for (const std::string& layer : options.layers) c << " --layers " << layer;
@@ -67,6 +68,12 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
     } else {
       reference.curve = validation::read_insertion_curve(options.reference);
       reference.kind = "measured";
+      if (!std::isfinite(options.reference_depth_offset_mm))
+        throw UsageError("--reference-depth-offset must be a finite number (mm)");
+      if (options.reference_depth_offset_mm != 0.0) {
+        for (double& d : reference.curve.depth_m) d -= options.reference_depth_offset_mm * 1e-3;
+        reference.curve.metadata["depth_offset_mm"] = std::to_string(options.reference_depth_offset_mm);
+      }
     }
 
     validation::CalibrationOptions calibration;

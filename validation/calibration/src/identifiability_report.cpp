@@ -26,12 +26,12 @@ void classify(const JacobianStatistics& st, std::size_t j, const Parameter& p, d
               ParameterIdentifiability& out) {
   const Eigen::Index i = static_cast<Eigen::Index>(j);
   const std::string bound = bound_name(p, x);
-  if (!bound.empty()) {
-    out.status = "at a bound";
-    out.reason = "ended at its " + bound + " bound";
-  } else if (!(st.sensitivity(i) > 1e-6 * max_sensitivity)) {
+  if (!(st.sensitivity(i) > 1e-6 * max_sensitivity)) {
     out.status = "not identifiable";
     out.reason = "the objective does not change with it at the optimum";
+  } else if (!bound.empty()) {
+    out.status = "at a bound";
+    out.reason = "ended at its " + bound + " bound";
   } else if (!std::isfinite(st.standard_error(i))) {
     out.status = "not identifiable";
     out.reason = "the Jacobian is singular in its direction (another parameter compensates it)";

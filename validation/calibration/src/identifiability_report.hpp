@@ -7,10 +7,11 @@
 // Out: per tuned parameter its sensitivity, standard error (in its unit) and
 //      status; the correlation matrix and the pairs above 0.95; the withheld
 //      ones as "not identifiable" with their reason.
-// Status of a tuned parameter: "at a bound" when it ended within 0.1 % of a
-// bound; "not identifiable" when the objective does not change with it (its
-// Jacobian column below 1e-6 of the largest), J^T J is singular in its
-// direction, or its standard error in x exceeds 1 (for x = ln p: a
+// Status of a tuned parameter: "not identifiable" when the objective does
+// not change with it (its Jacobian column below 1e-6 of the largest, e.g. a
+// presliding length with no friction left); else "at a bound" when it ended
+// within 0.1 % of a bound; else "not identifiable" when J^T J is singular in
+// its direction or its standard error in x exceeds 1 (for x = ln p: a
 // standard error above the value itself); else "identified".
 #pragma once
 
