@@ -115,6 +115,28 @@ std::string calibration_identifiability_report(const CalibrationResult& r, const
   return s.str();
 }
 
+std::string calibration_summary_markdown(const CalibrationResult& result, const Scene& scene,
+                                        const ReferenceCurve& reference, const io::Provenance& provenance,
+                                        const std::string& method, double seconds, const std::string& name) {
+  std::ostringstream md;
+  md << "# Calibration of " << scene.name << "\n\nMade by `" << provenance.command << "` on " << provenance.machine
+     << ", " << provenance.date_utc << " (program " << provenance.program_version << ", git " << provenance.git_revision
+     << ").\n\nReference: " << reference.kind << " (" << reference.curve.source << "). Method: " << method << ", "
+     << result.evaluations << " model runs in " << num(seconds) << " s (wall, reference already available). Objective "
+     << num(result.objective_before) << " -> " << num(result.objective_after) << ".\n\n"
+     << "## Objective, term by term\n\n" << calibration_terms_table(result) << "\n## Punctures\n\n"
+     << calibration_punctures_table(result, scene) << "\n## Tuned parameters\n\n" << calibration_parameters_table(result)
+     << "\n## Identifiability\n\n" << calibration_identifiability_table(result) << "\nTuned preset: `" << name
+     << ".json` (a scene `puncture run` accepts), provenance: `" << name << ".provenance.json`, identifiability: `"
+     << name << ".identifiability.md`.\n";
+  if (!result.damping_note.empty()) md << "\nDamping d: " << result.damping_note << "\n";
+  if (!result.warnings.empty()) {
+    md << "\n## Warnings\n\n";
+    for (const std::string& w : result.warnings) md << "- " << w << "\n";
+  }
+  return md.str();
+}
+
 std::string calibration_curves_csv(const std::vector<std::pair<std::string, const InsertionCurve*>>& curves,
                                    const io::Provenance& provenance) {
   io::CsvWriter csv({"curve", "time_s", "depth_mm", "force_N", "phase"});

@@ -15,6 +15,10 @@
 //   the correlated pairs (|r| > 0.95) and the correlation matrix.
 // calibration_identifiability_report(result, name): that table as the page
 //   <name>.identifiability.md written beside every tuned preset.
+// calibration_summary_markdown(result, scene, reference, provenance, method,
+//   seconds, preset_name): calibration_summary.md: the command, machine and
+//   date, the reference, method, model runs and wall time, the objective
+//   before and after, then the tables above, d's note and the warnings.
 // calibration_curves_csv(curves, provenance): curve,time_s,depth_mm,force_N,phase
 //   rows of the whole trajectory of each named curve (reference, before,
 //   after; phase insertion, dwell or withdrawal), with the provenance header;
@@ -41,6 +45,10 @@ std::string calibration_parameters_table(const CalibrationResult& result);
 std::string calibration_identifiability_table(const CalibrationResult& result);
 
 std::string calibration_identifiability_report(const CalibrationResult& result, const std::string& preset_name);
+
+std::string calibration_summary_markdown(const CalibrationResult& result, const Scene& scene,
+                                        const ReferenceCurve& reference, const io::Provenance& provenance,
+                                        const std::string& method, double seconds, const std::string& preset_name);
 
 std::string calibration_curves_csv(const std::vector<std::pair<std::string, const InsertionCurve*>>& curves,
                                    const io::Provenance& provenance);
