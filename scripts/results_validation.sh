@@ -6,7 +6,9 @@
 #   results/tuned_preset/        puncture calibrate: tuned preset of the Table 2 slab
 #                                with the physical force law (scenes/default_force_law.json:
 #                                critical-force breakthrough, stiffening, cutting, friction),
-#                                provenance, before/after plot, wall time
+#                                provenance, identifiability, before/after plot, wall time
+#   results/liver_calibration/   puncture calibrate of the two-layer liver scene against the
+#                                measured Okamura 2004 curve (../shared/data)
 #   results/validation_tuned/    puncture validate of the tuned preset
 #   results/accuracy_cost/       puncture sweep of the tuned preset (real-time knobs
 #                                against the default-resolution FEM)
@@ -30,6 +32,9 @@ fem_dir="$(ls -td out/.fem_cache/*/ | head -1)"
 # puncture depths weigh 1 per L (0.1 let the muscle break 4.8 mm early).
 "$build/apps/puncture" calibrate scenes/default_force_law.json -o results/tuned_preset --name default_tuned --integrator implicit \
   --force-weight 4 --depth-weight 1
+shared="${PUNCTURE_SHARED_DATA_DIR:-$root/../shared/data}"
+"$build/apps/puncture" calibrate scenes/liver_okamura.json -o results/liver_calibration --name liver_tuned \
+  --reference "$shared/okamura2004_liver_depth_force.csv" --reference-depth-offset 9.5 --puncture-depths 9.65,9.66
 "${mpi[@]}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json -o results/validation_tuned
 "$build/apps/puncture" sweep results/tuned_preset/default_tuned.json --no-fem-knobs -o results/accuracy_cost
-echo "results in results/validation_default, results/tuned_preset, results/validation_tuned, results/accuracy_cost"
+echo "results in results/validation_default, results/tuned_preset, results/liver_calibration, results/validation_tuned, results/accuracy_cost"

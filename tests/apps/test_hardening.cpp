@@ -344,7 +344,7 @@ std::string collapsed_text(const fs::path& path) {
 
 TEST(DocumentedDefaults, CalibrationBoundFactorIsOneValueInTheCommandTheLibraryAndTheDocs) {
   // One default, declared once (validation::kDefaultCalibrationBoundFactor): the command's options, the
-  // library's options, `calibrate --help`, apps/README.md and validation/README.md all say the same number.
+  // library's options, `calibrate --help`, apps/README.md and validation/calibration/README.md all say the same number.
   const double f = validation::kDefaultCalibrationBoundFactor;
   EXPECT_EQ(CalibrateOptions{}.bound_factor, f);
   EXPECT_EQ(validation::CalibrationOptions{}.bound_factor, f);
@@ -355,10 +355,10 @@ TEST(DocumentedDefaults, CalibrationBoundFactorIsOneValueInTheCommandTheLibraryA
   EXPECT_NE(help.out.find("range); default " + number.str()), std::string::npos) << help.out;
   const std::string apps_readme = collapsed_text(kSourceDir / "apps" / "README.md");
   EXPECT_NE(apps_readme.find("F = " + number.str() + " by default"), std::string::npos) << "apps/README.md";
-  const std::string validation_readme = collapsed_text(kSourceDir / "validation" / "README.md");
-  EXPECT_NE(validation_readme.find("f = `CalibrationOptions::bound_factor`, " + number.str() + " by default"),
+  const std::string calibration_readme = collapsed_text(kSourceDir / "validation" / "calibration" / "README.md");
+  EXPECT_NE(calibration_readme.find("f = `CalibrationOptions::bound_factor`, " + number.str() + " by default"),
             std::string::npos)
-      << "validation/README.md";
+      << "validation/calibration/README.md";
 }
 
 }  // namespace

@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# Benchmark: how long `puncture calibrate` takes, and what each gain came from.
+#
+#   bash scripts/calibration_speed.sh [output dir]     (default results/calibration_speed)
+#
+# Cases: the default slab (scenes/default_force_law.json against its cached
+# FEM reference, the command of scripts/results_validation.sh) and the liver
+# scene against the measured Okamura 2004 curve (../shared/data). Rows: the
+# derivative-free Nelder-Mead with whole model runs on one thread (the
+# calibration as it was, with this build's cheaper model runs), with runs that
+# turn past each stage's depths, then Levenberg-Marquardt on one thread and
+# on every core. LM rows are the median of REPEATS runs (default 5), NM rows
+# one run each (4-10 minutes apiece). PUNCTURE_BEFORE_BIN=<puncture binary of
+# an older revision> adds its default-slab run as the "before" row, with the
+# revision given by PUNCTURE_BEFORE_REV. Writes README.md (the table, the
+# command, machine, date) and the runs' calibration summaries.
+# The machine should be otherwise idle: these are wall-clock times.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${PUNCTURE_BUILD_DIR:-$root/build}"
+out="${1:-$root/results/calibration_speed}"
+repeats="${REPEATS:-5}"
+shared="${PUNCTURE_SHARED_DATA_DIR:-$root/../shared/data}"
+cd "$root"
+[ -x "$build/apps/puncture" ] || bash scripts/build.sh
+export OMPI_ALLOW_RUN_AS_ROOT="${OMPI_ALLOW_RUN_AS_ROOT:-1}" OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="${OMPI_ALLOW_RUN_AS_ROOT_CONFIRM:-1}"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+
+default_args=(scenes/default_force_law.json --integrator implicit --force-weight 4 --depth-weight 1)
+liver_args=(scenes/liver_okamura.json --reference "$shared/okamura2004_liver_depth_force.csv"
+            --reference-depth-offset 9.5 --puncture-depths 9.65,9.66)
+# The FEM reference of the default slab, computed once if not cached (not timed).
+"$build/apps/puncture" calibrate "${default_args[@]}" -o "$work/warmup" -q >/dev/null
+
+rows="$work/rows.tsv"
+: > "$rows"
+count=0
+# run <case> <label> <gain> <n> <binary> <args...>: n runs, records the median wall time, runs and objective.
+run() {
+  local case="$1" label="$2" gain="$3" n="$4" bin="$5"
+  shift 5
+  local times=() i=0 summary=""
+  for ((i = 1; i <= n; ++i)); do
+    count=$((count + 1))
+    local dir="$work/run_$count"
+    echo "[calibration_speed] $case / $label: run $i of $n" >&2
+    local t0 t1
+    t0=$(date +%s.%N)
+    "$bin" calibrate "$@" -o "$dir" --name run -q >/dev/null 2>"$dir.err" || { cat "$dir.err" >&2; exit 1; }
+    t1=$(date +%s.%N)
+    times+=("$(awk -v a="$t0" -v b="$t1" 'BEGIN {printf "%.3f", b - a}')")
+    summary="$dir/calibration_summary.md"
+  done
+  local median
+  median=$(printf '%s\n' "${times[@]}" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}')
+  local all
+  all=$(printf '%s\n' "${times[@]}" | awk '{printf "%s%.1f", (NR > 1 ? ", " : ""), $1}')
+  local runs objective
+  runs=$(grep -o '[0-9]* model runs in' "$summary" | head -1 | awk '{print $1}')
+  objective=$(grep -o 'Objective [0-9.e+-]* -> [0-9.e+-]*' "$summary" | head -1 | awk '{print $4}')
+  local exact
+  exact=$(python3 -c "import json,sys; print('%.6f' % json.load(open(sys.argv[1]))['objective_after'])" "$(dirname "$summary")/run.provenance.json")
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$case" "$label" "$gain" "$median" "$all" "$runs" "$exact" "$n" >> "$rows"
+  mkdir -p "$out/summaries"
+  cp "$summary" "$out/summaries/${case}_$(echo "$label" | tr -c 'A-Za-z0-9' '_' | sed 's/_*$//').md"
+}
+
+mkdir -p "$out"
+if [ -n "${PUNCTURE_BEFORE_BIN:-}" ]; then
+  run default "before (git ${PUNCTURE_BEFORE_REV:-?}): Nelder-Mead, whole runs" "-" 1 "$PUNCTURE_BEFORE_BIN" \
+    "${default_args[@]}" --method nelder_mead
+fi
+run default "Nelder-Mead, whole runs, 1 thread" "model runs without stored ticks, timing or per-tick positions" 1 \
+  "$build/apps/puncture" "${default_args[@]}" --method nelder_mead --stage-turn-margin 0 --threads 1
+run default "Nelder-Mead, stage runs turn 2 mm past their depths, 1 thread" "shorter per-layer stage runs" 1 \
+  "$build/apps/puncture" "${default_args[@]}" --method nelder_mead --threads 1
+run default "Levenberg-Marquardt, 1 thread" "least squares on the residual vector: fewer model runs" "$repeats" \
+  "$build/apps/puncture" "${default_args[@]}" --threads 1
+run default "Levenberg-Marquardt, 2 threads (default)" "Jacobian columns and trial steps on both cores" "$repeats" \
+  "$build/apps/puncture" "${default_args[@]}"
+run liver "Nelder-Mead, whole runs, 1 thread" "-" 1 \
+  "$build/apps/puncture" "${liver_args[@]}" --method nelder_mead --stage-turn-margin 0 --threads 1
+run liver "Levenberg-Marquardt, 2 threads (default)" "all of the above" "$repeats" \
+  "$build/apps/puncture" "${liver_args[@]}"
+
+python3 - "$rows" "$out/README.md" "$repeats" <<'EOF'
+import subprocess, sys, datetime, platform, os
+rows = [l.rstrip('\n').split('\t') for l in open(sys.argv[1]) if l.strip()]
+git = subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], capture_output=True, text=True).stdout.strip()
+dirty = subprocess.run(['git', 'status', '--porcelain', '--untracked-files=no'], capture_output=True, text=True).stdout.strip()
+cpu = next((l.split(':', 1)[1].strip() for l in open('/proc/cpuinfo') if l.startswith('model name')), platform.processor())
+lines = ["# Calibration speed", "",
+         f"Made by `bash scripts/calibration_speed.sh` on {platform.node()} ({cpu}, {os.cpu_count()} cores), "
+         f"{datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%dT%H:%M:%SZ')}, git {git}{'-dirty' if dirty else ''}. "
+         f"Wall time of the whole `puncture calibrate` process (reference already cached; report and plot included). "
+         f"Levenberg-Marquardt rows: median of {sys.argv[3]} runs; Nelder-Mead rows: one run each.", ""]
+for case, title in (("default", "Default slab against its FEM reference (scenes/default_force_law.json, 3 layers, 15 tuned parameters)"),
+                    ("liver", "Liver against the measured Okamura 2004 curve (scenes/liver_okamura.json, 2 layers, 11 tuned parameters)")):
+    sel = [r for r in rows if r[0] == case]
+    if not sel: continue
+    lines += [f"## {title}", "", "| configuration | gain from | wall time (s, median) | runs (s) | model runs | objective after |",
+              "|---|---|---|---|---|---|"]
+    for r in sel:
+        lines.append(f"| {r[1]} | {r[2]} | {float(r[3]):.1f} | {r[4]} | {r[5]} | {r[6]} |")
+    lines.append("")
+open(sys.argv[2], 'w').write('\n'.join(lines))
+EOF
+echo "[calibration_speed] $out/README.md"
