@@ -94,7 +94,10 @@ lines = ["# Calibration speed", "",
          f"Made by `bash scripts/calibration_speed.sh` on {platform.node()} ({cpu}, {os.cpu_count()} cores), "
          f"{datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%dT%H:%M:%SZ')}, git {git}{'-dirty' if dirty else ''}. "
          f"Wall time of the whole `puncture calibrate` process (reference already cached; report and plot included). "
-         f"Levenberg-Marquardt rows: median of {sys.argv[3]} runs; Nelder-Mead rows: one run each.", ""]
+         f"Levenberg-Marquardt rows: median of {sys.argv[3]} runs; Nelder-Mead rows: one run each. "
+         "The objective is the one the calibration minimises (calibration_summary.md, sum of weight x value^2 over every term); "
+         "on one thread Levenberg-Marquardt tries one step per iteration instead of two, so its path and optimum differ. "
+         "Each configuration's last calibration summary is in summaries/.", ""]
 for case, title in (("default", "Default slab against its FEM reference (scenes/default_force_law.json, 3 layers, 15 tuned parameters)"),
                     ("liver", "Liver against the measured Okamura 2004 curve (scenes/liver_okamura.json, 2 layers, 11 tuned parameters)")):
     sel = [r for r in rows if r[0] == case]
