@@ -15,8 +15,8 @@
 //   Q_i(t) = int_{-inf}^{t} beta_i exp(-(t - s)/tau_i) d(S_iso^inf)/ds ds,
 // so S = S_vol + S_iso^inf + sum_i Q_i. The bulk response stays elastic.
 //
-// Time integration (Holzapfel 2000, Sec. 6.10, the recurrence cited by the issue as
-// Eq. 6.158-6.159; Simo 1987, Comput. Methods Appl. Mech. Engrg. 60:153-173):
+// Time integration (Holzapfel 2000, Sec. 6.10; Simo 1987, Comput. Methods
+// Appl. Mech. Engrg. 60:153-173):
 // the hereditary integral over one step [t_n, t_n + dt] by the midpoint rule
 // for the kernel, xi_i = -dt / (2 tau_i):
 //   H_i       = exp(xi_i) (exp(xi_i) Q_i^n - beta_i S_iso^{inf,n})
