@@ -99,6 +99,9 @@ int main(int argc, char** argv) {
                             "Each tuned scale parameter stays within [start / f, start * f] (and its physical "
                             "range); default " +
                                 default_text(puncture::validation::kDefaultCalibrationBoundFactor));
+  calibrate_cmd->add_flag("--tune-unidentifiable", calibrate.tune_unidentifiable,
+                          "Also tune the parameters the reference cannot identify (default: they keep the scene's "
+                          "values, listed in the identifiability report)");
   calibrate_cmd->add_option("--reference-depth-offset", calibrate.reference_depth_offset_mm,
                             "Subtracted from the measured curve's depths (mm): a trace that starts above the tissue "
                             "surface (e.g. 9.5 for the Okamura liver trace); default 0");

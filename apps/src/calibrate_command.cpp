@@ -35,6 +35,7 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
   for (std::size_t i = 0; i < options.also_tune.size(); ++i) c << (i ? "," : " --also-tune ") << options.also_tune[i];
   for (const std::string& layer : options.layers) c << " --layers " << layer;
   if (options.threads > 0) c << " --threads " << options.threads;
+  if (options.tune_unidentifiable) c << " --tune-unidentifiable";
   c << " --stage-turn-margin " << options.stage_turn_margin_mm;
   c << " --bound-factor " << options.bound_factor << " --depth-weight " << options.depth_weight
     << " --force-weight " << options.force_weight << " --integrator "
@@ -100,6 +101,7 @@ validation::CalibrationOptions calibration_options(const CalibrateOptions& optio
   c.method = validation::parse_calibration_method(options.method);
   c.layers = options.layers;
   c.threads = options.threads;
+  c.keep_unidentifiable_at_start = !options.tune_unidentifiable;
   c.stage_turn_margin_m = options.stage_turn_margin_mm * 1e-3;
   check_finite_at_least(options.bound_factor, 1.0, true, "--bound-factor");
   c.bound_factor = options.bound_factor;

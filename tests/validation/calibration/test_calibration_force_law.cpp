@@ -459,4 +459,22 @@ TEST(CalibrationForceLaw, ParametersTheReferenceCannotIdentifyKeepTheirStartValu
   bool fat_K_tuned = false;
   for (const pv::TunedParameterRecord& p : r.parameters) fat_K_tuned = fat_K_tuned || (p.layer == "fat" && p.name == "K");
   EXPECT_TRUE(fat_K_tuned);
+  // The identifiability report lists them with the reason.
+  int listed = 0;
+  for (const pv::ParameterIdentifiability& p : r.identifiability.parameters)
+    if (p.layer == "fat" && p.status == "not identifiable" && p.reason.find("kept at its start value") != std::string::npos)
+      ++listed;
+  EXPECT_GE(listed, 3);
+
+  // Asked to tune them anyway: they are tuned (and said to be), not withheld.
+  o.keep_unidentifiable_at_start = false;
+  const pv::CalibrationResult forced = pv::calibrate(start, ref, o);
+  bool fat_critical_tuned = false;
+  for (const pv::TunedParameterRecord& p : forced.parameters)
+    fat_critical_tuned = fat_critical_tuned || (p.layer == "fat" && p.name == "critical_force");
+  EXPECT_TRUE(fat_critical_tuned);
+  int requested = 0;
+  for (const std::string& w : forced.warnings)
+    if (w.find("layer fat: critical_force tuned on request although") != std::string::npos) ++requested;
+  EXPECT_EQ(requested, 1);
 }

@@ -104,21 +104,29 @@ void find_reference_events(Calibration& c, CalibrationResult& result) {
   }
 }
 
+/// Why the references cannot identify a parameter; "" when they can, or
+/// when the user asked to tune it anyway (keep_unidentifiable_at_start off).
+std::string withheld_reason(const Calibration& c, std::size_t k, ParamKind kind) {
+  return c.options.keep_unidentifiable_at_start ? unidentified_reason(c.identifiable[k], kind) : std::string();
+}
+
 /// Warns for each requested parameter the references cannot identify (it
-/// keeps its start value); returns the number that will be tuned and requested.
+/// keeps its start value, or is tuned on request); returns the number that
+/// will be tuned and requested.
 std::pair<std::size_t, std::size_t> withhold_unidentified(const Calibration& c, CalibrationResult& result) {
   std::size_t tuned = 0, requested = 0;
   for (std::size_t k : c.layers) {
     for (ParamKind kind : layer_kinds(c.scene, k, c.options.parameters)) {
       ++requested;
       const std::string why = unidentified_reason(c.identifiable[k], kind);
-      if (why.empty()) {
-        ++tuned;
-        continue;
-      }
-      result.warnings.push_back("layer " + c.scene.layers[k].name + ": " + info(kind).name + " kept at its start value (" +
-                                std::to_string(param_value(c.scene, k, kind) * info(kind).to_unit) + " " +
-                                info(kind).unit + "): " + why);
+      if (!why.empty())
+        result.warnings.push_back(
+            "layer " + c.scene.layers[k].name + ": " + info(kind).name +
+            (c.options.keep_unidentifiable_at_start
+                 ? " kept at its start value (" + std::to_string(param_value(c.scene, k, kind) * info(kind).to_unit) +
+                       " " + info(kind).unit + "): " + why
+                 : " tuned on request although " + why));
+      if (withheld_reason(c, k, kind).empty()) ++tuned;
     }
   }
   return {tuned, requested};
@@ -216,7 +224,8 @@ std::pair<Scene, double> run_ring_candidate(Calibration& c, CalibrationResult& r
   stage.scene = candidate;
   stage.selection = layer_stage_selection(c, result, k);
   stage.turn_depth_m = stage_turn_depth(stage.selection, c.options);
-  for (ParamKind kind : layer_kinds(candidate, k, c.options.parameters, &c.identifiable[k]))
+  for (ParamKind kind : layer_kinds(candidate, k, c.options.parameters,
+                                    c.options.keep_unidentifiable_at_start ? &c.identifiable[k] : nullptr))
     stage.parameters.push_back(c.parameter(k, kind));
   if (stage.parameters.size() > static_cast<std::size_t>(kMaxParameters))
     throw std::invalid_argument("calibrate: too many parameters in one stage");
@@ -402,7 +411,7 @@ void report_identifiability(Calibration& c, CalibrationResult& result) {
   std::vector<WithheldParameter> withheld;
   for (std::size_t k : c.layers)
     for (ParamKind kind : layer_kinds(c.scene, k, c.options.parameters)) {
-      const std::string why = unidentified_reason(c.identifiable[k], kind);
+      const std::string why = withheld_reason(c, k, kind);
       if (!why.empty()) withheld.push_back({k, kind, why});
     }
   if (!result.damping_tuned && c.scene.effects.damping)

@@ -69,6 +69,7 @@ struct CalibrateOptions {
   std::string preset_name;            ///< empty: <scene name>_tuned
   std::vector<std::string> layers;    ///< empty: all
   int threads = 0;                    ///< model runs at once; 0: every core
+  bool tune_unidentifiable = false;   ///< also tune what the reference cannot identify
   /// Subtracted from the measured curve's depths (mm), for a trace that starts above the surface.
   double reference_depth_offset_mm = 0.0;
   /// Per-layer stages turn this far past their compared depth range (mm); 0: whole runs.

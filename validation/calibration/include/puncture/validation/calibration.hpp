@@ -163,9 +163,12 @@ struct CalibrationOptions {
   /// slab's skin stage at 0.0017 against 0.0014).
   double lm_difference_step = 5e-2;
   double lm_difference_step_min = 1e-4;  ///< refined down to this on a stall (levenberg_marquardt.hpp)
-  /// A tuned parameter the whole objective does not change with at the
-  /// optimum (identifiability report) goes back to its start value; false:
-  /// it keeps wherever the optimiser left it.
+  /// Parameters the references cannot identify keep their start values:
+  /// those withheld before the fit (reference_checks.hpp: no puncture of the
+  /// layer, too few samples) and a tuned one the whole objective does not
+  /// change with at the optimum. false (`puncture calibrate
+  /// --tune-unidentifiable`): they are tuned and left where the optimiser
+  /// left them, with a warning each.
   bool keep_unidentifiable_at_start = true;
   /// Per-layer stages run the model down to the end of their compared depth
   /// range plus this margin and turn there (not to the reference's deepest
