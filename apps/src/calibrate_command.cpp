@@ -71,10 +71,8 @@ bool load_reference(const CalibrateOptions& options, const Scene& scene, std::os
   return true;
 }
 
-void check_finite_at_least(double value, double least, bool strictly, const char* option) {
-  if (!std::isfinite(value) || value < least || (strictly && value == least))
-    throw UsageError(std::string(option) + " must be a finite number " + (strictly ? "> " : ">= ") +
-                     (least == 0.0 ? "0" : "1"));
+void check_option(bool ok, const std::string& message) {
+  if (!ok) throw UsageError(message);
 }
 
 /// The parameters --also-tune adds and --keep removes.
@@ -103,14 +101,16 @@ validation::CalibrationOptions calibration_options(const CalibrateOptions& optio
   c.threads = options.threads;
   c.keep_unidentifiable_at_start = !options.tune_unidentifiable;
   c.stage_turn_margin_m = options.stage_turn_margin_mm * 1e-3;
-  check_finite_at_least(options.bound_factor, 1.0, true, "--bound-factor");
+  check_option(std::isfinite(options.bound_factor) && options.bound_factor > 1.0, "--bound-factor must be a finite number > 1");
   c.bound_factor = options.bound_factor;
   c.integrator = options.integrator.empty() ? scene.realtime.integrator : options.integrator;
   if (c.integrator != "quasi_static" && c.integrator != "explicit" && c.integrator != "implicit")
     throw UsageError("--integrator must be quasi_static, explicit or implicit (got '" + c.integrator + "')");
-  check_finite_at_least(options.depth_weight, 0.0, false, "--depth-weight");
+  check_option(std::isfinite(options.depth_weight) && options.depth_weight >= 0.0,
+               "--depth-weight must be a finite number >= 0");
   c.weights.puncture_depth = options.depth_weight;
-  check_finite_at_least(options.force_weight, 0.0, false, "--force-weight");
+  check_option(std::isfinite(options.force_weight) && options.force_weight >= 0.0,
+               "--force-weight must be a finite number >= 0");
   c.weights.puncture_force = options.force_weight;
   select_parameters(options, c.parameters);
   for (double d : options.puncture_depths_mm) {

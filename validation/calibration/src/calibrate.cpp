@@ -381,27 +381,23 @@ void record_parameters(const Calibration& c, CalibrationResult& result) {
 /// then rises.
 void restore_unidentified(Calibration& c, CalibrationResult& result) {
   if (!c.options.keep_unidentifiable_at_start) return;
+  // The report lists the tuned parameters first, in this order.
+  const std::vector<Parameter> tuned = calibrated_parameters(c);
+  std::vector<ParameterIdentifiability>& report = result.identifiability.parameters;
   Scene restored = result.tuned_scene;
   std::vector<std::size_t> changed;
-  for (std::size_t i = 0; i < result.identifiability.parameters.size(); ++i) {
-    const ParameterIdentifiability& p = result.identifiability.parameters[i];
-    if (p.status != "not identifiable" || p.reason.find("does not change") == std::string::npos) continue;
-    for (const Parameter& q : c.parameters)
-      if (c.scene.layers[q.layer].name == p.layer && info(q.kind).name == p.name) {
-        set_param(restored, q, param_value(c.scene, q.layer, q.kind));
-        changed.push_back(i);
-      }
-  }
+  for (std::size_t j = 0; j < tuned.size() && j < report.size(); ++j)
+    if (report[j].insensitive) {
+      set_param(restored, tuned[j], param_value(c.scene, tuned[j].layer, tuned[j].kind));
+      changed.push_back(j);
+    }
   if (changed.empty()) return;
   StageObjective whole = whole_objective_stage(c, result, "restore", restored, {});
   if (!(whole.value_of(restored) <= result.objective_after * (1.0 + 1e-9))) return;
   result.tuned_scene = restored;
-  for (std::size_t i : changed) {
-    ParameterIdentifiability& p = result.identifiability.parameters[i];
-    for (const Parameter& q : c.parameters)
-      if (c.scene.layers[q.layer].name == p.layer && info(q.kind).name == p.name)
-        p.value = param_value(restored, q.layer, q.kind) * info(q.kind).to_unit;
-    p.reason += "; back at its start value";
+  for (std::size_t j : changed) {
+    report[j].value = param_value(restored, tuned[j].layer, tuned[j].kind) * info(tuned[j].kind).to_unit;
+    report[j].reason += "; back at its start value";
   }
 }
 

@@ -28,6 +28,7 @@ void classify(const JacobianStatistics& st, std::size_t j, const Parameter& p, d
   const std::string bound = bound_name(p, x);
   if (!(st.sensitivity(i) > 1e-6 * max_sensitivity)) {
     out.status = "not identifiable";
+    out.insensitive = true;
     out.reason = "the objective does not change with it at the optimum";
   } else if (!bound.empty()) {
     out.status = "at a bound";

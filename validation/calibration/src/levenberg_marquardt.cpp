@@ -107,7 +107,7 @@ Eigen::MatrixXd finite_difference_jacobian(const ResidualFunction& r, const std:
   std::vector<double> step(x.size(), h);
   for (std::size_t j = 0; j < x.size(); ++j) {
     if (x[j] + h > upper[j]) step[j] = x[j] - h >= lower[j] ? -h : (upper[j] - x[j] >= x[j] - lower[j] ? upper[j] - x[j] : lower[j] - x[j]);
-    if (step[j] == 0.0) step[j] = h;  // a box narrower than nothing: the column stays 0 if r cannot be run there
+    if (step[j] == 0.0) step[j] = h;  // an empty box (lower = upper): r is tried just outside it
     points[j][j] += step[j];
   }
   std::vector<std::vector<double>> rs;

@@ -47,6 +47,7 @@ struct ParameterIdentifiability {
   double sensitivity = 0.0;         ///< |d residuals / d x|, x = ln p or p / scale
   double standard_error = 0.0;      ///< in unit (delta method: p x se_x for ln p); +inf: not determined
   std::string status;               ///< "identified", "at a bound" or "not identifiable"
+  bool insensitive = false;         ///< tuned, and the objective does not change with it
   std::string reason;               ///< why, for the latter two
 };
 
