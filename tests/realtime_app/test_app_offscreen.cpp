@@ -389,7 +389,7 @@ TEST(PunctureApp, PythonBridgeExampleDrivesTheApp) {
     ASSERT_TRUE(client.wait_for_app(0.002, session)) << "the app never answered a pose";
   }
   const ProcessResult bridge = run("python3 " + std::string(PUNCTURE_SOURCE_DIR) +
-                                   "/apps/realtime_app/tools/udp_bridge_example.py --port " + std::to_string(port) +
+                                   "/realtime/tools/udp_bridge_example.py --port " + std::to_string(port) +
                                    " --seconds 1.5 --speed-mm-s 20");
   const ProcessResult r = session.get();
   ASSERT_EQ(r.exit_code, 0) << r.output;

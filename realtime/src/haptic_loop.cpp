@@ -7,6 +7,37 @@
 #include "puncture/realtime/replay.hpp"
 
 namespace puncture::realtime {
+namespace {
+
+/// The recording of one model tick (recording.hpp): the NeedleState fed to
+/// the model, the device's pose, the forces (N) and the tip depth (m).
+TickRecord tick_record(std::int64_t n, double wall_time_s, bool fresh, std::uint32_t flags, const NeedleState& needle,
+                       const DevicePose& pose, const TickOutputs& out, double depth_m) noexcept {
+  TickRecord r;
+  r.tick = static_cast<std::uint64_t>(n);
+  r.flags = (fresh ? kRecFreshTissue : 0u) | ((flags & kOutMagnitudeClamped) ? kRecMagnitudeClamped : 0u) |
+            ((flags & kOutRateClamped) ? kRecRateClamped : 0u) | ((flags & kOutNoPose) ? kRecNoPose : 0u);
+  r.layer_states = out.layer_states;
+  r.wall_time_s = wall_time_s;
+  r.needle_time_s = needle.time_s;
+  for (int i = 0; i < 3; ++i) {
+    r.tip_m[i] = needle.tip_position_m[i];
+    r.direction[i] = needle.direction[i];
+    r.pose_position_m[i] = pose.position_m[i];
+    r.force_raw_N[i] = out.force_raw_N[i];
+    r.force_sent_N[i] = out.force_sent_N[i];
+  }
+  r.axial_velocity_m_per_s = needle.axial_velocity_m_per_s;
+  r.pose_orientation_wxyz[0] = pose.orientation.w();
+  r.pose_orientation_wxyz[1] = pose.orientation.x();
+  r.pose_orientation_wxyz[2] = pose.orientation.y();
+  r.pose_orientation_wxyz[3] = pose.orientation.z();
+  r.tissue_force_N = out.tissue_force_N;
+  r.depth_m = depth_m;
+  return r;
+}
+
+}  // namespace
 
 HapticLoop::HapticLoop(const Scene& scene, ModelSupplier& models, HapticDevice& device, ForceGuard guard,
                        HapticLoopOptions options, HapticLoopSinks sinks)
@@ -103,30 +134,9 @@ bool HapticLoop::step(std::int64_t n, double wall_time_s) {
   counters_.max_tissue_force_N = std::max(counters_.max_tissue_force_N, std::abs(out.tissue_force_N));
   counters_.max_sent_force_N = std::max(counters_.max_sent_force_N, out.force_sent_N.norm());
 
-  if (sinks_.recorder) {
-    TickRecord r;
-    r.tick = static_cast<std::uint64_t>(n);
-    r.flags = (fresh ? kRecFreshTissue : 0u) | ((flags & kOutMagnitudeClamped) ? kRecMagnitudeClamped : 0u) |
-              ((flags & kOutRateClamped) ? kRecRateClamped : 0u) | ((flags & kOutNoPose) ? kRecNoPose : 0u);
-    r.layer_states = out.layer_states;
-    r.wall_time_s = wall_time_s;
-    r.needle_time_s = needle.time_s;
-    for (int i = 0; i < 3; ++i) {
-      r.tip_m[i] = needle.tip_position_m[i];
-      r.direction[i] = needle.direction[i];
-      r.pose_position_m[i] = input_.pose.position_m[i];
-      r.force_raw_N[i] = out.force_raw_N[i];
-      r.force_sent_N[i] = out.force_sent_N[i];
-    }
-    r.axial_velocity_m_per_s = needle.axial_velocity_m_per_s;
-    r.pose_orientation_wxyz[0] = input_.pose.orientation.w();
-    r.pose_orientation_wxyz[1] = input_.pose.orientation.x();
-    r.pose_orientation_wxyz[2] = input_.pose.orientation.y();
-    r.pose_orientation_wxyz[3] = input_.pose.orientation.z();
-    r.tissue_force_N = out.tissue_force_N;
-    r.depth_m = result.depth_m;
-    if (!sinks_.recorder->push(r)) ++counters_.records_dropped;
-  }
+  if (sinks_.recorder &&
+      !sinks_.recorder->push(tick_record(n, wall_time_s, fresh, flags, needle, input_.pose, out, result.depth_m)))
+    ++counters_.records_dropped;
   publish(n, wall_time_s, result, out, flags);
   ++counters_.model_ticks;
   ++counters_.ticks;

@@ -71,4 +71,9 @@ class ModelSupplier {
   std::thread thread_;
 };
 
+/// The builder of a session's models: build_realtime_model(scene), the effects
+/// the scene lists (the same model as `puncture run`). `scene` must outlive
+/// the supplier.
+ModelSupplier::Builder scene_model_builder(const Scene& scene);
+
 }  // namespace puncture::realtime

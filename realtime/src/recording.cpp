@@ -85,6 +85,21 @@ TickRecord decode_record(const std::uint8_t* in) noexcept {
 
 // ---------------------------------------------------------------- writer
 
+nlohmann::json recording_header(const Scene& scene, const std::string& scene_file, const std::string& scene_text,
+                                const std::string& device_name, const nlohmann::json& provenance) {
+  nlohmann::json header = {{"format", "puncture-recording"},
+                           {"version", 1},
+                           {"scene_file", scene_file},
+                           {"scene_text", scene_text},
+                           {"device", device_name},
+                           {"haptic_rate_Hz", scene.realtime.haptic_rate_Hz},
+                           {"provenance", provenance}};
+  nlohmann::json names = nlohmann::json::array();
+  for (const Layer& l : scene.layers) names.push_back(l.name);
+  header["layers"] = names;
+  return header;
+}
+
 RecordingWriter::RecordingWriter(const std::filesystem::path& path, const nlohmann::json& header,
                                  std::size_t ring_capacity)
     : path_(path), partial_(path.string() + ".partial"), ring_(ring_capacity) {

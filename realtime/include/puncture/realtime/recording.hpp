@@ -87,6 +87,12 @@ struct TickRecord {
 void encode_record(const TickRecord& r, std::uint8_t (&out)[kRecordSize]) noexcept;
 TickRecord decode_record(const std::uint8_t* in) noexcept;
 
+/// The header of a session's recording (the JSON described above): `scene`'s
+/// file name and text verbatim, its layer names and haptic rate (Hz), the
+/// device's name and the session's provenance as given.
+nlohmann::json recording_header(const Scene& scene, const std::string& scene_file, const std::string& scene_text,
+                                const std::string& device_name, const nlohmann::json& provenance);
+
 class RecordingWriter {
  public:
   /// Opens "<path>.partial" and writes the header; throws std::runtime_error on IO errors.

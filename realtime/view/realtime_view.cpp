@@ -196,8 +196,195 @@ struct RealtimeView::Impl {
     renderer->ResetCameraClippingRange();
   }
 
+  // Building the scene graph (the constructor), in drawing order.
+  void create_window();
+  void add_layer(std::size_t k, const RealtimeModel& model);
+  void add_top_face(LayerActors& a, const Rgb& c);
+  void add_side_wall(const LayerActors& a);
+  void add_cap(LayerActors& a, const Rgb& c);
+  void add_hole(LayerActors& a);
+  void add_nodes(LayerActors& a);
+  void add_needle();
+  void add_overlay();
+  void create_interactor();
+
   void update_text(const ViewSnapshot& snap, const ViewStatus& status);
 };
+
+void RealtimeView::Impl::create_window() {
+  window = vtkSmartPointer<vtkRenderWindow>::New();
+  window->SetSize(options.width, options.height);
+  window->SetWindowName(options.title.c_str());
+  window->SetMultiSamples(0);  // multisampling costs 4x in software rendering (llvmpipe)
+  if (options.offscreen) window->SetOffScreenRendering(1);
+
+  renderer = vtkSmartPointer<vtkRenderer>::New();
+  renderer->SetBackground(0.20, 0.23, 0.29);  // solid: a gradient costs a full-screen pass in software rendering
+  window->AddRenderer(renderer);
+}
+
+// Layers: back half of the top face and side wall, and the cut face at y = 0.
+void RealtimeView::Impl::add_layer(std::size_t k, const RealtimeModel& model) {
+  LayerActors a;
+  a.mesh = build_layer_view_mesh(*model.surfaces[k], layer_disc(scene, k).bottom_z_m);
+  const PunctureSimulator& sim = *model.simulator;
+  if (const ForceMesh* fm = sim.force_mesh(k))
+    a.deformer = std::make_unique<LayerDeformer>(fm->lattice(), scene.layers[k].force_mesh.spacing_L_m);
+  a.vertices = a.mesh.rest_vertices;
+  a.points = vtkSmartPointer<vtkPoints>::New();
+  a.points->SetDataTypeToDouble();
+  set_points(a.points, a.vertices);
+  const Rgb c = layer_colour(k);
+  add_top_face(a, c);
+  add_side_wall(a);
+  add_cap(a, c);
+  add_hole(a);
+  add_nodes(a);
+  layers.push_back(std::move(a));
+}
+
+// Top face: points shared with the cap, updated when the force mesh moves;
+// its normals are recomputed then.
+void RealtimeView::Impl::add_top_face(LayerActors& a, const Rgb& c) {
+  a.shell = vtkSmartPointer<vtkPolyData>::New();
+  a.shell->SetPoints(a.points);
+  a.shell->SetPolys(triangles_of(a.mesh.top_triangles));
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputData(a.shell);
+  normals->SplittingOff();  // a smooth surface: no feature edges to split
+  normals->ConsistencyOff();
+  normals->AutoOrientNormalsOff();
+  vtkNew<vtkPolyDataMapper> shell_mapper;
+  shell_mapper->SetInputConnection(normals->GetOutputPort());
+  a.shell_actor = vtkSmartPointer<vtkActor>::New();
+  a.shell_actor->SetMapper(shell_mapper);
+  a.shell_actor->GetProperty()->SetColor(c.r, c.g, c.b);
+  a.shell_actor->GetProperty()->SetAmbient(0.30);
+  a.shell_actor->GetProperty()->SetDiffuse(0.75);
+  a.shell_actor->GetProperty()->SetSpecular(0.15);
+  a.shell_actor->GetProperty()->SetSpecularPower(20.0);
+  a.shell_actor->GetProperty()->BackfaceCullingOn();
+  renderer->AddActor(a.shell_actor);
+}
+
+// Side wall: its own points, never deformed; the top face's material.
+void RealtimeView::Impl::add_side_wall(const LayerActors& a) {
+  vtkNew<vtkPoints> side_points;
+  side_points->SetDataTypeToDouble();
+  set_points(side_points, a.mesh.rest_vertices);
+  vtkNew<vtkPolyData> side;
+  side->SetPoints(side_points);
+  side->SetPolys(triangles_of(a.mesh.side_triangles));
+  vtkNew<vtkPolyDataNormals> side_normals;
+  side_normals->SetInputData(side);
+  side_normals->SplittingOff();
+  side_normals->ConsistencyOff();
+  side_normals->AutoOrientNormalsOff();
+  vtkNew<vtkPolyDataMapper> side_mapper;
+  side_mapper->SetInputConnection(side_normals->GetOutputPort());
+  vtkNew<vtkActor> side_actor;
+  side_actor->SetMapper(side_mapper);
+  side_actor->SetProperty(a.shell_actor->GetProperty());
+  renderer->AddActor(side_actor);
+}
+
+// The cut face at y = 0, a shade darker than the top face.
+void RealtimeView::Impl::add_cap(LayerActors& a, const Rgb& c) {
+  a.cap = vtkSmartPointer<vtkPolyData>::New();
+  a.cap->SetPoints(a.points);
+  a.cap->SetPolys(triangles_of(a.mesh.cap_triangles));
+  vtkNew<vtkPolyDataMapper> cap_mapper;
+  cap_mapper->SetInputData(a.cap);
+  a.cap_actor = vtkSmartPointer<vtkActor>::New();
+  a.cap_actor->SetMapper(cap_mapper);
+  a.cap_actor->GetProperty()->SetColor(0.85 * c.r, 0.85 * c.g, 0.85 * c.b);
+  a.cap_actor->GetProperty()->SetAmbient(0.35);
+  a.cap_actor->GetProperty()->SetDiffuse(0.70);
+  a.cap_actor->GetProperty()->BackfaceCullingOn();
+  renderer->AddActor(a.cap_actor);
+}
+
+// Puncture hole: a dark ring around the needle at the entry point.
+void RealtimeView::Impl::add_hole(LayerActors& a) {
+  vtkNew<vtkDiskSource> disk;
+  disk->SetInnerRadius(scene.needle.radius_m);
+  disk->SetOuterRadius(3.0 * scene.needle.radius_m);
+  disk->SetCircumferentialResolution(48);
+  vtkNew<vtkPolyDataMapper> disk_mapper;
+  disk_mapper->SetInputConnection(disk->GetOutputPort());
+  a.hole_actor = vtkSmartPointer<vtkActor>::New();
+  a.hole_actor->SetMapper(disk_mapper);
+  a.hole_actor->GetProperty()->SetColor(0.30, 0.05, 0.05);
+  a.hole_actor->GetProperty()->LightingOff();
+  a.hole_actor->VisibilityOff();
+  renderer->AddActor(a.hole_actor);
+}
+
+// Force-mesh nodes (back half), shown while the layer is pressed or resuming.
+void RealtimeView::Impl::add_nodes(LayerActors& a) {
+  a.node_points = vtkSmartPointer<vtkPoints>::New();
+  a.nodes = vtkSmartPointer<vtkPolyData>::New();
+  a.nodes->SetPoints(a.node_points);
+  a.nodes->SetVerts(vtkSmartPointer<vtkCellArray>::New());
+  vtkNew<vtkPolyDataMapper> node_mapper;
+  node_mapper->SetInputData(a.nodes);
+  a.nodes_actor = vtkSmartPointer<vtkActor>::New();
+  a.nodes_actor->SetMapper(node_mapper);
+  a.nodes_actor->GetProperty()->SetColor(0.12, 0.16, 0.45);
+  a.nodes_actor->GetProperty()->SetPointSize(4.0);
+  renderer->AddActor(a.nodes_actor);
+}
+
+// Needle: a cylinder along its axis, ending at the tip.
+void RealtimeView::Impl::add_needle() {
+  vtkNew<vtkCylinderSource> cylinder;
+  cylinder->SetRadius(scene.needle.radius_m);
+  needle_length_m = 0.5 * scene.sample.diameter_m + scene.insertion.start_height_m;
+  cylinder->SetHeight(needle_length_m);
+  cylinder->SetResolution(24);
+  vtkNew<vtkPolyDataMapper> needle_mapper;
+  needle_mapper->SetInputConnection(cylinder->GetOutputPort());
+  needle_actor = vtkSmartPointer<vtkActor>::New();
+  needle_actor->SetMapper(needle_mapper);
+  needle_actor->GetProperty()->SetColor(0.80, 0.82, 0.86);
+  needle_actor->GetProperty()->SetSpecular(0.8);
+  needle_actor->GetProperty()->SetSpecularPower(60.0);
+  renderer->AddActor(needle_actor);
+}
+
+// Overlay text, and the key bindings at the bottom of an interactive window with the mouse device.
+void RealtimeView::Impl::add_overlay() {
+  text = vtkSmartPointer<vtkTextActor>::New();
+  text->GetTextProperty()->SetFontFamilyToCourier();
+  text->GetTextProperty()->SetFontSize(16);
+  text->GetTextProperty()->SetColor(0.95, 0.95, 0.95);
+  text->GetTextProperty()->SetVerticalJustificationToTop();
+  text->GetPositionCoordinate()->SetCoordinateSystemToNormalizedDisplay();
+  text->GetPositionCoordinate()->SetValue(0.01, 0.985);
+  renderer->AddViewProp(text);
+  if (pointer && !options.offscreen) {
+    help = vtkSmartPointer<vtkTextActor>::New();
+    help->SetInput(
+        "wheel, Up/Down: depth   Shift+drag: depth and x   Left/Right, PgUp/PgDn: x, y   Home: start   "
+        "n: fresh tissue   c: camera   q: quit");
+    help->GetTextProperty()->SetFontSize(13);
+    help->GetTextProperty()->SetColor(0.8, 0.85, 0.9);
+    help->GetPositionCoordinate()->SetCoordinateSystemToNormalizedDisplay();
+    help->GetPositionCoordinate()->SetValue(0.01, 0.01);
+    renderer->AddViewProp(help);
+  }
+}
+
+void RealtimeView::Impl::create_interactor() {
+  interactor = vtkSmartPointer<vtkRenderWindowInteractor>::New();
+  interactor->SetRenderWindow(window);
+  vtkNew<NeedleInteractorStyle> style;
+  style->pointer = pointer;
+  Impl* impl = this;
+  style->reset_camera = [impl] { impl->reset_camera(); };
+  interactor->SetInteractorStyle(style);
+  interactor->Initialize();
+}
 
 RealtimeView::RealtimeView(const Scene& scene, const RealtimeModel& model, ViewOptions options, PointerDevice* pointer)
     : impl_(std::make_unique<Impl>()) {
@@ -205,164 +392,15 @@ RealtimeView::RealtimeView(const Scene& scene, const RealtimeModel& model, ViewO
   m.scene = scene;
   m.options = options;
   m.pointer = pointer;
-
-  m.window = vtkSmartPointer<vtkRenderWindow>::New();
-  m.window->SetSize(options.width, options.height);
-  m.window->SetWindowName(options.title.c_str());
-  m.window->SetMultiSamples(0);  // multisampling costs 4x in software rendering (llvmpipe)
-  if (options.offscreen) m.window->SetOffScreenRendering(1);
-
-  m.renderer = vtkSmartPointer<vtkRenderer>::New();
-  m.renderer->SetBackground(0.20, 0.23, 0.29);  // solid: a gradient costs a full-screen pass in software rendering
-  m.window->AddRenderer(m.renderer);
-
-  // Layers: back half of the top face and side wall, and the cut face at y = 0.
-  const PunctureSimulator& sim = *model.simulator;
-  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
-    Impl::LayerActors a;
-    a.mesh = build_layer_view_mesh(*model.surfaces[k], layer_disc(scene, k).bottom_z_m);
-    if (const ForceMesh* fm = sim.force_mesh(k))
-      a.deformer = std::make_unique<LayerDeformer>(fm->lattice(), scene.layers[k].force_mesh.spacing_L_m);
-    a.vertices = a.mesh.rest_vertices;
-    a.points = vtkSmartPointer<vtkPoints>::New();
-    a.points->SetDataTypeToDouble();
-    set_points(a.points, a.vertices);
-    const Rgb c = layer_colour(k);
-
-    // Top face: points shared with the cap, updated when the force mesh moves;
-    // its normals are recomputed then. Side wall: its own points, never deformed.
-    a.shell = vtkSmartPointer<vtkPolyData>::New();
-    a.shell->SetPoints(a.points);
-    a.shell->SetPolys(triangles_of(a.mesh.top_triangles));
-    vtkNew<vtkPolyDataNormals> normals;
-    normals->SetInputData(a.shell);
-    normals->SplittingOff();  // a smooth surface: no feature edges to split
-    normals->ConsistencyOff();
-    normals->AutoOrientNormalsOff();
-    vtkNew<vtkPolyDataMapper> shell_mapper;
-    shell_mapper->SetInputConnection(normals->GetOutputPort());
-    a.shell_actor = vtkSmartPointer<vtkActor>::New();
-    a.shell_actor->SetMapper(shell_mapper);
-    a.shell_actor->GetProperty()->SetColor(c.r, c.g, c.b);
-    a.shell_actor->GetProperty()->SetAmbient(0.30);
-    a.shell_actor->GetProperty()->SetDiffuse(0.75);
-    a.shell_actor->GetProperty()->SetSpecular(0.15);
-    a.shell_actor->GetProperty()->SetSpecularPower(20.0);
-    a.shell_actor->GetProperty()->BackfaceCullingOn();
-    m.renderer->AddActor(a.shell_actor);
-
-    vtkNew<vtkPoints> side_points;
-    side_points->SetDataTypeToDouble();
-    set_points(side_points, a.mesh.rest_vertices);
-    vtkNew<vtkPolyData> side;
-    side->SetPoints(side_points);
-    side->SetPolys(triangles_of(a.mesh.side_triangles));
-    vtkNew<vtkPolyDataNormals> side_normals;
-    side_normals->SetInputData(side);
-    side_normals->SplittingOff();
-    side_normals->ConsistencyOff();
-    side_normals->AutoOrientNormalsOff();
-    vtkNew<vtkPolyDataMapper> side_mapper;
-    side_mapper->SetInputConnection(side_normals->GetOutputPort());
-    vtkNew<vtkActor> side_actor;
-    side_actor->SetMapper(side_mapper);
-    side_actor->SetProperty(a.shell_actor->GetProperty());
-    m.renderer->AddActor(side_actor);
-
-    a.cap = vtkSmartPointer<vtkPolyData>::New();
-    a.cap->SetPoints(a.points);
-    a.cap->SetPolys(triangles_of(a.mesh.cap_triangles));
-    vtkNew<vtkPolyDataMapper> cap_mapper;
-    cap_mapper->SetInputData(a.cap);
-    a.cap_actor = vtkSmartPointer<vtkActor>::New();
-    a.cap_actor->SetMapper(cap_mapper);
-    a.cap_actor->GetProperty()->SetColor(0.85 * c.r, 0.85 * c.g, 0.85 * c.b);
-    a.cap_actor->GetProperty()->SetAmbient(0.35);
-    a.cap_actor->GetProperty()->SetDiffuse(0.70);
-    a.cap_actor->GetProperty()->BackfaceCullingOn();
-    m.renderer->AddActor(a.cap_actor);
-
-    // Puncture hole: a dark ring around the needle at the entry point.
-    vtkNew<vtkDiskSource> disk;
-    disk->SetInnerRadius(scene.needle.radius_m);
-    disk->SetOuterRadius(3.0 * scene.needle.radius_m);
-    disk->SetCircumferentialResolution(48);
-    vtkNew<vtkPolyDataMapper> disk_mapper;
-    disk_mapper->SetInputConnection(disk->GetOutputPort());
-    a.hole_actor = vtkSmartPointer<vtkActor>::New();
-    a.hole_actor->SetMapper(disk_mapper);
-    a.hole_actor->GetProperty()->SetColor(0.30, 0.05, 0.05);
-    a.hole_actor->GetProperty()->LightingOff();
-    a.hole_actor->VisibilityOff();
-    m.renderer->AddActor(a.hole_actor);
-
-    // Force-mesh nodes (back half), shown while the layer is pressed or resuming.
-    a.node_points = vtkSmartPointer<vtkPoints>::New();
-    a.nodes = vtkSmartPointer<vtkPolyData>::New();
-    a.nodes->SetPoints(a.node_points);
-    a.nodes->SetVerts(vtkSmartPointer<vtkCellArray>::New());
-    vtkNew<vtkPolyDataMapper> node_mapper;
-    node_mapper->SetInputData(a.nodes);
-    a.nodes_actor = vtkSmartPointer<vtkActor>::New();
-    a.nodes_actor->SetMapper(node_mapper);
-    a.nodes_actor->GetProperty()->SetColor(0.12, 0.16, 0.45);
-    a.nodes_actor->GetProperty()->SetPointSize(4.0);
-    m.renderer->AddActor(a.nodes_actor);
-    m.layers.push_back(std::move(a));
-  }
-
-  // Needle: a cylinder along its axis, ending at the tip.
-  vtkNew<vtkCylinderSource> cylinder;
-  cylinder->SetRadius(scene.needle.radius_m);
-  m.needle_length_m = 0.5 * scene.sample.diameter_m + scene.insertion.start_height_m;
-  cylinder->SetHeight(m.needle_length_m);
-  cylinder->SetResolution(24);
-  vtkNew<vtkPolyDataMapper> needle_mapper;
-  needle_mapper->SetInputConnection(cylinder->GetOutputPort());
-  m.needle_actor = vtkSmartPointer<vtkActor>::New();
-  m.needle_actor->SetMapper(needle_mapper);
-  m.needle_actor->GetProperty()->SetColor(0.80, 0.82, 0.86);
-  m.needle_actor->GetProperty()->SetSpecular(0.8);
-  m.needle_actor->GetProperty()->SetSpecularPower(60.0);
-  m.renderer->AddActor(m.needle_actor);
-
-  // Overlay text.
-  m.text = vtkSmartPointer<vtkTextActor>::New();
-  m.text->GetTextProperty()->SetFontFamilyToCourier();
-  m.text->GetTextProperty()->SetFontSize(16);
-  m.text->GetTextProperty()->SetColor(0.95, 0.95, 0.95);
-  m.text->GetTextProperty()->SetVerticalJustificationToTop();
-  m.text->GetPositionCoordinate()->SetCoordinateSystemToNormalizedDisplay();
-  m.text->GetPositionCoordinate()->SetValue(0.01, 0.985);
-  m.renderer->AddViewProp(m.text);
-  if (pointer && !options.offscreen) {
-    m.help = vtkSmartPointer<vtkTextActor>::New();
-    m.help->SetInput(
-        "wheel, Up/Down: depth   Shift+drag: depth and x   Left/Right, PgUp/PgDn: x, y   Home: start   "
-        "n: fresh tissue   c: camera   q: quit");
-    m.help->GetTextProperty()->SetFontSize(13);
-    m.help->GetTextProperty()->SetColor(0.8, 0.85, 0.9);
-    m.help->GetPositionCoordinate()->SetCoordinateSystemToNormalizedDisplay();
-    m.help->GetPositionCoordinate()->SetValue(0.01, 0.01);
-    m.renderer->AddViewProp(m.help);
-  }
-
+  m.create_window();
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) m.add_layer(k, model);
+  m.add_needle();
+  m.add_overlay();
   // Live force-depth graph in the lower right corner.
   m.graph.build(m.renderer, 0.60, 0.06, 0.985, 0.46, std::max(scene.insertion.target_depth_m, 5e-3) / kMm,
                 std::max(0.5, options.graph_max_force_N));
-
   m.reset_camera();
-
-  if (!options.offscreen) {
-    m.interactor = vtkSmartPointer<vtkRenderWindowInteractor>::New();
-    m.interactor->SetRenderWindow(m.window);
-    vtkNew<NeedleInteractorStyle> style;
-    style->pointer = pointer;
-    Impl* impl = &m;
-    style->reset_camera = [impl] { impl->reset_camera(); };
-    m.interactor->SetInteractorStyle(style);
-    m.interactor->Initialize();
-  }
+  if (!options.offscreen) m.create_interactor();
 }
 
 RealtimeView::~RealtimeView() = default;

@@ -70,4 +70,8 @@ std::string ModelSupplier::error() const {
   return error_;
 }
 
+ModelSupplier::Builder scene_model_builder(const Scene& scene) {
+  return [&scene] { return std::make_unique<RealtimeModel>(build_realtime_model(scene)); };
+}
+
 }  // namespace puncture::realtime
