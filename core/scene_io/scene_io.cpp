@@ -130,6 +130,29 @@ ForceMeshParams read_force_mesh(ObjectReader r) {
   return p;
 }
 
+/// material.viscoelastic: {"prony": [{"g", "tau_s"}, ...], "modulus": "instantaneous" | "long_term", "source"}.
+Viscoelasticity read_viscoelastic(ObjectReader r, const std::string& file) {
+  Viscoelasticity v;
+  const json& terms = r.raw("prony");
+  if (!terms.is_array() || terms.empty())
+    r.fail(r.child("prony"), "must be a non-empty array of {g, tau_s} objects");
+  for (std::size_t i = 0; i < terms.size(); ++i) {
+    ObjectReader t(terms[i], r.child("prony") + "/" + std::to_string(i), file);
+    v.terms.push_back(PronyRelaxationTerm{t.number("g"), t.number("tau_s")});
+    t.reject_unknown_keys();
+  }
+  const std::string basis = r.string("modulus");
+  if (basis == "instantaneous")
+    v.modulus_basis = Viscoelasticity::ModulusBasis::Instantaneous;
+  else if (basis == "long_term")
+    v.modulus_basis = Viscoelasticity::ModulusBasis::LongTerm;
+  else
+    r.fail(r.child("modulus"), "unknown modulus basis '" + basis + "' (known: instantaneous, long_term)");
+  v.source = r.string("source", "");
+  r.reject_unknown_keys();
+  return v;
+}
+
 ContinuumMaterial read_material(ObjectReader r, const std::string& file) {
   ContinuumMaterial m;
   m.model = r.string("model", m.model);
@@ -150,6 +173,8 @@ ContinuumMaterial read_material(ObjectReader r, const std::string& file) {
     }
   }
   m.veronda_westmann_gamma = r.number("veronda_westmann_gamma", m.veronda_westmann_gamma);
+  if (r.has("viscoelastic"))
+    m.viscoelastic = read_viscoelastic(ObjectReader(r.raw("viscoelastic"), r.child("viscoelastic"), file), file);
   m.source = r.string("source", "");
   r.reject_unknown_keys();
   return m;
@@ -432,6 +457,21 @@ void require(bool ok, const std::string& file, const std::string& path, const st
   throw SceneError(file, path, msg.str());
 }
 
+/// Prony terms: each g_i in (0, 1) and tau_i in [1e-6, 1e6] s; the g_i sum
+/// to less than 1 (a solid keeps part of its stress at equilibrium).
+void validate_viscoelastic(const Viscoelasticity& v, const std::string& file, const std::string& p) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < v.terms.size(); ++i) {
+    const std::string tp = p + "/prony/" + std::to_string(i);
+    require(v.terms[i].g > 0 && v.terms[i].g < 1, file, tp + "/g", "in (0, 1)", v.terms[i].g);
+    require(v.terms[i].tau_s >= 1e-6 && v.terms[i].tau_s <= 1e6, file, tp + "/tau_s", "in [1e-6, 1e6] s",
+            v.terms[i].tau_s);
+    sum += v.terms[i].g;
+  }
+  require(sum < 0.99, file, p + "/prony",
+          "g_i summing to less than 0.99 (the relaxed fraction 1 - sum g_i must stay above 1 %)", sum);
+}
+
 /// The layer's force_law object (every value is checked, used or not: a
 /// scene that switches an effect on later must already be valid).
 void validate_force_law(const ForceLaw& law, const std::string& file, const std::string& p, double thickness_m) {
@@ -548,6 +588,7 @@ void validate_scene(const Scene& s, const std::string& file) {
     }
     require(m.veronda_westmann_gamma > 0 && m.veronda_westmann_gamma <= 100, file,
             p + "/material/veronda_westmann_gamma", "in (0, 100]", m.veronda_westmann_gamma);
+    validate_viscoelastic(m.viscoelastic, file, p + "/material/viscoelastic");
     const PunctureCriterion& c = l.puncture;
     if (c.kind == PunctureCriterion::Kind::CriticalForce)
       require(c.critical_force_N > 0, file, p + "/puncture/critical_force_N", "> 0", c.critical_force_N);
@@ -702,6 +743,14 @@ Scene load_scene(const std::filesystem::path& path) {
 
 namespace {
 
+json viscoelastic_json(const Viscoelasticity& v) {
+  json terms = json::array();
+  for (const PronyRelaxationTerm& t : v.terms) terms.push_back({{"g", t.g}, {"tau_s", t.tau_s}});
+  return {{"prony", terms},
+          {"modulus", v.modulus_basis == Viscoelasticity::ModulusBasis::Instantaneous ? "instantaneous" : "long_term"},
+          {"source", v.source}};
+}
+
 json force_law_json(const ForceLaw& law) {
   json j;
   const BreakthroughCriterion& b = law.breakthrough;
@@ -770,6 +819,7 @@ std::string scene_to_json_text(const Scene& s) {
       for (const OgdenTerm& t : l.material.ogden_terms) terms.push_back({{"mu_fraction", t.mu_fraction}, {"alpha", t.alpha}});
       j["material"]["ogden_terms"] = terms;
     }
+    if (l.material.viscoelastic.enabled()) j["material"]["viscoelastic"] = viscoelastic_json(l.material.viscoelastic);
     const PunctureCriterion& c = l.puncture;
     if (c.kind == PunctureCriterion::Kind::CriticalForce)
       j["puncture"] = {{"criterion", "critical_force"}, {"critical_force_N", c.critical_force_N}};

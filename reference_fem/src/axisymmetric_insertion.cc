@@ -53,8 +53,10 @@ struct TrajectoryPoint {
 };
 
 /// The scene's trajectory as the list of step end points: the approach to the
-/// surface in one step, insertion in steps of load_step, the dwell in two
-/// steps, withdrawal in steps of twice the load step back to the start height.
+/// surface in one step, insertion in steps of load_step, the dwell in steps
+/// that start at an insertion step's duration and double (a relaxation is
+/// fast at first, slow later), withdrawal in steps of twice the load step back
+/// to the start height.
 std::vector<TrajectoryPoint> trajectory(const Scene& scene, double stop_depth_m) {
   const Insertion& in = scene.insertion;
   const double step = scene.fem.load_step_m;
@@ -70,8 +72,13 @@ std::vector<TrajectoryPoint> trajectory(const Scene& scene, double stop_depth_m)
   t += target / in.speed_m_per_s;
   if (stop_depth_m > 0.0) return out;  // a study stops at this depth
   if (in.dwell_s > 0.0) {
-    out.push_back({t + 0.5 * in.dwell_s, target, "dwell"});
-    out.push_back({t + in.dwell_s, target, "dwell"});
+    double held = 0.0, dt = step / in.speed_m_per_s;
+    while (held < in.dwell_s) {
+      // Never leave a last sliver shorter than half a step.
+      held = held + 1.5 * dt >= in.dwell_s ? in.dwell_s : held + dt;
+      out.push_back({t + held, target, "dwell"});
+      dt *= 2.0;
+    }
     t += in.dwell_s;
   }
   const double w_step = 2.0 * step, end = -in.start_height_m;
@@ -83,19 +90,39 @@ std::vector<TrajectoryPoint> trajectory(const Scene& scene, double stop_depth_m)
   return out;
 }
 
-/// Per-layer crack laws and friction from the scene.
+/// Per-layer materials (the long-term laws of viscoelastic layers), Prony
+/// series (empty: elastic), crack laws and friction from the scene.
 struct LayerLaws {
   std::vector<LayerMaterial> materials;
+  std::vector<std::vector<PronyTerm>> prony;
   std::vector<LayerCrack> cracks;
   std::vector<FrictionCoefficients> friction;
 };
+
+/// The layer's long-term law: its material, scaled by the relaxed fraction
+/// g_inf when the scene's modulus is the instantaneous one (nu kept, so the
+/// bulk modulus scales with it).
+LayerMaterial long_term_material(const ContinuumMaterial& m) {
+  const Viscoelasticity& v = m.viscoelastic;
+  if (!v.enabled() || v.modulus_basis == Viscoelasticity::ModulusBasis::LongTerm) return LayerMaterial(m);
+  ContinuumMaterial relaxed = m;
+  relaxed.youngs_modulus_Pa *= v.relaxed_fraction();
+  return LayerMaterial(relaxed);
+}
+
+std::vector<PronyTerm> prony_terms(const Viscoelasticity& v) {
+  std::vector<NormalisedPronyTerm> normalised;
+  for (const PronyRelaxationTerm& t : v.terms) normalised.push_back({t.g, t.tau_s});
+  return prony_terms_from_normalised(normalised);
+}
 
 LayerLaws layer_laws(const Scene& scene, double crack_radius_m) {
   LayerLaws laws;
   const bool bevel = scene.needle.tip == "bevel";
   const double a = scene.needle.radius_m;
   for (const Layer& l : scene.layers) {
-    laws.materials.emplace_back(l.material);
+    laws.materials.push_back(long_term_material(l.material));
+    laws.prony.push_back(prony_terms(l.material.viscoelastic));
     LayerCrack c;
     if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy) {
       c.kind = LayerCrack::Kind::Cohesive;
@@ -260,6 +287,7 @@ AxisymmetricInsertionRun::AxisymmetricInsertionRun(const Scene& scene, const Fem
       peak_time_(n_layers_, 0.0),
       peak_profile_(n_layers_),
       depth_(-scene.insertion.start_height_m) {
+  solver_.set_viscoelasticity(laws_.prony);
   solver_.setup(0.5 * scene.sample.diameter_m, scene.total_thickness_m());
   describe_model(comm);
   if (options.write_files) std::filesystem::create_directories(out_dir_);

@@ -105,8 +105,17 @@ struct CellState {
   std::vector<std::vector<double>> Np;
 };
 
+/// A viscoelastic cell's law, its points' committed histories and the step
+/// (law nullptr: elastic).
+struct ViscousCell {
+  const ViscoelasticMaterial<LayerMaterial>* law = nullptr;
+  const std::vector<ViscoelasticHistory>* history = nullptr;
+  double dt_s = 0.0;
+};
+
 bool evaluate_cell(const LayerMaterial& material, unsigned degree, const FEValues<2>& fev,
-                   const std::vector<Tensor<2, 3>>& H, CellState& st, bool with_tangent = true) {
+                   const std::vector<Tensor<2, 3>>& H, CellState& st, bool with_tangent = true,
+                   const ViscousCell& viscous = {}) {
   const unsigned nq = fev.n_quadrature_points, np = n_pressure_modes(degree);
   st.F.resize(nq);
   st.J.resize(nq);
@@ -150,12 +159,21 @@ bool evaluate_cell(const LayerMaterial& material, unsigned degree, const FEValue
   for (unsigned q = 0; q < nq; ++q) {
     for (unsigned a = 0; a < np; ++a) pressure[q] += cp[a] * st.Np[q][a];
     const SymTensor2 C = right_cauchy_green(st.F[q]);
-    if (with_tangent) {
+    if (viscous.law) {  // long-term law + Prony stresses from the committed history
+      const ViscoelasticHistory& h = (*viscous.history)[q];
+      if (with_tangent)
+        viscous.law->isochoric_stress_and_tangent(C, viscous.dt_s, h, st.S[q], st.CC[q]);
+      else
+        st.S[q] = viscous.law->isochoric_stress(C, viscous.dt_s, h);
+    } else if (with_tangent) {
       material.isochoric_stress_and_tangent(C, st.S[q], st.CC[q]);
-      add_volumetric_at_fixed_pressure(invert(C), st.J[q], pressure[q], st.S[q], st.CC[q]);
     } else {  // residual only: the stress without its tangent
-      st.S[q] = material.isochoric_stress(C) + (pressure[q] * st.J[q]) * invert(C);
+      st.S[q] = material.isochoric_stress(C);
     }
+    if (with_tangent)
+      add_volumetric_at_fixed_pressure(invert(C), st.J[q], pressure[q], st.S[q], st.CC[q]);
+    else
+      st.S[q] += (pressure[q] * st.J[q]) * invert(C);
     if (!finite(st.S[q])) return false;
   }
   return true;
@@ -406,8 +424,51 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
   broken_layers_.assign(materials_.size(), 0);
   dissipated_J_ = dissipated_trial_J_ = 0.0;
   stabilization_J_ = stabilization_trial_J_ = 0.0;
+  const unsigned n_points = (settings_.degree + 1) * (settings_.degree + 1);
+  viscous_history_.assign(triangulation_.n_active_cells(), {});
+  for (const auto& cell : dof_handler_.active_cell_iterators())
+    if (const ViscoelasticMaterial<LayerMaterial>* law = viscoelastic_of(cell))
+      viscous_history_[cell->active_cell_index()].assign(n_points, law->initial_history());
   assemble(solution_, true);
   update_penalties();
+}
+
+void AxisymmetricSolver::set_viscoelasticity(const std::vector<std::vector<PronyTerm>>& prony_per_layer) {
+  if (prony_per_layer.size() != materials_.size())
+    throw std::invalid_argument("AxisymmetricSolver: one Prony series (possibly empty) per layer");
+  viscoelastic_.assign(materials_.size(), std::nullopt);
+  for (std::size_t l = 0; l < materials_.size(); ++l)
+    if (!prony_per_layer[l].empty()) viscoelastic_[l] = make_viscoelastic_layer(materials_[l], prony_per_layer[l]);
+}
+
+const ViscoelasticMaterial<LayerMaterial>* AxisymmetricSolver::viscoelastic_of(
+    const DoFHandler<2>::active_cell_iterator& cell) const {
+  if (viscoelastic_.empty() || core_cell_[cell->active_cell_index()]) return nullptr;
+  const auto& law = viscoelastic_[cell->material_id()];
+  return law ? &*law : nullptr;
+}
+
+void AxisymmetricSolver::commit_viscous_history() {
+  const QGauss<2> quadrature(settings_.degree + 1);
+  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points);
+  const FEValuesExtractors::Scalar ur(0), uz(1);
+  const unsigned nq = quadrature.size();
+  std::vector<Tensor<1, 2>> g_ur(nq), g_uz(nq);
+  std::vector<double> v_ur(nq);
+  for (const auto& cell : cells_) {
+    const ViscoelasticMaterial<LayerMaterial>* law = viscoelastic_of(cell);
+    if (!law) continue;
+    fev.reinit(cell);
+    fev[ur].get_function_gradients(solution_, g_ur);
+    fev[uz].get_function_gradients(solution_, g_uz);
+    fev[ur].get_function_values(solution_, v_ur);
+    std::vector<ViscoelasticHistory>& history = viscous_history_[cell->active_cell_index()];
+    for (unsigned q = 0; q < nq; ++q) {
+      const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) +
+                             displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+      law->commit(right_cauchy_green(F), dt_s_, history[q]);
+    }
+  }
 }
 
 const LayerMaterial& AxisymmetricSolver::material_of(const DoFHandler<2>::active_cell_iterator& cell) const {
@@ -508,7 +569,8 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
     fev[ur].get_function_values(u, v_ur);
     for (unsigned q = 0; q < nq; ++q)
       H[q] = displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
-    if (!evaluate_cell(material_of(cell), degree, fev, H, st, with_matrix)) return false;
+    const ViscousCell viscous{viscoelastic_of(cell), &viscous_history_[cell->active_cell_index()], dt_s_};
+    if (!evaluate_cell(material_of(cell), degree, fev, H, st, with_matrix, viscous)) return false;
     Ke = 0.0;
     Re = 0.0;
     B = 0.0;
@@ -730,6 +792,7 @@ void AxisymmetricSolver::update_penalties() {
 }
 
 void AxisymmetricSolver::commit() {
+  commit_viscous_history();
   cohesive_committed_ = cohesive_trial_;
   friction_committed_ = friction_trial_;
   dissipated_J_ = dissipated_trial_J_;
@@ -740,7 +803,7 @@ void AxisymmetricSolver::commit() {
 AxisymmetricSolver::Snapshot AxisymmetricSolver::snapshot() const {
   return {solution_,          last_increment_,     cohesive_committed_, friction_committed_,
           punch_contact_,     punch_lateral_hold_, broken_layers_,      dissipated_J_,
-          stabilization_J_};
+          stabilization_J_,   viscous_history_};
 }
 
 void AxisymmetricSolver::restore(const Snapshot& s) {
@@ -753,8 +816,12 @@ void AxisymmetricSolver::restore(const Snapshot& s) {
   broken_layers_ = s.broken_layers;
   dissipated_J_ = dissipated_trial_J_ = s.dissipated_J;
   stabilization_J_ = stabilization_trial_J_ = s.stabilization_J;
+  viscous_history_ = s.viscous_history;
   step_start_ = solution_;
+  const double dt_s = dt_s_;  // the restored state itself: no step, no viscous advance
+  dt_s_ = 0.0;
   assemble(solution_, true);
+  dt_s_ = dt_s;
   force_ = force_trial_;
   update_penalties();
 }
@@ -1053,7 +1120,9 @@ void AxisymmetricSolver::write_vtu(const std::string& path) const {
     fev[ur].get_function_values(solution_, v_ur);
     for (unsigned q = 0; q < nq; ++q) H[q] = displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
     layer(c) = cell->material_id();
-    const bool ok = evaluate_cell(material_of(cell), settings_.degree, fev, H, st);
+    // dt = 0 with the committed history: the committed (converged) stress.
+    const ViscousCell viscous{viscoelastic_of(cell), &viscous_history_[c], 0.0};
+    const bool ok = evaluate_cell(material_of(cell), settings_.degree, fev, H, st, true, viscous);
     double j_sum = 0.0, vm_sum = 0.0, s_max = 1.0;
     for (unsigned q = 0; q < nq; ++q) {
       const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) + H[q];

@@ -810,6 +810,9 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
     if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy)
       throw std::invalid_argument("fem: the 3d reference has no fracture_energy criterion (layer '" + l.name +
                                   "'); use geometry axisymmetric");
+    else if (l.material.viscoelastic.enabled())
+      throw std::invalid_argument("fem: the 3d reference has no viscoelastic layers (layer '" + l.name +
+                                  "', material.viscoelastic); use geometry axisymmetric");
   SlabInsertionRun run(scene, options, comm);  // slab, solver, node sets
   return run.run();  // per load step: advance, detect puncture, open the hole, release, record; write
 }

@@ -103,3 +103,67 @@ TEST(AxisymmetricSolver, ThinBondedLayerMatchesBottomEffectCorrection) {
   const double sneddon = 2 * E * a * depth / (1 - nu * nu);
   EXPECT_NEAR(q.force_N / sneddon, 1.95, 0.05 * 1.95) << q.dofs << " dofs";
 }
+
+namespace {
+
+/// Flat punch pressed suddenly (one step of 1e-6 s) to `depth` and held,
+/// with hold steps doubling from 0.01 s to t_end: the punch force at each
+/// time (s, N). Prony series per layer (empty: elastic); no viscous
+/// stabilisation (it would resist the sudden step).
+std::vector<std::pair<double, double>> indent_and_hold(const Scene& s, double depth,
+                                                       const std::vector<std::vector<PronyTerm>>& prony,
+                                                       double t_end) {
+  const auto mesh = meshing::build_axisymmetric_slab_mesh(s, 0);
+  std::vector<LayerMaterial> materials;
+  std::vector<LayerCrack> cracks(s.layers.size());
+  for (LayerCrack& c : cracks) c.kind = LayerCrack::Kind::TiedUntilBroken;
+  for (const Layer& l : s.layers) materials.emplace_back(l.material);
+  AxisymmetricSettings settings;
+  settings.newton_tolerance = 1e-10;
+  settings.stabilization_time_s = 0.0;
+  AxisymmetricSolver solver(mesh, materials, cracks, std::vector<FrictionCoefficients>(s.layers.size()), settings);
+  solver.set_viscoelasticity(prony);
+  solver.setup(0.5 * s.sample.diameter_m, s.total_thickness_m());
+  std::vector<std::pair<double, double>> out;
+  solver.set_flat_punch(s.needle.radius_m, -depth);
+  solver.set_time_step(1e-6);
+  double t = 1e-6;
+  for (double dt = 0.01;; dt *= 2.0) {
+    const auto report = solver.solve_step();
+    EXPECT_TRUE(report.converged) << report.failure << " at t = " << t;
+    out.emplace_back(t, solver.needle_force().total_N);
+    if (t >= t_end) break;
+    solver.set_time_step(dt);
+    t += dt;
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(AxisymmetricSolver, ViscoelasticBlockRelaxesAsItsPronySeries) {
+  // Thick nearly incompressible block (as the Sneddon test), long-term
+  // E = 30 kPa, two Prony terms (beta 1.0 at 0.2 s, 0.5 at 3 s). At small
+  // strain the held punch force of an incompressible solid is proportional to
+  // the shear relaxation function (correspondence principle), so
+  // F(t) / F(0+) = g(t) = (1 + sum beta_i exp(-t/tau_i)) / (1 + sum beta_i);
+  // the bulk stays elastic, so with nu = 0.499 within 2 % of g(0+) - g(inf).
+  // Fully relaxed, the force is the elastic long-term block's, and at 0+ it
+  // is (1 + sum beta_i) times it (Sneddon's force is proportional to mu).
+  const double a = 1e-3, h = 20e-3, E = 3e4, nu = 0.499, depth = 0.01 * a;
+  const Scene s = block_scene(a, h, 60e-3, E, nu, 4);
+  const std::vector<PronyTerm> terms{{1.0, 0.2}, {0.5, 3.0}};
+  const auto held = indent_and_hold(s, depth, {terms}, 100.0);
+  const auto elastic = indent_and_hold(s, depth, {{}}, 0.01);
+  const double F0 = held.front().second, F_long = elastic.back().second;
+  const double factor = 1.0 + 1.0 + 0.5;
+  EXPECT_NEAR(F0 / F_long, factor, 0.02 * factor);
+  for (const auto& [t, F] : held) {
+    const double g = (1.0 + 1.0 * std::exp(-t / 0.2) + 0.5 * std::exp(-t / 3.0)) / factor;
+    EXPECT_NEAR(F / F0, g, 0.02 * (1.0 - 1.0 / factor)) << "t = " << t << " s";
+  }
+  EXPECT_NEAR(held.back().second / F_long, 1.0, 1e-3) << "fully relaxed: the long-term elastic block";
+  // An elastic layer (no Prony terms) does not relax.
+  const auto elastic_held = indent_and_hold(s, depth, {{}}, 10.0);
+  EXPECT_NEAR(elastic_held.back().second / elastic_held.front().second, 1.0, 1e-9);
+}

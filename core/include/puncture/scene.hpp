@@ -44,13 +44,46 @@ struct OgdenTerm {
 /// isochoric + volumetric (reference_fem/include/puncture/fem/hyperelastic_materials.hpp);
 /// E and nu are the SMALL-STRAIN (initial) values: they fix the initial shear
 /// modulus mu_0 = E / (2 (1 + nu)) and the bulk modulus kappa = E / (3 (1 - 2 nu)),
-/// whatever the law does at large strain.
+/// whatever the law does at large strain. For a viscoelastic layer they are
+/// the instantaneous or the long-term values (Viscoelasticity::modulus_basis).
 ///   neo_hookean:      mu_0/2 (I1bar - 3)
 ///   mooney_rivlin:    c10 (I1bar - 3) + c01 (I2bar - 3), c01 = fraction x mu_0 / 2
 ///   ogden:            sum_p 2 mu_p / alpha_p^2 (lambda1bar^alpha_p + lambda2bar^alpha_p + lambda3bar^alpha_p - 3),
 ///                     mu_p = mu_fraction_p x mu_0 (strain-stiffening for alpha > 2)
 ///   veronda_westmann: c1 (exp(gamma (I1bar - 3)) - 1) - c1 gamma / 2 (I2bar - 3), c1 = mu_0 / gamma
 ///                     (exponential stiffening; Veronda & Westmann 1970)
+/// One term of a normalised Prony series (relaxation function)
+///   g(t) = 1 - sum_i g_i (1 - exp(-t / tau_i)),
+/// the form in which stress-relaxation tests are reported (Abaqus, FEBio).
+struct PronyRelaxationTerm {
+  double g = 0.0;      ///< g_i in (0, 1): share of the instantaneous modulus that relaxes with tau_i
+  double tau_s = 1.0;  ///< tau_i > 0, s
+};
+
+/// Viscoelasticity of a layer's isochoric (shear) response in the FEM
+/// reference: a finite-strain Prony series (Simo 1987; Holzapfel 2000,
+/// Sec. 6.10; reference_fem/include/puncture/fem/viscoelastic_material.hpp).
+/// The bulk response stays elastic. No terms: the layer is elastic.
+struct Viscoelasticity {
+  std::vector<PronyRelaxationTerm> terms;
+  /// Which modulus the layer's youngs_modulus_Pa (and its Ogden/... law) is:
+  ///   instantaneous: measured fast (at t = 0+); the long-term law is that law
+  ///     scaled by the relaxed fraction g_inf = 1 - sum g_i;
+  ///   long_term: measured at equilibrium; the instantaneous law is 1 / g_inf
+  ///     times stiffer.
+  enum class ModulusBasis { Instantaneous, LongTerm };
+  ModulusBasis modulus_basis = ModulusBasis::Instantaneous;
+  std::string source;  ///< where the terms come from
+
+  bool enabled() const { return !terms.empty(); }
+  /// g_inf = 1 - sum g_i: the fraction of an instantaneous stress left after full relaxation.
+  double relaxed_fraction() const {
+    double g_inf = 1.0;
+    for (const PronyRelaxationTerm& t : terms) g_inf -= t.g;
+    return g_inf;
+  }
+};
+
 struct ContinuumMaterial {
   std::string model = "neo_hookean";  ///< "neo_hookean", "mooney_rivlin", "ogden" or "veronda_westmann"
   double youngs_modulus_Pa = 1e5;     ///< initial (small-strain) Young's modulus
@@ -58,6 +91,7 @@ struct ContinuumMaterial {
   double mooney_rivlin_c01_fraction = 0.0;  ///< share of the shear modulus carried by the C01 (I2) term
   std::vector<OgdenTerm> ogden_terms;       ///< model "ogden": at least one term
   double veronda_westmann_gamma = 1.0;      ///< model "veronda_westmann": exponent gamma (> 0)
+  Viscoelasticity viscoelastic;             ///< Prony relaxation of the isochoric part (none: elastic)
   std::string source;                       ///< where the numbers come from
 };
 

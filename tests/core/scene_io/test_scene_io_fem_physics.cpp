@@ -77,7 +77,7 @@ TEST(SceneIoFemPhysics, OutOfRangeMaterialPunctureAndFrictionNameTheJsonPath) {
   }
   {
     json j = default_json();
-    j["layers"][1]["shaft_friction"]["static_coefficient"] = 0.1;  // below the dynamic 0.2
+    j["layers"][1]["shaft_friction"]["static_coefficient"] = 0.05;  // below the dynamic 0.1
     expect_error(j, "/layers/1/shaft_friction/static_coefficient");
   }
   {
@@ -95,6 +95,57 @@ TEST(SceneIoFemPhysics, OutOfRangeMaterialPunctureAndFrictionNameTheJsonPath) {
     j["layers"][0]["material"]["ogden_alpha"] = std::nan("");
     EXPECT_FALSE(error_of(j).empty());
   }
+}
+
+}  // namespace puncture
+
+namespace puncture {
+namespace {
+
+json with_prony(json j, int layer, json prony, const std::string& modulus = "instantaneous") {
+  j["layers"][layer]["material"]["viscoelastic"] = {{"prony", prony}, {"modulus", modulus}, {"source", "test"}};
+  return j;
+}
+
+}  // namespace
+
+TEST(SceneIoFemPhysics, ViscoelasticTermsAreReadAndWrittenBack) {
+  json j = with_prony(default_json(), 2, json::array({{{"g", 0.3}, {"tau_s", 0.5}}, {{"g", 0.2}, {"tau_s", 10.0}}}),
+                      "long_term");
+  const Scene s = parse_scene(j.dump(), "visco.json");
+  const Viscoelasticity& v = s.layers[2].material.viscoelastic;
+  ASSERT_EQ(v.terms.size(), 2u);
+  EXPECT_DOUBLE_EQ(v.terms[1].g, 0.2);
+  EXPECT_DOUBLE_EQ(v.terms[1].tau_s, 10.0);
+  EXPECT_EQ(v.modulus_basis, Viscoelasticity::ModulusBasis::LongTerm);
+  EXPECT_NEAR(v.relaxed_fraction(), 0.5, 1e-15);
+  const Scene back = parse_scene(scene_to_json_text(s), "roundtrip");
+  const Viscoelasticity& w = back.layers[2].material.viscoelastic;
+  ASSERT_EQ(w.terms.size(), 2u);
+  EXPECT_DOUBLE_EQ(w.terms[0].g, 0.3);
+  EXPECT_DOUBLE_EQ(w.terms[0].tau_s, 0.5);
+  EXPECT_EQ(w.modulus_basis, Viscoelasticity::ModulusBasis::LongTerm);
+  EXPECT_EQ(w.source, "test");
+}
+
+TEST(SceneIoFemPhysics, BadPronyTermsNameTheJsonPath) {
+  const json good = {{"g", 0.3}, {"tau_s", 0.5}};
+  expect_error(with_prony(default_json(), 1, json::array({good, {{"g", 1.2}, {"tau_s", 1.0}}})),
+               "/layers/1/material/viscoelastic/prony/1/g");
+  expect_error(with_prony(default_json(), 1, json::array({good, {{"g", 0.1}, {"tau_s", -1.0}}})),
+               "/layers/1/material/viscoelastic/prony/1/tau_s");
+  expect_error(with_prony(default_json(), 0, json::array({good, {{"g", 0.1}}})),
+               "/layers/0/material/viscoelastic/prony/1/tau_s");
+  expect_error(with_prony(default_json(), 0, json::array({good, {{"g", 0.1}, {"tau_s", 1.0}, {"beta", 2}}})),
+               "/layers/0/material/viscoelastic/prony/1/beta");
+  expect_error(with_prony(default_json(), 2, json::array({{{"g", 0.6}, {"tau_s", 1.0}}, {{"g", 0.5}, {"tau_s", 9.0}}})),
+               "/layers/2/material/viscoelastic/prony");
+  expect_error(with_prony(default_json(), 2, json::array()), "/layers/2/material/viscoelastic/prony");
+  expect_error(with_prony(default_json(), 2, json::array({good}), "relaxed"),
+               "/layers/2/material/viscoelastic/modulus");
+  json j = default_json();
+  j["layers"][0]["material"]["viscoelastic"] = {{"prony", json::array({good})}};
+  expect_error(j, "/layers/0/material/viscoelastic/modulus");
 }
 
 }  // namespace puncture

@@ -54,6 +54,7 @@ const std::vector<std::string>& realtime_only_fields() {
       "/layers/*/resumption_time_s",
       "/layers/*/force_law",          // breakthrough, stiffening, cutting, friction of the real-time law
       "/layers/*/material/source",    // provenance text
+      "/layers/*/material/viscoelastic/source",
       "/layers/*/puncture/source",
       "/layers/*/shaft_friction/source",
       "/realtime",

@@ -18,7 +18,11 @@
 //   dV = 2 pi R dA, so nodal forces are those of the whole ring (N).
 // Material: any LayerMaterial (hyperelastic_materials.hpp) in the three-field
 // Hu-Washizu form of the 3D solver (Q1-P0 or Q2-P1, condensed per cell), so
-// the nearly incompressible layers do not lock.
+// the nearly incompressible layers do not lock. A layer given a Prony series
+// (set_viscoelasticity) is viscoelastic (viscoelastic_material.hpp): its
+// LayerMaterial is then the long-term law, every quadrature point keeps its
+// Prony history, read during a step's Newton iterations and committed with
+// the converged step (time step: set_time_step).
 // Boundary conditions: base Z = -H fixed, lateral R = R_s fixed (the sample
 // held in a ring), axis u_R = 0, top free except where the needle touches it.
 // Crack: every pair of crack nodes is joined by the layer's cohesive law
@@ -47,12 +51,14 @@
 #include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/vector.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <puncture/fem/cohesive_law.hpp>
 #include <puncture/fem/hyperelastic_materials.hpp>
 #include <puncture/fem/needle_contact.hpp>
+#include <puncture/fem/viscoelastic_material.hpp>
 #include <puncture/meshing/axisymmetric_slab_mesh.hpp>
 
 namespace puncture::fem {
@@ -152,6 +158,11 @@ class AxisymmetricSolver {
                      std::vector<LayerCrack> cracks, std::vector<FrictionCoefficients> friction,
                      const AxisymmetricSettings& settings, std::vector<LayerMaterial> core_materials = {});
 
+  /// Optional, before setup(): one Prony series per layer (empty: that layer
+  /// is elastic). The layer's material given to the constructor is then its
+  /// long-term (relaxed) law; the core filler cells stay elastic.
+  void set_viscoelasticity(const std::vector<std::vector<PronyTerm>>& prony_per_layer);
+
   /// Distributes the dofs, finds the crack pairs and the contact nodes, u = 0.
   void setup(double sample_radius_m, double total_thickness_m);
   const AxisymmetricSettings& settings() const { return settings_; }
@@ -165,7 +176,8 @@ class AxisymmetricSolver {
   void set_cutting_needle(const RigidNeedle& needle);
   /// Flat punch of radius a whose face is at height z_face_m (blunt tip).
   void set_flat_punch(double radius_m, double z_face_m);
-  /// Time step of the coming solve (s), for the cohesive viscosity.
+  /// Time step of the coming solve (s), for the cohesive viscosity and the
+  /// viscoelastic layers.
   void set_time_step(double dt_s) { dt_s_ = dt_s; }
 
   // --- solving ----------------------------------------------------------------
@@ -183,6 +195,7 @@ class AxisymmetricSolver {
     std::vector<char> broken_layers;
     double dissipated_J = 0.0;
     double stabilization_J = 0.0;
+    std::vector<std::vector<ViscoelasticHistory>> viscous_history;
   };
   Snapshot snapshot() const;
   void restore(const Snapshot& s);
@@ -245,6 +258,16 @@ class AxisymmetricSolver {
   std::vector<LayerMaterial> materials_, core_materials_;
   std::vector<char> core_cell_;  ///< per active cell: inside the crack radius on the needle path
   const LayerMaterial& material_of(const dealii::DoFHandler<2>::active_cell_iterator& cell) const;
+  /// Per layer: its viscoelastic law (absent: elastic).
+  std::vector<std::optional<ViscoelasticMaterial<LayerMaterial>>> viscoelastic_;
+  /// Per active cell: the Prony history of its quadrature points at the last
+  /// converged step (empty for elastic cells).
+  std::vector<std::vector<ViscoelasticHistory>> viscous_history_;
+  /// The viscoelastic law of a cell (nullptr: elastic).
+  const ViscoelasticMaterial<LayerMaterial>* viscoelastic_of(
+      const dealii::DoFHandler<2>::active_cell_iterator& cell) const;
+  /// Advances every viscoelastic point's history to the converged solution_.
+  void commit_viscous_history();
   std::vector<LayerCrack> cracks_;
   std::vector<FrictionCoefficients> friction_;
   AxisymmetricSettings settings_;
