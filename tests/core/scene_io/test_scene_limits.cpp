@@ -103,7 +103,7 @@ TEST(SceneLimits, TicksTimesLayersAndFrameFilesAreBounded) {
   // The default scene is far inside every limit.
   const Scene s = load_scene(kDefaultScene);
   EXPECT_LT(scene_limits::scripted_ticks(s) * 5, scene_limits::kMaxTickLayerProduct / 100);
-  EXPECT_NEAR(scene_limits::scripted_duration_s(s.insertion), 0.032 / 0.01 + 0.5 + 0.032 / 0.01, 1e-12);
+  EXPECT_NEAR(scene_limits::scripted_duration_s(s.insertion), 0.032 / 0.01 + 5.0 + 0.032 / 0.01, 1e-12);
 }
 
 TEST(SceneJson, DuplicateKeysAreRejectedWithThePathOfTheSecond) {
@@ -122,7 +122,7 @@ TEST(SceneJson, NumbersOutOfRangeAndSyntaxErrorsNameThePath) {
       << message;
   message = error_of_text(replaced(default_text(), "\"w\": 4,", "\"w\": 4294967300,"));
   EXPECT_NE(message.find("bad.json: /layers/1/force_mesh/w: integer out of range"), std::string::npos) << message;
-  message = error_of_text(replaced(default_text(), "\"dwell_s\": 0.5,", "\"dwell_s\": 0.5x,"));
+  message = error_of_text(replaced(default_text(), "\"dwell_s\": 5.0,", "\"dwell_s\": 5.0x,"));
   EXPECT_NE(message.find("bad.json: /insertion/dwell_s: malformed JSON"), std::string::npos) << message;
   message = error_of_text(std::string(100, '[') + std::string(100, ']'));
   EXPECT_NE(message.find("nested deeper than"), std::string::npos) << message;
