@@ -53,6 +53,9 @@ int main(int argc, char** argv) {
   fem_cmd->add_option("--refinement", fem.refinement, "Global refinements (overrides the scene)")->check(CLI::Range(0, 4));
   fem_cmd->add_option("--degree", fem.degree, "Element degree 1 (Q1) or 2 (Q2) (overrides the scene)")->check(CLI::Range(1, 2));
   fem_cmd->add_flag("--no-vtu", [&](std::int64_t) { fem.write_vtu = false; }, "Do not write .vtu field output");
+  fem_cmd->add_option("--stop-depth", fem.stop_depth_mm,
+                      "Stop the insertion at this tip depth (mm; no dwell, no withdrawal): for studies")
+      ->check(CLI::PositiveNumber);
   fem_cmd->add_flag("-q,--quiet", fem.quiet, "Nothing on stdout");
 
   ValidateOptions validate;

@@ -6,20 +6,69 @@ by `puncture fem` or `puncture validate`) and the scene it ran, and writes a
 Markdown table that puts each number a reader can compare with a measurement
 beside that measurement and its source (../shared/LITERATURE.md).
 
-Usage: scripts/fem_vs_literature.py FEM_DIR SCENE_JSON OUT_MD
+Usage: scripts/fem_vs_literature.py FEM_DIR SCENE_JSON OUT_MD [RATE_JSON]
+RATE_JSON: results/fem_rate/rate.json (scripts/fem_rate_study.sh), for the
+speed-trend rows.
 """
 import csv
 import json
 import os
 import sys
 
+import fem_metrics  # scripts/fem_metrics.py
 import provenance  # scripts/provenance.py (the script's own folder is on sys.path)
 
 
+def cavity_pressure_kPa(mu0_kPa, alpha, stretch, n=4000):
+    """Pressure (kPa) that opens a cylindrical hole in an infinite incompressible
+    one-term Ogden solid (initial shear modulus mu0, exponent alpha) until its
+    wall's hoop stretch is `stretch`, in plane strain (lambda_theta = lambda,
+    lambda_r = 1/lambda): p = int_1^stretch W'(l) / (l^2 - 1) dl with
+    W'(l) = 2 mu0 / alpha (l^(alpha-1) - l^(-alpha-1)) (midpoint rule)."""
+    h = (stretch - 1.0) / n
+    total = 0.0
+    for i in range(n):
+        l = 1.0 + (i + 0.5) * h
+        total += 2 * mu0_kPa / alpha * (l ** (alpha - 1) - l ** (-alpha - 1)) / (l * l - 1) * h
+    return total
+
+
+def radial_pressure_notes(summary, rows, layers, a_mm):
+    """What drives the shaft friction: the radial pressure the friction per
+    unit length implies, beside the closed-form pressure that opens the bevel's
+    stand-in ring crack (radius 2a/pi) to the needle radius a in each layer's law."""
+    fr = fem_metrics.friction_per_mm(summary, rows)
+    last = layers[-1]
+    mat, fric = last.get("material", {}), last.get("shaft_friction", {})
+    if not fr or mat.get("model") != "ogden" or "ogden_alpha" not in mat or "coefficient" not in fric:
+        return []
+    mu_c = fric["coefficient"]
+    implied = fr[0] / (mu_c * 2 * 3.141592653589793 * a_mm) * 1e3  # N/mm^2 -> kPa
+    stretch = 3.141592653589793 / 2  # a / (2a/pi)
+    mu0 = mat["youngs_modulus_kPa"] / (2 * (1 + mat["poisson_ratio"]))
+    alpha = mat["ogden_alpha"]
+    g_inf = 1 - sum(t["g"] for t in mat.get("viscoelastic", {}).get("prony", []))
+    p_inst = cavity_pressure_kPa(mu0, alpha, stretch)
+    sens = ", ".join(f"alpha {al:g}: {cavity_pressure_kPa(mu0, al, stretch):.0f} kPa" for al in (2, 9, 15))
+    return [f"What drives the shaft friction ({last['name']}, where the friction per unit length is fitted): the "
+            f"radial pressure it implies is {implied:.0f} kPa (friction per mm / (coefficient {mu_c:g} x 2 pi a)). The "
+            f"bevel's stand-in ring crack (radius 2a/pi) is opened to the needle radius a, a hoop stretch of pi/2; the "
+            f"pressure that does this in an infinite incompressible one-term Ogden solid of the {last['name']}'s law "
+            f"(mu0 {mu0:.1f} kPa, alpha {alpha:g}; plane strain, closed-form integral) is {p_inst:.0f} kPa "
+            f"instantaneous and {g_inf * p_inst:.0f} kPa fully relaxed (relaxed fraction {g_inf:.2f}); with other "
+            f"exponents: {sens}. So the Ogden exponent at a stretch far beyond the range it was fitted on sets the "
+            "pressure (a factor of about 30 between alpha 9 and 21.4), relaxation removes part of it behind the tip, and "
+            "the coefficient scales the friction linearly. The FEM's pressure is below the closed form's: the closed "
+            "form opens the hole at once in plane strain in an infinite medium, where in the FEM the crack faces open "
+            "over the bevel's length, relax while the tip moves on, and the tissue above and below carries part of the "
+            "hoop load; the split between these was not measured."]
+
+
 def main():
-    if len(sys.argv) != 4:
+    if len(sys.argv) not in (4, 5):
         sys.exit(__doc__)
-    fem_dir, scene_path, out = sys.argv[1:]
+    fem_dir, scene_path, out = sys.argv[1:4]
+    rate = json.load(open(sys.argv[4])) if len(sys.argv) == 5 else None
     summary = json.load(open(os.path.join(fem_dir, "fem_summary.json")))
     scene = json.load(open(scene_path))
     rows = list(csv.DictReader(l for l in open(os.path.join(fem_dir, "fem_force_depth.csv")) if not l.startswith("#")))
@@ -36,7 +85,8 @@ def main():
     L = []
     L.append("# FEM reference against measurements\n")
     rev = provenance.git_revision()
-    L.append(f"Command: `scripts/fem_vs_literature.py {fem_dir} {scene_path} {out}` on the FEM run in `{fem_dir}` "
+    rate_arg = f" {sys.argv[4]}" if rate else ""
+    L.append(f"Command: `scripts/fem_vs_literature.py {fem_dir} {scene_path} {out}{rate_arg}` on the FEM run in `{fem_dir}` "
              f"(scene `{scene_path}`), git {rev}.  ")
     L.append(f"Machine: {provenance.machine()}.  ")
     L.append(f"Date: {provenance.utc_now()} UTC.\n")
@@ -85,22 +135,46 @@ def main():
     # column against depth from 1 mm below the last puncture to the target
     # depth (the shaft then slides through every punctured layer).
     if ins and order:
-        z0 = max(p["depth_mm"] for p in summary["punctures"]) + 1.0
-        pts = [(f(r, "depth_mm"), f(r, "friction_force_N")) for r in ins if f(r, "depth_mm") >= z0]
-        if len(pts) >= 3:
-            n = len(pts)
-            mx = sum(z for z, _ in pts) / n
-            my = sum(v for _, v in pts) / n
-            slope = sum((z - mx) * (v - my) for z, v in pts) / sum((z - mx) ** 2 for z, _ in pts)
+        fr = fem_metrics.friction_per_mm(summary, rows)
+        if fr:
+            slope, z0, z1, n = fr
             band = "inside" if 0.013 <= slope <= 0.080 else ("above" if slope > 0.080 else "below")
             L.append(f"| shaft friction per unit length | {slope:.3f} N/mm (slope of the friction column over "
-                     f"{pts[0][0]:.1f}-{pts[-1][0]:.1f} mm, {n} steps; {band} the measured 0.013-0.080 N/mm) | "
+                     f"{z0:.1f}-{z1:.1f} mm, {n} steps; {band} the measured 0.013-0.080 N/mm) | "
                      "bovine liver 0.013 N/mm sliding, 0.018 N/mm static (Karnopp fit per metre of contact); "
                      "PVC phantom 0.034 / 0.059 / 0.080 N/mm at 1 / 3 / 9 mm/s | "
                      "Okamura, Simone, O'Leary 2004, IEEE TBME 51:1707; DiMaio & Salcudean 2003 (via van Gerwen 2012) |")
         L.append(f"| friction force at the target depth | {f(ins[-1], 'friction_force_N'):.2f} N | survey of maximum "
                  "friction forces: median 1.0 N, range 0.15-2.8 N (10 papers) | van Gerwen, Dankelman, "
                  "van den Dobbelsteen 2012, Med. Eng. Phys. 34:665, Table 2 |")
+    relax = fem_metrics.dwell_relaxation(rows)
+    if relax:
+        f0, f1, hold, frac = relax
+        terms = ", ".join(f"{l['name']} g_inf {1 - sum(t['g'] for t in l['material']['viscoelastic']['prony']):.2f}"
+                          for l in layers if "viscoelastic" in l.get("material", {}))
+        L.append(f"| relaxation in the hold at the target depth | {f0:.2f} N -> {f1:.2f} N after {hold:.1f} s: "
+                 f"{frac:.2f} of the force left ({terms or 'elastic layers'}) | insertion forces relax by tens of "
+                 "percent within seconds of a hold; passive muscle under a sudden indentation: long-term / short-term "
+                 "shear modulus 0.07-0.14, plateau after about 20 s | Okamura 2004, Mahvash & Dupont 2010 "
+                 "(LITERATURE.md); Palevski et al. 2006, J. Biomech. Eng. 128:782 |")
+    if rate:
+        runs = sorted(rate["runs"], key=lambda r: r["speed_mm_per_s"])
+        lo, hi = runs[0], runs[-1]
+        def pf(run, name):
+            return next((p["force_N"] for p in run["punctures"] if p["layer"] == name), None)
+        for l in layers:
+            a, b = pf(lo, l["name"]), pf(hi, l["name"])
+            if a and b:
+                L.append(f"| {l['name']} puncture force, {lo['speed_mm_per_s']:g} -> {hi['speed_mm_per_s']:g} mm/s | "
+                         f"{a:.2f} -> {b:.2f} N ({100 * (b / a - 1):+.0f} %) | cadaver skin and muscle: insensitive to "
+                         "speed; porcine and lamb heart: falls with speed | Schneider, Peck & Melvin 1978; Mahvash & "
+                         "Dupont 2009; Alja'afreh 2010 (results/fem_rate/README.md) |")
+        a, b = lo["friction_per_mm_N"], hi["friction_per_mm_N"]
+        if a and b:
+            L.append(f"| shaft friction per unit length, {lo['speed_mm_per_s']:g} -> {hi['speed_mm_per_s']:g} mm/s | "
+                     f"{a:.3f} -> {b:.3f} N/mm ({100 * (b / a - 1):+.0f} %) | PVC phantom 0.034 -> 0.080 N/mm at "
+                     "1 -> 9 mm/s (+135 %) | DiMaio & Salcudean 2003 (via van Gerwen 2012) [2nd] |")
+    pressure_notes = radial_pressure_notes(summary, rows, layers, a_mm)
     if wd:
         mn = min(f(r, "force_N") for r in wd)
         mf = min(f(r, "friction_force_N") for r in wd)
@@ -114,6 +188,7 @@ def main():
              "part of the cohesive law); while a crack runs ahead of the tip it also carries energy the tissue releases, "
              "so single steps can exceed the needle force. The skin tents deeply on the 60 mm slab before it cuts, "
              "which puts the puncture depth beyond the few millimetres of in vivo tests on skin held by the body.")
+    L += [""] + pressure_notes
     tmp = out + ".part"
     open(tmp, "w").write("\n".join(L) + "\n")
     os.replace(tmp, out)

@@ -31,6 +31,7 @@ int fem_command(const FemOptions& options, std::ostream& stdout_stream, std::ost
     fem_options.refinement_override = options.refinement;
     fem_options.degree_override = options.degree;
     fem_options.write_vtu = options.write_vtu;
+    fem_options.stop_depth_m = options.stop_depth_mm > 0.0 ? options.stop_depth_mm * 1e-3 : -1.0;
     fem_options.verbose = !options.quiet;
     const fem::FemRunSummary summary = fem::run_needle_insertion(scene, fem_options, MPI_COMM_WORLD);
     if (root) {

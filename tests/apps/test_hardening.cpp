@@ -96,6 +96,7 @@ TEST(ProgramContract, ExitCodesAreTheDocumentedOnes) {
   EXPECT_EQ(run_program("frobnicate").exit_code, kExitBadInput);        // unknown subcommand
   EXPECT_EQ(run_program("run --bogus-flag").exit_code, kExitBadInput);  // unknown option
   EXPECT_EQ(run_program("fem --refinement 9").exit_code, kExitBadInput);
+  EXPECT_EQ(run_program("fem --stop-depth -1").exit_code, kExitBadInput);
   EXPECT_EQ(run_program("grade").exit_code, kExitBadInput);             // missing required argument
 
   Result r = run_program("run /nonexistent/scene.json");
@@ -134,6 +135,24 @@ TEST(ProgramContract, ExitCodesAreTheDocumentedOnes) {
   EXPECT_FALSE(fs::exists(out_dir));
   fs::remove(bad);
 }
+
+#ifdef PUNCTURE_HAVE_FEM
+TEST(ProgramContract, FemStopDepthEndsTheInsertionThereWithoutHoldOrWithdrawal) {
+  const fs::path dir = fresh("fem_stop");
+  const Result r = run_program("fem " + (kSourceDir / "scenes" / "default.json").string() +
+                               " --stop-depth 0.6 --no-vtu -q -o " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const io::CsvDocument t = io::read_csv_file(dir / "fem_force_depth.csv");
+  ASSERT_FALSE(t.records.empty());
+  const std::size_t depth = t.require_column("depth_mm"), phase = t.require_column("phase");
+  EXPECT_NEAR(t.number(t.records.back(), depth), 0.6, 1e-9);
+  for (const io::CsvRecord& row : t.records) {
+    EXPECT_NE(row.fields[phase], "dwell");
+    EXPECT_NE(row.fields[phase], "withdrawal");
+  }
+  fs::remove_all(dir);
+}
+#endif
 
 TEST(ProgramContract, QuietPrintsNothingOnStdout) {
   const fs::path dir = fresh("quiet");

@@ -40,6 +40,7 @@ struct FemOptions {
   int refinement = -1;                ///< -1: from the scene
   int degree = -1;                    ///< -1: from the scene
   bool write_vtu = true;
+  double stop_depth_mm = -1.0;  ///< > 0: stop the insertion at this tip depth (no dwell, no withdrawal)
   bool quiet = false;                 ///< nothing on `out`
 };
 
