@@ -3,6 +3,7 @@
 #   results/validation_default/  puncture validate: the default (Table 2) real-time
 #                                model against the FEM reference
 #   results/fem_vs_literature.md the FEM reference's numbers beside the measurements
+#   results/validation_paper_table2/ puncture validate of the paper's model as written
 #   results/tuned_preset/        puncture calibrate: tuned preset of the Table 2 slab
 #                                with the physical force law (scenes/default_force_law.json:
 #                                critical-force breakthrough, stiffening, cutting, friction),
@@ -24,9 +25,15 @@ cd "$root"
 export OMPI_ALLOW_RUN_AS_ROOT="${OMPI_ALLOW_RUN_AS_ROOT:-1}" OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="${OMPI_ALLOW_RUN_AS_ROOT_CONFIRM:-1}"
 mpi=(mpirun --oversubscribe -np "$ranks")
 "${mpi[@]}" "$build/apps/puncture" validate scenes/default.json -o results/validation_default
-# The FEM reference beside the measurements (from the cached FEM run just used).
-fem_dir="$(ls -td out/.fem_cache/*/ | head -1)"
-"${PYTHON:-$(command -v /usr/bin/python3 || command -v python3)}" scripts/fem_vs_literature.py "${fem_dir%/}" scenes/default.json results/fem_vs_literature.md
+# The FEM reference beside the measurements (from the cached FEM run just
+# used), with the speed trends of results/fem_rate (scripts/fem_rate_study.sh).
+py="${PYTHON:-$(command -v /usr/bin/python3 || command -v python3)}"
+fem_dir="$("$py" -c 'import json,sys; print(json.load(open(sys.argv[1]))["fem_reference"]["cache_dir"])' results/validation_default/validation_metrics.json)"
+rate=()
+[ -f results/fem_rate/rate.json ] && rate=(results/fem_rate/rate.json)
+"$py" scripts/fem_vs_literature.py "${fem_dir%/}" scenes/default.json results/fem_vs_literature.md "${rate[@]}"
+# The seed paper's model as written, on the same slab and FEM reference.
+"${mpi[@]}" "$build/apps/puncture" validate scenes/paper_table2.json -o results/validation_paper_table2
 # Puncture forces weigh 4x (the acceptance asks for them within 10 %, and a
 # weight of 1 let the skin's trade 10 % for a closer fit after its peak);
 # puncture depths weigh 1 per L (0.1 let the muscle break 4.8 mm early).
@@ -37,4 +44,4 @@ shared="${PUNCTURE_SHARED_DATA_DIR:-$root/../shared/data}"
   --reference "$shared/okamura2004_liver_depth_force.csv" --reference-depth-offset 9.5 --puncture-depths 9.65,9.66
 "${mpi[@]}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json -o results/validation_tuned
 "$build/apps/puncture" sweep results/tuned_preset/default_tuned.json --no-fem-knobs -o results/accuracy_cost
-echo "results in results/validation_default, results/tuned_preset, results/liver_calibration, results/validation_tuned, results/accuracy_cost"
+echo "results in results/validation_default, results/validation_paper_table2, results/tuned_preset, results/liver_calibration, results/validation_tuned, results/accuracy_cost"
