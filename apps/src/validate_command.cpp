@@ -15,8 +15,9 @@
 //      of the layer's top surface at the nearest recorded depth;
 //   5. recovery after breakthrough: the FEM's spring-back profile (same depth,
 //      after the material was removed; fem_recovery_profile.csv) against the
-//      real-time ring deflections ceil(1 / eta_r) haptic steps after the
-//      breakthrough (when Eq. 8's recovery factor has reached 0);
+//      real-time ring deflections the layer's resumption time (rounded up to
+//      haptic steps) after the breakthrough (when Eq. 8's recovery factor has
+//      reached 0);
 //   6. report folder: CSV, JSON, VTK (.vtp, .vtu, one validation.pvd), then
 //      PNG plots (scripts/plot_validation.py) and validation_summary.md.
 #include <algorithm>

@@ -316,7 +316,7 @@ std::string validation_summary_markdown(const Scene& scene, const io::Provenance
         "the layer is intact in both models: ring deflections Delta Z_j at r = (j - 1) L against the FEM's -u_z "
         "of the layer's top surface at the same distance from the needle. The recovery compares the FEM's "
         "spring-back (same depth, after the material along the needle path was removed) with the real-time "
-        "ring deflections ceil(1 / eta_r) haptic steps after its breakthrough.\n\n";
+        "ring deflections one resumption time (the layer's resumption_time_s, rounded up to haptic steps) after its breakthrough.\n\n";
   if (!acceptance_section.empty()) {
     md << "## Acceptance per layer (whole trajectory)\n\n"
           "A layer is accepted when its force RMSE over pressing and cut is at most 10 % of the FEM peak, "

@@ -103,7 +103,8 @@ struct LayerDeflectionComparison {
 /// both models (the smaller of the two pre-breakthrough depths); the real-time
 /// Delta Z_j at that tick against the FEM profile of the layer at that depth
 /// (linear between the two recorded load steps that bracket it). After: the FEM spring-back profile against the real-time rings
-/// ceil(1 / eta_r) ticks after the real-time breakthrough.
+/// ceil(resumption time x haptic rate) ticks after the real-time breakthrough
+/// (the layer's resumption_time_s, when Eq. 8's recovery factor has reached 0).
 LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size_t k, const ScriptedRunResult& run,
                                                    const RingRecorder& recorder, const FemResultFiles& fem);
 
