@@ -33,6 +33,31 @@ def cavity_pressure_kPa(mu0_kPa, alpha, stretch, n=4000):
     return total
 
 
+def drop_notes(summary, rows, layers):
+    """Per punctured layer: the force drop at its puncture, and whether its
+    crack was already running (cutting column above 0.1 N while the layer was
+    still flagged pressed), which releases the stored energy gradually."""
+    out = []
+    for p in summary.get("punctures", []):
+        name = p["name"]
+        state = f"{name}_state"
+        running = [r for r in rows if r["phase"] == "insertion" and r.get(state) == "pressed"
+                   and float(r["cutting_force_N"]) > 0.1]
+        drop = p["force_N"] - p.get("force_after_N", p["force_N"])
+        text = (f"{name}: {p['force_N']:.2f} N at its puncture ({p['depth_mm']:.1f} mm), {p.get('force_after_N', float('nan')):.2f} N "
+                f"one step later (drop {drop:.2f} N)")
+        if running and float(running[0]["depth_mm"]) <= p["depth_mm"] - 1.0:
+            text += (f"; its crack was already dissipating fracture energy from {float(running[0]['depth_mm']):.1f} mm "
+                     f"(cutting column {float(running[0]['cutting_force_N']):.2f} N there), i.e. it grew stably with the "
+                     f"tip for {p['depth_mm'] - float(running[0]['depth_mm']):.1f} mm before it opened through the "
+                     "layer's top, so its stored energy was released gradually")
+        out.append(text)
+    if not out:
+        return []
+    return ["Force drops at the punctures (measured curves show a drop where a tented layer's stored energy is released "
+            "at once): " + "; ".join(out) + "."]
+
+
 def radial_pressure_notes(summary, rows, layers, a_mm):
     """What drives the shaft friction: the radial pressure the friction per
     unit length implies, beside the closed-form pressure that opens the bevel's
@@ -175,6 +200,7 @@ def main():
                      f"{a:.3f} -> {b:.3f} N/mm ({100 * (b / a - 1):+.0f} %) | PVC phantom 0.034 -> 0.080 N/mm at "
                      "1 -> 9 mm/s (+135 %) | DiMaio & Salcudean 2003 (via van Gerwen 2012) [2nd] |")
     pressure_notes = radial_pressure_notes(summary, rows, layers, a_mm)
+    pressure_notes += drop_notes(summary, rows, layers)
     if wd:
         mn = min(f(r, "force_N") for r in wd)
         mf = min(f(r, "friction_force_N") for r in wd)
