@@ -37,11 +37,13 @@ L = ["# Does the fat puncture on its own?\n",
      "depth below the fat's top (32.8 mm).\n",
      "| slab | fat rest thickness (mm) | skin puncture | fat puncture | fat puncture after the skin's (mm) | skin top's deflection at the skin puncture (mm) |",
      "|---|---|---|---|---|---|"]
+lags, cut_at_fat = [], []
 for name, fat in (("default", 8.4), ("thick_fat", 25.2)):
     summary, rows = fem_metrics.read_fem(os.path.join(work, name))
     ev = {p["name"]: p for p in summary["punctures"]}
     sk, ft = ev.get("skin"), ev.get("fat")
-    prof = [l.split(",") for l in open(os.path.join(work, name, "fem_surface_profile.csv")) if not l.startswith(("#", "step"))]
+    prof = [l.strip().split(",") for l in open(os.path.join(work, name, "fem_surface_profile.csv"))
+            if not l.startswith(("#", "step"))]
     tent = None
     if sk:
         at = [p for p in prof if p[4] == "skin" and float(p[1]) <= sk["depth_mm"] + 1e-9]
@@ -50,13 +52,30 @@ for name, fat in (("default", 8.4), ("thick_fat", 25.2)):
             tent = -min(float(p[3]) for p in at if float(p[1]) == last_depth)
     fmt = lambda e: f"{e['force_N']:.2f} N at {e['depth_mm']:.1f} mm" if e else "none"
     gap = f"{ft['depth_mm'] - sk['depth_mm']:.1f}" if sk and ft else "n/a"
+    lags.append(ft["depth_mm"] - sk["depth_mm"] if sk and ft else None)
+    fat_cut = [float(r["cutting_force_N"]) for r in rows if r["phase"] == "insertion" and sk and ft
+               and sk["depth_mm"] < float(r["depth_mm"]) <= ft["depth_mm"] + 1e-9]
+    cut_at_fat.append(max(fat_cut) if fat_cut else None)
     L.append(f"| {name} | {fat:g} | {fmt(sk)} | {fmt(ft)} | {gap} | {tent:.2f} |" if tent is not None else
              f"| {name} | {fat:g} | {fmt(sk)} | {fmt(ft)} | {gap} | n/a |")
-L += ["", "Reading: in the default slab the skin tents by more than the fat is thick (8.4 mm): when the skin cuts, the "
-      "tip is already at the fat's rest bottom and the fat under it is a film squeezed against the muscle, which gives "
-      "way at once. With the fat thicker than the skin's tenting the fat punctures on its own, millimetres later. "
-      "So the near-coincident punctures are the physics of this slab's geometry (a thin soft layer under a skin that "
-      "stiffens and tents deeply), not an artefact of the solver."]
+fat = json.load(open("scenes/default.json"))["layers"][1]
+if all(l is not None and l < 1.0 for l in lags):
+    L += ["", f"Reading: the fat punctures {lags[0]:.1f} mm after the skin in the default slab and {lags[1]:.1f} mm after it "
+          "with three times the fat, so the near-coincidence does not come from a thin fat squeezed against the muscle. "
+          "It comes from the fat itself: when the skin gives way the tip carries the skin's puncture force (about "
+          f"{json.load(open(os.path.join(work, 'default', 'fem_summary.json')))['punctures'][0]['force_N']:.1f} N), far "
+          f"more than a layer of the fat's strength and toughness ({fat['puncture']['cohesive_strength_kPa']:g} kPa, "
+          f"{fat['puncture']['toughness_J_per_m2']:g} J/m^2, cutting force G_c x 2a = "
+          f"{fat['puncture']['toughness_J_per_m2'] * 1.27e-3:.2f} N) and modulus ({fat['material']['youngs_modulus_kPa']:g} kPa) "
+          "can resist, so the fat's crack opens as soon as the tip reaches it and the energy the skin stored is spent "
+          "cutting it (the cutting column peaks at "
+          + ", ".join(f"{c:.2f} N" for c in cut_at_fat if c is not None) + " between the two punctures). The FEM "
+          "predicts no puncture of the fat of its own for any fat thickness under this skin; that is the physics of a "
+          "soft, weak layer under a tough, stiffening one in this model, not an artefact of the slab's geometry."]
+else:
+    L += ["", "Reading: with the fat thicker the fat punctures on its own, "
+          + ", ".join(f"{l:.1f} mm" for l in lags if l is not None) + " after the skin: the near-coincidence in the "
+          "default slab comes from its thin fat squeezed between the tented skin and the muscle."]
 open(out + ".part", "w").write("\n".join(L) + "\n")
 os.replace(out + ".part", out)
 print("wrote", out)
