@@ -212,6 +212,23 @@ def plot(path, curve, before, after, fit_depth, note):
     os.replace(tmp, path)
 
 
+def friction_note(feat, x, scene):
+    """Why Coulomb friction on this parenchyma cannot give the measured friction."""
+    a_mm = scene["needle"]["radius_mm"]
+    measured = 0.013  # N/mm, Okamura 2004 Karnopp fit (../shared/LITERATURE.md)
+    p_needed = measured / (x[2] * 2 * math.pi * a_mm) * 1e3  # kPa
+    mu_shear = x[1] / 3.0  # kPa, incompressible
+    fem = feat.get("friction_per_mm_N") or 0.0
+    return (f"Shaft friction: the identified FEM gives {fem:.4f} N/mm where the measurement gives {measured} N/mm. With "
+            f"Coulomb friction (coefficient {x[2]:.3g}) that measurement needs a radial pressure of about {p_needed:.0f} kPa "
+            f"on the shaft, {p_needed / mu_shear:.0f} times the identified parenchyma's shear modulus ({mu_shear:.2f} kPa): "
+            "a tissue this soft cannot press that hard on a needle it has been opened around, so the measured friction "
+            "of liver is not Coulomb friction on the parenchyma's elastic pressure (adhesion or a pressure-independent "
+            "interface shear, which the FEM does not model, are the candidates). The coefficient is therefore not "
+            "identifiable from this curve (the search moved it little); the friction is the real-time force law's, "
+            "calibrated on the same curve in results/liver_calibration.")
+
+
 def held_out_rmse(ins, curve, lo, hi):
     err = [interp(ins, d) - f for d, f in binned(curve, lo, hi) if interp(ins, d) is not None]
     return math.sqrt(sum(e * e for e in err) / len(err)) if err else None
@@ -305,7 +322,8 @@ def main():
     command = (f"scripts/liver_fem_identification.sh (= liver_fem_identification.py {args.scene} {args.curve} {args.out_dir} "
                f"PUNCTURE --offset-mm {args.offset_mm:g} --evaluations {args.evaluations} --fit-depth-mm {args.fit_depth_mm:g}"
                + (f" --from-evaluations {args.from_evaluations}" if args.from_evaluations else "") + ")")
-    stamp = f"{command}, git {provenance.git_revision()}, {provenance.machine()}, {provenance.utc_now()} UTC"
+    stamp = (f"bash scripts/liver_fem_identification.sh, git {provenance.git_revision()}, {provenance.machine()}, "
+             f"{provenance.utc_now()} UTC")
     plot(os.path.join(args.out_dir, "liver_fem_vs_okamura.png"), curve, ins_b, ins_a, args.fit_depth_mm, stamp)
     identified["description"] += (" Identified against the Okamura curve: " +
                                   ", ".join(f"{n} {v:.4g}" for n, v in zip(NAMES, x_best)) + ".")
@@ -338,7 +356,7 @@ def main():
           f"the logarithms of the three parameters ({count[0]} FEM runs stopped at {args.fit_depth_mm + 1:g} mm; "
           "evaluations.csv lists each). Beyond the fitted range the measured trace rises and drops again at structures "
           "inside the liver (vessels) that the two-layer scene does not model; its RMSE there is shown, not fitted. "
-          "The identified scene is `liver_identified.json`."]
+          "The identified scene is `liver_identified.json`.", "", friction_note(feat_a, x_best, scene)]
     write(os.path.join(args.out_dir, "README.md"), "\n".join(L) + "\n")
     shutil.rmtree(work, ignore_errors=True)
     print("wrote", args.out_dir)

@@ -10,7 +10,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${PUNCTURE_BUILD_DIR:-$root/build}"
-shared="${PUNCTURE_SHARED_DATA_DIR:-$root/../shared/data}"
+shared="${PUNCTURE_SHARED_DATA_DIR:-../shared/data}"  # relative to the repository
 cd "$root"
 [ -x "$build/apps/puncture" ] || bash scripts/build.sh
 "$(command -v /usr/bin/python3 || command -v python3)" scripts/liver_fem_identification.py scenes/liver_okamura.json \
