@@ -70,7 +70,7 @@ if all(l is not None and l < 1.0 for l in lags):
           "can resist, so the fat's crack opens as soon as the tip reaches it and the energy the skin stored is spent "
           "cutting it (the cutting column peaks at "
           + ", ".join(f"{c:.2f} N" for c in cut_at_fat if c is not None) + " between the two punctures). The FEM "
-          "predicts no puncture of the fat of its own for any fat thickness under this skin; that is the physics of a "
+          "predicts no puncture of the fat of its own at either fat thickness tried under this skin; that is the physics of a "
           "soft, weak layer under a tough, stiffening one in this model, not an artefact of the slab's geometry."]
 else:
     L += ["", "Reading: with the fat thicker the fat punctures on its own, "
