@@ -1,5 +1,6 @@
 // axisymmetric_solver.cc: see axisymmetric_solver.hpp for the formulation.
 #include <puncture/fem/axisymmetric_solver.hpp>
+#include <puncture/fem/kinematics.hpp>
 
 #include <deal.II/base/function.h>
 #include <deal.II/base/quadrature_lib.h>
@@ -42,57 +43,6 @@ enum BoundaryId : types::boundary_id {
 
 unsigned n_pressure_modes(unsigned degree) { return degree == 1 ? 1 : 3; }
 double pressure_mode(unsigned a, const Point<2>& p) { return a == 0 ? 1.0 : p[a - 1] - 0.5; }
-
-SymTensor2 right_cauchy_green(const Tensor<2, 3>& F) {
-  SymTensor2 C;
-  for (unsigned a = 0; a < 3; ++a)
-    for (unsigned b = a; b < 3; ++b) {
-      double s = 0.0;
-      for (unsigned i = 0; i < 3; ++i) s += F[i][a] * F[i][b];
-      C[a][b] = s;
-    }
-  return C;
-}
-
-SymTensor2 strain_variation(const Tensor<2, 3>& F, const Tensor<2, 3>& G) {
-  SymTensor2 dE;
-  for (unsigned a = 0; a < 3; ++a)
-    for (unsigned b = a; b < 3; ++b) {
-      double s = 0.0;
-      for (unsigned i = 0; i < 3; ++i) s += F[i][a] * G[i][b] + G[i][a] * F[i][b];
-      dE[a][b] = 0.5 * s;
-    }
-  return dE;
-}
-
-/// 3x3 gradient (R, Z, theta) of a vector shape function of component c
-/// with value N and 2D gradient g at radius R: the hoop entry N/R for c = R.
-Tensor<2, 3> shape_gradient(unsigned c, double N, const Tensor<1, 2>& g, double R) {
-  Tensor<2, 3> G;
-  G[c][0] = g[0];
-  G[c][1] = g[1];
-  if (c == 0) G[2][2] = N / R;
-  return G;
-}
-
-/// Displacement gradient (3x3) at a quadrature point from the 2D gradients
-/// of u_R, u_Z and the value of u_R.
-Tensor<2, 3> displacement_gradient(const Tensor<1, 2>& grad_ur, const Tensor<1, 2>& grad_uz, double ur, double R) {
-  Tensor<2, 3> H;
-  H[0][0] = grad_ur[0];
-  H[0][1] = grad_ur[1];
-  H[1][0] = grad_uz[0];
-  H[1][1] = grad_uz[1];
-  H[2][2] = ur / R;
-  return H;
-}
-
-bool finite(const SymTensor2& t) {
-  for (unsigned a = 0; a < 3; ++a)
-    for (unsigned b = a; b < 3; ++b)
-      if (!std::isfinite(t[a][b])) return false;
-  return true;
-}
 
 /// Constitutive state of one cell at its quadrature points (three-field,
 /// condensed; see finite_strain_solver.hpp).
@@ -174,7 +124,7 @@ bool evaluate_cell(const LayerMaterial& material, unsigned degree, const FEValue
       add_volumetric_at_fixed_pressure(invert(C), st.J[q], pressure[q], st.S[q], st.CC[q]);
     else
       st.S[q] += (pressure[q] * st.J[q]) * invert(C);
-    if (!finite(st.S[q])) return false;
+    if (!all_finite(st.S[q])) return false;
   }
   return true;
 }
@@ -464,8 +414,9 @@ void AxisymmetricSolver::commit_viscous_history() {
     fev[ur].get_function_values(solution_, v_ur);
     std::vector<ViscoelasticHistory>& history = viscous_history_[cell->active_cell_index()];
     for (unsigned q = 0; q < nq; ++q) {
-      const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) +
-                             displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+      const Tensor<2, 3> F =
+          Tensor<2, 3>(unit_symmetric_tensor<3>()) +
+          axisymmetric_displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
       law->commit(right_cauchy_green(F), dt_s_, history[q]);
     }
   }
@@ -568,7 +519,7 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
     fev[uz].get_function_gradients(u, g_uz);
     fev[ur].get_function_values(u, v_ur);
     for (unsigned q = 0; q < nq; ++q)
-      H[q] = displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+      H[q] = axisymmetric_displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
     const ViscousCell viscous{viscoelastic_of(cell), &viscous_history_[cell->active_cell_index()], dt_s_};
     if (!evaluate_cell(material_of(cell), degree, fev, H, st, with_matrix, viscous)) return false;
     Ke = 0.0;
@@ -585,12 +536,12 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
     for (unsigned q = 0; q < nq; ++q) {
       const double R = fev.quadrature_point(q)[0];
       for (unsigned i = 0; i < dpc; ++i) {
-        gradN[i] = shape_gradient(comp[i], fev.shape_value(i, q), fev.shape_grad(i, q), R);
+        gradN[i] = axisymmetric_shape_gradient(comp[i], fev.shape_value(i, q), fev.shape_grad(i, q), R);
         dE[i] = strain_variation(st.F[q], gradN[i]);
         Re(i) += scalar_product(st.S[q], dE[i]) * st.dV[q];
       }
       if (stabilize) {
-        const Tensor<2, 3> dH = H[q] - displacement_gradient(g0_ur[q], g0_uz[q], v0_ur[q], R);
+        const Tensor<2, 3> dH = H[q] - axisymmetric_displacement_gradient(g0_ur[q], g0_uz[q], v0_ur[q], R);
         const Tensor<2, 3> eps = 0.5 * (dH + transpose(dH));
         out.stabilization_J += two_mu_v * scalar_product(eps, eps) * st.dV[q];
         for (unsigned i = 0; i < dpc; ++i) {
@@ -1072,7 +1023,8 @@ double AxisymmetricSolver::max_principal_stretch(int layer, double r_max_m, doub
     fev[ur].get_function_values(solution_, v_ur);
     for (unsigned q = 0; q < quadrature.size(); ++q) {
       const Tensor<2, 3> F =
-          Tensor<2, 3>(unit_symmetric_tensor<3>()) + displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+          Tensor<2, 3>(unit_symmetric_tensor<3>()) +
+          axisymmetric_displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
       const auto ev = eigenvalues(right_cauchy_green(F));
       stretch = std::max(stretch, std::sqrt(std::max(ev[0], 0.0)));
     }
@@ -1118,7 +1070,8 @@ void AxisymmetricSolver::write_vtu(const std::string& path) const {
     fev[ur].get_function_gradients(solution_, g_ur);
     fev[uz].get_function_gradients(solution_, g_uz);
     fev[ur].get_function_values(solution_, v_ur);
-    for (unsigned q = 0; q < nq; ++q) H[q] = displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+    for (unsigned q = 0; q < nq; ++q)
+      H[q] = axisymmetric_displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
     layer(c) = cell->material_id();
     // dt = 0 with the committed history: the committed (converged) stress.
     const ViscousCell viscous{viscoelastic_of(cell), &viscous_history_[c], 0.0};
