@@ -44,6 +44,29 @@ enum BoundaryId : types::boundary_id {
 unsigned n_pressure_modes(unsigned degree) { return degree == 1 ? 1 : 3; }
 double pressure_mode(unsigned a, const Point<2>& p) { return a == 0 ? 1.0 : p[a - 1] - 0.5; }
 
+/// Lumped (Newton-Cotes) weight of the face node at p on a face of the given
+/// length from its vertex v0: 1/2 (Q1); 1/6, 4/6, 1/6 (Q2).
+double newton_cotes_weight(unsigned degree, const Point<2>& p, const Point<2>& v0, double length) {
+  const double s = (p - v0).norm() / length;
+  if (degree == 1) return 0.5;
+  return (s < 0.25 || s > 0.75) ? 1.0 / 6.0 : 4.0 / 6.0;
+}
+
+/// A face by its centre (rounded to 1e3 x tol), to find the other side of a crack face.
+std::pair<long, long> face_key(const Point<2>& p, double tol) {
+  return std::make_pair(std::lround(p[0] / tol * 1e-3), std::lround(p[1] / tol * 1e-3));
+}
+
+/// The face's Z dof at the support point p (the last such dof; 0 if none).
+unsigned z_dof_at(const FiniteElement<2>& fe, const std::vector<types::global_dof_index>& face_dofs,
+                  const std::vector<Point<2>>& support, const Point<2>& p, double tol) {
+  unsigned dz = 0;
+  for (unsigned j = 0; j < face_dofs.size(); ++j)
+    if (fe.face_system_to_component_index(j).first == 1 && support[face_dofs[j]].distance(p) < tol)
+      dz = face_dofs[j];
+  return dz;
+}
+
 /// Constitutive state of one cell at its quadrature points (three-field,
 /// condensed; see finite_strain_solver.hpp).
 struct CellState {
@@ -160,6 +183,20 @@ AxisymmetricSolver::AxisymmetricSolver(const meshing::AxisymmetricSlabMesh& mesh
 }
 
 void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m) {
+  const double tol = 1e-9 * sample_radius_m;  // geometric tolerance (m)
+  build_triangulation(sample_radius_m, total_thickness_m, tol);
+  distribute_dofs_and_constraints();
+  std::vector<Point<2>> support(dof_handler_.n_dofs());
+  DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
+  find_crack_pairs(support, tol);
+  find_contact_nodes(support, tol);
+  make_sparsity();
+  allocate_state();
+  assemble(solution_, true);  // the unloaded tangent gives the first contact penalties
+  update_penalties();
+}
+
+void AxisymmetricSolver::build_triangulation(double sample_radius_m, double total_thickness_m, double tol) {
   // Triangulation from the plain mesh (crack vertices duplicated: the two
   // sides share no face and their faces are boundary faces).
   std::vector<Point<2>> vertices;
@@ -175,7 +212,6 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
   triangulation_.clear();
   triangulation_.create_triangulation(vertices, cells, SubCellData());
   const double r_c = mesh_.crack_radius_m;
-  const double tol = 1e-9 * sample_radius_m;
   for (const auto& cell : triangulation_.active_cell_iterators())
     for (const unsigned f : cell->face_indices()) {
       if (!cell->face(f)->at_boundary()) continue;
@@ -203,16 +239,14 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
     for (const auto& cell : triangulation_.active_cell_iterators())
       core_cell_[cell->active_cell_index()] =
           cell->center()[0] < r_c && cell->center()[1] > -mesh_.path_depth_m ? 1 : 0;
+}
 
+void AxisymmetricSolver::distribute_dofs_and_constraints() {
   dof_handler_.distribute_dofs(fe_);
   cells_.clear();
   for (const auto& cell : dof_handler_.active_cell_iterators()) cells_.push_back(cell);
   cell_work_.assign(cells_.size(), CellContribution{FullMatrix<double>(fe_.n_dofs_per_cell(), fe_.n_dofs_per_cell()),
                                                     Vector<double>(fe_.n_dofs_per_cell()), 0.0});
-  const unsigned n = dof_handler_.n_dofs();
-  std::vector<Point<2>> support(n);
-  DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
-
   // Homogeneous Dirichlet conditions.
   dirichlet_.clear();
   VectorTools::interpolate_boundary_values(dof_handler_, kBase, Functions::ZeroFunction<2>(2), dirichlet_);
@@ -220,29 +254,101 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
   VectorTools::interpolate_boundary_values(dof_handler_, kAxis, Functions::ZeroFunction<2>(2), dirichlet_,
                                            fe_.component_mask(FEValuesExtractors::Scalar(0)));
   dirichlet_.close();
+}
 
-  // Contact nodes and cohesive points from the boundary faces.
-  contact_nodes_.clear();
+void AxisymmetricSolver::find_crack_pairs(const std::vector<Point<2>>& support, double tol) {
+  // Cohesive points, in the order of the cells and their faces: the outer
+  // wall nodes of an open channel tied to the crack plane, and the crack
+  // nodes of the core side paired with their copies on the outer side.
   cohesive_points_.clear();
-  std::map<unsigned, std::size_t> node_of_rdof;  // R-dof -> contact node
-  const unsigned dpf = fe_.n_dofs_per_face();
-  std::vector<types::global_dof_index> face_dofs(dpf);
   // Crack faces of the outer side by the centre of the face, to pair with the core side.
   std::map<std::pair<long, long>, std::pair<DoFHandler<2>::active_cell_iterator, unsigned>> outer_faces;
-  auto key = [&](const Point<2>& p) {
-    return std::make_pair(std::lround(p[0] / tol * 1e-3), std::lround(p[1] / tol * 1e-3));
-  };
   for (const auto& cell : dof_handler_.active_cell_iterators())
     for (const unsigned f : cell->face_indices())
       if (cell->face(f)->at_boundary() && cell->face(f)->boundary_id() == kCrackOuter)
-        outer_faces[key(cell->face(f)->center())] = {cell, f};
+        outer_faces[face_key(cell->face(f)->center(), tol)] = {cell, f};
 
-  auto newton_cotes_weight = [&](const Point<2>& p, const Point<2>& v0, double length) {
-    const double s = (p - v0).norm() / length;
-    if (settings_.degree == 1) return 0.5;
-    return (s < 0.25 || s > 0.75) ? 1.0 / 6.0 : 4.0 / 6.0;
-  };
+  for (const auto& cell : dof_handler_.active_cell_iterators())
+    for (const unsigned f : cell->face_indices()) {
+      if (!cell->face(f)->at_boundary()) continue;
+      const auto id = cell->face(f)->boundary_id();
+      if (id == kCrackOuter && mesh_.open_channel) {
+        add_channel_wall_points(cell, f, support, tol);
+      } else if (id == kCrackCore) {
+        const auto match = outer_faces.find(face_key(cell->face(f)->center(), tol));
+        if (match == outer_faces.end()) throw std::logic_error("AxisymmetricSolver: unmatched crack face");
+        pair_crack_face(cell, f, match->second.first, match->second.second, support, tol);
+      }
+    }
+}
 
+void AxisymmetricSolver::add_channel_wall_points(const DoFHandler<2>::active_cell_iterator& cell, unsigned f,
+                                                 const std::vector<Point<2>>& support, double tol) {
+  // Open channel: each wall node is tied to the rigid crack plane.
+  const auto face = cell->face(f);
+  std::vector<types::global_dof_index> face_dofs(fe_.n_dofs_per_face());
+  face->get_dof_indices(face_dofs);
+  const double length = face->measure();
+  for (unsigned i = 0; i < face_dofs.size(); ++i) {
+    if (fe_.face_system_to_component_index(i).first != 0) continue;
+    const Point<2> p = support[face_dofs[i]];
+    CohesivePoint cp{};
+    cp.to_plane = true;
+    cp.outer_r = cp.core_r = face_dofs[i];
+    cp.outer_z = cp.core_z = z_dof_at(fe_, face_dofs, support, p, tol);
+    cp.Z = p[1];
+    cp.area_m2 = kTwoPi * mesh_.crack_radius_m * newton_cotes_weight(settings_.degree, p, face->vertex(0), length) *
+                 length;
+    cp.layer = static_cast<int>(cell->material_id());
+    cohesive_points_.push_back(cp);
+  }
+}
+
+void AxisymmetricSolver::pair_crack_face(const DoFHandler<2>::active_cell_iterator& cell, unsigned f,
+                                         const DoFHandler<2>::active_cell_iterator& outer_cell, unsigned outer_f,
+                                         const std::vector<Point<2>>& support, double tol) {
+  // Cohesive points: pair the core face's dofs with the outer face's.
+  const auto face = cell->face(f);
+  const unsigned dpf = fe_.n_dofs_per_face();
+  std::vector<types::global_dof_index> face_dofs(dpf), outer_dofs(dpf);
+  face->get_dof_indices(face_dofs);
+  outer_cell->face(outer_f)->get_dof_indices(outer_dofs);
+  const double length = face->measure();
+  for (unsigned i = 0; i < dpf; ++i) {
+    if (fe_.face_system_to_component_index(i).first != 0) continue;
+    const Point<2> p = support[face_dofs[i]];
+    CohesivePoint cp{};
+    cp.core_r = face_dofs[i];
+    cp.core_z = z_dof_at(fe_, face_dofs, support, p, tol);
+    bool found_r = false, found_z = false;
+    for (unsigned j = 0; j < dpf; ++j) {
+      if (support[outer_dofs[j]].distance(p) >= tol) continue;
+      if (fe_.face_system_to_component_index(j).first == 0) {
+        cp.outer_r = outer_dofs[j];
+        found_r = true;
+      } else {
+        cp.outer_z = outer_dofs[j];
+        found_z = true;
+      }
+    }
+    if (!found_r || !found_z) throw std::logic_error("AxisymmetricSolver: crack dofs do not pair up");
+    if (cp.outer_r == cp.core_r) continue;  // shared node at the path depth
+    cp.Z = p[1];
+    cp.area_m2 = kTwoPi * mesh_.crack_radius_m * newton_cotes_weight(settings_.degree, p, face->vertex(0), length) *
+                 length;
+    cp.layer = static_cast<int>(cell->material_id());
+    cohesive_points_.push_back(cp);
+  }
+}
+
+void AxisymmetricSolver::find_contact_nodes(const std::vector<Point<2>>& support, double tol) {
+  // One node per R-dof of the top surface and of the crack faces; its lumped
+  // area adds up over the faces that hold it.
+  contact_nodes_.clear();
+  std::map<unsigned, std::size_t> node_of_rdof;  // R-dof -> contact node
+  const double r_c = mesh_.crack_radius_m;
+  const unsigned dpf = fe_.n_dofs_per_face();
+  std::vector<types::global_dof_index> face_dofs(dpf);
   for (const auto& cell : dof_handler_.active_cell_iterators())
     for (const unsigned f : cell->face_indices()) {
       const auto face = cell->face(f);
@@ -257,13 +363,9 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
       for (unsigned i = 0; i < dpf; ++i) {
         if (fe_.face_system_to_component_index(i).first != 0) continue;
         const unsigned dr = face_dofs[i];
-        unsigned dz = 0;
-        for (unsigned j = 0; j < dpf; ++j)
-          if (fe_.face_system_to_component_index(j).first == 1 &&
-              support[face_dofs[j]].distance(support[dr]) < tol)
-            dz = face_dofs[j];
+        const unsigned dz = z_dof_at(fe_, face_dofs, support, support[dr], tol);
         const Point<2> p = support[dr];
-        const double area = kTwoPi * std::max(p[0], 0.0) * newton_cotes_weight(p, v0, length) * length;
+        const double area = kTwoPi * std::max(p[0], 0.0) * newton_cotes_weight(settings_.degree, p, v0, length) * length;
         auto it = node_of_rdof.find(dr);
         if (it == node_of_rdof.end()) {
           node_of_rdof[dr] = contact_nodes_.size();
@@ -273,56 +375,6 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
           node.area_m2 += area;
           node.on_top = node.on_top || id == kTop;
         }
-      }
-      if (id == kCrackOuter && mesh_.open_channel) {
-        // Open channel: each wall node is tied to the rigid crack plane.
-        for (unsigned i = 0; i < dpf; ++i) {
-          if (fe_.face_system_to_component_index(i).first != 0) continue;
-          const Point<2> p = support[face_dofs[i]];
-          CohesivePoint cp{};
-          cp.to_plane = true;
-          cp.outer_r = cp.core_r = face_dofs[i];
-          for (unsigned j = 0; j < dpf; ++j)
-            if (fe_.face_system_to_component_index(j).first == 1 && support[face_dofs[j]].distance(p) < tol)
-              cp.outer_z = cp.core_z = face_dofs[j];
-          cp.Z = p[1];
-          cp.area_m2 = kTwoPi * r_c * newton_cotes_weight(p, face->vertex(0), length) * length;
-          cp.layer = layer;
-          cohesive_points_.push_back(cp);
-        }
-        continue;
-      }
-      if (id != kCrackCore) continue;
-      // Cohesive points: pair the core face's dofs with the outer face's.
-      const auto match = outer_faces.find(key(face->center()));
-      if (match == outer_faces.end()) throw std::logic_error("AxisymmetricSolver: unmatched crack face");
-      std::vector<types::global_dof_index> outer_dofs(dpf);
-      match->second.first->face(match->second.second)->get_dof_indices(outer_dofs);
-      for (unsigned i = 0; i < dpf; ++i) {
-        if (fe_.face_system_to_component_index(i).first != 0) continue;
-        const Point<2> p = support[face_dofs[i]];
-        CohesivePoint cp{};
-        cp.core_r = face_dofs[i];
-        for (unsigned j = 0; j < dpf; ++j)
-          if (fe_.face_system_to_component_index(j).first == 1 && support[face_dofs[j]].distance(p) < tol)
-            cp.core_z = face_dofs[j];
-        bool found_r = false, found_z = false;
-        for (unsigned j = 0; j < dpf; ++j) {
-          if (support[outer_dofs[j]].distance(p) >= tol) continue;
-          if (fe_.face_system_to_component_index(j).first == 0) {
-            cp.outer_r = outer_dofs[j];
-            found_r = true;
-          } else {
-            cp.outer_z = outer_dofs[j];
-            found_z = true;
-          }
-        }
-        if (!found_r || !found_z) throw std::logic_error("AxisymmetricSolver: crack dofs do not pair up");
-        if (cp.outer_r == cp.core_r) continue;  // shared node at the path depth
-        cp.Z = p[1];
-        cp.area_m2 = kTwoPi * r_c * newton_cotes_weight(p, face->vertex(0), length) * length;
-        cp.layer = layer;
-        cohesive_points_.push_back(cp);
       }
     }
 
@@ -334,7 +386,9 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
         contact_nodes_[i].partner = static_cast<int>(j);
         contact_nodes_[j].partner = static_cast<int>(i);
       }
+}
 
+void AxisymmetricSolver::make_sparsity() {
   // Sparsity: cells, plus the couplings of each cohesive point.
   // (condensed with every possible crack tie, so that any set of tie
   // constraints can be condensed into the matrix later).
@@ -348,6 +402,7 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
       }
   }
   all_ties.close();
+  const unsigned n = dof_handler_.n_dofs();
   DynamicSparsityPattern dsp(n, n);
   DoFTools::make_sparsity_pattern(dof_handler_, dsp, all_ties, true);
   for (const CohesivePoint& cp : cohesive_points_) {
@@ -357,6 +412,12 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
       for (unsigned b : d) dsp.add(a, b);
   }
   sparsity_.copy_from(dsp);
+}
+
+void AxisymmetricSolver::allocate_state() {
+  // Matrices, vectors, and the state of the unloaded slab: u = 0, no damage,
+  // no contact, no dissipation, the viscoelastic points at rest.
+  const unsigned n = dof_handler_.n_dofs();
   tangent_.reinit(sparsity_);
   system_matrix_.reinit(sparsity_);
   residual_.reinit(n);
@@ -379,8 +440,6 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
   for (const auto& cell : dof_handler_.active_cell_iterators())
     if (const ViscoelasticMaterial<LayerMaterial>* law = viscoelastic_of(cell))
       viscous_history_[cell->active_cell_index()].assign(n_points, law->initial_history());
-  assemble(solution_, true);
-  update_penalties();
 }
 
 void AxisymmetricSolver::set_viscoelasticity(const std::vector<std::vector<PronyTerm>>& prony_per_layer) {

@@ -42,6 +42,7 @@
 // non-finite is kept.
 #pragma once
 
+#include <deal.II/base/point.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/grid/tria.h>
@@ -248,6 +249,27 @@ class AxisymmetricSolver {
     double area_m2;
     int layer;
   };
+  // --- setup(), in this order ------------------------------------------------
+  /// Triangulation of the mesh, boundary ids of its faces, the core cells.
+  void build_triangulation(double sample_radius_m, double total_thickness_m, double tol);
+  /// Dofs, the cell list and its scratch, the homogeneous Dirichlet constraints.
+  void distribute_dofs_and_constraints();
+  /// Cohesive points: the crack dofs paired across the crack (or tied to its plane).
+  void find_crack_pairs(const std::vector<dealii::Point<2>>& support, double tol);
+  /// Open channel: the outer wall nodes of face f tied to the crack plane.
+  void add_channel_wall_points(const dealii::DoFHandler<2>::active_cell_iterator& cell, unsigned f,
+                               const std::vector<dealii::Point<2>>& support, double tol);
+  /// The cohesive points joining core face f to its outer copy outer_f.
+  void pair_crack_face(const dealii::DoFHandler<2>::active_cell_iterator& cell, unsigned f,
+                       const dealii::DoFHandler<2>::active_cell_iterator& outer_cell, unsigned outer_f,
+                       const std::vector<dealii::Point<2>>& support, double tol);
+  /// Contact nodes of the top surface and crack faces, their areas and partners.
+  void find_contact_nodes(const std::vector<dealii::Point<2>>& support, double tol);
+  /// Sparsity of the cells and of every possible crack coupling.
+  void make_sparsity();
+  /// Matrices, vectors and the histories of the unloaded slab (u = 0).
+  void allocate_state();
+
   bool assemble(const dealii::Vector<double>& u, bool with_matrix);
   void make_constraints(const dealii::Vector<double>& u, dealii::AffineConstraints<double>& c) const;
   double free_residual_norm(const dealii::AffineConstraints<double>& c) const;
