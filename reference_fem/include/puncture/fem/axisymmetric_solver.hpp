@@ -270,6 +270,33 @@ class AxisymmetricSolver {
   /// Matrices, vectors and the histories of the unloaded slab (u = 0).
   void allocate_state();
 
+  // --- solve_step(), one Newton step in phases --------------------------------
+  struct Step;     ///< what the phases of one step share (defined in the .cc)
+  struct Iterate;  ///< one Newton iterate: residual, force scale, tests, log line (in the .cc)
+  using Failure = std::optional<std::string>;  ///< why the step fails (nullopt: it goes on)
+  /// Saves the start of the step, applies the predictor, lets the punch take in the nodes it reaches.
+  void start_step(Step& step, double predictor_scale);
+  /// Assembles at solution_: the free residual, the force scale, stall and convergence tests.
+  Failure evaluate_iterate(Step& step, int it, Iterate& x);
+  /// Appends the free residual to the step's history; true if Newton stalls.
+  bool check_stall(std::vector<double>& history, double free) const;
+  /// The iterate's line of the Newton log (residual, scale, force, contact and crack counts).
+  void write_iterate_line(int it, Iterate& x) const;
+  /// Flat punch: frees the nodes the face would pull (tensile reaction); true if any.
+  bool release_pulled_punch_nodes(std::vector<char>& released_in_step, double scale);
+  /// Flat punch: the top nodes within its radius that the face has reached join; true if any.
+  bool update_punch_contact(const std::vector<char>& released_in_step);
+  /// Too many iterations or a stall: why the step is given up (nullopt: go on).
+  Failure give_up_reason(int it, const Iterate& x) const;
+  /// Newton direction: K du = -R with the increment constraints condensed in.
+  Failure newton_direction(Step& step, Iterate& x);
+  /// Backtracking line search along du from solution_: the step length alpha and step.trial.
+  Failure line_search(Step& step, const Iterate& x, double& alpha);
+  /// A converged step: its log line, the last increment, the histories committed.
+  AxisymmetricNewtonReport accept_step(Step& step, const Iterate& x, int it);
+  /// A failed step: the state at its start restored, the reason reported.
+  AxisymmetricNewtonReport fail_step(Step& step, const std::string& why);
+
   bool assemble(const dealii::Vector<double>& u, bool with_matrix);
   void make_constraints(const dealii::Vector<double>& u, dealii::AffineConstraints<double>& c) const;
   double free_residual_norm(const dealii::AffineConstraints<double>& c) const;
