@@ -153,6 +153,60 @@ bool evaluate_cell(const LayerMaterial& material, unsigned degree, const FEValue
   return true;
 }
 
+/// Displacement gradients H (3x3, R Z theta) at the quadrature points of a
+/// cell from a nodal vector u (scratch for one cell at a time).
+class DisplacementGradients {
+ public:
+  explicit DisplacementGradients(unsigned nq) : g_ur_(nq), g_uz_(nq), v_ur_(nq) {}
+  void compute(const FEValues<2>& fev, const Vector<double>& u, std::vector<Tensor<2, 3>>& H) {
+    fev[ur_].get_function_gradients(u, g_ur_);
+    fev[uz_].get_function_gradients(u, g_uz_);
+    fev[ur_].get_function_values(u, v_ur_);
+    for (unsigned q = 0; q < H.size(); ++q)
+      H[q] = axisymmetric_displacement_gradient(g_ur_[q], g_uz_[q], v_ur_[q], fev.quadrature_point(q)[0]);
+  }
+
+ private:
+  const FEValuesExtractors::Scalar ur_{0}, uz_{1};
+  std::vector<Tensor<1, 2>> g_ur_, g_uz_;
+  std::vector<double> v_ur_;
+};
+
+/// Viscous stabilisation at one quadrature point: the stress two_mu_v sym(dH)
+/// (dH the step's increment of the displacement gradient) against the test
+/// gradients gradN: adds its forces to Re and, with_matrix, its stiffness to
+/// the lower triangle of Ke. Returns its energy two_mu_v |sym(dH)|^2 dV (J).
+double add_stabilization(double two_mu_v, const Tensor<2, 3>& dH, const std::vector<Tensor<2, 3>>& gradN,
+                         double dV, bool with_matrix, FullMatrix<double>& Ke, Vector<double>& Re) {
+  const Tensor<2, 3> eps = 0.5 * (dH + transpose(dH));
+  for (unsigned i = 0; i < gradN.size(); ++i) {
+    const Tensor<2, 3> ei = 0.5 * (gradN[i] + transpose(gradN[i]));
+    Re(i) += two_mu_v * scalar_product(ei, eps) * dV;
+    if (with_matrix)
+      for (unsigned j = 0; j <= i; ++j) Ke(i, j) += two_mu_v * scalar_product(ei, gradN[j]) * dV;
+  }
+  return two_mu_v * scalar_product(eps, eps) * dV;
+}
+
+/// Adds the condensed pressure stiffness B^T (M^-1 K_JJ M^-1) B of the
+/// three-field form (B: the cell's dJ couplings, np x dofs) to the lower
+/// triangle of Ke, then mirrors the lower triangle into the upper one.
+void add_condensed_pressure_stiffness(const CellState& st, const FullMatrix<double>& B, FullMatrix<double>& Ke) {
+  const unsigned np = B.m(), dpc = B.n();
+  FullMatrix<double> tmp(np, np), G(np, np), GB(np, dpc);
+  st.M_inv.mmult(tmp, st.K_JJ);
+  tmp.mmult(G, st.M_inv);
+  G.mmult(GB, B);
+  for (unsigned i = 0; i < dpc; ++i)
+    for (unsigned j = 0; j <= i; ++j) {
+      double s = 0.0;
+      for (unsigned a = 0; a < np; ++a) s += B(a, i) * GB(a, j);
+      Ke(i, j) += s;
+    }
+  for (unsigned i = 0; i < dpc; ++i)
+    for (unsigned j = i + 1; j < dpc; ++j) Ke(i, j) = Ke(j, i);
+}
+
 }  // namespace
 
 AxisymmetricSolver::AxisymmetricSolver(const meshing::AxisymmetricSlabMesh& mesh,
@@ -462,22 +516,17 @@ const ViscoelasticMaterial<LayerMaterial>* AxisymmetricSolver::viscoelastic_of(
 void AxisymmetricSolver::commit_viscous_history() {
   const QGauss<2> quadrature(settings_.degree + 1);
   FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points);
-  const FEValuesExtractors::Scalar ur(0), uz(1);
   const unsigned nq = quadrature.size();
-  std::vector<Tensor<1, 2>> g_ur(nq), g_uz(nq);
-  std::vector<double> v_ur(nq);
+  DisplacementGradients gradients(nq);
+  std::vector<Tensor<2, 3>> H(nq);
   for (const auto& cell : cells_) {
     const ViscoelasticMaterial<LayerMaterial>* law = viscoelastic_of(cell);
     if (!law) continue;
     fev.reinit(cell);
-    fev[ur].get_function_gradients(solution_, g_ur);
-    fev[uz].get_function_gradients(solution_, g_uz);
-    fev[ur].get_function_values(solution_, v_ur);
+    gradients.compute(fev, solution_, H);
     std::vector<ViscoelasticHistory>& history = viscous_history_[cell->active_cell_index()];
     for (unsigned q = 0; q < nq; ++q) {
-      const Tensor<2, 3> F =
-          Tensor<2, 3>(unit_symmetric_tensor<3>()) +
-          axisymmetric_displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+      const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) + H[q];
       law->commit(right_cauchy_green(F), dt_s_, history[q]);
     }
   }
@@ -552,16 +601,12 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
   const QGauss<2> quadrature(degree + 1);
   FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_JxW_values | update_quadrature_points);
   const unsigned dpc = fe_.n_dofs_per_cell(), nq = quadrature.size(), np = n_pressure_modes(degree);
-  FullMatrix<double> B(np, dpc), G(np, np), tmp(np, np), GB(np, dpc);
-  std::vector<Tensor<2, 3>> H(nq), gradN(dpc);
+  FullMatrix<double> B(np, dpc);
+  std::vector<Tensor<2, 3>> H(nq), H0(nq), gradN(dpc);
   std::vector<SymTensor2> dE(dpc), CC_dE(dpc);
   std::vector<unsigned> comp(dpc);
   for (unsigned i = 0; i < dpc; ++i) comp[i] = fe_.system_to_component_index(i).first;
-  const FEValuesExtractors::Scalar ur(0), uz(1);
-  std::vector<Tensor<1, 2>> g_ur(nq), g_uz(nq);
-  std::vector<double> v_ur(nq);
-  std::vector<Tensor<1, 2>> g0_ur(nq), g0_uz(nq);
-  std::vector<double> v0_ur(nq);
+  DisplacementGradients gradients(nq);
   CellState st;
   // Viscous stabilisation (Kelvin-Voigt on the step's strain increment):
   // sigma_v = (tau / dt) 2 mu_0 sym(H - H_step_start), mu_0 the layer's
@@ -576,11 +621,7 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
     Vector<double>& Re = out.Re;
     out.stabilization_J = 0.0;
     fev.reinit(cell);
-    fev[ur].get_function_gradients(u, g_ur);
-    fev[uz].get_function_gradients(u, g_uz);
-    fev[ur].get_function_values(u, v_ur);
-    for (unsigned q = 0; q < nq; ++q)
-      H[q] = axisymmetric_displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+    gradients.compute(fev, u, H);
     const ViscousCell viscous{viscoelastic_of(cell), &viscous_history_[cell->active_cell_index()], dt_s_};
     if (!evaluate_cell(material_of(cell), degree, fev, H, st, with_matrix, viscous)) return false;
     Ke = 0.0;
@@ -588,9 +629,7 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
     B = 0.0;
     double two_mu_v = 0.0;
     if (stabilize) {
-      fev[ur].get_function_gradients(step_start_, g0_ur);
-      fev[uz].get_function_gradients(step_start_, g0_uz);
-      fev[ur].get_function_values(step_start_, v0_ur);
+      gradients.compute(fev, step_start_, H0);
       const LayerMaterial& m = material_of(cell);
       two_mu_v = stab_ratio * m.youngs_modulus_Pa() / (1.0 + m.poisson_ratio());
     }
@@ -601,17 +640,8 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
         dE[i] = strain_variation(st.F[q], gradN[i]);
         Re(i) += scalar_product(st.S[q], dE[i]) * st.dV[q];
       }
-      if (stabilize) {
-        const Tensor<2, 3> dH = H[q] - axisymmetric_displacement_gradient(g0_ur[q], g0_uz[q], v0_ur[q], R);
-        const Tensor<2, 3> eps = 0.5 * (dH + transpose(dH));
-        out.stabilization_J += two_mu_v * scalar_product(eps, eps) * st.dV[q];
-        for (unsigned i = 0; i < dpc; ++i) {
-          const Tensor<2, 3> ei = 0.5 * (gradN[i] + transpose(gradN[i]));
-          Re(i) += two_mu_v * scalar_product(ei, eps) * st.dV[q];
-          if (with_matrix)
-            for (unsigned j = 0; j <= i; ++j) Ke(i, j) += two_mu_v * scalar_product(ei, gradN[j]) * st.dV[q];
-        }
-      }
+      if (stabilize)
+        out.stabilization_J += add_stabilization(two_mu_v, H[q] - H0[q], gradN, st.dV[q], with_matrix, Ke, Re);
       if (!with_matrix) continue;
       const Tensor<2, 3> S_full(st.S[q]);
       const Tensor<2, 3> F_inv_T = transpose(invert(st.F[q]));
@@ -624,24 +654,28 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
         for (unsigned a = 0; a < np; ++a) B(a, i) += st.Np[q][a] * dJ_i * st.dV[q];
       }
     }
-    if (with_matrix) {
-      st.M_inv.mmult(tmp, st.K_JJ);
-      tmp.mmult(G, st.M_inv);
-      G.mmult(GB, B);
-      for (unsigned i = 0; i < dpc; ++i)
-        for (unsigned j = 0; j <= i; ++j) {
-          double s = 0.0;
-          for (unsigned a = 0; a < np; ++a) s += B(a, i) * GB(a, j);
-          Ke(i, j) += s;
-        }
-      for (unsigned i = 0; i < dpc; ++i)
-        for (unsigned j = i + 1; j < dpc; ++j) Ke(i, j) = Ke(j, i);
-    }
+    if (with_matrix) add_condensed_pressure_stiffness(st, B, Ke);
   }
   return true;
 }
 
 bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
+  if (!compute_cell_contributions(u, with_matrix)) return false;
+  add_cell_contributions(with_matrix);
+  if (!add_cohesive_forces(u, with_matrix)) return false;
+  // Needle: penalty contact with friction (cutting tip) or flat punch reactions.
+  force_trial_ = NeedleForce{};
+  if (cutting_)
+    add_needle_contact(u, with_matrix);
+  else
+    add_punch_reactions();
+  force_trial_.total_N = force_trial_.normal_N + force_trial_.friction_N;
+  for (std::size_t i = 0; i < residual_.size(); ++i)
+    if (!std::isfinite(residual_(i))) return false;
+  return true;
+}
+
+bool AxisymmetricSolver::compute_cell_contributions(const Vector<double>& u, bool with_matrix) {
   // Cells: computed in parallel (each thread its own range and scratch), added
   // to the global system in cell order, so the result does not depend on the
   // number of threads.
@@ -666,7 +700,10 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
     if (e) std::rethrow_exception(e);
   for (const char o : ok)
     if (!o) return false;
+  return true;
+}
 
+void AxisymmetricSolver::add_cell_contributions(bool with_matrix) {
   stabilization_trial_J_ = stabilization_J_;
   if (with_matrix) {
     tangent_ = 0.0;
@@ -674,7 +711,7 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
   }
   residual_ = 0.0;
   std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
-  for (std::size_t k = 0; k < n_cells; ++k) {
+  for (std::size_t k = 0; k < cells_.size(); ++k) {
     const CellContribution& c = cell_work_[k];
     cells_[k]->get_dof_indices(dofs);
     stabilization_trial_J_ += c.stabilization_J;
@@ -684,7 +721,9 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
     }
     if (with_matrix) tangent_.add(dofs, c.Ke, false);
   }
+}
 
+bool AxisymmetricSolver::add_cohesive_forces(const Vector<double>& u, bool with_matrix) {
   // Cohesive points: R_outer += A t, R_core -= A t.
   dissipated_trial_J_ = dissipated_J_;
   for (std::size_t k = 0; k < cohesive_points_.size(); ++k) {
@@ -728,54 +767,52 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
         for (unsigned j = 0; j < 4; ++j)
           tangent_.add(d[i], d[j], sgn[i] * sgn[j] * A * scale[i % 2] * scale[j % 2] * r.tangent[i % 2][j % 2]);
   }
+  return true;
+}
 
-  // Needle: penalty contact with friction (cutting tip) or flat punch reactions.
-  force_trial_ = NeedleForce{};
-  if (cutting_) {
-    const Vec2 edge{needle_.edge_radius_m, needle_.z_tip_m};
-    for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
-      const ContactNode& nd = contact_nodes_[i];
-      const Vec2 x{nd.R + u[nd.dof_r], nd.Z + u[nd.dof_z]};
-      const ContactPenalty penalty{penalty_[i], settings_.contact_rounding * mesh_.tip_element_size_m};
-      NodalContactResponse resp;
-      ContactPoint c;
-      if (nd.core_side) {
-        resp = core_wall_contact(needle_, x, penalty,
-                                 settings_.hold_crack_line ? -1.0 : settings_.edge_rounding * mesh_.tip_element_size_m);
-        c.penetration_m = std::max(x[0] - needle_.edge_radius_m, 0.0);
-      } else {
-        c = outer_contact(needle_, x, settings_.edge_rounding * mesh_.tip_element_size_m);
-        resp = nodal_contact(c, x, edge, friction_committed_[i], friction_[nd.layer], penalty,
-                             settings_.friction_penalty * penalty_[i]);
-      }
-      friction_trial_[i] = resp.history;
-      if (!resp.history.in_contact) continue;
-      if (debug_contacts_)
-        std::cout << "        node R " << nd.R * 1e3 << " Z " << nd.Z * 1e3 << (nd.core_side ? " core" : " outer")
-                  << " x (" << x[0] * 1e3 << ", " << x[1] * 1e3 << ") pen " << c.penetration_m * 1e6 << " um n ("
-                  << c.normal[0] << "," << c.normal[1] << ") k " << penalty_[i] << " f " << resp.normal_force[0] << ","
-                  << resp.normal_force[1] << " ft " << resp.friction_force[1] << std::endl;
-      const unsigned d[2] = {nd.dof_r, nd.dof_z};
-      for (unsigned a = 0; a < 2; ++a) {
-        residual_(d[a]) -= resp.normal_force[a] + resp.friction_force[a];
-        if (with_matrix)
-          for (unsigned b = 0; b < 2; ++b) tangent_.add(d[a], d[b], -resp.dforce_dx[a][b]);
-      }
-      force_trial_.normal_N -= resp.normal_force[1];
-      force_trial_.friction_N -= resp.friction_force[1];
+void AxisymmetricSolver::add_needle_contact(const Vector<double>& u, bool with_matrix) {
+  // Cutting tip: penalty contact with Coulomb friction at every contact node.
+  const Vec2 edge{needle_.edge_radius_m, needle_.z_tip_m};
+  for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
+    const ContactNode& nd = contact_nodes_[i];
+    const Vec2 x{nd.R + u[nd.dof_r], nd.Z + u[nd.dof_z]};
+    const ContactPenalty penalty{penalty_[i], settings_.contact_rounding * mesh_.tip_element_size_m};
+    NodalContactResponse resp;
+    ContactPoint c;
+    if (nd.core_side) {
+      resp = core_wall_contact(needle_, x, penalty,
+                               settings_.hold_crack_line ? -1.0 : settings_.edge_rounding * mesh_.tip_element_size_m);
+      c.penetration_m = std::max(x[0] - needle_.edge_radius_m, 0.0);
+    } else {
+      c = outer_contact(needle_, x, settings_.edge_rounding * mesh_.tip_element_size_m);
+      resp = nodal_contact(c, x, edge, friction_committed_[i], friction_[nd.layer], penalty,
+                           settings_.friction_penalty * penalty_[i]);
+    }
+    friction_trial_[i] = resp.history;
+    if (!resp.history.in_contact) continue;
+    if (debug_contacts_)
+      std::cout << "        node R " << nd.R * 1e3 << " Z " << nd.Z * 1e3 << (nd.core_side ? " core" : " outer")
+                << " x (" << x[0] * 1e3 << ", " << x[1] * 1e3 << ") pen " << c.penetration_m * 1e6 << " um n ("
+                << c.normal[0] << "," << c.normal[1] << ") k " << penalty_[i] << " f " << resp.normal_force[0] << ","
+                << resp.normal_force[1] << " ft " << resp.friction_force[1] << std::endl;
+    const unsigned d[2] = {nd.dof_r, nd.dof_z};
+    for (unsigned a = 0; a < 2; ++a) {
+      residual_(d[a]) -= resp.normal_force[a] + resp.friction_force[a];
+      if (with_matrix)
+        for (unsigned b = 0; b < 2; ++b) tangent_.add(d[a], d[b], -resp.dforce_dx[a][b]);
+    }
+    force_trial_.normal_N -= resp.normal_force[1];
+    force_trial_.friction_N -= resp.friction_force[1];
+    ++force_trial_.nodes_in_contact;
+  }
+}
+
+void AxisymmetricSolver::add_punch_reactions() {
+  for (std::size_t i = 0; i < contact_nodes_.size(); ++i)
+    if (punch_contact_[i]) {
+      force_trial_.normal_N -= residual_(contact_nodes_[i].dof_z);  // R_z < 0 where the punch presses
       ++force_trial_.nodes_in_contact;
     }
-  } else {
-    for (std::size_t i = 0; i < contact_nodes_.size(); ++i)
-      if (punch_contact_[i]) {
-        force_trial_.normal_N -= residual_(contact_nodes_[i].dof_z);  // R_z < 0 where the punch presses
-        ++force_trial_.nodes_in_contact;
-      }
-  }
-  force_trial_.total_N = force_trial_.normal_N + force_trial_.friction_N;
-  for (std::size_t i = 0; i < residual_.size(); ++i)
-    if (!std::isfinite(residual_(i))) return false;
-  return true;
 }
 
 double AxisymmetricSolver::free_residual_norm(const AffineConstraints<double>& c) const {
@@ -1129,22 +1166,17 @@ std::vector<std::pair<double, double>> AxisymmetricSolver::vertical_displacement
 double AxisymmetricSolver::max_principal_stretch(int layer, double r_max_m, double z_lo_m, double z_hi_m) const {
   const QGauss<2> quadrature(settings_.degree + 1);
   FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points);
-  const FEValuesExtractors::Scalar ur(0), uz(1);
-  std::vector<Tensor<1, 2>> g_ur(quadrature.size()), g_uz(quadrature.size());
-  std::vector<double> v_ur(quadrature.size());
+  DisplacementGradients gradients(quadrature.size());
+  std::vector<Tensor<2, 3>> H(quadrature.size());
   double stretch = 1.0;
   for (const auto& cell : dof_handler_.active_cell_iterators()) {
     if (static_cast<int>(cell->material_id()) != layer) continue;
     const Point<2> c = cell->center();
     if (c[0] > r_max_m || c[1] < z_lo_m || c[1] > z_hi_m) continue;
     fev.reinit(cell);
-    fev[ur].get_function_gradients(solution_, g_ur);
-    fev[uz].get_function_gradients(solution_, g_uz);
-    fev[ur].get_function_values(solution_, v_ur);
+    gradients.compute(fev, solution_, H);
     for (unsigned q = 0; q < quadrature.size(); ++q) {
-      const Tensor<2, 3> F =
-          Tensor<2, 3>(unit_symmetric_tensor<3>()) +
-          axisymmetric_displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+      const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) + H[q];
       const auto ev = eigenvalues(right_cauchy_green(F));
       stretch = std::max(stretch, std::sqrt(std::max(ev[0], 0.0)));
     }
@@ -1178,20 +1210,14 @@ void AxisymmetricSolver::write_vtu(const std::string& path) const {
   Vector<double> layer(n), J(n), von_mises(n), stretch(n), damage(n);
   const QGauss<2> quadrature(settings_.degree + 1);
   FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points | update_JxW_values);
-  const FEValuesExtractors::Scalar ur(0), uz(1);
   const unsigned nq = quadrature.size();
-  std::vector<Tensor<1, 2>> g_ur(nq), g_uz(nq);
-  std::vector<double> v_ur(nq);
+  DisplacementGradients gradients(nq);
   std::vector<Tensor<2, 3>> H(nq);
   CellState st;
   for (const auto& cell : dof_handler_.active_cell_iterators()) {
     const unsigned c = cell->active_cell_index();
     fev.reinit(cell);
-    fev[ur].get_function_gradients(solution_, g_ur);
-    fev[uz].get_function_gradients(solution_, g_uz);
-    fev[ur].get_function_values(solution_, v_ur);
-    for (unsigned q = 0; q < nq; ++q)
-      H[q] = axisymmetric_displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+    gradients.compute(fev, solution_, H);
     layer(c) = cell->material_id();
     // dt = 0 with the committed history: the committed (converged) stress.
     const ViscousCell viscous{viscoelastic_of(cell), &viscous_history_[c], 0.0};

@@ -297,7 +297,20 @@ class AxisymmetricSolver {
   /// A failed step: the state at its start restored, the reason reported.
   AxisymmetricNewtonReport fail_step(Step& step, const std::string& why);
 
+  // --- assemble(): residual_ and (with_matrix) tangent_ at u -----------------
+  /// Cells, cohesive crack, needle; the trial histories and needle force; false
+  /// on an inverted or non-finite state.
   bool assemble(const dealii::Vector<double>& u, bool with_matrix);
+  /// Every cell's stiffness and forces into cell_work_, on assembly_threads threads.
+  bool compute_cell_contributions(const dealii::Vector<double>& u, bool with_matrix);
+  /// Adds cell_work_ to the system in cell order (and the bulk diagonal, the stabilisation energy).
+  void add_cell_contributions(bool with_matrix);
+  /// The cohesive tractions of the crack points (trial histories, dissipation); false if non-finite.
+  bool add_cohesive_forces(const dealii::Vector<double>& u, bool with_matrix);
+  /// Cutting tip: penalty contact with Coulomb friction at the contact nodes, the needle force.
+  void add_needle_contact(const dealii::Vector<double>& u, bool with_matrix);
+  /// Flat punch: its force from the reactions of the nodes it holds.
+  void add_punch_reactions();
   void make_constraints(const dealii::Vector<double>& u, dealii::AffineConstraints<double>& c) const;
   double free_residual_norm(const dealii::AffineConstraints<double>& c) const;
   void update_penalties();
