@@ -12,14 +12,12 @@
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/sparse_direct.h>
-#include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/vector_tools.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <exception>
 #include <iostream>
@@ -30,20 +28,23 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "axisymmetric_cell.hpp"
+
 namespace puncture::fem {
 
 using namespace dealii;
+using axisymmetric_cell::CellState;
+using axisymmetric_cell::DisplacementGradients;
+using axisymmetric_cell::ViscousCell;
+using axisymmetric_cell::evaluate_cell;
+using axisymmetric_cell::kTwoPi;
+using axisymmetric_cell::n_pressure_modes;
 
 namespace {
-
-constexpr double kTwoPi = 6.283185307179586;
 
 enum BoundaryId : types::boundary_id {
   kTop = 0, kBase = 1, kLateral = 2, kAxis = 3, kCrackCore = 4, kCrackOuter = 5, kChannelFloor = 6
 };
-
-unsigned n_pressure_modes(unsigned degree) { return degree == 1 ? 1 : 3; }
-double pressure_mode(unsigned a, const Point<2>& p) { return a == 0 ? 1.0 : p[a - 1] - 0.5; }
 
 /// Lumped (Newton-Cotes) weight of the face node at p on a face of the given
 /// length from its vertex v0: 1/2 (Q1); 1/6, 4/6, 1/6 (Q2).
@@ -67,110 +68,6 @@ unsigned z_dof_at(const FiniteElement<2>& fe, const std::vector<types::global_do
       dz = face_dofs[j];
   return dz;
 }
-
-/// Constitutive state of one cell at its quadrature points (three-field,
-/// condensed; see finite_strain_solver.hpp).
-struct CellState {
-  std::vector<Tensor<2, 3>> F;
-  std::vector<double> J, dV;
-  std::vector<SymTensor2> S;
-  std::vector<SymTensor4> CC;
-  FullMatrix<double> M_inv, K_JJ;
-  std::vector<std::vector<double>> Np;
-};
-
-/// A viscoelastic cell's law, its points' committed histories and the step
-/// (law nullptr: elastic).
-struct ViscousCell {
-  const ViscoelasticMaterial<LayerMaterial>* law = nullptr;
-  const std::vector<ViscoelasticHistory>* history = nullptr;
-  double dt_s = 0.0;
-};
-
-bool evaluate_cell(const LayerMaterial& material, unsigned degree, const FEValues<2>& fev,
-                   const std::vector<Tensor<2, 3>>& H, CellState& st, bool with_tangent = true,
-                   const ViscousCell& viscous = {}) {
-  const unsigned nq = fev.n_quadrature_points, np = n_pressure_modes(degree);
-  st.F.resize(nq);
-  st.J.resize(nq);
-  st.dV.resize(nq);
-  st.S.resize(nq);
-  st.CC.resize(nq);
-  st.M_inv.reinit(np, np);
-  st.K_JJ.reinit(np, np);
-  st.Np.assign(nq, std::vector<double>(np, 0.0));
-  const Tensor<2, 3> I = unit_symmetric_tensor<3>();
-  const auto& unit_points = fev.get_quadrature().get_points();
-  FullMatrix<double> M(np, np);
-  std::vector<double> bJ(np, 0.0), bp(np, 0.0), cJ(np, 0.0), cp(np, 0.0);
-  for (unsigned q = 0; q < nq; ++q) {
-    st.F[q] = I + H[q];
-    st.J[q] = determinant(st.F[q]);
-    if (!(st.J[q] > 0.0) || !std::isfinite(st.J[q])) return false;
-    st.dV[q] = kTwoPi * fev.quadrature_point(q)[0] * fev.JxW(q);
-    for (unsigned a = 0; a < np; ++a) st.Np[q][a] = pressure_mode(a, unit_points[q]);
-    for (unsigned a = 0; a < np; ++a) {
-      bJ[a] += st.Np[q][a] * st.J[q] * st.dV[q];
-      for (unsigned b = 0; b < np; ++b) M(a, b) += st.Np[q][a] * st.Np[q][b] * st.dV[q];
-    }
-  }
-  st.M_inv.invert(M);
-  for (unsigned a = 0; a < np; ++a)
-    for (unsigned b = 0; b < np; ++b) cJ[a] += st.M_inv(a, b) * bJ[b];
-  const VolumetricLaw& vol = material.volumetric();
-  std::vector<double> J_tilde(nq, 0.0), pressure(nq, 0.0);
-  for (unsigned q = 0; q < nq; ++q) {
-    for (unsigned a = 0; a < np; ++a) J_tilde[q] += cJ[a] * st.Np[q][a];
-    if (!(J_tilde[q] > 0.0) || !std::isfinite(J_tilde[q])) return false;
-    const double dp = vol.dpressure_dJ(J_tilde[q]);
-    for (unsigned a = 0; a < np; ++a) {
-      bp[a] += st.Np[q][a] * vol.pressure(J_tilde[q]) * st.dV[q];
-      for (unsigned b = 0; b < np; ++b) st.K_JJ(a, b) += dp * st.Np[q][a] * st.Np[q][b] * st.dV[q];
-    }
-  }
-  for (unsigned a = 0; a < np; ++a)
-    for (unsigned b = 0; b < np; ++b) cp[a] += st.M_inv(a, b) * bp[b];
-  for (unsigned q = 0; q < nq; ++q) {
-    for (unsigned a = 0; a < np; ++a) pressure[q] += cp[a] * st.Np[q][a];
-    const SymTensor2 C = right_cauchy_green(st.F[q]);
-    if (viscous.law) {  // long-term law + Prony stresses from the committed history
-      const ViscoelasticHistory& h = (*viscous.history)[q];
-      if (with_tangent)
-        viscous.law->isochoric_stress_and_tangent(C, viscous.dt_s, h, st.S[q], st.CC[q]);
-      else
-        st.S[q] = viscous.law->isochoric_stress(C, viscous.dt_s, h);
-    } else if (with_tangent) {
-      material.isochoric_stress_and_tangent(C, st.S[q], st.CC[q]);
-    } else {  // residual only: the stress without its tangent
-      st.S[q] = material.isochoric_stress(C);
-    }
-    if (with_tangent)
-      add_volumetric_at_fixed_pressure(invert(C), st.J[q], pressure[q], st.S[q], st.CC[q]);
-    else
-      st.S[q] += (pressure[q] * st.J[q]) * invert(C);
-    if (!all_finite(st.S[q])) return false;
-  }
-  return true;
-}
-
-/// Displacement gradients H (3x3, R Z theta) at the quadrature points of a
-/// cell from a nodal vector u (scratch for one cell at a time).
-class DisplacementGradients {
- public:
-  explicit DisplacementGradients(unsigned nq) : g_ur_(nq), g_uz_(nq), v_ur_(nq) {}
-  void compute(const FEValues<2>& fev, const Vector<double>& u, std::vector<Tensor<2, 3>>& H) {
-    fev[ur_].get_function_gradients(u, g_ur_);
-    fev[uz_].get_function_gradients(u, g_uz_);
-    fev[ur_].get_function_values(u, v_ur_);
-    for (unsigned q = 0; q < H.size(); ++q)
-      H[q] = axisymmetric_displacement_gradient(g_ur_[q], g_uz_[q], v_ur_[q], fev.quadrature_point(q)[0]);
-  }
-
- private:
-  const FEValuesExtractors::Scalar ur_{0}, uz_{1};
-  std::vector<Tensor<1, 2>> g_ur_, g_uz_;
-  std::vector<double> v_ur_;
-};
 
 /// Viscous stabilisation at one quadrature point: the stress two_mu_v sym(dH)
 /// (dH the step's increment of the displacement gradient) against the test
@@ -1127,150 +1024,6 @@ AxisymmetricNewtonReport AxisymmetricSolver::fail_step(Step& step, const std::st
   step.report.failure = why;
   if (settings_.verbose) std::cout << "      newton failed: " << why << std::endl;
   return step.report;
-}
-
-double AxisymmetricSolver::crack_front_depth_m(int layer, double damage_threshold) const {
-  double depth = -1.0;
-  for (std::size_t k = 0; k < cohesive_points_.size(); ++k)
-    if (cohesive_points_[k].layer == layer && cohesive_committed_[k].damage >= damage_threshold)
-      depth = std::max(depth, -cohesive_points_[k].Z);
-  return depth;
-}
-
-double AxisymmetricSolver::max_damage(int layer) const {
-  double d = 0.0;
-  for (std::size_t k = 0; k < cohesive_points_.size(); ++k)
-    if (cohesive_points_[k].layer == layer) d = std::max(d, cohesive_committed_[k].damage);
-  return d;
-}
-
-std::vector<std::pair<double, double>> AxisymmetricSolver::vertical_displacement_along(double z_line_m) const {
-  std::vector<Point<2>> support(dof_handler_.n_dofs());
-  DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
-  std::vector<std::pair<double, double>> out;
-  const double tol = 1e-9;
-  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
-  std::vector<char> seen(dof_handler_.n_dofs(), 0);
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
-    cell->get_dof_indices(dofs);
-    for (unsigned i = 0; i < dofs.size(); ++i) {
-      if (fe_.system_to_component_index(i).first != 1 || seen[dofs[i]]) continue;
-      seen[dofs[i]] = 1;
-      if (std::abs(support[dofs[i]][1] - z_line_m) < tol) out.emplace_back(support[dofs[i]][0], solution_(dofs[i]));
-    }
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-double AxisymmetricSolver::max_principal_stretch(int layer, double r_max_m, double z_lo_m, double z_hi_m) const {
-  const QGauss<2> quadrature(settings_.degree + 1);
-  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points);
-  DisplacementGradients gradients(quadrature.size());
-  std::vector<Tensor<2, 3>> H(quadrature.size());
-  double stretch = 1.0;
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
-    if (static_cast<int>(cell->material_id()) != layer) continue;
-    const Point<2> c = cell->center();
-    if (c[0] > r_max_m || c[1] < z_lo_m || c[1] > z_hi_m) continue;
-    fev.reinit(cell);
-    gradients.compute(fev, solution_, H);
-    for (unsigned q = 0; q < quadrature.size(); ++q) {
-      const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) + H[q];
-      const auto ev = eigenvalues(right_cauchy_green(F));
-      stretch = std::max(stretch, std::sqrt(std::max(ev[0], 0.0)));
-    }
-  }
-  return stretch;
-}
-
-std::array<double, 2> AxisymmetricSolver::displacement_at(double R_m, double Z_m) const {
-  std::vector<Point<2>> support(dof_handler_.n_dofs());
-  DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
-  const Point<2> p(R_m, Z_m);
-  double best[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-  std::array<double, 2> u{0.0, 0.0};
-  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
-    cell->get_dof_indices(dofs);
-    for (unsigned i = 0; i < dofs.size(); ++i) {
-      const unsigned c = fe_.system_to_component_index(i).first;
-      const double d = support[dofs[i]].distance(p);
-      if (d < best[c]) {
-        best[c] = d;
-        u[c] = solution_(dofs[i]);
-      }
-    }
-  }
-  return u;
-}
-
-void AxisymmetricSolver::write_vtu(const std::string& path) const {
-  const unsigned n = triangulation_.n_active_cells();
-  Vector<double> layer(n), J(n), von_mises(n), stretch(n), damage(n);
-  const QGauss<2> quadrature(settings_.degree + 1);
-  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points | update_JxW_values);
-  const unsigned nq = quadrature.size();
-  DisplacementGradients gradients(nq);
-  std::vector<Tensor<2, 3>> H(nq);
-  CellState st;
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
-    const unsigned c = cell->active_cell_index();
-    fev.reinit(cell);
-    gradients.compute(fev, solution_, H);
-    layer(c) = cell->material_id();
-    // dt = 0 with the committed history: the committed (converged) stress.
-    const ViscousCell viscous{viscoelastic_of(cell), &viscous_history_[c], 0.0};
-    const bool ok = evaluate_cell(material_of(cell), settings_.degree, fev, H, st, true, viscous);
-    double j_sum = 0.0, vm_sum = 0.0, s_max = 1.0;
-    for (unsigned q = 0; q < nq; ++q) {
-      const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) + H[q];
-      const double Jq = determinant(F);
-      j_sum += Jq;
-      const auto ev = eigenvalues(right_cauchy_green(F));
-      s_max = std::max(s_max, std::sqrt(std::max(ev[0], 0.0)));
-      if (ok) {
-        const Tensor<2, 3> sigma = (1.0 / Jq) * F * Tensor<2, 3>(st.S[q]) * transpose(F);
-        const SymTensor2 s = deviator(symmetrize(sigma));
-        vm_sum += std::sqrt(1.5 * scalar_product(s, s));
-      }
-    }
-    J(c) = j_sum / nq;
-    von_mises(c) = vm_sum / nq;
-    stretch(c) = s_max;
-  }
-  // Crack damage on the cells along the crack (largest of their points).
-  std::map<unsigned, double> damage_of_dof;
-  for (std::size_t k = 0; k < cohesive_points_.size(); ++k) {
-    damage_of_dof[cohesive_points_[k].core_r] = std::max(damage_of_dof[cohesive_points_[k].core_r], cohesive_committed_[k].damage);
-    damage_of_dof[cohesive_points_[k].outer_r] = std::max(damage_of_dof[cohesive_points_[k].outer_r], cohesive_committed_[k].damage);
-  }
-  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
-    cell->get_dof_indices(dofs);
-    double d = 0.0;
-    for (auto dof : dofs) {
-      const auto it = damage_of_dof.find(dof);
-      if (it != damage_of_dof.end()) d = std::max(d, it->second);
-    }
-    damage(cell->active_cell_index()) = d;
-  }
-  DataOut<2> out;
-  out.attach_dof_handler(dof_handler_);
-  std::vector<std::string> names{"displacement_m", "displacement_m"};
-  std::vector<DataComponentInterpretation::DataComponentInterpretation> interp(
-      2, DataComponentInterpretation::component_is_part_of_vector);
-  out.add_data_vector(solution_, names, DataOut<2>::type_dof_data, interp);
-  out.add_data_vector(layer, "layer_id");
-  out.add_data_vector(J, "J");
-  out.add_data_vector(von_mises, "von_mises_Pa");
-  out.add_data_vector(stretch, "max_principal_stretch");
-  out.add_data_vector(damage, "crack_damage");
-  out.build_patches(settings_.degree);
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error("cannot write " + path);
-  out.write_vtu(file);
-  if (!file) throw std::runtime_error("error while writing " + path);
 }
 
 }  // namespace puncture::fem
