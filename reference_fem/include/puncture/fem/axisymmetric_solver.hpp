@@ -311,9 +311,14 @@ class AxisymmetricSolver {
   void add_needle_contact(const dealii::Vector<double>& u, bool with_matrix);
   /// Flat punch: its force from the reactions of the nodes it holds.
   void add_punch_reactions();
+
+  /// The Newton increment's constraints at u: Dirichlet, unbroken ties, the flat punch.
   void make_constraints(const dealii::Vector<double>& u, dealii::AffineConstraints<double>& c) const;
+  /// Norm of residual_ over the dofs c leaves free (constrained dofs hand theirs to their masters).
   double free_residual_norm(const dealii::AffineConstraints<double>& c) const;
+  /// Contact penalties from the bulk diagonal of the last assembly.
   void update_penalties();
+  /// Makes the trial histories, dissipation and needle force the committed ones.
   void commit();
 
   const meshing::AxisymmetricSlabMesh& mesh_;
