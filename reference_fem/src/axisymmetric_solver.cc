@@ -1,5 +1,6 @@
 // axisymmetric_solver.cc: see axisymmetric_solver.hpp for the formulation.
 #include <puncture/fem/axisymmetric_solver.hpp>
+#include <puncture/fem/kinematics.hpp>
 
 #include <deal.II/base/function.h>
 #include <deal.II/base/quadrature_lib.h>
@@ -11,172 +12,96 @@
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/sparse_direct.h>
-#include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/vector_tools.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <exception>
 #include <iostream>
 #include <thread>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+
+#include "axisymmetric_cell.hpp"
 
 namespace puncture::fem {
 
 using namespace dealii;
+using axisymmetric_cell::CellState;
+using axisymmetric_cell::DisplacementGradients;
+using axisymmetric_cell::ViscousCell;
+using axisymmetric_cell::evaluate_cell;
+using axisymmetric_cell::kTwoPi;
+using axisymmetric_cell::n_pressure_modes;
 
 namespace {
-
-constexpr double kTwoPi = 6.283185307179586;
 
 enum BoundaryId : types::boundary_id {
   kTop = 0, kBase = 1, kLateral = 2, kAxis = 3, kCrackCore = 4, kCrackOuter = 5, kChannelFloor = 6
 };
 
-unsigned n_pressure_modes(unsigned degree) { return degree == 1 ? 1 : 3; }
-double pressure_mode(unsigned a, const Point<2>& p) { return a == 0 ? 1.0 : p[a - 1] - 0.5; }
+/// Lumped (Newton-Cotes) weight of the face node at p on a face of the given
+/// length from its vertex v0: 1/2 (Q1); 1/6, 4/6, 1/6 (Q2).
+double newton_cotes_weight(unsigned degree, const Point<2>& p, const Point<2>& v0, double length) {
+  const double s = (p - v0).norm() / length;
+  if (degree == 1) return 0.5;
+  return (s < 0.25 || s > 0.75) ? 1.0 / 6.0 : 4.0 / 6.0;
+}
 
-SymTensor2 right_cauchy_green(const Tensor<2, 3>& F) {
-  SymTensor2 C;
-  for (unsigned a = 0; a < 3; ++a)
-    for (unsigned b = a; b < 3; ++b) {
+/// A face by its centre (rounded to 1e3 x tol), to find the other side of a crack face.
+std::pair<long, long> face_key(const Point<2>& p, double tol) {
+  return std::make_pair(std::lround(p[0] / tol * 1e-3), std::lround(p[1] / tol * 1e-3));
+}
+
+/// The face's Z dof at the support point p (the last such dof; 0 if none).
+unsigned z_dof_at(const FiniteElement<2>& fe, const std::vector<types::global_dof_index>& face_dofs,
+                  const std::vector<Point<2>>& support, const Point<2>& p, double tol) {
+  unsigned dz = 0;
+  for (unsigned j = 0; j < face_dofs.size(); ++j)
+    if (fe.face_system_to_component_index(j).first == 1 && support[face_dofs[j]].distance(p) < tol)
+      dz = face_dofs[j];
+  return dz;
+}
+
+/// Viscous stabilisation at one quadrature point: the stress two_mu_v sym(dH)
+/// (dH the step's increment of the displacement gradient) against the test
+/// gradients gradN: adds its forces to Re and, with_matrix, its stiffness to
+/// the lower triangle of Ke. Returns its energy two_mu_v |sym(dH)|^2 dV (J).
+double add_stabilization(double two_mu_v, const Tensor<2, 3>& dH, const std::vector<Tensor<2, 3>>& gradN,
+                         double dV, bool with_matrix, FullMatrix<double>& Ke, Vector<double>& Re) {
+  const Tensor<2, 3> eps = 0.5 * (dH + transpose(dH));
+  for (unsigned i = 0; i < gradN.size(); ++i) {
+    const Tensor<2, 3> ei = 0.5 * (gradN[i] + transpose(gradN[i]));
+    Re(i) += two_mu_v * scalar_product(ei, eps) * dV;
+    if (with_matrix)
+      for (unsigned j = 0; j <= i; ++j) Ke(i, j) += two_mu_v * scalar_product(ei, gradN[j]) * dV;
+  }
+  return two_mu_v * scalar_product(eps, eps) * dV;
+}
+
+/// Adds the condensed pressure stiffness B^T (M^-1 K_JJ M^-1) B of the
+/// three-field form (B: the cell's dJ couplings, np x dofs) to the lower
+/// triangle of Ke, then mirrors the lower triangle into the upper one.
+void add_condensed_pressure_stiffness(const CellState& st, const FullMatrix<double>& B, FullMatrix<double>& Ke) {
+  const unsigned np = B.m(), dpc = B.n();
+  FullMatrix<double> tmp(np, np), G(np, np), GB(np, dpc);
+  st.M_inv.mmult(tmp, st.K_JJ);
+  tmp.mmult(G, st.M_inv);
+  G.mmult(GB, B);
+  for (unsigned i = 0; i < dpc; ++i)
+    for (unsigned j = 0; j <= i; ++j) {
       double s = 0.0;
-      for (unsigned i = 0; i < 3; ++i) s += F[i][a] * F[i][b];
-      C[a][b] = s;
+      for (unsigned a = 0; a < np; ++a) s += B(a, i) * GB(a, j);
+      Ke(i, j) += s;
     }
-  return C;
-}
-
-SymTensor2 strain_variation(const Tensor<2, 3>& F, const Tensor<2, 3>& G) {
-  SymTensor2 dE;
-  for (unsigned a = 0; a < 3; ++a)
-    for (unsigned b = a; b < 3; ++b) {
-      double s = 0.0;
-      for (unsigned i = 0; i < 3; ++i) s += F[i][a] * G[i][b] + G[i][a] * F[i][b];
-      dE[a][b] = 0.5 * s;
-    }
-  return dE;
-}
-
-/// 3x3 gradient (R, Z, theta) of a vector shape function of component c
-/// with value N and 2D gradient g at radius R: the hoop entry N/R for c = R.
-Tensor<2, 3> shape_gradient(unsigned c, double N, const Tensor<1, 2>& g, double R) {
-  Tensor<2, 3> G;
-  G[c][0] = g[0];
-  G[c][1] = g[1];
-  if (c == 0) G[2][2] = N / R;
-  return G;
-}
-
-/// Displacement gradient (3x3) at a quadrature point from the 2D gradients
-/// of u_R, u_Z and the value of u_R.
-Tensor<2, 3> displacement_gradient(const Tensor<1, 2>& grad_ur, const Tensor<1, 2>& grad_uz, double ur, double R) {
-  Tensor<2, 3> H;
-  H[0][0] = grad_ur[0];
-  H[0][1] = grad_ur[1];
-  H[1][0] = grad_uz[0];
-  H[1][1] = grad_uz[1];
-  H[2][2] = ur / R;
-  return H;
-}
-
-bool finite(const SymTensor2& t) {
-  for (unsigned a = 0; a < 3; ++a)
-    for (unsigned b = a; b < 3; ++b)
-      if (!std::isfinite(t[a][b])) return false;
-  return true;
-}
-
-/// Constitutive state of one cell at its quadrature points (three-field,
-/// condensed; see finite_strain_solver.hpp).
-struct CellState {
-  std::vector<Tensor<2, 3>> F;
-  std::vector<double> J, dV;
-  std::vector<SymTensor2> S;
-  std::vector<SymTensor4> CC;
-  FullMatrix<double> M_inv, K_JJ;
-  std::vector<std::vector<double>> Np;
-};
-
-/// A viscoelastic cell's law, its points' committed histories and the step
-/// (law nullptr: elastic).
-struct ViscousCell {
-  const ViscoelasticMaterial<LayerMaterial>* law = nullptr;
-  const std::vector<ViscoelasticHistory>* history = nullptr;
-  double dt_s = 0.0;
-};
-
-bool evaluate_cell(const LayerMaterial& material, unsigned degree, const FEValues<2>& fev,
-                   const std::vector<Tensor<2, 3>>& H, CellState& st, bool with_tangent = true,
-                   const ViscousCell& viscous = {}) {
-  const unsigned nq = fev.n_quadrature_points, np = n_pressure_modes(degree);
-  st.F.resize(nq);
-  st.J.resize(nq);
-  st.dV.resize(nq);
-  st.S.resize(nq);
-  st.CC.resize(nq);
-  st.M_inv.reinit(np, np);
-  st.K_JJ.reinit(np, np);
-  st.Np.assign(nq, std::vector<double>(np, 0.0));
-  const Tensor<2, 3> I = unit_symmetric_tensor<3>();
-  const auto& unit_points = fev.get_quadrature().get_points();
-  FullMatrix<double> M(np, np);
-  std::vector<double> bJ(np, 0.0), bp(np, 0.0), cJ(np, 0.0), cp(np, 0.0);
-  for (unsigned q = 0; q < nq; ++q) {
-    st.F[q] = I + H[q];
-    st.J[q] = determinant(st.F[q]);
-    if (!(st.J[q] > 0.0) || !std::isfinite(st.J[q])) return false;
-    st.dV[q] = kTwoPi * fev.quadrature_point(q)[0] * fev.JxW(q);
-    for (unsigned a = 0; a < np; ++a) st.Np[q][a] = pressure_mode(a, unit_points[q]);
-    for (unsigned a = 0; a < np; ++a) {
-      bJ[a] += st.Np[q][a] * st.J[q] * st.dV[q];
-      for (unsigned b = 0; b < np; ++b) M(a, b) += st.Np[q][a] * st.Np[q][b] * st.dV[q];
-    }
-  }
-  st.M_inv.invert(M);
-  for (unsigned a = 0; a < np; ++a)
-    for (unsigned b = 0; b < np; ++b) cJ[a] += st.M_inv(a, b) * bJ[b];
-  const VolumetricLaw& vol = material.volumetric();
-  std::vector<double> J_tilde(nq, 0.0), pressure(nq, 0.0);
-  for (unsigned q = 0; q < nq; ++q) {
-    for (unsigned a = 0; a < np; ++a) J_tilde[q] += cJ[a] * st.Np[q][a];
-    if (!(J_tilde[q] > 0.0) || !std::isfinite(J_tilde[q])) return false;
-    const double dp = vol.dpressure_dJ(J_tilde[q]);
-    for (unsigned a = 0; a < np; ++a) {
-      bp[a] += st.Np[q][a] * vol.pressure(J_tilde[q]) * st.dV[q];
-      for (unsigned b = 0; b < np; ++b) st.K_JJ(a, b) += dp * st.Np[q][a] * st.Np[q][b] * st.dV[q];
-    }
-  }
-  for (unsigned a = 0; a < np; ++a)
-    for (unsigned b = 0; b < np; ++b) cp[a] += st.M_inv(a, b) * bp[b];
-  for (unsigned q = 0; q < nq; ++q) {
-    for (unsigned a = 0; a < np; ++a) pressure[q] += cp[a] * st.Np[q][a];
-    const SymTensor2 C = right_cauchy_green(st.F[q]);
-    if (viscous.law) {  // long-term law + Prony stresses from the committed history
-      const ViscoelasticHistory& h = (*viscous.history)[q];
-      if (with_tangent)
-        viscous.law->isochoric_stress_and_tangent(C, viscous.dt_s, h, st.S[q], st.CC[q]);
-      else
-        st.S[q] = viscous.law->isochoric_stress(C, viscous.dt_s, h);
-    } else if (with_tangent) {
-      material.isochoric_stress_and_tangent(C, st.S[q], st.CC[q]);
-    } else {  // residual only: the stress without its tangent
-      st.S[q] = material.isochoric_stress(C);
-    }
-    if (with_tangent)
-      add_volumetric_at_fixed_pressure(invert(C), st.J[q], pressure[q], st.S[q], st.CC[q]);
-    else
-      st.S[q] += (pressure[q] * st.J[q]) * invert(C);
-    if (!finite(st.S[q])) return false;
-  }
-  return true;
+  for (unsigned i = 0; i < dpc; ++i)
+    for (unsigned j = i + 1; j < dpc; ++j) Ke(i, j) = Ke(j, i);
 }
 
 }  // namespace
@@ -210,6 +135,20 @@ AxisymmetricSolver::AxisymmetricSolver(const meshing::AxisymmetricSlabMesh& mesh
 }
 
 void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m) {
+  const double tol = 1e-9 * sample_radius_m;  // geometric tolerance (m)
+  build_triangulation(sample_radius_m, total_thickness_m, tol);
+  distribute_dofs_and_constraints();
+  std::vector<Point<2>> support(dof_handler_.n_dofs());
+  DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
+  find_crack_pairs(support, tol);
+  find_contact_nodes(support, tol);
+  make_sparsity();
+  allocate_state();
+  assemble(solution_, true);  // the unloaded tangent gives the first contact penalties
+  update_penalties();
+}
+
+void AxisymmetricSolver::build_triangulation(double sample_radius_m, double total_thickness_m, double tol) {
   // Triangulation from the plain mesh (crack vertices duplicated: the two
   // sides share no face and their faces are boundary faces).
   std::vector<Point<2>> vertices;
@@ -225,7 +164,6 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
   triangulation_.clear();
   triangulation_.create_triangulation(vertices, cells, SubCellData());
   const double r_c = mesh_.crack_radius_m;
-  const double tol = 1e-9 * sample_radius_m;
   for (const auto& cell : triangulation_.active_cell_iterators())
     for (const unsigned f : cell->face_indices()) {
       if (!cell->face(f)->at_boundary()) continue;
@@ -253,16 +191,14 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
     for (const auto& cell : triangulation_.active_cell_iterators())
       core_cell_[cell->active_cell_index()] =
           cell->center()[0] < r_c && cell->center()[1] > -mesh_.path_depth_m ? 1 : 0;
+}
 
+void AxisymmetricSolver::distribute_dofs_and_constraints() {
   dof_handler_.distribute_dofs(fe_);
   cells_.clear();
   for (const auto& cell : dof_handler_.active_cell_iterators()) cells_.push_back(cell);
   cell_work_.assign(cells_.size(), CellContribution{FullMatrix<double>(fe_.n_dofs_per_cell(), fe_.n_dofs_per_cell()),
                                                     Vector<double>(fe_.n_dofs_per_cell()), 0.0});
-  const unsigned n = dof_handler_.n_dofs();
-  std::vector<Point<2>> support(n);
-  DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
-
   // Homogeneous Dirichlet conditions.
   dirichlet_.clear();
   VectorTools::interpolate_boundary_values(dof_handler_, kBase, Functions::ZeroFunction<2>(2), dirichlet_);
@@ -270,29 +206,101 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
   VectorTools::interpolate_boundary_values(dof_handler_, kAxis, Functions::ZeroFunction<2>(2), dirichlet_,
                                            fe_.component_mask(FEValuesExtractors::Scalar(0)));
   dirichlet_.close();
+}
 
-  // Contact nodes and cohesive points from the boundary faces.
-  contact_nodes_.clear();
+void AxisymmetricSolver::find_crack_pairs(const std::vector<Point<2>>& support, double tol) {
+  // Cohesive points, in the order of the cells and their faces: the outer
+  // wall nodes of an open channel tied to the crack plane, and the crack
+  // nodes of the core side paired with their copies on the outer side.
   cohesive_points_.clear();
-  std::map<unsigned, std::size_t> node_of_rdof;  // R-dof -> contact node
-  const unsigned dpf = fe_.n_dofs_per_face();
-  std::vector<types::global_dof_index> face_dofs(dpf);
   // Crack faces of the outer side by the centre of the face, to pair with the core side.
   std::map<std::pair<long, long>, std::pair<DoFHandler<2>::active_cell_iterator, unsigned>> outer_faces;
-  auto key = [&](const Point<2>& p) {
-    return std::make_pair(std::lround(p[0] / tol * 1e-3), std::lround(p[1] / tol * 1e-3));
-  };
   for (const auto& cell : dof_handler_.active_cell_iterators())
     for (const unsigned f : cell->face_indices())
       if (cell->face(f)->at_boundary() && cell->face(f)->boundary_id() == kCrackOuter)
-        outer_faces[key(cell->face(f)->center())] = {cell, f};
+        outer_faces[face_key(cell->face(f)->center(), tol)] = {cell, f};
 
-  auto newton_cotes_weight = [&](const Point<2>& p, const Point<2>& v0, double length) {
-    const double s = (p - v0).norm() / length;
-    if (settings_.degree == 1) return 0.5;
-    return (s < 0.25 || s > 0.75) ? 1.0 / 6.0 : 4.0 / 6.0;
-  };
+  for (const auto& cell : dof_handler_.active_cell_iterators())
+    for (const unsigned f : cell->face_indices()) {
+      if (!cell->face(f)->at_boundary()) continue;
+      const auto id = cell->face(f)->boundary_id();
+      if (id == kCrackOuter && mesh_.open_channel) {
+        add_channel_wall_points(cell, f, support, tol);
+      } else if (id == kCrackCore) {
+        const auto match = outer_faces.find(face_key(cell->face(f)->center(), tol));
+        if (match == outer_faces.end()) throw std::logic_error("AxisymmetricSolver: unmatched crack face");
+        pair_crack_face(cell, f, match->second.first, match->second.second, support, tol);
+      }
+    }
+}
 
+void AxisymmetricSolver::add_channel_wall_points(const DoFHandler<2>::active_cell_iterator& cell, unsigned f,
+                                                 const std::vector<Point<2>>& support, double tol) {
+  // Open channel: each wall node is tied to the rigid crack plane.
+  const auto face = cell->face(f);
+  std::vector<types::global_dof_index> face_dofs(fe_.n_dofs_per_face());
+  face->get_dof_indices(face_dofs);
+  const double length = face->measure();
+  for (unsigned i = 0; i < face_dofs.size(); ++i) {
+    if (fe_.face_system_to_component_index(i).first != 0) continue;
+    const Point<2> p = support[face_dofs[i]];
+    CohesivePoint cp{};
+    cp.to_plane = true;
+    cp.outer_r = cp.core_r = face_dofs[i];
+    cp.outer_z = cp.core_z = z_dof_at(fe_, face_dofs, support, p, tol);
+    cp.Z = p[1];
+    cp.area_m2 = kTwoPi * mesh_.crack_radius_m * newton_cotes_weight(settings_.degree, p, face->vertex(0), length) *
+                 length;
+    cp.layer = static_cast<int>(cell->material_id());
+    cohesive_points_.push_back(cp);
+  }
+}
+
+void AxisymmetricSolver::pair_crack_face(const DoFHandler<2>::active_cell_iterator& cell, unsigned f,
+                                         const DoFHandler<2>::active_cell_iterator& outer_cell, unsigned outer_f,
+                                         const std::vector<Point<2>>& support, double tol) {
+  // Cohesive points: pair the core face's dofs with the outer face's.
+  const auto face = cell->face(f);
+  const unsigned dpf = fe_.n_dofs_per_face();
+  std::vector<types::global_dof_index> face_dofs(dpf), outer_dofs(dpf);
+  face->get_dof_indices(face_dofs);
+  outer_cell->face(outer_f)->get_dof_indices(outer_dofs);
+  const double length = face->measure();
+  for (unsigned i = 0; i < dpf; ++i) {
+    if (fe_.face_system_to_component_index(i).first != 0) continue;
+    const Point<2> p = support[face_dofs[i]];
+    CohesivePoint cp{};
+    cp.core_r = face_dofs[i];
+    cp.core_z = z_dof_at(fe_, face_dofs, support, p, tol);
+    bool found_r = false, found_z = false;
+    for (unsigned j = 0; j < dpf; ++j) {
+      if (support[outer_dofs[j]].distance(p) >= tol) continue;
+      if (fe_.face_system_to_component_index(j).first == 0) {
+        cp.outer_r = outer_dofs[j];
+        found_r = true;
+      } else {
+        cp.outer_z = outer_dofs[j];
+        found_z = true;
+      }
+    }
+    if (!found_r || !found_z) throw std::logic_error("AxisymmetricSolver: crack dofs do not pair up");
+    if (cp.outer_r == cp.core_r) continue;  // shared node at the path depth
+    cp.Z = p[1];
+    cp.area_m2 = kTwoPi * mesh_.crack_radius_m * newton_cotes_weight(settings_.degree, p, face->vertex(0), length) *
+                 length;
+    cp.layer = static_cast<int>(cell->material_id());
+    cohesive_points_.push_back(cp);
+  }
+}
+
+void AxisymmetricSolver::find_contact_nodes(const std::vector<Point<2>>& support, double tol) {
+  // One node per R-dof of the top surface and of the crack faces; its lumped
+  // area adds up over the faces that hold it.
+  contact_nodes_.clear();
+  std::map<unsigned, std::size_t> node_of_rdof;  // R-dof -> contact node
+  const double r_c = mesh_.crack_radius_m;
+  const unsigned dpf = fe_.n_dofs_per_face();
+  std::vector<types::global_dof_index> face_dofs(dpf);
   for (const auto& cell : dof_handler_.active_cell_iterators())
     for (const unsigned f : cell->face_indices()) {
       const auto face = cell->face(f);
@@ -307,13 +315,10 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
       for (unsigned i = 0; i < dpf; ++i) {
         if (fe_.face_system_to_component_index(i).first != 0) continue;
         const unsigned dr = face_dofs[i];
-        unsigned dz = 0;
-        for (unsigned j = 0; j < dpf; ++j)
-          if (fe_.face_system_to_component_index(j).first == 1 &&
-              support[face_dofs[j]].distance(support[dr]) < tol)
-            dz = face_dofs[j];
+        const unsigned dz = z_dof_at(fe_, face_dofs, support, support[dr], tol);
         const Point<2> p = support[dr];
-        const double area = kTwoPi * std::max(p[0], 0.0) * newton_cotes_weight(p, v0, length) * length;
+        const double area =
+            kTwoPi * std::max(p[0], 0.0) * newton_cotes_weight(settings_.degree, p, v0, length) * length;
         auto it = node_of_rdof.find(dr);
         if (it == node_of_rdof.end()) {
           node_of_rdof[dr] = contact_nodes_.size();
@@ -323,56 +328,6 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
           node.area_m2 += area;
           node.on_top = node.on_top || id == kTop;
         }
-      }
-      if (id == kCrackOuter && mesh_.open_channel) {
-        // Open channel: each wall node is tied to the rigid crack plane.
-        for (unsigned i = 0; i < dpf; ++i) {
-          if (fe_.face_system_to_component_index(i).first != 0) continue;
-          const Point<2> p = support[face_dofs[i]];
-          CohesivePoint cp{};
-          cp.to_plane = true;
-          cp.outer_r = cp.core_r = face_dofs[i];
-          for (unsigned j = 0; j < dpf; ++j)
-            if (fe_.face_system_to_component_index(j).first == 1 && support[face_dofs[j]].distance(p) < tol)
-              cp.outer_z = cp.core_z = face_dofs[j];
-          cp.Z = p[1];
-          cp.area_m2 = kTwoPi * r_c * newton_cotes_weight(p, face->vertex(0), length) * length;
-          cp.layer = layer;
-          cohesive_points_.push_back(cp);
-        }
-        continue;
-      }
-      if (id != kCrackCore) continue;
-      // Cohesive points: pair the core face's dofs with the outer face's.
-      const auto match = outer_faces.find(key(face->center()));
-      if (match == outer_faces.end()) throw std::logic_error("AxisymmetricSolver: unmatched crack face");
-      std::vector<types::global_dof_index> outer_dofs(dpf);
-      match->second.first->face(match->second.second)->get_dof_indices(outer_dofs);
-      for (unsigned i = 0; i < dpf; ++i) {
-        if (fe_.face_system_to_component_index(i).first != 0) continue;
-        const Point<2> p = support[face_dofs[i]];
-        CohesivePoint cp{};
-        cp.core_r = face_dofs[i];
-        for (unsigned j = 0; j < dpf; ++j)
-          if (fe_.face_system_to_component_index(j).first == 1 && support[face_dofs[j]].distance(p) < tol)
-            cp.core_z = face_dofs[j];
-        bool found_r = false, found_z = false;
-        for (unsigned j = 0; j < dpf; ++j) {
-          if (support[outer_dofs[j]].distance(p) >= tol) continue;
-          if (fe_.face_system_to_component_index(j).first == 0) {
-            cp.outer_r = outer_dofs[j];
-            found_r = true;
-          } else {
-            cp.outer_z = outer_dofs[j];
-            found_z = true;
-          }
-        }
-        if (!found_r || !found_z) throw std::logic_error("AxisymmetricSolver: crack dofs do not pair up");
-        if (cp.outer_r == cp.core_r) continue;  // shared node at the path depth
-        cp.Z = p[1];
-        cp.area_m2 = kTwoPi * r_c * newton_cotes_weight(p, face->vertex(0), length) * length;
-        cp.layer = layer;
-        cohesive_points_.push_back(cp);
       }
     }
 
@@ -384,7 +339,9 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
         contact_nodes_[i].partner = static_cast<int>(j);
         contact_nodes_[j].partner = static_cast<int>(i);
       }
+}
 
+void AxisymmetricSolver::make_sparsity() {
   // Sparsity: cells, plus the couplings of each cohesive point.
   // (condensed with every possible crack tie, so that any set of tie
   // constraints can be condensed into the matrix later).
@@ -398,6 +355,7 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
       }
   }
   all_ties.close();
+  const unsigned n = dof_handler_.n_dofs();
   DynamicSparsityPattern dsp(n, n);
   DoFTools::make_sparsity_pattern(dof_handler_, dsp, all_ties, true);
   for (const CohesivePoint& cp : cohesive_points_) {
@@ -407,6 +365,12 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
       for (unsigned b : d) dsp.add(a, b);
   }
   sparsity_.copy_from(dsp);
+}
+
+void AxisymmetricSolver::allocate_state() {
+  // Matrices, vectors, and the state of the unloaded slab: u = 0, no damage,
+  // no contact, no dissipation, the viscoelastic points at rest.
+  const unsigned n = dof_handler_.n_dofs();
   tangent_.reinit(sparsity_);
   system_matrix_.reinit(sparsity_);
   residual_.reinit(n);
@@ -429,8 +393,6 @@ void AxisymmetricSolver::setup(double sample_radius_m, double total_thickness_m)
   for (const auto& cell : dof_handler_.active_cell_iterators())
     if (const ViscoelasticMaterial<LayerMaterial>* law = viscoelastic_of(cell))
       viscous_history_[cell->active_cell_index()].assign(n_points, law->initial_history());
-  assemble(solution_, true);
-  update_penalties();
 }
 
 void AxisymmetricSolver::set_viscoelasticity(const std::vector<std::vector<PronyTerm>>& prony_per_layer) {
@@ -451,21 +413,17 @@ const ViscoelasticMaterial<LayerMaterial>* AxisymmetricSolver::viscoelastic_of(
 void AxisymmetricSolver::commit_viscous_history() {
   const QGauss<2> quadrature(settings_.degree + 1);
   FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points);
-  const FEValuesExtractors::Scalar ur(0), uz(1);
   const unsigned nq = quadrature.size();
-  std::vector<Tensor<1, 2>> g_ur(nq), g_uz(nq);
-  std::vector<double> v_ur(nq);
+  DisplacementGradients gradients(nq);
+  std::vector<Tensor<2, 3>> H(nq);
   for (const auto& cell : cells_) {
     const ViscoelasticMaterial<LayerMaterial>* law = viscoelastic_of(cell);
     if (!law) continue;
     fev.reinit(cell);
-    fev[ur].get_function_gradients(solution_, g_ur);
-    fev[uz].get_function_gradients(solution_, g_uz);
-    fev[ur].get_function_values(solution_, v_ur);
+    gradients.compute(fev, solution_, H);
     std::vector<ViscoelasticHistory>& history = viscous_history_[cell->active_cell_index()];
     for (unsigned q = 0; q < nq; ++q) {
-      const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) +
-                             displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+      const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) + H[q];
       law->commit(right_cauchy_green(F), dt_s_, history[q]);
     }
   }
@@ -540,16 +498,12 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
   const QGauss<2> quadrature(degree + 1);
   FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_JxW_values | update_quadrature_points);
   const unsigned dpc = fe_.n_dofs_per_cell(), nq = quadrature.size(), np = n_pressure_modes(degree);
-  FullMatrix<double> B(np, dpc), G(np, np), tmp(np, np), GB(np, dpc);
-  std::vector<Tensor<2, 3>> H(nq), gradN(dpc);
+  FullMatrix<double> B(np, dpc);
+  std::vector<Tensor<2, 3>> H(nq), H0(nq), gradN(dpc);
   std::vector<SymTensor2> dE(dpc), CC_dE(dpc);
   std::vector<unsigned> comp(dpc);
   for (unsigned i = 0; i < dpc; ++i) comp[i] = fe_.system_to_component_index(i).first;
-  const FEValuesExtractors::Scalar ur(0), uz(1);
-  std::vector<Tensor<1, 2>> g_ur(nq), g_uz(nq);
-  std::vector<double> v_ur(nq);
-  std::vector<Tensor<1, 2>> g0_ur(nq), g0_uz(nq);
-  std::vector<double> v0_ur(nq);
+  DisplacementGradients gradients(nq);
   CellState st;
   // Viscous stabilisation (Kelvin-Voigt on the step's strain increment):
   // sigma_v = (tau / dt) 2 mu_0 sym(H - H_step_start), mu_0 the layer's
@@ -564,11 +518,7 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
     Vector<double>& Re = out.Re;
     out.stabilization_J = 0.0;
     fev.reinit(cell);
-    fev[ur].get_function_gradients(u, g_ur);
-    fev[uz].get_function_gradients(u, g_uz);
-    fev[ur].get_function_values(u, v_ur);
-    for (unsigned q = 0; q < nq; ++q)
-      H[q] = displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
+    gradients.compute(fev, u, H);
     const ViscousCell viscous{viscoelastic_of(cell), &viscous_history_[cell->active_cell_index()], dt_s_};
     if (!evaluate_cell(material_of(cell), degree, fev, H, st, with_matrix, viscous)) return false;
     Ke = 0.0;
@@ -576,30 +526,19 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
     B = 0.0;
     double two_mu_v = 0.0;
     if (stabilize) {
-      fev[ur].get_function_gradients(step_start_, g0_ur);
-      fev[uz].get_function_gradients(step_start_, g0_uz);
-      fev[ur].get_function_values(step_start_, v0_ur);
+      gradients.compute(fev, step_start_, H0);
       const LayerMaterial& m = material_of(cell);
       two_mu_v = stab_ratio * m.youngs_modulus_Pa() / (1.0 + m.poisson_ratio());
     }
     for (unsigned q = 0; q < nq; ++q) {
       const double R = fev.quadrature_point(q)[0];
       for (unsigned i = 0; i < dpc; ++i) {
-        gradN[i] = shape_gradient(comp[i], fev.shape_value(i, q), fev.shape_grad(i, q), R);
+        gradN[i] = axisymmetric_shape_gradient(comp[i], fev.shape_value(i, q), fev.shape_grad(i, q), R);
         dE[i] = strain_variation(st.F[q], gradN[i]);
         Re(i) += scalar_product(st.S[q], dE[i]) * st.dV[q];
       }
-      if (stabilize) {
-        const Tensor<2, 3> dH = H[q] - displacement_gradient(g0_ur[q], g0_uz[q], v0_ur[q], R);
-        const Tensor<2, 3> eps = 0.5 * (dH + transpose(dH));
-        out.stabilization_J += two_mu_v * scalar_product(eps, eps) * st.dV[q];
-        for (unsigned i = 0; i < dpc; ++i) {
-          const Tensor<2, 3> ei = 0.5 * (gradN[i] + transpose(gradN[i]));
-          Re(i) += two_mu_v * scalar_product(ei, eps) * st.dV[q];
-          if (with_matrix)
-            for (unsigned j = 0; j <= i; ++j) Ke(i, j) += two_mu_v * scalar_product(ei, gradN[j]) * st.dV[q];
-        }
-      }
+      if (stabilize)
+        out.stabilization_J += add_stabilization(two_mu_v, H[q] - H0[q], gradN, st.dV[q], with_matrix, Ke, Re);
       if (!with_matrix) continue;
       const Tensor<2, 3> S_full(st.S[q]);
       const Tensor<2, 3> F_inv_T = transpose(invert(st.F[q]));
@@ -612,24 +551,28 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
         for (unsigned a = 0; a < np; ++a) B(a, i) += st.Np[q][a] * dJ_i * st.dV[q];
       }
     }
-    if (with_matrix) {
-      st.M_inv.mmult(tmp, st.K_JJ);
-      tmp.mmult(G, st.M_inv);
-      G.mmult(GB, B);
-      for (unsigned i = 0; i < dpc; ++i)
-        for (unsigned j = 0; j <= i; ++j) {
-          double s = 0.0;
-          for (unsigned a = 0; a < np; ++a) s += B(a, i) * GB(a, j);
-          Ke(i, j) += s;
-        }
-      for (unsigned i = 0; i < dpc; ++i)
-        for (unsigned j = i + 1; j < dpc; ++j) Ke(i, j) = Ke(j, i);
-    }
+    if (with_matrix) add_condensed_pressure_stiffness(st, B, Ke);
   }
   return true;
 }
 
 bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
+  if (!compute_cell_contributions(u, with_matrix)) return false;
+  add_cell_contributions(with_matrix);
+  if (!add_cohesive_forces(u, with_matrix)) return false;
+  // Needle: penalty contact with friction (cutting tip) or flat punch reactions.
+  force_trial_ = NeedleForce{};
+  if (cutting_)
+    add_needle_contact(u, with_matrix);
+  else
+    add_punch_reactions();
+  force_trial_.total_N = force_trial_.normal_N + force_trial_.friction_N;
+  for (std::size_t i = 0; i < residual_.size(); ++i)
+    if (!std::isfinite(residual_(i))) return false;
+  return true;
+}
+
+bool AxisymmetricSolver::compute_cell_contributions(const Vector<double>& u, bool with_matrix) {
   // Cells: computed in parallel (each thread its own range and scratch), added
   // to the global system in cell order, so the result does not depend on the
   // number of threads.
@@ -654,7 +597,10 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
     if (e) std::rethrow_exception(e);
   for (const char o : ok)
     if (!o) return false;
+  return true;
+}
 
+void AxisymmetricSolver::add_cell_contributions(bool with_matrix) {
   stabilization_trial_J_ = stabilization_J_;
   if (with_matrix) {
     tangent_ = 0.0;
@@ -662,7 +608,7 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
   }
   residual_ = 0.0;
   std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
-  for (std::size_t k = 0; k < n_cells; ++k) {
+  for (std::size_t k = 0; k < cells_.size(); ++k) {
     const CellContribution& c = cell_work_[k];
     cells_[k]->get_dof_indices(dofs);
     stabilization_trial_J_ += c.stabilization_J;
@@ -672,7 +618,9 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
     }
     if (with_matrix) tangent_.add(dofs, c.Ke, false);
   }
+}
 
+bool AxisymmetricSolver::add_cohesive_forces(const Vector<double>& u, bool with_matrix) {
   // Cohesive points: R_outer += A t, R_core -= A t.
   dissipated_trial_J_ = dissipated_J_;
   for (std::size_t k = 0; k < cohesive_points_.size(); ++k) {
@@ -716,54 +664,52 @@ bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
         for (unsigned j = 0; j < 4; ++j)
           tangent_.add(d[i], d[j], sgn[i] * sgn[j] * A * scale[i % 2] * scale[j % 2] * r.tangent[i % 2][j % 2]);
   }
+  return true;
+}
 
-  // Needle: penalty contact with friction (cutting tip) or flat punch reactions.
-  force_trial_ = NeedleForce{};
-  if (cutting_) {
-    const Vec2 edge{needle_.edge_radius_m, needle_.z_tip_m};
-    for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
-      const ContactNode& nd = contact_nodes_[i];
-      const Vec2 x{nd.R + u[nd.dof_r], nd.Z + u[nd.dof_z]};
-      const ContactPenalty penalty{penalty_[i], settings_.contact_rounding * mesh_.tip_element_size_m};
-      NodalContactResponse resp;
-      ContactPoint c;
-      if (nd.core_side) {
-        resp = core_wall_contact(needle_, x, penalty,
-                                 settings_.hold_crack_line ? -1.0 : settings_.edge_rounding * mesh_.tip_element_size_m);
-        c.penetration_m = std::max(x[0] - needle_.edge_radius_m, 0.0);
-      } else {
-        c = outer_contact(needle_, x, settings_.edge_rounding * mesh_.tip_element_size_m);
-        resp = nodal_contact(c, x, edge, friction_committed_[i], friction_[nd.layer], penalty,
-                             settings_.friction_penalty * penalty_[i]);
-      }
-      friction_trial_[i] = resp.history;
-      if (!resp.history.in_contact) continue;
-      if (debug_contacts_)
-        std::cout << "        node R " << nd.R * 1e3 << " Z " << nd.Z * 1e3 << (nd.core_side ? " core" : " outer")
-                  << " x (" << x[0] * 1e3 << ", " << x[1] * 1e3 << ") pen " << c.penetration_m * 1e6 << " um n ("
-                  << c.normal[0] << "," << c.normal[1] << ") k " << penalty_[i] << " f " << resp.normal_force[0] << ","
-                  << resp.normal_force[1] << " ft " << resp.friction_force[1] << std::endl;
-      const unsigned d[2] = {nd.dof_r, nd.dof_z};
-      for (unsigned a = 0; a < 2; ++a) {
-        residual_(d[a]) -= resp.normal_force[a] + resp.friction_force[a];
-        if (with_matrix)
-          for (unsigned b = 0; b < 2; ++b) tangent_.add(d[a], d[b], -resp.dforce_dx[a][b]);
-      }
-      force_trial_.normal_N -= resp.normal_force[1];
-      force_trial_.friction_N -= resp.friction_force[1];
+void AxisymmetricSolver::add_needle_contact(const Vector<double>& u, bool with_matrix) {
+  // Cutting tip: penalty contact with Coulomb friction at every contact node.
+  const Vec2 edge{needle_.edge_radius_m, needle_.z_tip_m};
+  for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
+    const ContactNode& nd = contact_nodes_[i];
+    const Vec2 x{nd.R + u[nd.dof_r], nd.Z + u[nd.dof_z]};
+    const ContactPenalty penalty{penalty_[i], settings_.contact_rounding * mesh_.tip_element_size_m};
+    NodalContactResponse resp;
+    ContactPoint c;
+    if (nd.core_side) {
+      resp = core_wall_contact(needle_, x, penalty,
+                               settings_.hold_crack_line ? -1.0 : settings_.edge_rounding * mesh_.tip_element_size_m);
+      c.penetration_m = std::max(x[0] - needle_.edge_radius_m, 0.0);
+    } else {
+      c = outer_contact(needle_, x, settings_.edge_rounding * mesh_.tip_element_size_m);
+      resp = nodal_contact(c, x, edge, friction_committed_[i], friction_[nd.layer], penalty,
+                           settings_.friction_penalty * penalty_[i]);
+    }
+    friction_trial_[i] = resp.history;
+    if (!resp.history.in_contact) continue;
+    if (debug_contacts_)
+      std::cout << "        node R " << nd.R * 1e3 << " Z " << nd.Z * 1e3 << (nd.core_side ? " core" : " outer")
+                << " x (" << x[0] * 1e3 << ", " << x[1] * 1e3 << ") pen " << c.penetration_m * 1e6 << " um n ("
+                << c.normal[0] << "," << c.normal[1] << ") k " << penalty_[i] << " f " << resp.normal_force[0] << ","
+                << resp.normal_force[1] << " ft " << resp.friction_force[1] << std::endl;
+    const unsigned d[2] = {nd.dof_r, nd.dof_z};
+    for (unsigned a = 0; a < 2; ++a) {
+      residual_(d[a]) -= resp.normal_force[a] + resp.friction_force[a];
+      if (with_matrix)
+        for (unsigned b = 0; b < 2; ++b) tangent_.add(d[a], d[b], -resp.dforce_dx[a][b]);
+    }
+    force_trial_.normal_N -= resp.normal_force[1];
+    force_trial_.friction_N -= resp.friction_force[1];
+    ++force_trial_.nodes_in_contact;
+  }
+}
+
+void AxisymmetricSolver::add_punch_reactions() {
+  for (std::size_t i = 0; i < contact_nodes_.size(); ++i)
+    if (punch_contact_[i]) {
+      force_trial_.normal_N -= residual_(contact_nodes_[i].dof_z);  // R_z < 0 where the punch presses
       ++force_trial_.nodes_in_contact;
     }
-  } else {
-    for (std::size_t i = 0; i < contact_nodes_.size(); ++i)
-      if (punch_contact_[i]) {
-        force_trial_.normal_N -= residual_(contact_nodes_[i].dof_z);  // R_z < 0 where the punch presses
-        ++force_trial_.nodes_in_contact;
-      }
-  }
-  force_trial_.total_N = force_trial_.normal_N + force_trial_.friction_N;
-  for (std::size_t i = 0; i < residual_.size(); ++i)
-    if (!std::isfinite(residual_(i))) return false;
-  return true;
 }
 
 double AxisymmetricSolver::free_residual_norm(const AffineConstraints<double>& c) const {
@@ -826,352 +772,258 @@ void AxisymmetricSolver::restore(const Snapshot& s) {
   update_penalties();
 }
 
-AxisymmetricNewtonReport AxisymmetricSolver::solve_step(double predictor_scale) {
+/// What the phases of one solve_step share.
+struct AxisymmetricSolver::Step {
   AxisymmetricNewtonReport report;
-  const Vector<double> u_start(solution_);
-  step_start_ = u_start;
-  const auto punch_contact_start = punch_contact_;
-  const auto punch_hold_start = punch_lateral_hold_;
-  auto fail = [&](const std::string& why) {
-    solution_ = u_start;
-    punch_contact_ = punch_contact_start;
-    punch_lateral_hold_ = punch_hold_start;
-    cohesive_trial_ = cohesive_committed_;
-    friction_trial_ = friction_committed_;
-    assemble(solution_, true);
-    report.converged = false;
-    report.failure = why;
-    if (settings_.verbose) std::cout << "      newton failed: " << why << std::endl;
-    return report;
-  };
-  if (predictor_scale > 0.0 && last_increment_.linfty_norm() > 0.0) {
-    solution_.add(predictor_scale, last_increment_);
-    if (!assemble(solution_, false)) solution_ = u_start;
-  }
-  // Flat punch: top nodes within the punch radius that the face has reached
-  // join; a node released for a tensile reaction stays free for this step.
-  std::vector<char> released_in_step(contact_nodes_.size(), 0);
-  auto update_punch_contact = [&]() {
-    bool changed = false;
-    if (cutting_) return changed;
-    for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
-      const ContactNode& nd = contact_nodes_[i];
-      if (punch_contact_[i] || released_in_step[i] || !nd.on_top || nd.R > punch_radius_m_ * (1 + 1e-9) ||
-          tied_slave(i))
-        continue;
-      if (nd.Z + solution_(nd.dof_z) >= punch_z_m_) {
-        punch_contact_[i] = 1;
-        punch_lateral_hold_[i] = solution_(nd.dof_r);
-        if (nd.partner >= 0 && tied_slave(static_cast<std::size_t>(nd.partner))) punch_contact_[nd.partner] = 1;
-        changed = true;
-      }
-    }
-    return changed;
-  };
-  update_punch_contact();
-
-  AffineConstraints<double> constraints;
+  Vector<double> u_start;                 ///< the last converged solution (restored on failure)
+  std::vector<char> punch_contact_start;  ///< the flat punch's contact set at the start
+  std::vector<double> punch_hold_start;   ///< and its held u_R
+  std::vector<char> released_in_step;     ///< punch nodes released for a tensile reaction (free for the step)
+  AffineConstraints<double> constraints;  ///< the Newton increment's constraints at solution_
   SparseDirectUMFPACK direct;
-  Vector<double> du(solution_.size()), trial(solution_.size());
-  double max_free = 0.0;
-  int contact_changes = 0;
-  std::vector<double> history;  // free residual per iteration (stall detection)
+  Vector<double> du, trial;               ///< Newton direction; the line search's state
+  double max_free = 0.0;                  ///< largest free residual of the step so far (N)
+  int contact_changes = 0;                ///< changes of the punch contact set so far
+  std::vector<double> history;            ///< free residual per iteration (stall detection)
+};
+
+/// One Newton iterate (the state solution_).
+struct AxisymmetricSolver::Iterate {
+  double free = 0.0;   ///< free residual (N)
+  double gap = 0.0;    ///< largest prescribed punch displacement not yet reached (m)
+  double scale = 0.0;  ///< force scale of the convergence test (N)
+  bool stalled = false, strict = false, converged = false;
+  double assemble_s = 0.0, solve_s = 0.0;
+  std::ostringstream line;  ///< the iterate's line of the Newton log
+};
+
+AxisymmetricNewtonReport AxisymmetricSolver::solve_step(double predictor_scale) {
+  Step step;
+  start_step(step, predictor_scale);
   for (int it = 0;; ++it) {
-    debug_contacts_ = settings_.verbose && std::getenv("PUNCTURE_FEM_DEBUG_CONTACT") != nullptr;
-    make_constraints(solution_, constraints);
-    const auto t_assemble = std::chrono::steady_clock::now();
-    if (!assemble(solution_, true)) return fail("inverted or non-finite state");
-    debug_contacts_ = false;
-    const double assemble_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_assemble).count();
-    const double free = free_residual_norm(constraints);
-    double gap = 0.0;
-    for (std::size_t i = 0; i < solution_.size(); ++i)
-      if (constraints.is_inhomogeneously_constrained(i)) gap = std::max(gap, std::abs(constraints.get_inhomogeneity(i)));
-    max_free = std::max(max_free, free);
-    double reaction = std::abs(force_trial_.total_N);
-    for (std::size_t i = 0; i < solution_.size(); ++i)
-      if (constraints.is_constrained(i)) reaction = std::max(reaction, std::abs(residual_(i)));
-    const double scale = std::max({reaction, max_free, 1e-300});
-    report.residual_N = free;
-    report.force_scale_N = scale;
-    if (!std::isfinite(free)) return fail("non-finite residual");
-    // Stall: the best residual of the last stall_window iterations is not
-    // below stall_factor x the best before them.
-    history.push_back(free);
-    bool stalled = false;
-    const int window = settings_.stall_window;
-    if (window > 0 && static_cast<int>(history.size()) > window) {
-      const double before = *std::min_element(history.begin(), history.end() - window);
-      const double recent = *std::min_element(history.end() - window, history.end());
-      stalled = recent > settings_.stall_factor * before;
-    }
-    const bool gap_closed = gap <= 1e-12 * std::max(1e-3, punch_radius_m_);
-    const bool strict = free <= settings_.newton_tolerance * scale || free <= settings_.absolute_residual_floor_N;
-    const bool loose = stalled && free <= settings_.stall_acceptance_tolerance * scale;
-    const bool converged = gap_closed && (strict || loose);
-    std::ostringstream line;
-    int sliding = 0, damaged = 0, broken = 0, closed = 0;
-    for (const auto& h : friction_trial_) sliding += h.sliding ? 1 : 0;
-    for (std::size_t k = 0; k < cohesive_points_.size(); ++k) {
-      damaged += cohesive_trial_[k].damage > 0.0 ? 1 : 0;
-      broken += cohesive_trial_[k].damage >= 1.0 ? 1 : 0;
-      closed += (cohesive_trial_[k].damage > 0.0 &&
-                 solution_(cohesive_points_[k].outer_r) < solution_(cohesive_points_[k].core_r)) ? 1 : 0;
-    }
-    line << std::setw(4) << it << "  |R_free| " << std::scientific << std::setprecision(3) << free << " N  scale "
-         << scale << " N  F_needle " << force_trial_.total_N << " N  contact " << force_trial_.nodes_in_contact
-         << " sliding " << sliding << " damaged " << damaged << " broken " << broken << " closed " << closed;
-    if (converged) {
-      // Flat punch: release nodes pulled by the face (tensile reaction), then go on.
-      bool released = false;
-      if (!cutting_)
-        for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
-          if (!punch_contact_[i] || tied_slave(i)) continue;
-          // A tied pair of crack nodes carries its reaction together.
-          const int p = contact_nodes_[i].partner;
-          double reaction = residual_(contact_nodes_[i].dof_z);
-          if (p >= 0 && tied_slave(static_cast<std::size_t>(p))) reaction += residual_(contact_nodes_[p].dof_z);
-          if (reaction > 1e-6 * scale) {  // R_z > 0: the face would pull the node
-            if (settings_.verbose)
-              std::cout << "      punch releases node R=" << contact_nodes_[i].R << " reaction " << reaction << std::endl;
-            punch_contact_[i] = 0;
-            released_in_step[i] = 1;
-            if (p >= 0 && tied_slave(static_cast<std::size_t>(p))) punch_contact_[p] = 0;
-            released = true;
-          }
-        }
-      if (update_punch_contact()) released = true;
-      if (released && ++contact_changes > 50) return fail("flat punch contact set does not settle");
-      if (!released) {
-        report.accepted_at_stall = !strict;
-        report.table.push_back(line.str() + (strict ? "  converged" : "  converged (stalled below the acceptance tolerance)"));
-        if (settings_.verbose) std::cout << "      " << report.table.back() << std::endl;
-        report.converged = true;
-        report.iterations = it;
-        last_increment_ = solution_;
-        last_increment_ -= u_start;
-        commit();
-        update_penalties();
-        return report;
-      }
-      line << "  (punch contact set changed)";
-      report.table.push_back(line.str());
+    Iterate x;
+    if (const Failure why = evaluate_iterate(step, it, x)) return fail_step(step, *why);
+    if (x.converged) {
+      // Flat punch: release nodes pulled by the face (tensile reaction) and
+      // take in the nodes it reaches; if the contact set changed, go on.
+      const bool released = release_pulled_punch_nodes(step.released_in_step, x.scale);
+      const bool joined = update_punch_contact(step.released_in_step);
+      if (!released && !joined) return accept_step(step, x, it);
+      if (++step.contact_changes > 50) return fail_step(step, "flat punch contact set does not settle");
+      x.line << "  (punch contact set changed)";
+      step.report.table.push_back(x.line.str());
       continue;
     }
-    if (it >= settings_.max_newton_iterations) {
-      report.table.push_back(line.str());
-      report.iterations = it;
-      return fail("no convergence in " + std::to_string(it) + " Newton iterations");
+    if (const Failure why = give_up_reason(it, x)) {
+      step.report.table.push_back(x.line.str());
+      step.report.iterations = it;
+      return fail_step(step, *why);
     }
-    if (stalled) {
-      report.table.push_back(line.str());
-      report.iterations = it;
-      std::ostringstream why;
-      why << "Newton stalls: |R_free| " << std::scientific << std::setprecision(3) << free << " N did not fall by "
-          << std::defaultfloat << 100.0 * (1.0 - settings_.stall_factor) << " % in " << window << " iterations";
-      return fail(why.str());
-    }
-    // Linear system K du = -R with the increment constraints condensed in
-    // (UMFPACK takes the nonsymmetric tangent of sliding friction).
-    rhs_ = residual_;
-    rhs_ *= -1.0;
-    const auto t_solve = std::chrono::steady_clock::now();
-    system_matrix_.copy_from(tangent_);
-    constraints.condense(system_matrix_, rhs_);
-    try {
-      direct.initialize(system_matrix_);
-      direct.vmult(du, rhs_);
-    } catch (const std::exception& e) {
-      return fail(std::string("sparse direct solve failed: ") + e.what());
-    }
-    const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_solve).count();
-    constraints.distribute(du);
-    if (!std::isfinite(du.l2_norm())) return fail("non-finite Newton update");
-
-    double alpha = 1.0, best_alpha = -1.0, best_free = std::numeric_limits<double>::infinity();
-    bool accepted = false;
-    for (int h = 0; h <= settings_.max_line_search_halvings; ++h, alpha *= 0.5) {
-      trial = solution_;
-      trial.add(alpha, du);
-      if (!assemble(trial, false)) continue;
-      AffineConstraints<double> tc;
-      make_constraints(trial, tc);
-      const double trial_free = free_residual_norm(tc);
-      if (!std::isfinite(trial_free)) continue;
-      if (gap > 0.0 || trial_free < (1.0 - 1e-4 * alpha) * free || trial_free <= settings_.absolute_residual_floor_N) {
-        accepted = true;
-        break;
-      }
-      if (trial_free < best_free) {
-        best_free = trial_free;
-        best_alpha = alpha;
-      }
-    }
-    if (!accepted) {
-      if (best_alpha < 0.0) return fail("line search: every trial state is inverted or non-finite");
-      alpha = best_alpha;
-      trial = solution_;
-      trial.add(alpha, du);
-    }
-    line << "  alpha " << std::defaultfloat << alpha << "  t_assemble " << std::setprecision(3) << assemble_s
-         << " s  t_solve " << solve_s << " s";
-    report.table.push_back(line.str());
-    if (settings_.verbose) std::cout << "      " << report.table.back() << std::endl;
-    solution_ = trial;
+    if (const Failure why = newton_direction(step, x)) return fail_step(step, *why);
+    double alpha = 0.0;
+    if (const Failure why = line_search(step, x, alpha)) return fail_step(step, *why);
+    x.line << "  alpha " << std::defaultfloat << alpha << "  t_assemble " << std::setprecision(3) << x.assemble_s
+           << " s  t_solve " << x.solve_s << " s";
+    step.report.table.push_back(x.line.str());
+    if (settings_.verbose) std::cout << "      " << step.report.table.back() << std::endl;
+    solution_ = step.trial;
   }
 }
 
-double AxisymmetricSolver::crack_front_depth_m(int layer, double damage_threshold) const {
-  double depth = -1.0;
-  for (std::size_t k = 0; k < cohesive_points_.size(); ++k)
-    if (cohesive_points_[k].layer == layer && cohesive_committed_[k].damage >= damage_threshold)
-      depth = std::max(depth, -cohesive_points_[k].Z);
-  return depth;
-}
-
-double AxisymmetricSolver::max_damage(int layer) const {
-  double d = 0.0;
-  for (std::size_t k = 0; k < cohesive_points_.size(); ++k)
-    if (cohesive_points_[k].layer == layer) d = std::max(d, cohesive_committed_[k].damage);
-  return d;
-}
-
-std::vector<std::pair<double, double>> AxisymmetricSolver::vertical_displacement_along(double z_line_m) const {
-  std::vector<Point<2>> support(dof_handler_.n_dofs());
-  DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
-  std::vector<std::pair<double, double>> out;
-  const double tol = 1e-9;
-  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
-  std::vector<char> seen(dof_handler_.n_dofs(), 0);
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
-    cell->get_dof_indices(dofs);
-    for (unsigned i = 0; i < dofs.size(); ++i) {
-      if (fe_.system_to_component_index(i).first != 1 || seen[dofs[i]]) continue;
-      seen[dofs[i]] = 1;
-      if (std::abs(support[dofs[i]][1] - z_line_m) < tol) out.emplace_back(support[dofs[i]][0], solution_(dofs[i]));
-    }
+void AxisymmetricSolver::start_step(Step& step, double predictor_scale) {
+  step.u_start = solution_;
+  step_start_ = step.u_start;
+  step.punch_contact_start = punch_contact_;
+  step.punch_hold_start = punch_lateral_hold_;
+  if (predictor_scale > 0.0 && last_increment_.linfty_norm() > 0.0) {
+    solution_.add(predictor_scale, last_increment_);
+    if (!assemble(solution_, false)) solution_ = step.u_start;
   }
-  std::sort(out.begin(), out.end());
-  return out;
+  step.released_in_step.assign(contact_nodes_.size(), 0);
+  update_punch_contact(step.released_in_step);
+  step.du.reinit(solution_.size());
+  step.trial.reinit(solution_.size());
 }
 
-double AxisymmetricSolver::max_principal_stretch(int layer, double r_max_m, double z_lo_m, double z_hi_m) const {
-  const QGauss<2> quadrature(settings_.degree + 1);
-  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points);
-  const FEValuesExtractors::Scalar ur(0), uz(1);
-  std::vector<Tensor<1, 2>> g_ur(quadrature.size()), g_uz(quadrature.size());
-  std::vector<double> v_ur(quadrature.size());
-  double stretch = 1.0;
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
-    if (static_cast<int>(cell->material_id()) != layer) continue;
-    const Point<2> c = cell->center();
-    if (c[0] > r_max_m || c[1] < z_lo_m || c[1] > z_hi_m) continue;
-    fev.reinit(cell);
-    fev[ur].get_function_gradients(solution_, g_ur);
-    fev[uz].get_function_gradients(solution_, g_uz);
-    fev[ur].get_function_values(solution_, v_ur);
-    for (unsigned q = 0; q < quadrature.size(); ++q) {
-      const Tensor<2, 3> F =
-          Tensor<2, 3>(unit_symmetric_tensor<3>()) + displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
-      const auto ev = eigenvalues(right_cauchy_green(F));
-      stretch = std::max(stretch, std::sqrt(std::max(ev[0], 0.0)));
-    }
-  }
-  return stretch;
+AxisymmetricSolver::Failure AxisymmetricSolver::evaluate_iterate(Step& step, int it, Iterate& x) {
+  debug_contacts_ = settings_.verbose && std::getenv("PUNCTURE_FEM_DEBUG_CONTACT") != nullptr;
+  make_constraints(solution_, step.constraints);
+  const auto t_assemble = std::chrono::steady_clock::now();
+  if (!assemble(solution_, true)) return "inverted or non-finite state";
+  debug_contacts_ = false;
+  x.assemble_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_assemble).count();
+  const AffineConstraints<double>& constraints = step.constraints;
+  x.free = free_residual_norm(constraints);
+  for (std::size_t i = 0; i < solution_.size(); ++i)
+    if (constraints.is_inhomogeneously_constrained(i))
+      x.gap = std::max(x.gap, std::abs(constraints.get_inhomogeneity(i)));
+  step.max_free = std::max(step.max_free, x.free);
+  double reaction = std::abs(force_trial_.total_N);
+  for (std::size_t i = 0; i < solution_.size(); ++i)
+    if (constraints.is_constrained(i)) reaction = std::max(reaction, std::abs(residual_(i)));
+  x.scale = std::max({reaction, step.max_free, 1e-300});
+  step.report.residual_N = x.free;
+  step.report.force_scale_N = x.scale;
+  if (!std::isfinite(x.free)) return "non-finite residual";
+  x.stalled = check_stall(step.history, x.free);
+  const bool gap_closed = x.gap <= 1e-12 * std::max(1e-3, punch_radius_m_);
+  x.strict = x.free <= settings_.newton_tolerance * x.scale || x.free <= settings_.absolute_residual_floor_N;
+  const bool loose = x.stalled && x.free <= settings_.stall_acceptance_tolerance * x.scale;
+  x.converged = gap_closed && (x.strict || loose);
+  write_iterate_line(it, x);
+  return std::nullopt;
 }
 
-std::array<double, 2> AxisymmetricSolver::displacement_at(double R_m, double Z_m) const {
-  std::vector<Point<2>> support(dof_handler_.n_dofs());
-  DoFTools::map_dofs_to_support_points(MappingQ1<2>(), dof_handler_, support);
-  const Point<2> p(R_m, Z_m);
-  double best[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-  std::array<double, 2> u{0.0, 0.0};
-  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
-    cell->get_dof_indices(dofs);
-    for (unsigned i = 0; i < dofs.size(); ++i) {
-      const unsigned c = fe_.system_to_component_index(i).first;
-      const double d = support[dofs[i]].distance(p);
-      if (d < best[c]) {
-        best[c] = d;
-        u[c] = solution_(dofs[i]);
-      }
-    }
-  }
-  return u;
+bool AxisymmetricSolver::check_stall(std::vector<double>& history, double free) const {
+  // Stall: the best residual of the last stall_window iterations is not
+  // below stall_factor x the best before them.
+  history.push_back(free);
+  const int window = settings_.stall_window;
+  if (window <= 0 || static_cast<int>(history.size()) <= window) return false;
+  const double before = *std::min_element(history.begin(), history.end() - window);
+  const double recent = *std::min_element(history.end() - window, history.end());
+  return recent > settings_.stall_factor * before;
 }
 
-void AxisymmetricSolver::write_vtu(const std::string& path) const {
-  const unsigned n = triangulation_.n_active_cells();
-  Vector<double> layer(n), J(n), von_mises(n), stretch(n), damage(n);
-  const QGauss<2> quadrature(settings_.degree + 1);
-  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points | update_JxW_values);
-  const FEValuesExtractors::Scalar ur(0), uz(1);
-  const unsigned nq = quadrature.size();
-  std::vector<Tensor<1, 2>> g_ur(nq), g_uz(nq);
-  std::vector<double> v_ur(nq);
-  std::vector<Tensor<2, 3>> H(nq);
-  CellState st;
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
-    const unsigned c = cell->active_cell_index();
-    fev.reinit(cell);
-    fev[ur].get_function_gradients(solution_, g_ur);
-    fev[uz].get_function_gradients(solution_, g_uz);
-    fev[ur].get_function_values(solution_, v_ur);
-    for (unsigned q = 0; q < nq; ++q) H[q] = displacement_gradient(g_ur[q], g_uz[q], v_ur[q], fev.quadrature_point(q)[0]);
-    layer(c) = cell->material_id();
-    // dt = 0 with the committed history: the committed (converged) stress.
-    const ViscousCell viscous{viscoelastic_of(cell), &viscous_history_[c], 0.0};
-    const bool ok = evaluate_cell(material_of(cell), settings_.degree, fev, H, st, true, viscous);
-    double j_sum = 0.0, vm_sum = 0.0, s_max = 1.0;
-    for (unsigned q = 0; q < nq; ++q) {
-      const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) + H[q];
-      const double Jq = determinant(F);
-      j_sum += Jq;
-      const auto ev = eigenvalues(right_cauchy_green(F));
-      s_max = std::max(s_max, std::sqrt(std::max(ev[0], 0.0)));
-      if (ok) {
-        const Tensor<2, 3> sigma = (1.0 / Jq) * F * Tensor<2, 3>(st.S[q]) * transpose(F);
-        const SymTensor2 s = deviator(symmetrize(sigma));
-        vm_sum += std::sqrt(1.5 * scalar_product(s, s));
-      }
-    }
-    J(c) = j_sum / nq;
-    von_mises(c) = vm_sum / nq;
-    stretch(c) = s_max;
-  }
-  // Crack damage on the cells along the crack (largest of their points).
-  std::map<unsigned, double> damage_of_dof;
+void AxisymmetricSolver::write_iterate_line(int it, Iterate& x) const {
+  int sliding = 0, damaged = 0, broken = 0, closed = 0;
+  for (const auto& h : friction_trial_) sliding += h.sliding ? 1 : 0;
   for (std::size_t k = 0; k < cohesive_points_.size(); ++k) {
-    damage_of_dof[cohesive_points_[k].core_r] = std::max(damage_of_dof[cohesive_points_[k].core_r], cohesive_committed_[k].damage);
-    damage_of_dof[cohesive_points_[k].outer_r] = std::max(damage_of_dof[cohesive_points_[k].outer_r], cohesive_committed_[k].damage);
+    damaged += cohesive_trial_[k].damage > 0.0 ? 1 : 0;
+    broken += cohesive_trial_[k].damage >= 1.0 ? 1 : 0;
+    closed += (cohesive_trial_[k].damage > 0.0 &&
+               solution_(cohesive_points_[k].outer_r) < solution_(cohesive_points_[k].core_r)) ? 1 : 0;
   }
-  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
-    cell->get_dof_indices(dofs);
-    double d = 0.0;
-    for (auto dof : dofs) {
-      const auto it = damage_of_dof.find(dof);
-      if (it != damage_of_dof.end()) d = std::max(d, it->second);
+  x.line << std::setw(4) << it << "  |R_free| " << std::scientific << std::setprecision(3) << x.free << " N  scale "
+         << x.scale << " N  F_needle " << force_trial_.total_N << " N  contact " << force_trial_.nodes_in_contact
+         << " sliding " << sliding << " damaged " << damaged << " broken " << broken << " closed " << closed;
+}
+
+bool AxisymmetricSolver::release_pulled_punch_nodes(std::vector<char>& released_in_step, double scale) {
+  bool released = false;
+  if (cutting_) return released;
+  for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
+    if (!punch_contact_[i] || tied_slave(i)) continue;
+    // A tied pair of crack nodes carries its reaction together.
+    const int p = contact_nodes_[i].partner;
+    double reaction = residual_(contact_nodes_[i].dof_z);
+    if (p >= 0 && tied_slave(static_cast<std::size_t>(p))) reaction += residual_(contact_nodes_[p].dof_z);
+    if (reaction > 1e-6 * scale) {  // R_z > 0: the face would pull the node
+      if (settings_.verbose)
+        std::cout << "      punch releases node R=" << contact_nodes_[i].R << " reaction " << reaction << std::endl;
+      punch_contact_[i] = 0;
+      released_in_step[i] = 1;
+      if (p >= 0 && tied_slave(static_cast<std::size_t>(p))) punch_contact_[p] = 0;
+      released = true;
     }
-    damage(cell->active_cell_index()) = d;
   }
-  DataOut<2> out;
-  out.attach_dof_handler(dof_handler_);
-  std::vector<std::string> names{"displacement_m", "displacement_m"};
-  std::vector<DataComponentInterpretation::DataComponentInterpretation> interp(
-      2, DataComponentInterpretation::component_is_part_of_vector);
-  out.add_data_vector(solution_, names, DataOut<2>::type_dof_data, interp);
-  out.add_data_vector(layer, "layer_id");
-  out.add_data_vector(J, "J");
-  out.add_data_vector(von_mises, "von_mises_Pa");
-  out.add_data_vector(stretch, "max_principal_stretch");
-  out.add_data_vector(damage, "crack_damage");
-  out.build_patches(settings_.degree);
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error("cannot write " + path);
-  out.write_vtu(file);
-  if (!file) throw std::runtime_error("error while writing " + path);
+  return released;
+}
+
+bool AxisymmetricSolver::update_punch_contact(const std::vector<char>& released_in_step) {
+  // Flat punch: top nodes within the punch radius that the face has reached
+  // join; a node released for a tensile reaction stays free for this step.
+  bool changed = false;
+  if (cutting_) return changed;
+  for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
+    const ContactNode& nd = contact_nodes_[i];
+    if (punch_contact_[i] || released_in_step[i] || !nd.on_top || nd.R > punch_radius_m_ * (1 + 1e-9) ||
+        tied_slave(i))
+      continue;
+    if (nd.Z + solution_(nd.dof_z) >= punch_z_m_) {
+      punch_contact_[i] = 1;
+      punch_lateral_hold_[i] = solution_(nd.dof_r);
+      if (nd.partner >= 0 && tied_slave(static_cast<std::size_t>(nd.partner))) punch_contact_[nd.partner] = 1;
+      changed = true;
+    }
+  }
+  return changed;
+}
+
+AxisymmetricSolver::Failure AxisymmetricSolver::give_up_reason(int it, const Iterate& x) const {
+  if (it >= settings_.max_newton_iterations) return "no convergence in " + std::to_string(it) + " Newton iterations";
+  if (!x.stalled) return std::nullopt;
+  std::ostringstream why;
+  why << "Newton stalls: |R_free| " << std::scientific << std::setprecision(3) << x.free << " N did not fall by "
+      << std::defaultfloat << 100.0 * (1.0 - settings_.stall_factor) << " % in " << settings_.stall_window
+      << " iterations";
+  return why.str();
+}
+
+AxisymmetricSolver::Failure AxisymmetricSolver::newton_direction(Step& step, Iterate& x) {
+  // Linear system K du = -R with the increment constraints condensed in
+  // (UMFPACK takes the nonsymmetric tangent of sliding friction).
+  rhs_ = residual_;
+  rhs_ *= -1.0;
+  const auto t_solve = std::chrono::steady_clock::now();
+  system_matrix_.copy_from(tangent_);
+  step.constraints.condense(system_matrix_, rhs_);
+  try {
+    step.direct.initialize(system_matrix_);
+    step.direct.vmult(step.du, rhs_);
+  } catch (const std::exception& e) {
+    return std::string("sparse direct solve failed: ") + e.what();
+  }
+  x.solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_solve).count();
+  step.constraints.distribute(step.du);
+  if (!std::isfinite(step.du.l2_norm())) return "non-finite Newton update";
+  return std::nullopt;
+}
+
+AxisymmetricSolver::Failure AxisymmetricSolver::line_search(Step& step, const Iterate& x, double& alpha) {
+  // Backtracking: the first of alpha = 1, 1/2, 1/4, ... whose free residual
+  // falls enough (any admissible one while the punch gap closes), else the
+  // best admissible one.
+  double best_alpha = -1.0, best_free = std::numeric_limits<double>::infinity();
+  alpha = 1.0;
+  for (int h = 0; h <= settings_.max_line_search_halvings; ++h, alpha *= 0.5) {
+    step.trial = solution_;
+    step.trial.add(alpha, step.du);
+    if (!assemble(step.trial, false)) continue;
+    AffineConstraints<double> tc;
+    make_constraints(step.trial, tc);
+    const double trial_free = free_residual_norm(tc);
+    if (!std::isfinite(trial_free)) continue;
+    if (x.gap > 0.0 || trial_free < (1.0 - 1e-4 * alpha) * x.free || trial_free <= settings_.absolute_residual_floor_N)
+      return std::nullopt;
+    if (trial_free < best_free) {
+      best_free = trial_free;
+      best_alpha = alpha;
+    }
+  }
+  if (best_alpha < 0.0) return "line search: every trial state is inverted or non-finite";
+  alpha = best_alpha;
+  step.trial = solution_;
+  step.trial.add(alpha, step.du);
+  return std::nullopt;
+}
+
+AxisymmetricNewtonReport AxisymmetricSolver::accept_step(Step& step, const Iterate& x, int it) {
+  AxisymmetricNewtonReport& report = step.report;
+  report.accepted_at_stall = !x.strict;
+  report.table.push_back(x.line.str() +
+                         (x.strict ? "  converged" : "  converged (stalled below the acceptance tolerance)"));
+  if (settings_.verbose) std::cout << "      " << report.table.back() << std::endl;
+  report.converged = true;
+  report.iterations = it;
+  last_increment_ = solution_;
+  last_increment_ -= step.u_start;
+  commit();
+  update_penalties();
+  return report;
+}
+
+AxisymmetricNewtonReport AxisymmetricSolver::fail_step(Step& step, const std::string& why) {
+  solution_ = step.u_start;
+  punch_contact_ = step.punch_contact_start;
+  punch_lateral_hold_ = step.punch_hold_start;
+  cohesive_trial_ = cohesive_committed_;
+  friction_trial_ = friction_committed_;
+  assemble(solution_, true);
+  step.report.converged = false;
+  step.report.failure = why;
+  if (settings_.verbose) std::cout << "      newton failed: " << why << std::endl;
+  return step.report;
 }
 
 }  // namespace puncture::fem

@@ -1,5 +1,6 @@
 // finite_strain_solver.cc: see finite_strain_solver.hpp for the formulation.
 #include <puncture/fem/finite_strain_solver.hpp>
+#include <puncture/fem/kinematics.hpp>
 
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
@@ -42,36 +43,6 @@ unsigned int n_pressure_modes(unsigned int degree) { return degree == 1 ? 1 : 4;
 
 double pressure_mode(unsigned int a, const Point<3>& unit_point) {
   return a == 0 ? 1.0 : unit_point[a - 1] - 0.5;
-}
-
-SymTensor2 right_cauchy_green(const Tensor<2, 3>& F) {
-  SymTensor2 C;
-  for (unsigned a = 0; a < 3; ++a)
-    for (unsigned b = a; b < 3; ++b) {
-      double s = 0.0;
-      for (unsigned i = 0; i < 3; ++i) s += F[i][a] * F[i][b];
-      C[a][b] = s;
-    }
-  return C;
-}
-
-/// F^T G, symmetrised: the variation of the Green-Lagrange strain.
-SymTensor2 strain_variation(const Tensor<2, 3>& F, const Tensor<2, 3>& G) {
-  SymTensor2 dE;
-  for (unsigned a = 0; a < 3; ++a)
-    for (unsigned b = a; b < 3; ++b) {
-      double s = 0.0;
-      for (unsigned i = 0; i < 3; ++i) s += F[i][a] * G[i][b] + G[i][a] * F[i][b];
-      dE[a][b] = 0.5 * s;
-    }
-  return dE;
-}
-
-bool finite(const SymTensor2& t) {
-  for (unsigned a = 0; a < 3; ++a)
-    for (unsigned b = a; b < 3; ++b)
-      if (!std::isfinite(t[a][b])) return false;
-  return true;
 }
 
 /// Constitutive state of one (not removed) cell at its quadrature points.
@@ -156,7 +127,7 @@ bool evaluate_cell(const LayerMaterial& material, VolumetricFormulation formulat
     if (formulation == VolumetricFormulation::one_field)
       st.CC[q] += (st.J[q] * st.J[q] * vol.dpressure_dJ(st.J[q])) *
                   outer_product(st.C_inv[q], st.C_inv[q]);
-    if (!finite(st.S[q])) return false;
+    if (!all_finite(st.S[q])) return false;
   }
   return true;
 }

@@ -42,6 +42,7 @@
 // non-finite is kept.
 #pragma once
 
+#include <deal.II/base/point.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/grid/tria.h>
@@ -248,10 +249,76 @@ class AxisymmetricSolver {
     double area_m2;
     int layer;
   };
+  // --- setup(), in this order ------------------------------------------------
+  /// Triangulation of the mesh, boundary ids of its faces, the core cells.
+  void build_triangulation(double sample_radius_m, double total_thickness_m, double tol);
+  /// Dofs, the cell list and its scratch, the homogeneous Dirichlet constraints.
+  void distribute_dofs_and_constraints();
+  /// Cohesive points: the crack dofs paired across the crack (or tied to its plane).
+  void find_crack_pairs(const std::vector<dealii::Point<2>>& support, double tol);
+  /// Open channel: the outer wall nodes of face f tied to the crack plane.
+  void add_channel_wall_points(const dealii::DoFHandler<2>::active_cell_iterator& cell, unsigned f,
+                               const std::vector<dealii::Point<2>>& support, double tol);
+  /// The cohesive points joining core face f to its outer copy outer_f.
+  void pair_crack_face(const dealii::DoFHandler<2>::active_cell_iterator& cell, unsigned f,
+                       const dealii::DoFHandler<2>::active_cell_iterator& outer_cell, unsigned outer_f,
+                       const std::vector<dealii::Point<2>>& support, double tol);
+  /// Contact nodes of the top surface and crack faces, their areas and partners.
+  void find_contact_nodes(const std::vector<dealii::Point<2>>& support, double tol);
+  /// Sparsity of the cells and of every possible crack coupling.
+  void make_sparsity();
+  /// Matrices, vectors and the histories of the unloaded slab (u = 0).
+  void allocate_state();
+
+  // --- solve_step(), one Newton step in phases --------------------------------
+  struct Step;     ///< what the phases of one step share (defined in the .cc)
+  struct Iterate;  ///< one Newton iterate: residual, force scale, tests, log line (in the .cc)
+  using Failure = std::optional<std::string>;  ///< why the step fails (nullopt: it goes on)
+  /// Saves the start of the step, applies the predictor, lets the punch take in the nodes it reaches.
+  void start_step(Step& step, double predictor_scale);
+  /// Assembles at solution_: the free residual, the force scale, stall and convergence tests.
+  Failure evaluate_iterate(Step& step, int it, Iterate& x);
+  /// Appends the free residual to the step's history; true if Newton stalls.
+  bool check_stall(std::vector<double>& history, double free) const;
+  /// The iterate's line of the Newton log (residual, scale, force, contact and crack counts).
+  void write_iterate_line(int it, Iterate& x) const;
+  /// Flat punch: frees the nodes the face would pull (tensile reaction); true if any.
+  bool release_pulled_punch_nodes(std::vector<char>& released_in_step, double scale);
+  /// Flat punch: the top nodes within its radius that the face has reached join; true if any.
+  bool update_punch_contact(const std::vector<char>& released_in_step);
+  /// Too many iterations or a stall: why the step is given up (nullopt: go on).
+  Failure give_up_reason(int it, const Iterate& x) const;
+  /// Newton direction: K du = -R with the increment constraints condensed in.
+  Failure newton_direction(Step& step, Iterate& x);
+  /// Backtracking line search along du from solution_: the step length alpha and step.trial.
+  Failure line_search(Step& step, const Iterate& x, double& alpha);
+  /// A converged step: its log line, the last increment, the histories committed.
+  AxisymmetricNewtonReport accept_step(Step& step, const Iterate& x, int it);
+  /// A failed step: the state at its start restored, the reason reported.
+  AxisymmetricNewtonReport fail_step(Step& step, const std::string& why);
+
+  // --- assemble(): residual_ and (with_matrix) tangent_ at u -----------------
+  /// Cells, cohesive crack, needle; the trial histories and needle force; false
+  /// on an inverted or non-finite state.
   bool assemble(const dealii::Vector<double>& u, bool with_matrix);
+  /// Every cell's stiffness and forces into cell_work_, on assembly_threads threads.
+  bool compute_cell_contributions(const dealii::Vector<double>& u, bool with_matrix);
+  /// Adds cell_work_ to the system in cell order (and the bulk diagonal, the stabilisation energy).
+  void add_cell_contributions(bool with_matrix);
+  /// The cohesive tractions of the crack points (trial histories, dissipation); false if non-finite.
+  bool add_cohesive_forces(const dealii::Vector<double>& u, bool with_matrix);
+  /// Cutting tip: penalty contact with Coulomb friction at the contact nodes, the needle force.
+  void add_needle_contact(const dealii::Vector<double>& u, bool with_matrix);
+  /// Flat punch: its force from the reactions of the nodes it holds.
+  void add_punch_reactions();
+
+  /// The Newton increment's constraints at u: Dirichlet, unbroken ties, the flat punch.
   void make_constraints(const dealii::Vector<double>& u, dealii::AffineConstraints<double>& c) const;
+  /// Norm of residual_ over the dofs c leaves free (constrained dofs hand theirs to their masters).
   double free_residual_norm(const dealii::AffineConstraints<double>& c) const;
+  /// Contact penalties from the bulk diagonal of the last assembly.
   void update_penalties();
+  /// Makes the trial histories, dissipation and needle force the committed ones.
   void commit();
 
   const meshing::AxisymmetricSlabMesh& mesh_;
