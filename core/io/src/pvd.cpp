@@ -2,29 +2,13 @@
 
 #include <puncture/io/output_session.hpp>
 #include <puncture/io/vtk_xml_field_data.hpp>
+#include <puncture/io/xml_escape.hpp>
 
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
 
 namespace puncture::io {
-
-namespace {
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-}  // namespace
 
 std::string pvd_document(const std::vector<PvdEntry>& entries, const Provenance* provenance) {
   std::string out = "<?xml version=\"1.0\"?>\n";
