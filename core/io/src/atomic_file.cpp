@@ -3,13 +3,13 @@
 #include <unistd.h>
 
 #include <atomic>
-#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
+#include "puncture/io/host.hpp"
 #include "puncture/io/interrupt_cleanup.hpp"
 
 namespace puncture::io {
@@ -17,16 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 std::atomic<unsigned long> staging_counter{0};
-
-std::string host_tag() {
-  char host[256] = "unknown";
-  gethostname(host, sizeof host - 1);
-  host[sizeof host - 1] = '\0';
-  std::string h = host;
-  for (char& c : h)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' || c == '_')) c = '_';
-  return h;
-}
 }  // namespace
 
 fs::path staging_path_for(const fs::path& final_path) {
