@@ -573,9 +573,8 @@ void AxisymmetricInsertionRun::write_frame(double time) {
   if (!options_.write_files || !options_.write_vtu) return;
   std::ostringstream name;
   name << "fem_fields_" << std::setw(4) << std::setfill('0') << frames_.size() << ".vtu";
-  const std::filesystem::path tmp = out_dir_ / (name.str() + ".part");
-  solver_.write_vtu(tmp.string());
-  std::filesystem::rename(tmp, out_dir_ / name.str());
+  io::write_file_atomically_with(out_dir_ / name.str(),
+                                 [&](const std::filesystem::path& staged) { solver_.write_vtu(staged.string()); });
   frames_.emplace_back(time, name.str());
   summary_.files_written.push_back(name.str());
 }
@@ -587,7 +586,7 @@ void AxisymmetricInsertionRun::write_outputs() {
   insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
   write_pvd();
   insertion::list_text_outputs(summary_.files_written);
-  write_file_atomically(out_dir_ / "fem_summary.json", summary_json().dump(2) + "\n");
+  io::write_file_atomically(out_dir_ / "fem_summary.json", summary_json().dump(2) + "\n");
 }
 
 // fem_force_depth.csv: one line per recorded row.
@@ -615,7 +614,7 @@ void AxisymmetricInsertionRun::write_pvd() const {
   for (const auto& [t, name] : frames_)
     pvd << "    <DataSet timestep=\"" << format_double(t) << "\" part=\"0\" file=\"" << name << "\"/>\n";
   pvd << "  </Collection>\n</VTKFile>\n";
-  write_file_atomically(out_dir_ / "fem_fields.pvd", pvd.str());
+  io::write_file_atomically(out_dir_ / "fem_fields.pvd", pvd.str());
   summary_.files_written.push_back("fem_fields.pvd");
 }
 

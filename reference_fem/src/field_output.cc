@@ -6,31 +6,14 @@
 #include <deal.II/lac/vector.h>
 #include <deal.II/numerics/data_out.h>
 
-#include <cstdio>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
 #include <puncture/fem/finite_strain_solver.hpp>
+#include <puncture/io/atomic_file.hpp>
 
 namespace puncture::fem {
-
-void write_file_atomically(const std::filesystem::path& path, const std::string& contents) {
-  const std::filesystem::path tmp = path.string() + ".part";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot open " + tmp.string() + " for writing");
-    out << contents;
-    out.flush();
-    if (!out) {
-      out.close();
-      std::filesystem::remove(tmp);
-      throw std::runtime_error("cannot write " + tmp.string());
-    }
-  }
-  std::filesystem::rename(tmp, path);
-}
 
 FieldOutputSeries::FieldOutputSeries(std::filesystem::path folder, std::string base_name, MPI_Comm comm)
     : folder_(std::move(folder)), base_name_(std::move(base_name)), comm_(comm) {}
@@ -69,7 +52,7 @@ std::vector<std::string> FieldOutputSeries::write_frame(const FiniteStrainSolver
   {
     std::ostringstream vtu;
     data_out.write_vtu(vtu);
-    write_file_atomically(folder_ / piece, vtu.str());
+    io::write_file_atomically(folder_ / piece, vtu.str());
     written.push_back(piece);
   }
   const std::string pvtu = frame_name.str() + ".pvtu";
@@ -78,7 +61,7 @@ std::vector<std::string> FieldOutputSeries::write_frame(const FiniteStrainSolver
     for (unsigned r = 0; r < n_ranks; ++r) pieces.push_back(frame_name.str() + "." + std::to_string(r) + ".vtu");
     std::ostringstream out;
     data_out.write_pvtu_record(out, pieces);
-    write_file_atomically(folder_ / pvtu, out.str());
+    io::write_file_atomically(folder_ / pvtu, out.str());
     written.push_back(pvtu);
   }
   frames_.emplace_back(time_s, pvtu);
@@ -92,7 +75,7 @@ std::string FieldOutputSeries::write_collection() const {
   std::ostringstream out;
   dealii::DataOutBase::write_pvd_record(out, frames_);
   const std::string name = base_name_ + ".pvd";
-  write_file_atomically(folder_ / name, out.str());
+  io::write_file_atomically(folder_ / name, out.str());
   return name;
 }
 

@@ -21,8 +21,8 @@
 #include <utility>
 #include <vector>
 
-#include <puncture/fem/field_output.hpp>
 #include <puncture/fem/needle_insertion.hpp>
+#include <puncture/io/atomic_file.hpp>
 #include <puncture/scene.hpp>
 
 namespace puncture::fem::insertion {
@@ -115,10 +115,10 @@ inline int refinement_level(const Scene& scene, const FemRunOptions& options) {
 /// Newton log into `out_dir`, each atomically.
 inline void write_text_outputs(const std::filesystem::path& out_dir, const std::string& force_depth_csv,
                                const InsertionRecords& records) {
-  write_file_atomically(out_dir / "fem_force_depth.csv", force_depth_csv);
-  write_file_atomically(out_dir / "fem_surface_profile.csv", records.profile_csv.str());
-  write_file_atomically(out_dir / "fem_recovery_profile.csv", records.recovery_csv.str());
-  write_file_atomically(out_dir / "fem_newton_log.txt", records.newton_log.str());
+  io::write_file_atomically(out_dir / "fem_force_depth.csv", force_depth_csv);
+  io::write_file_atomically(out_dir / "fem_surface_profile.csv", records.profile_csv.str());
+  io::write_file_atomically(out_dir / "fem_recovery_profile.csv", records.recovery_csv.str());
+  io::write_file_atomically(out_dir / "fem_newton_log.txt", records.newton_log.str());
 }
 
 /// Appends the names of the text outputs and of fem_summary.json to `files`.

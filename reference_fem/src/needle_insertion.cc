@@ -747,7 +747,7 @@ void SlabInsertionRun::write_outputs(const std::string& status, const std::strin
   insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
   insertion::list_text_outputs(summary_.files_written);
   summary_.wall_time_s = insertion::seconds_since(wall_start_);
-  write_file_atomically(out_dir_ / "fem_summary.json", summary_json(status, error).dump(2) + "\n");
+  io::write_file_atomically(out_dir_ / "fem_summary.json", summary_json(status, error).dump(2) + "\n");
 }
 
 // fem_force_depth.csv: one line per recorded row.
