@@ -31,6 +31,7 @@
 #include <puncture/fem/axisymmetric_solver.hpp>
 #include <puncture/fem/field_output.hpp>
 #include <puncture/fem/needle_insertion.hpp>
+#include <puncture/io/pvd.hpp>
 #include <puncture/meshing/axisymmetric_slab_mesh.hpp>
 
 #include "insertion_common.hpp"
@@ -606,15 +607,18 @@ std::string AxisymmetricInsertionRun::force_depth_csv() const {
   return csv.str();
 }
 
-// fem_fields.pvd: the collection of the VTU frames (if any were written).
+// fem_fields.pvd: the collection of the VTU frames (if any were written),
+// spelt as this reference always wrote it: no byte order, no group, times
+// with 9 significant digits (format_double).
 void AxisymmetricInsertionRun::write_pvd() const {
   if (frames_.empty()) return;
-  std::ostringstream pvd;
-  pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
-  for (const auto& [t, name] : frames_)
-    pvd << "    <DataSet timestep=\"" << format_double(t) << "\" part=\"0\" file=\"" << name << "\"/>\n";
-  pvd << "  </Collection>\n</VTKFile>\n";
-  io::write_file_atomically(out_dir_ / "fem_fields.pvd", pvd.str());
+  std::vector<io::PvdEntry> entries;
+  for (const auto& [t, name] : frames_) entries.push_back({t, 0, name});
+  io::PvdFormat format;
+  format.byte_order_attribute.clear();
+  format.group_attribute = false;
+  format.time_digits = 9;
+  io::write_pvd_file(out_dir_ / "fem_fields.pvd", entries, nullptr, format);
   summary_.files_written.push_back("fem_fields.pvd");
 }
 
