@@ -282,7 +282,7 @@ AxisymmetricInsertionRun::AxisymmetricInsertionRun(const Scene& scene, const Fem
       out_dir_(options.output_dir),
       plan_(trajectory(scene, options.stop_depth_m)),
       frame_every_(std::max<int>(1, static_cast<int>(plan_.size()) / std::max(1, options.max_vtu_frames))),
-      states_(n_layers_, LayerState::untouched),
+      states_(n_layers_, LayerState::Untouched),
       peak_force_(n_layers_, 0.0),
       peak_depth_(n_layers_, 0.0),
       peak_time_(n_layers_, 0.0),
@@ -413,11 +413,11 @@ void AxisymmetricInsertionRun::cut_step(const AxisymmetricNewtonReport& report, 
 void AxisymmetricInsertionRun::detect_punctures() {
   const NeedleForce f = solver_.needle_force();
   for (std::size_t i = 0; i < n_layers_; ++i) {
-    if (states_[i] == LayerState::punctured) continue;
+    if (states_[i] == LayerState::Punctured) continue;
     const bool first_intact = static_cast<int>(i) == pressed_layer();
-    if (states_[i] == LayerState::untouched && first_intact && f.nodes_in_contact > 0 && tip_reached_top(i))
-      states_[i] = LayerState::pressed;
-    if (states_[i] != LayerState::pressed) continue;
+    if (states_[i] == LayerState::Untouched && first_intact && f.nodes_in_contact > 0 && tip_reached_top(i))
+      states_[i] = LayerState::Pressed;
+    if (states_[i] != LayerState::Pressed) continue;
     if (f.total_N > peak_force_[i]) {
       peak_force_[i] = f.total_N;
       peak_depth_[i] = depth_;
@@ -463,7 +463,7 @@ void AxisymmetricInsertionRun::open_crack(std::size_t i) {
 // Records layer i's puncture: the event (at its peak force), the surface
 // before (at the peak) and now, a log line and a frame.
 void AxisymmetricInsertionRun::record_puncture(std::size_t i, double force_after_N) {
-  states_[i] = LayerState::punctured;
+  states_[i] = LayerState::Punctured;
   PunctureEvent e;
   e.layer = static_cast<int>(i);
   e.layer_name = scene_.layers[i].name;
@@ -488,7 +488,7 @@ void AxisymmetricInsertionRun::record_step(const std::string& phase, const StepA
   const double velocity = phase == "dwell" ? 0.0 : (t1 > t0 ? step.advance_m / (t1 - t0) : 0.0);
   record(phase, velocity, step.cutting_N);
   const int p = pressed_layer();
-  if (p >= 0 && states_[p] == LayerState::pressed && step_index_ % 2 == 0)
+  if (p >= 0 && states_[p] == LayerState::Pressed && step_index_ % 2 == 0)
     records_.add_surface_profile(step_index_, depth_, layer_top_profile(p), scene_.layers[p].name);
   if (step_index_ % frame_every_ == 0) write_frame(time_);
   if (options_.verbose && step_index_ % 10 == 0) {
@@ -553,7 +553,7 @@ void AxisymmetricInsertionRun::place_needle(double depth) {
 // The first layer not punctured (-1: all are).
 int AxisymmetricInsertionRun::pressed_layer() const {
   for (std::size_t i = 0; i < n_layers_; ++i)
-    if (states_[i] != LayerState::punctured) return static_cast<int>(i);
+    if (states_[i] != LayerState::Punctured) return static_cast<int>(i);
   return -1;
 }
 

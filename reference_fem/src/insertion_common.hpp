@@ -1,6 +1,6 @@
 // insertion_common.hpp: what the two insertion drivers share
-// (axisymmetric_insertion.cc, needle_insertion.cc): the state of a layer, the
-// number format of the CSV files, the rows of the surface and recovery
+// (axisymmetric_insertion.cc, needle_insertion.cc): the state of a layer (the
+// core's LayerState), the number format of the CSV files, the rows of the surface and recovery
 // profiles, the force-depth CSV's layer-state columns, the checks of the
 // scene both drivers make, the text outputs and the puncture events of the
 // summary. Internal to reference_fem/src (not part of the public headers).
@@ -23,21 +23,14 @@
 
 #include <puncture/fem/needle_insertion.hpp>
 #include <puncture/io/atomic_file.hpp>
+#include <puncture/puncture_force.hpp>
 #include <puncture/scene.hpp>
 
 namespace puncture::fem::insertion {
 
-/// What the needle has done to a layer so far.
-enum class LayerState { untouched, pressed, punctured };
-
-inline const char* to_string(LayerState s) {
-  switch (s) {
-    case LayerState::untouched: return "untouched";
-    case LayerState::pressed: return "pressed";
-    case LayerState::punctured: return "punctured";
-  }
-  return "?";
-}
+/// What the needle has done to a layer so far: the real-time model's
+/// LayerState (puncture_force.hpp), written with its to_string.
+using puncture::LayerState;
 
 /// `v` with `precision` significant digits (the number format of every CSV).
 inline std::string format_double(double v, int precision = 9) {
