@@ -31,6 +31,7 @@
 #include <puncture/fem/axisymmetric_solver.hpp>
 #include <puncture/fem/field_output.hpp>
 #include <puncture/fem/needle_insertion.hpp>
+#include <puncture/io/pvd.hpp>
 #include <puncture/meshing/axisymmetric_slab_mesh.hpp>
 
 #include "insertion_common.hpp"
@@ -281,7 +282,7 @@ AxisymmetricInsertionRun::AxisymmetricInsertionRun(const Scene& scene, const Fem
       out_dir_(options.output_dir),
       plan_(trajectory(scene, options.stop_depth_m)),
       frame_every_(std::max<int>(1, static_cast<int>(plan_.size()) / std::max(1, options.max_vtu_frames))),
-      states_(n_layers_, LayerState::untouched),
+      states_(n_layers_, LayerState::Untouched),
       peak_force_(n_layers_, 0.0),
       peak_depth_(n_layers_, 0.0),
       peak_time_(n_layers_, 0.0),
@@ -412,11 +413,11 @@ void AxisymmetricInsertionRun::cut_step(const AxisymmetricNewtonReport& report, 
 void AxisymmetricInsertionRun::detect_punctures() {
   const NeedleForce f = solver_.needle_force();
   for (std::size_t i = 0; i < n_layers_; ++i) {
-    if (states_[i] == LayerState::punctured) continue;
+    if (states_[i] == LayerState::Punctured) continue;
     const bool first_intact = static_cast<int>(i) == pressed_layer();
-    if (states_[i] == LayerState::untouched && first_intact && f.nodes_in_contact > 0 && tip_reached_top(i))
-      states_[i] = LayerState::pressed;
-    if (states_[i] != LayerState::pressed) continue;
+    if (states_[i] == LayerState::Untouched && first_intact && f.nodes_in_contact > 0 && tip_reached_top(i))
+      states_[i] = LayerState::Pressed;
+    if (states_[i] != LayerState::Pressed) continue;
     if (f.total_N > peak_force_[i]) {
       peak_force_[i] = f.total_N;
       peak_depth_[i] = depth_;
@@ -462,7 +463,7 @@ void AxisymmetricInsertionRun::open_crack(std::size_t i) {
 // Records layer i's puncture: the event (at its peak force), the surface
 // before (at the peak) and now, a log line and a frame.
 void AxisymmetricInsertionRun::record_puncture(std::size_t i, double force_after_N) {
-  states_[i] = LayerState::punctured;
+  states_[i] = LayerState::Punctured;
   PunctureEvent e;
   e.layer = static_cast<int>(i);
   e.layer_name = scene_.layers[i].name;
@@ -487,7 +488,7 @@ void AxisymmetricInsertionRun::record_step(const std::string& phase, const StepA
   const double velocity = phase == "dwell" ? 0.0 : (t1 > t0 ? step.advance_m / (t1 - t0) : 0.0);
   record(phase, velocity, step.cutting_N);
   const int p = pressed_layer();
-  if (p >= 0 && states_[p] == LayerState::pressed && step_index_ % 2 == 0)
+  if (p >= 0 && states_[p] == LayerState::Pressed && step_index_ % 2 == 0)
     records_.add_surface_profile(step_index_, depth_, layer_top_profile(p), scene_.layers[p].name);
   if (step_index_ % frame_every_ == 0) write_frame(time_);
   if (options_.verbose && step_index_ % 10 == 0) {
@@ -552,7 +553,7 @@ void AxisymmetricInsertionRun::place_needle(double depth) {
 // The first layer not punctured (-1: all are).
 int AxisymmetricInsertionRun::pressed_layer() const {
   for (std::size_t i = 0; i < n_layers_; ++i)
-    if (states_[i] != LayerState::punctured) return static_cast<int>(i);
+    if (states_[i] != LayerState::Punctured) return static_cast<int>(i);
   return -1;
 }
 
@@ -573,9 +574,8 @@ void AxisymmetricInsertionRun::write_frame(double time) {
   if (!options_.write_files || !options_.write_vtu) return;
   std::ostringstream name;
   name << "fem_fields_" << std::setw(4) << std::setfill('0') << frames_.size() << ".vtu";
-  const std::filesystem::path tmp = out_dir_ / (name.str() + ".part");
-  solver_.write_vtu(tmp.string());
-  std::filesystem::rename(tmp, out_dir_ / name.str());
+  io::write_file_atomically_with(out_dir_ / name.str(),
+                                 [&](const std::filesystem::path& staged) { solver_.write_vtu(staged.string()); });
   frames_.emplace_back(time, name.str());
   summary_.files_written.push_back(name.str());
 }
@@ -587,7 +587,7 @@ void AxisymmetricInsertionRun::write_outputs() {
   insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
   write_pvd();
   insertion::list_text_outputs(summary_.files_written);
-  write_file_atomically(out_dir_ / "fem_summary.json", summary_json().dump(2) + "\n");
+  io::write_file_atomically(out_dir_ / "fem_summary.json", summary_json().dump(2) + "\n");
 }
 
 // fem_force_depth.csv: one line per recorded row.
@@ -607,15 +607,18 @@ std::string AxisymmetricInsertionRun::force_depth_csv() const {
   return csv.str();
 }
 
-// fem_fields.pvd: the collection of the VTU frames (if any were written).
+// fem_fields.pvd: the collection of the VTU frames (if any were written),
+// spelt as this reference always wrote it: no byte order, no group, times
+// with 9 significant digits (format_double).
 void AxisymmetricInsertionRun::write_pvd() const {
   if (frames_.empty()) return;
-  std::ostringstream pvd;
-  pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
-  for (const auto& [t, name] : frames_)
-    pvd << "    <DataSet timestep=\"" << format_double(t) << "\" part=\"0\" file=\"" << name << "\"/>\n";
-  pvd << "  </Collection>\n</VTKFile>\n";
-  write_file_atomically(out_dir_ / "fem_fields.pvd", pvd.str());
+  std::vector<io::PvdEntry> entries;
+  for (const auto& [t, name] : frames_) entries.push_back({t, 0, name});
+  io::PvdFormat format;
+  format.byte_order_attribute.clear();
+  format.group_attribute = false;
+  format.time_digits = 9;
+  io::write_pvd_file(out_dir_ / "fem_fields.pvd", entries, nullptr, format);
   summary_.files_written.push_back("fem_fields.pvd");
 }
 

@@ -1,6 +1,6 @@
 // insertion_common.hpp: what the two insertion drivers share
-// (axisymmetric_insertion.cc, needle_insertion.cc): the state of a layer, the
-// number format of the CSV files, the rows of the surface and recovery
+// (axisymmetric_insertion.cc, needle_insertion.cc): the state of a layer (the
+// core's LayerState), the number format of the CSV files, the rows of the surface and recovery
 // profiles, the force-depth CSV's layer-state columns, the checks of the
 // scene both drivers make, the text outputs and the puncture events of the
 // summary. Internal to reference_fem/src (not part of the public headers).
@@ -21,23 +21,16 @@
 #include <utility>
 #include <vector>
 
-#include <puncture/fem/field_output.hpp>
 #include <puncture/fem/needle_insertion.hpp>
+#include <puncture/io/atomic_file.hpp>
+#include <puncture/puncture_force.hpp>
 #include <puncture/scene.hpp>
 
 namespace puncture::fem::insertion {
 
-/// What the needle has done to a layer so far.
-enum class LayerState { untouched, pressed, punctured };
-
-inline const char* to_string(LayerState s) {
-  switch (s) {
-    case LayerState::untouched: return "untouched";
-    case LayerState::pressed: return "pressed";
-    case LayerState::punctured: return "punctured";
-  }
-  return "?";
-}
+/// What the needle has done to a layer so far: the real-time model's
+/// LayerState (puncture_force.hpp), written with its to_string.
+using puncture::LayerState;
 
 /// `v` with `precision` significant digits (the number format of every CSV).
 inline std::string format_double(double v, int precision = 9) {
@@ -115,10 +108,10 @@ inline int refinement_level(const Scene& scene, const FemRunOptions& options) {
 /// Newton log into `out_dir`, each atomically.
 inline void write_text_outputs(const std::filesystem::path& out_dir, const std::string& force_depth_csv,
                                const InsertionRecords& records) {
-  write_file_atomically(out_dir / "fem_force_depth.csv", force_depth_csv);
-  write_file_atomically(out_dir / "fem_surface_profile.csv", records.profile_csv.str());
-  write_file_atomically(out_dir / "fem_recovery_profile.csv", records.recovery_csv.str());
-  write_file_atomically(out_dir / "fem_newton_log.txt", records.newton_log.str());
+  io::write_file_atomically(out_dir / "fem_force_depth.csv", force_depth_csv);
+  io::write_file_atomically(out_dir / "fem_surface_profile.csv", records.profile_csv.str());
+  io::write_file_atomically(out_dir / "fem_recovery_profile.csv", records.recovery_csv.str());
+  io::write_file_atomically(out_dir / "fem_newton_log.txt", records.newton_log.str());
 }
 
 /// Appends the names of the text outputs and of fem_summary.json to `files`.

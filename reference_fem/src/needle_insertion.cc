@@ -310,7 +310,7 @@ SlabInsertionRun::SlabInsertionRun(const Scene& scene, const FemRunOptions& opti
       tria_(slab_triangulation(scene, options, disc_.refinement, comm)),
       settings_(solver_settings(scene, options, disc_.degree, *tria_)),
       solver_(*tria_, layer_materials(scene), settings_),
-      states_(n_layers_, LayerState::untouched),
+      states_(n_layers_, LayerState::Untouched),
       load_step_(scene.fem.load_step_m),
       resolution_(options.puncture_depth_resolution_m > 0.0 ? options.puncture_depth_resolution_m
                                                              : load_step_ / 4.0),
@@ -459,7 +459,7 @@ bool SlabInsertionRun::accept_sub_step(double trial_depth, double advance) {
   ++summary_.load_steps;
   if (trial_depth == crossing_upper_) crossing_upper_ = std::numeric_limits<double>::infinity();
   const bool in_contact = any_contact();
-  if (current_layer_ < n_layers_ && in_contact) states_[current_layer_] = LayerState::pressed;
+  if (current_layer_ < n_layers_ && in_contact) states_[current_layer_] = LayerState::Pressed;
   predictor_valid_ = in_contact;
   last_advance_ = advance;
   return in_contact;
@@ -528,7 +528,7 @@ void SlabInsertionRun::open_hole(std::size_t layer) {
         return cell->material_id() == layer && std::hypot(c[0], c[1]) < needle_radius_;
       },
       /*release_gradually=*/true);
-  states_[layer] = LayerState::punctured;
+  states_[layer] = LayerState::Punctured;
 }
 
 // Releases the contact set: its nodes hang on anchor springs of 100x the
@@ -580,7 +580,7 @@ void SlabInsertionRun::spring_back(const std::string& layer_name) {
 void SlabInsertionRun::record_after_puncture(std::size_t layer, PunctureEvent event) {
   const bool touching = any_contact();
   event.force_after_N = touching ? needle_force() : 0.0;
-  if (current_layer_ < n_layers_ && touching) states_[current_layer_] = LayerState::pressed;
+  if (current_layer_ < n_layers_ && touching) states_[current_layer_] = LayerState::Pressed;
   records_.add_recovery_profile(layer, "after", depth_, surface_profile(layer));
   summary_.punctures.push_back(event);
   log("  PUNCTURE of " + event.layer_name + " at depth " + format_double(depth_ * 1e3, 5) + " mm, force " +
@@ -747,7 +747,7 @@ void SlabInsertionRun::write_outputs(const std::string& status, const std::strin
   insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
   insertion::list_text_outputs(summary_.files_written);
   summary_.wall_time_s = insertion::seconds_since(wall_start_);
-  write_file_atomically(out_dir_ / "fem_summary.json", summary_json(status, error).dump(2) + "\n");
+  io::write_file_atomically(out_dir_ / "fem_summary.json", summary_json(status, error).dump(2) + "\n");
 }
 
 // fem_force_depth.csv: one line per recorded row.

@@ -138,8 +138,10 @@ TEST(NeedleInsertion, PuncturesSkinThenFatWithSpringBackAndWritesFiles) {
   EXPECT_EQ(before, 1);
   EXPECT_EQ(after, 1);
   EXPECT_GT(uz_axis_after, uz_axis_before);
-  for (const auto& e : std::filesystem::directory_iterator(dir))
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
     EXPECT_NE(e.path().extension(), ".part") << e.path();
+    EXPECT_EQ(e.path().filename().string().find(".staging-"), std::string::npos) << e.path();
+  }
 }
 
 TEST(NeedleInsertion, HardCaseThinSkinNearlyIncompressibleDeepIndentationStaysFinite) {

@@ -3,13 +3,13 @@
 #include <unistd.h>
 
 #include <atomic>
-#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
+#include "puncture/io/host.hpp"
 #include "puncture/io/interrupt_cleanup.hpp"
 
 namespace puncture::io {
@@ -17,16 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 std::atomic<unsigned long> staging_counter{0};
-
-std::string host_tag() {
-  char host[256] = "unknown";
-  gethostname(host, sizeof host - 1);
-  host[sizeof host - 1] = '\0';
-  std::string h = host;
-  for (char& c : h)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' || c == '_')) c = '_';
-  return h;
-}
 }  // namespace
 
 fs::path staging_path_for(const fs::path& final_path) {
@@ -36,28 +26,53 @@ fs::path staging_path_for(const fs::path& final_path) {
                                      std::to_string(++staging_counter) + "@" + host);
 }
 
+namespace {
+// Removes the staged file and throws std::runtime_error naming `path`.
+[[noreturn]] void fail_staged(const fs::path& path, const fs::path& tmp, const std::string& what, int error) {
+  std::error_code ignored;
+  fs::remove(tmp, ignored);
+  unregister_cleanup(tmp);
+  throw std::runtime_error("cannot write '" + path.string() + "': " + what +
+                           (error ? std::string(": ") + std::strerror(error) : std::string()));
+}
+
+// Renames the complete staged file onto `path`.
+void commit_staged(const fs::path& tmp, const fs::path& path) {
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) fail_staged(path, tmp, "rename failed (" + ec.message() + ")", 0);
+  unregister_cleanup(tmp);
+}
+}  // namespace
+
 void write_file_atomically(const fs::path& path, const std::string& contents) {
   const fs::path tmp = staging_path_for(path);
   register_cleanup(tmp, CleanupKind::File);
-  auto fail = [&](const std::string& what, int error) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    unregister_cleanup(tmp);
-    throw std::runtime_error("cannot write '" + path.string() + "': " + what +
-                             (error ? std::string(": ") + std::strerror(error) : std::string()));
-  };
   {
     errno = 0;
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) fail("cannot create a file in '" + path.parent_path().string() + "'", errno);
+    if (!out) fail_staged(path, tmp, "cannot create a file in '" + path.parent_path().string() + "'", errno);
     out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
     out.flush();
-    if (!out) fail("write failed", errno);
+    if (!out) fail_staged(path, tmp, "write failed", errno);
+  }
+  commit_staged(tmp, path);
+}
+
+void write_file_atomically_with(const fs::path& path, const std::function<void(const fs::path&)>& write) {
+  const fs::path tmp = staging_path_for(path);
+  register_cleanup(tmp, CleanupKind::File);
+  try {
+    write(tmp);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    unregister_cleanup(tmp);
+    throw;
   }
   std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) fail("rename failed (" + ec.message() + ")", 0);
-  unregister_cleanup(tmp);
+  if (!fs::is_regular_file(tmp, ec)) fail_staged(path, tmp, "the writer made no file", 0);
+  commit_staged(tmp, path);
 }
 
 std::string read_text_file(const fs::path& path) {

@@ -1,5 +1,7 @@
 #include "puncture/io/interrupt_cleanup.hpp"
 
+#include "puncture/io/host.hpp"
+
 #include <pthread.h>
 #include <signal.h>
 #include <unistd.h>
@@ -37,16 +39,6 @@ sigset_t watched_signals() {
   sigaddset(&set, SIGTERM);
   sigaddset(&set, SIGHUP);
   return set;
-}
-
-std::string this_host() {
-  char host[256] = "unknown";
-  gethostname(host, sizeof host - 1);
-  host[sizeof host - 1] = '\0';
-  std::string h = host;
-  for (char& c : h)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' || c == '_')) c = '_';
-  return h;
 }
 
 bool process_alive(long pid) {
@@ -143,7 +135,7 @@ bool is_stale_staging_name(const std::string& name) {
   if (!read_number(counter)) return false;
   if (i < name.size()) {
     // "@<host>": only processes of this host can be checked.
-    if (name[i] != '@' || name.substr(i + 1) != this_host()) return false;
+    if (name[i] != '@' || name.substr(i + 1) != host_tag()) return false;
   }
   return !process_alive(pid);
 }

@@ -1,6 +1,6 @@
 #include "puncture/io/provenance.hpp"
 
-#include <unistd.h>
+#include "puncture/io/host.hpp"
 
 #include <ctime>
 #include <fstream>
@@ -38,10 +38,7 @@ std::string one_line(std::string s) {
 }  // namespace
 
 std::string machine_summary() {
-  char host[256] = "unknown";
-  gethostname(host, sizeof host - 1);
-  host[sizeof host - 1] = '\0';
-  return std::string(host) + " (" + cpu_model() + ", " + std::to_string(std::thread::hardware_concurrency()) +
+  return host_name() + " (" + cpu_model() + ", " + std::to_string(std::thread::hardware_concurrency()) +
          " cores)";
 }
 

@@ -1,26 +1,14 @@
 #include "puncture/io/vtk_xml_field_data.hpp"
 
+#include "puncture/io/xml_escape.hpp"
+
 #include <stdexcept>
 
 namespace puncture::io {
 
 namespace {
-std::string xml_attribute(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 std::string string_array(const std::string& name, const std::string& value) {
-  std::string out = "      <DataArray type=\"String\" Name=\"" + xml_attribute(name) +
+  std::string out = "      <DataArray type=\"String\" Name=\"" + xml_escape(name, /*escape_apostrophe=*/false) +
                     "\" NumberOfTuples=\"1\" format=\"ascii\">\n        ";
   for (unsigned char c : value) out += std::to_string(static_cast<int>(c)) + " ";
   out += "0\n      </DataArray>\n";

@@ -10,6 +10,7 @@
 #include <Eigen/Dense>
 
 #include "puncture/comparison/boussinesq.hpp"
+#include "puncture/sh/gauss_legendre.hpp"
 
 namespace puncture::comparison {
 
@@ -60,15 +61,6 @@ Eigen::Matrix4d layer_stiffness(const ElasticLayer& layer, double k) {
   return Psi * Phi.inverse();
 }
 
-void gauss_legendre_8(double* x, double* w) {
-  static const double xs[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267, 0.9602898564975363};
-  static const double ws[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
-  for (int i = 0; i < 4; ++i) {
-    x[i] = -xs[3 - i], w[i] = ws[3 - i];
-    x[4 + i] = xs[i], w[4 + i] = ws[i];
-  }
-}
-
 }  // namespace
 
 LayeredHalfSpace::LayeredHalfSpace(std::vector<ElasticLayer> layers, double max_radius_m)
@@ -86,8 +78,8 @@ LayeredHalfSpace::LayeredHalfSpace(std::vector<ElasticLayer> layers, double max_
   const double k_max = 30.0 / top.thickness_m;
   const double panel = 0.5 * kPi / max_radius_m_;
   const int panels = std::max(8, static_cast<int>(std::ceil(k_max / panel)));
-  double gx[8], gw[8];
-  gauss_legendre_8(gx, gw);
+  Eigen::VectorXd gx, gw;
+  gauss_legendre(8, gx, gw, GaussLegendreValues::Table16Digits);
   const double width = k_max / panels;
   for (int p = 0; p < panels; ++p)
     for (int q = 0; q < 8; ++q) {

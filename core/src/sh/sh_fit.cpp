@@ -70,45 +70,6 @@ SHFitReport fit_sh_least_squares(const RealSHBasis& basis, const Eigen::MatrixX3
   return report;
 }
 
-void gauss_legendre(int n, Eigen::VectorXd& nodes, Eigen::VectorXd& weights) {
-  if (n < 1) throw std::invalid_argument("gauss_legendre: need n >= 1");
-  nodes.resize(n);
-  weights.resize(n);
-  for (int i = 0; i < (n + 1) / 2; ++i) {
-    // Newton on P_n from the Tricomi initial guess (node i counted from +1).
-    double x = std::cos(kPi * (i + 0.75) / (n + 0.5));
-    double dp = 1.0;
-    for (int iter = 0; iter < 100; ++iter) {
-      double p0 = 1.0, p1 = x;  // P_0, P_1
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      const double pn = (n == 1) ? x : p1, pn1 = (n == 1) ? 1.0 : p0;
-      dp = n * (x * pn - pn1) / (x * x - 1.0);
-      const double dx = pn / dp;
-      x -= dx;
-      if (std::abs(dx) < 1e-16) break;
-    }
-    {  // final derivative at the converged node
-      double p0 = 1.0, p1 = x;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = (n == 1) ? 1.0 : n * (x * p1 - p0) / (x * x - 1.0);
-    }
-    const double w = 2.0 / ((1.0 - x * x) * dp * dp);
-    nodes(n - 1 - i) = x;
-    nodes(i) = -x;
-    weights(n - 1 - i) = w;
-    weights(i) = w;
-  }
-  if (n % 2 == 1) nodes(n / 2) = 0.0;
-}
-
 Eigen::Vector3d SHGrid::direction(int i, int j) const {
   const double z = cos_theta(i);
   const double s = std::sqrt(std::max(0.0, 1.0 - z * z));

@@ -99,6 +99,32 @@ TEST(Staging, CommittedFilesAreNoLongerRegistered) {
   fs::remove_all(dir);
 }
 
+TEST(AtomicFile, FileWrittenByNameIsStagedThenRenamed) {
+  // write_file_atomically_with: a library that writes a file by name (the FEM
+  // solver's write_vtu) writes the staging name, registered for the interrupt
+  // cleanup while it exists; then it is renamed onto the final name.
+  const fs::path dir = scratch("atomic_with");
+  fs::path seen;
+  write_file_atomically_with(dir / "frame.vtu", [&](const fs::path& staged) {
+    seen = staged;
+    EXPECT_NE(staged.filename().string().find(".staging-"), std::string::npos) << staged;
+    std::ofstream(staged) << "frame";
+  });
+  EXPECT_EQ(read_text_file(dir / "frame.vtu"), "frame");
+  EXPECT_FALSE(fs::exists(seen));
+  EXPECT_THROW(write_file_atomically_with(dir / "bad.vtu",
+                                          [&](const fs::path& staged) {
+                                            std::ofstream(staged) << "half";
+                                            throw std::runtime_error("writer failed");
+                                          }),
+               std::runtime_error);
+  std::size_t n = 0;
+  for (const auto& e : fs::directory_iterator(dir)) (void)e, ++n;
+  EXPECT_EQ(n, 1u) << "the failed writer's staged file is removed";
+  EXPECT_EQ(run_cleanup_now(), 0u) << "nothing left registered";
+  fs::remove_all(dir);
+}
+
 TEST(AtomicFile, WritesReplacesAndReportsTheOsReason) {
   const fs::path dir = scratch("atomic");
   write_file_atomically(dir / "a.csv", "one");

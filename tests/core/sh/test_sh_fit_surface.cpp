@@ -40,6 +40,18 @@ TEST(GaussLegendre, KnownNodesAndExactness) {
   }
 }
 
+TEST(GaussLegendre, TheEightPointTableAgreesWithTheComputedRuleToTheLastDigits) {
+  Eigen::VectorXd x, w, xt, wt;
+  gauss_legendre(8, x, w);
+  gauss_legendre(8, xt, wt, GaussLegendreValues::Table16Digits);
+  ASSERT_EQ(xt.size(), 8);
+  for (int i = 0; i < 8; ++i) {
+    EXPECT_NEAR(xt(i), x(i), 2e-16) << i;
+    EXPECT_NEAR(wt(i), w(i), 2e-16) << i;
+  }
+  EXPECT_THROW(gauss_legendre(7, xt, wt, GaussLegendreValues::Table16Digits), std::invalid_argument);
+}
+
 TEST(SHFit, SphereGivesOnlyTheConstantTerm) {
   const double R = 0.037;
   const Eigen::MatrixX3d dirs = random_directions(200, 1);

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "puncture/sh/gauss_legendre.hpp"
 #include "puncture/sh/real_sh.hpp"
 
 namespace puncture {
@@ -32,9 +33,6 @@ constexpr double kMaxFitConditionNumber = 1e10;
 /// BDCSVD (rank revealing; gives the exact condition number). Cost O(n L^4).
 SHFitReport fit_sh_least_squares(const RealSHBasis& basis, const Eigen::MatrixX3d& directions,
                                  const Eigen::MatrixXd& values, Eigen::MatrixXd& coefficients);
-
-/// n-point Gauss-Legendre rule on [-1, 1] (nodes ascending). n >= 1.
-void gauss_legendre(int n, Eigen::VectorXd& nodes, Eigen::VectorXd& weights);
 
 /// Tensor sample grid: cos(theta) at Gauss-Legendre nodes x uniform phi.
 /// Sample (i, j) has flat index i * n_phi + j.

@@ -8,7 +8,8 @@
 //      point vector), layer_id, removed (1 for void cells), J (cell mean),
 //      von_mises_Pa (cell mean of the Cauchy von Mises stress),
 //      max_principal_stretch (cell max). Every file is written under a
-//      temporary name and renamed when complete.
+//      temporary name and renamed when complete (io::write_file_atomically,
+//      core/io/atomic_file.hpp: the staged file is removed on SIGINT/SIGTERM).
 #pragma once
 
 #include <mpi.h>
@@ -21,10 +22,6 @@
 namespace puncture::fem {
 
 class FiniteStrainSolver;
-
-/// Writes `contents` to `path` atomically (temporary name, then
-/// rename). Throws std::runtime_error if the file cannot be written.
-void write_file_atomically(const std::filesystem::path& path, const std::string& contents);
 
 class FieldOutputSeries {
  public:

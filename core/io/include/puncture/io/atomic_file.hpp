@@ -9,16 +9,24 @@
 //   temporary is removed and std::runtime_error names the file and the OS
 //   reason. While it exists, the temporary is registered for removal on
 //   SIGINT/SIGTERM (interrupt_cleanup.hpp).
+// write_file_atomically_with(path, write): the same for a file another
+//   library writes by name (deal.II's DataOut behind a solver's write_vtu):
+//   write(staging_path) makes the file, which is then renamed onto path. An
+//   exception from write removes the staged file and propagates.
 // read_text_file(path): the bytes of a regular file; std::runtime_error with
 //   the OS reason ("No such file or directory", "Is a directory", ...).
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 
 namespace puncture::io {
 
 void write_file_atomically(const std::filesystem::path& path, const std::string& contents);
+
+void write_file_atomically_with(const std::filesystem::path& path,
+                                const std::function<void(const std::filesystem::path& staging_path)>& write);
 
 std::string read_text_file(const std::filesystem::path& path);
 
