@@ -110,8 +110,9 @@ def markdown(summary, cases_path, model_path, command):
     L += ["", f"Held out: {ok} of {len(held)} layer-cases accepted. Rules for cases that change the slab are in the "
           "cases file. Each case's report (validation_summary.md, plots) is in its folder."]
     for c in summary["cases"]:
-        if c.get("rule"):
-            L.append(f"\n`{c['name']}`: {c['rule']}.")
+        for key in ("rule", "note"):
+            if c.get(key):
+                L.append(f"\n`{c['name']}` ({key}): {c[key]}.")
     return "\n".join(L) + "\n"
 
 
@@ -148,7 +149,8 @@ def main():
                 os.replace(os.path.join(dest, f + ".part"), os.path.join(dest, f))
         metrics = json.load(open(os.path.join(report, "validation_metrics.json")))
         summary["cases"].append({"name": case["name"], "held_out": bool(case.get("overrides")),
-                                 "scene": scene_path, "rule": case.get("rule"), "layers": layer_rows(metrics)})
+                                 "scene": scene_path, "rule": case.get("rule"), "note": case.get("note"),
+                                 "layers": layer_rows(metrics)})
     command = f"scripts/results_heldout.sh (heldout_validation.py {args.model} {args.cases} {args.out_dir})"
     summary["provenance"] = {"command": command, "git_revision": provenance.git_revision(),
                              "machine": provenance.machine(), "date_utc": provenance.utc_now()}
