@@ -62,12 +62,12 @@ def layer_rows(metrics):
         frc = a.get("puncture_force_error_relative", {})
         defl = l.get("deflection", {}).get("relative_rmse")
         reasons = []
-        for key, label in (("pressing_and_cut_force_rmse_relative", "force RMSE"),
-                           ("puncture_depth_error_m", "puncture depth"),
-                           ("puncture_force_error_relative", "puncture force")):
+        for key, label, scale, unit in (("pressing_and_cut_force_rmse_relative", "force RMSE", 1.0, ""),
+                                        ("puncture_depth_error_m", "puncture depth", 1e3, " mm"),
+                                        ("puncture_force_error_relative", "puncture force", 1.0, "")):
             t = a.get(key, {})
             if t.get("available") and not t.get("met"):
-                reasons.append(f"{label} {t['value']:.3g} beyond {t['limit']:.3g}")
+                reasons.append(f"{label} {t['value'] * scale:.3g}{unit} beyond {t['limit'] * scale:.3g}{unit}")
             elif not t.get("available", True):
                 reasons.append(f"{label}: {t.get('note', 'not available')}")
         if defl is None:
