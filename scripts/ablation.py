@@ -18,7 +18,6 @@ import collections
 import json
 import os
 import subprocess
-import sys
 
 import heldout_validation as hv
 import provenance
@@ -65,7 +64,6 @@ def main():
     tuned = json.load(open(args.tuned), object_pairs_hook=collections.OrderedDict)
     paper = json.load(open(args.paper), object_pairs_hook=collections.OrderedDict)
     cases = json.load(open(args.cases))["cases"]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     result = []
     for i, (label, scene) in enumerate(rows(tuned, paper)):
         work = os.path.join("out", "ablation", f"row{i}")
@@ -75,16 +73,7 @@ def main():
         mean_us, p99_us = tick_cost(base_path, args.puncture, work)
         per_case = []
         for case in cases:
-            s = hv.case_scene(scene, case)
-            path = os.path.join(work, f"{case['name']}.json")
-            json.dump(s, open(path, "w"), indent=2, ensure_ascii=False)
-            report = os.path.join(work, case["name"])
-            print(f"ablation: row {i + 1} ({label}), case {case['name']}", flush=True)
-            r = subprocess.run(["mpirun", "--oversubscribe", "-np", str(args.ranks), args.puncture, "validate", path,
-                                "-o", report, "-q"], env=env)
-            if r.returncode != 0:
-                sys.exit(f"ablation: puncture validate failed (row {i + 1}, case {case['name']})")
-            m = json.load(open(os.path.join(report, "validation_metrics.json")))
+            _, _, m = hv.validate_case(scene, case, work, args.puncture, args.ranks, f"ablation row {i + 1} ({label})")
             layers = hv.layer_rows(m)
             per_case.append({"case": case["name"], "held_out": bool(case.get("overrides")),
                              "force_rmse_relative": m["overall"]["force_rmse_relative"],

@@ -133,7 +133,6 @@ def main():
             continue
         gc = p["toughness_J_per_m2"]
         expected = gc * 2 * a_mm * 1e-3
-        top = sum(x["thickness_mm"] for x in layers[:i])
         ev = events.get(l["name"])
         vals = []
         if ev:

@@ -54,6 +54,21 @@ def case_scene(model, case):
     return s
 
 
+def validate_case(model, case, work, puncture, ranks, label):
+    """The model scene with the case's overrides through `puncture validate`
+    into work/<case>: returns (scene path, report folder, validation metrics)."""
+    scene_path = os.path.join(work, f"{case['name']}.json")
+    json.dump(case_scene(model, case), open(scene_path, "w"), indent=2, ensure_ascii=False)
+    report = os.path.join(work, case["name"])
+    print(f"{label}: case {case['name']}", flush=True)
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    r = subprocess.run(["mpirun", "--oversubscribe", "-np", str(ranks), puncture, "validate", scene_path,
+                        "-o", report, "-q"], env=env)
+    if r.returncode != 0:
+        sys.exit(f"{label}: puncture validate failed on case {case['name']} (exit {r.returncode})")
+    return scene_path, report, json.load(open(os.path.join(report, "validation_metrics.json")))
+
+
 def layer_rows(metrics):
     acc = {a["layer"]: a for a in metrics["acceptance"]}
     rows = []
@@ -129,25 +144,16 @@ def main():
     work = os.path.join("out", "heldout")
     os.makedirs(work, exist_ok=True)
     os.makedirs(args.out_dir, exist_ok=True)
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     summary = {"model": args.model, "cases_file": args.cases, "cases": []}
     for i, case in enumerate(cases):
-        scene = case_scene(model, case)
-        scene_path = os.path.join(work, f"{case['name']}.json")
-        json.dump(scene, open(scene_path, "w"), indent=2, ensure_ascii=False)
-        report = os.path.join(work, case["name"])
-        print(f"heldout: case {i + 1}/{len(cases)} {case['name']}", flush=True)
-        r = subprocess.run(["mpirun", "--oversubscribe", "-np", str(args.ranks), args.puncture, "validate", scene_path,
-                            "-o", report, "-q"], env=env)
-        if r.returncode != 0:
-            sys.exit(f"heldout: puncture validate failed on case {case['name']} (exit {r.returncode})")
+        scene_path, report, metrics = validate_case(model, case, work, args.puncture, args.ranks,
+                                                    f"heldout {i + 1}/{len(cases)}")
         dest = os.path.join(args.out_dir, case["name"])
         os.makedirs(dest, exist_ok=True)
         for f in KEEP:
             if os.path.exists(os.path.join(report, f)):
                 shutil.copyfile(os.path.join(report, f), os.path.join(dest, f + ".part"))
                 os.replace(os.path.join(dest, f + ".part"), os.path.join(dest, f))
-        metrics = json.load(open(os.path.join(report, "validation_metrics.json")))
         summary["cases"].append({"name": case["name"], "held_out": bool(case.get("overrides")),
                                  "scene": scene_path, "rule": case.get("rule"), "note": case.get("note"),
                                  "layers": layer_rows(metrics)})
