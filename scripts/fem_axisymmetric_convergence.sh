@@ -3,7 +3,7 @@
 # reference on the default slab, before the skin punctures.
 #
 # The default scene (bevel needle, Ogden layers, cohesive crack, friction)
-# inserted to TARGET_MM (default 8 mm: the skin tents, it punctures near 8.8 mm)
+# inserted to TARGET_MM (default 8 mm: the skin tents, it punctures at 9.4 mm)
 # on meshes qD_n: degree D, n elements per needle radius (the path elements
 # and the first element of every layer scale with them): Q1 with n = 4, 8, 16,
 # 32 and Q2 with n = 4, 8, 16. The needle force at fixed depths (small and
@@ -100,7 +100,7 @@ L = ["# Axisymmetric FEM: convergence of the needle force before the skin punctu
      f"Machine: {host}; the runs went two at a time (1 rank and 1 assembly thread each), so wall times are indicative.  ",
      f"Date: {now} UTC.\n",
      f"The default scene (12 degree bevel, Ogden layers, cohesive crack along the path, shaft friction) inserted to "
-     f"{target} mm, before the skin punctures (near 8.8 mm), on meshes qD_n: element degree D, n elements per needle "
+     f"{target} mm, before the skin punctures (at 9.4 mm, results/fem_vs_literature.md), on meshes qD_n: element degree D, n elements per needle "
      "radius (the radial size under and around the needle, and the first element height at every layer top; the "
      "element height along the needle path scales with it: 0.4 mm x 4 / n). This refines where the error is: under the "
      "tip, through every layer (each layer starts with the tip element size at its top) and along the path; every "
