@@ -21,6 +21,7 @@ import subprocess
 
 import heldout_validation as hv
 import provenance
+import results_io
 
 
 def rows(tuned, paper):
@@ -104,9 +105,7 @@ def main():
     os.makedirs(args.out_dir, exist_ok=True)
     for name, text in (("ablation.json", json.dumps({"command": command, "rows": result}, indent=2) + "\n"),
                        ("README.md", "\n".join(L) + "\n")):
-        path = os.path.join(args.out_dir, name)
-        open(path + ".part", "w").write(text)
-        os.replace(path + ".part", path)
+        results_io.write_text(os.path.join(args.out_dir, name), text)
     print("wrote", args.out_dir)
 
 

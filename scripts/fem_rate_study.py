@@ -21,6 +21,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 import fem_metrics  # noqa: E402
 import provenance  # noqa: E402
+import results_io  # noqa: E402
 
 MEASURED_TRENDS = [
     ("puncture force of cadaver skin and muscle (883 tests)", "relatively insensitive to penetration velocity",
@@ -127,16 +128,7 @@ def plot(path, curves, note):
     ax.legend()
     fig.text(0.01, 0.01, note, fontsize=6)
     fig.tight_layout(rect=(0, 0.04, 1, 1))
-    tmp = path + ".part.png"
-    fig.savefig(tmp, dpi=120)
-    os.replace(tmp, path)
-
-
-def write(path, text):
-    tmp = path + ".part"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    results_io.save_figure(fig, path)
 
 
 def main():
@@ -167,10 +159,10 @@ def main():
           "depth. Relaxed fraction: force at the end of the hold over the force at the end of the insertion.", "",
           "## Measured speed trends\n", "| what | trend | source |", "|---|---|---|"]
     L += [f"| {w} | {t} | {s} |" for w, t, s in MEASURED_TRENDS]
-    write(os.path.join(out_dir, "rate.json"),
+    results_io.write_text(os.path.join(out_dir, "rate.json"),
           json.dumps({"scene": scene_path, "command": command, "runs": [dict(speed_mm_per_s=s, **n) for s, n in runs]},
                      indent=2) + "\n")
-    write(os.path.join(out_dir, "README.md"), "\n".join(L) + "\n")
+    results_io.write_text(os.path.join(out_dir, "README.md"), "\n".join(L) + "\n")
     print("wrote", out_dir)
 
 

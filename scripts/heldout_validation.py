@@ -28,6 +28,7 @@ import subprocess
 import sys
 
 import provenance
+import results_io
 
 DEFLECTION_LIMIT = 0.15
 KEEP = ["validation_metrics.json", "validation_summary.md", "force_depth.png", "deflection_profiles.png",
@@ -162,9 +163,7 @@ def main():
                              "machine": provenance.machine(), "date_utc": provenance.utc_now()}
     for name, text in (("heldout_summary.json", json.dumps(summary, indent=2) + "\n"),
                        ("heldout_summary.md", markdown(summary, args.cases, args.model, command))):
-        path = os.path.join(args.out_dir, name)
-        open(path + ".part", "w").write(text)
-        os.replace(path + ".part", path)
+        results_io.write_text(os.path.join(args.out_dir, name), text)
     print("wrote", args.out_dir)
 
 

@@ -39,6 +39,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 import fem_metrics  # noqa: E402
 import provenance  # noqa: E402
+import results_io  # noqa: E402
 
 NAMES = ["capsule_cohesive_strength_kPa", "parenchyma_youngs_modulus_kPa", "friction_coefficient"]
 
@@ -207,9 +208,7 @@ def plot(path, curve, before, after, fit_depth, note):
     ax.legend(fontsize=8)
     fig.text(0.01, 0.01, note, fontsize=6)
     fig.tight_layout(rect=(0, 0.04, 1, 1))
-    tmp = path + ".part.png"
-    fig.savefig(tmp, dpi=120)
-    os.replace(tmp, path)
+    results_io.save_figure(fig, path)
 
 
 def friction_note(feat, x, scene):
@@ -232,13 +231,6 @@ def friction_note(feat, x, scene):
 def held_out_rmse(ins, curve, lo, hi):
     err = [interp(ins, d) - f for d, f in binned(curve, lo, hi) if interp(ins, d) is not None]
     return math.sqrt(sum(e * e for e in err) / len(err)) if err else None
-
-
-def write(path, text):
-    tmp = path + ".part"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
 
 
 def main():
@@ -268,9 +260,8 @@ def main():
     if args.from_evaluations:
         with open(args.from_evaluations) as f:
             previous = [l.strip().split(",") for l in f if l.strip()][1:]
-    log = open(log_path + ".part", "w")
-    log.write("run," + ",".join(NAMES) + ",J,rmse_N,puncture_depth_mm,puncture_force_N,wall_s\n")
     count = [0]
+    log = None  # evaluations.csv.part while the search runs
 
     def evaluate(logx):
         x = [math.exp(v) for v in logx]
@@ -296,14 +287,14 @@ def main():
     if full_before is None:
         sys.exit("liver identification: the FEM run at the literature values failed")
     if previous:
-        log.close()
-        os.remove(log_path + ".part")
         if os.path.abspath(args.from_evaluations) != os.path.abspath(log_path):
             shutil.copyfile(args.from_evaluations, log_path)
         best = min(previous, key=lambda r: float(r[4]))
         x_best = [float(v) for v in best[1:4]]
         count[0] = len(previous)
     else:
+        log = open(log_path + ".part", "w")
+        log.write("run," + ",".join(NAMES) + ",J,rmse_N,puncture_depth_mm,puncture_force_N,wall_s\n")
         start = [math.log(v) for v in x0]
         best_log, best_J = nelder_mead(evaluate, start, [math.log(2.0)] * 3, args.evaluations)
         log.close()
@@ -327,12 +318,13 @@ def main():
     plot(os.path.join(args.out_dir, "liver_fem_vs_okamura.png"), curve, ins_b, ins_a, args.fit_depth_mm, stamp)
     identified["description"] += (" Identified against the Okamura curve: " +
                                   ", ".join(f"{n} {v:.4g}" for n, v in zip(NAMES, x_best)) + ".")
-    write(os.path.join(args.out_dir, "liver_identified.json"), json.dumps(identified, indent=2, ensure_ascii=False) + "\n")
+    results_io.write_text(os.path.join(args.out_dir, "liver_identified.json"),
+                          json.dumps(identified, indent=2, ensure_ascii=False) + "\n")
     result = {"parameters": NAMES, "literature": x0, "identified": x_best, "objective_before": obj_b,
               "objective_after": obj_a, "measured": measured, "fem_before": feat_b, "fem_after": feat_a,
               "held_out_rmse_N": {"before": held_b, "after": held_a, "range_mm": [args.fit_depth_mm, last]},
               "fem_runs": count[0] + 2, "wall_s": time.time() - t_start, "command": command}
-    write(os.path.join(args.out_dir, "identification.json"), json.dumps(result, indent=2) + "\n")
+    results_io.write_text(os.path.join(args.out_dir, "identification.json"), json.dumps(result, indent=2) + "\n")
     L = ["# Liver FEM beside a measured insertion (Okamura, Simone & O'Leary 2004)\n",
          f"Command: `{command}`.  ", f"Git {provenance.git_revision()}; machine: {provenance.machine()}; "
          f"date {provenance.utc_now()} UTC; " +
@@ -357,7 +349,7 @@ def main():
           "evaluations.csv lists each). Beyond the fitted range the measured trace rises and drops again at structures "
           "inside the liver (vessels) that the two-layer scene does not model; its RMSE there is shown, not fitted. "
           "The identified scene is `liver_identified.json`.", "", friction_note(feat_a, x_best, scene)]
-    write(os.path.join(args.out_dir, "README.md"), "\n".join(L) + "\n")
+    results_io.write_text(os.path.join(args.out_dir, "README.md"), "\n".join(L) + "\n")
     shutil.rmtree(work, ignore_errors=True)
     print("wrote", args.out_dir)
 
