@@ -112,6 +112,11 @@ int main(int argc, char** argv) {
                             "Puncture depths of the reference in mm, one per layer from the top (comma separated); "
                             "default: from its state columns, else from its force drops")
       ->delimiter(',');
+  calibrate_cmd->add_option("--fem-speeds", calibrate.fem_speeds_mm_per_s,
+                            "Also calibrate against the scene's FEM reference at these insertion speeds (mm/s, "
+                            "comma separated; withdrawal at the same speed): with a viscoelastic scene, two or more "
+                            "speeds identify the damping d; default: the scene's speed only")
+      ->delimiter(',');
   calibrate_cmd->add_option("--keep", calibrate.keep,
                             "Keep at the scene's values: K, breakthrough, cutting, friction, stiffening (comma "
                             "separated); default: tune each whose effect is on")

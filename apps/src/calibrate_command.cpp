@@ -20,6 +20,7 @@
 #include "puncture/validation/calibration.hpp"
 #include "puncture/validation/metrics.hpp"
 #include "puncture/validation/fem_comparison.hpp"
+#include "puncture/validation/fem_reference_curve.hpp"
 
 namespace puncture::apps {
 namespace {
@@ -43,23 +44,37 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
   for (std::size_t i = 0; i < options.puncture_depths_mm.size(); ++i)
     c << (i ? "," : " --puncture-depths ") << options.puncture_depths_mm[i];
   for (std::size_t i = 0; i < options.keep.size(); ++i) c << (i ? "," : " --keep ") << options.keep[i];
+  for (std::size_t i = 0; i < options.fem_speeds_mm_per_s.size(); ++i)
+    c << (i ? "," : " --fem-speeds ") << options.fem_speeds_mm_per_s[i];
   return c.str();
 }
 
-/// The reference: the scene's FEM reference (cached; false on the MPI ranks that only help with it) or the measured curve.
-bool load_reference(const CalibrateOptions& options, const Scene& scene, std::ostream& out,
-                    validation::ReferenceCurve& reference) {
+/// The references: the scene's FEM reference (cached) and, with
+/// --fem-speeds, the FEM references of the scene at those speeds; or the
+/// measured curve. False on the MPI ranks that only help with the FEM.
+bool load_references(const CalibrateOptions& options, const Scene& scene, std::ostream& out,
+                     std::vector<validation::ReferenceCurve>& references) {
   if (options.reference.empty()) {
     validation::FemReferenceOptions fem;
     if (!options.cache_dir.empty()) fem.cache_dir = options.cache_dir;
     fem.verbose = !options.quiet;
-    const validation::FemReference ref = validation::obtain_fem_reference(scene, fem, out);
-    if (!validation::is_mpi_root()) return false;
-    out << "[calibrate] FEM reference " << ref.hash << (ref.from_cache ? " (from cache)" : " (computed)") << '\n';
-    reference.curve = validation::read_insertion_curve(ref.dir / "fem_force_depth.csv");
-    reference.kind = "fem";
-    return true;
+    std::vector<Scene> scenes{scene};
+    for (double v : options.fem_speeds_mm_per_s) {
+      if (!(v > 0.0) || !std::isfinite(v)) throw UsageError("--fem-speeds: speeds must be finite and > 0 (mm/s)");
+      if (std::abs(v * 1e-3 - scene.insertion.speed_m_per_s) <= 1e-9) continue;  // the scene's own reference
+      scenes.push_back(validation::scene_at_insertion_speed(scene, v * 1e-3));
+    }
+    for (const Scene& s : scenes) {
+      const validation::FemReference ref = validation::obtain_fem_reference(s, fem, out);
+      if (!validation::is_mpi_root()) continue;
+      out << "[calibrate] FEM reference " << ref.hash << " at " << s.insertion.speed_m_per_s * 1e3 << " mm/s"
+          << (ref.from_cache ? " (from cache)" : " (computed)") << '\n';
+      references.push_back({validation::fem_insertion_curve(s, ref.dir / "fem_force_depth.csv"), "fem"});
+    }
+    return validation::is_mpi_root();
   }
+  if (!options.fem_speeds_mm_per_s.empty()) throw UsageError("--fem-speeds takes the scene's FEM reference, not --reference");
+  validation::ReferenceCurve reference;
   reference.curve = validation::read_insertion_curve(options.reference);
   reference.kind = "measured";
   if (!std::isfinite(options.reference_depth_offset_mm))
@@ -68,7 +83,25 @@ bool load_reference(const CalibrateOptions& options, const Scene& scene, std::os
     for (double& d : reference.curve.depth_m) d -= options.reference_depth_offset_mm * 1e-3;
     reference.curve.metadata["depth_offset_mm"] = std::to_string(options.reference_depth_offset_mm);
   }
+  references.push_back(reference);
   return true;
+}
+
+/// The curves the report plots: per reference, the reference and the model
+/// before and after; the first reference's series keep their plain names
+/// (reference kind, "before", "after"), the others carry "@<speed>mm_per_s".
+std::vector<std::pair<std::string, const validation::InsertionCurve*>> curve_list(
+    const std::vector<validation::ReferenceCurve>& references, const validation::CalibrationResult& result) {
+  std::vector<std::pair<std::string, const validation::InsertionCurve*>> curves;
+  for (std::size_t r = 0; r < references.size(); ++r) {
+    std::string suffix;
+    const auto speed = references[r].curve.metadata.find("speed_mm_per_s");
+    if (r > 0) suffix = "@" + (speed != references[r].curve.metadata.end() ? speed->second : std::to_string(r)) + "mm_per_s";
+    curves.push_back({references[r].kind + suffix, &references[r].curve});
+    curves.push_back({"before" + suffix, &result.model_before[r]});
+    curves.push_back({"after" + suffix, &result.model_after[r]});
+  }
+  return curves;
 }
 
 void check_option(bool ok, const std::string& message) {
@@ -130,8 +163,9 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
     const Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_calibration") : options.output_dir;
-    validation::ReferenceCurve reference;
-    if (!load_reference(options, scene, out, reference)) return 0;  // the other ranks only help with the FEM
+    std::vector<validation::ReferenceCurve> references;
+    if (!load_references(options, scene, out, references)) return 0;  // the other ranks only help with the FEM
+    const validation::ReferenceCurve& reference = references.front();
     const validation::CalibrationOptions calibration = calibration_options(options, scene);
     validation::CalibrationProgressCallback progress;
     if (!options.quiet)
@@ -141,19 +175,15 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
               << p.best_objective << '\n' << std::flush;
       };
     const auto t_start = std::chrono::steady_clock::now();
-    const validation::CalibrationResult result = validation::calibrate(scene, {reference}, calibration, progress);
+    const validation::CalibrationResult result = validation::calibrate(scene, references, calibration, progress);
     const double calibration_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
 
     io::OutputSession session(dir);
     const std::string name = options.preset_name.empty() ? scene.name + "_tuned" : options.preset_name;
     const io::Provenance provenance = io::make_provenance(command_line(options, scene_path, dir, name, calibration.integrator));
-    validation::write_tuned_preset(session, name, result, {reference}, calibration);
+    validation::write_tuned_preset(session, name, result, references, calibration);
     // The model curves the objective compared, before and after, for the report.
-    session.write_text("calibration_curves.csv",
-                       validation::calibration_curves_csv({{reference.kind, &reference.curve},
-                                                           {"before", &result.model_before.front()},
-                                                           {"after", &result.model_after.front()}},
-                                                          provenance));
+    session.write_text("calibration_curves.csv", validation::calibration_curves_csv(curve_list(references, result), provenance));
     session.commit();
     const std::string method = options.method + " on " +
                                (options.threads > 0 ? std::to_string(options.threads) : std::string("every")) +

@@ -141,8 +141,9 @@ TEST(CalibrateCommand, BadKeepOrPunctureDepthsAreErrorsWithNoOutput) {
   const fs::path ref_dir = fresh_dir("calibrate_bad_keep_reference");
   fs::create_directories(ref_dir);
   std::ofstream(ref_dir / "curve.csv") << "depth_mm,force_N\n0,0\n1,0.5\n2,1.0\n";
-  const char* names[] = {"--keep", "--puncture-depths", "--force-weight", "--force-weight"};
-  for (int which = 0; which < 4; ++which) {
+  // --fem-speeds asks for FEM references of the scene, which a measured --reference replaces.
+  const char* names[] = {"--keep", "--puncture-depths", "--force-weight", "--force-weight", "--fem-speeds"};
+  for (int which = 0; which < 5; ++which) {
     CalibrateOptions options;
     options.scene = kSourceDir / "scenes" / "default.json";
     options.reference = ref_dir / "curve.csv";
@@ -150,6 +151,7 @@ TEST(CalibrateCommand, BadKeepOrPunctureDepthsAreErrorsWithNoOutput) {
     options.quiet = true;
     if (which == 0) options.keep = {"everything"};
     else if (which == 1) options.puncture_depths_mm = {-1.0};
+    else if (which == 4) options.fem_speeds_mm_per_s = {3.0};
     else options.force_weight = which == 2 ? -1.0 : std::numeric_limits<double>::quiet_NaN();
     std::ostringstream out, err;
     EXPECT_EQ(calibrate_command(options, out, err), 2) << names[which];

@@ -11,6 +11,7 @@
 #include "puncture/io/output_session.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/calibration.hpp"
+#include "puncture/validation/fem_reference_curve.hpp"
 
 namespace pv = puncture::validation;
 using puncture::Scene;
@@ -185,13 +186,57 @@ TEST(Calibration, DampingIsTunedOnlyWithRateInformation) {
   EXPECT_FALSE(fixed.damping_tuned);
   EXPECT_EQ(fixed.tuned_scene.layers[0].damping_N_s_per_m2, start.layers[0].damping_N_s_per_m2);
 
-  // Marked rate dependent (a measured curve): d of the skin is recovered from
-  // the damping force d h v the needle feels after the skin broke.
+  // Marked rate dependent but at one speed: d h v cannot be told apart from
+  // anything else that grows with the shaft length, so d stays, and the note says why.
   ref.metadata["rate_dependent"] = "true";
   ref.metadata["speed_mm_per_s"] = "10";
-  const pv::CalibrationResult tuned = pv::calibrate(start, ref, options);
+  const pv::CalibrationResult one_speed = pv::calibrate(start, ref, options);
+  EXPECT_FALSE(one_speed.damping_tuned);
+  EXPECT_NE(one_speed.damping_note.find("one speed"), std::string::npos) << one_speed.damping_note;
+  EXPECT_EQ(one_speed.tuned_scene.layers[0].damping_N_s_per_m2, start.layers[0].damping_N_s_per_m2);
+
+  // With a second rate-dependent reference at 4 mm/s, d of the skin is
+  // recovered from how the force after the skin broke changes with speed.
+  const Scene slow_truth = pv::scene_at_insertion_speed(truth, 0.004);
+  pv::InsertionCurve slow = pv::simulate_insertion_curve(slow_truth);
+  slow.metadata["rate_dependent"] = "true";
+  slow.metadata["speed_mm_per_s"] = "4";
+  const pv::CalibrationResult tuned =
+      pv::calibrate(start, std::vector<pv::ReferenceCurve>{{ref, "measured"}, {slow, "measured"}}, options);
   EXPECT_TRUE(tuned.damping_tuned);
+  EXPECT_NE(tuned.damping_note.find("4, 10 mm/s"), std::string::npos) << tuned.damping_note;
   EXPECT_NEAR(tuned.tuned_scene.layers[0].damping_N_s_per_m2 / truth.layers[0].damping_N_s_per_m2, 1.0, 0.03);
+}
+
+TEST(Calibration, FemReferenceCurveCarriesSpeedAndRateInformation) {
+  // The FEM's CSV read back with the scene's trajectory; rate_dependent
+  // exactly when a layer relaxes (Prony terms), quasi_static otherwise.
+  const std::filesystem::path csv = std::filesystem::temp_directory_path() / "puncture_fem_reference_curve_test.csv";
+  {
+    std::ofstream f(csv);
+    f << "time_s,depth_mm,velocity_mm_per_s,force_N\n0,0,4,0\n0.25,1,4,0.1\n0.5,2,4,0.3\n";
+  }
+  Scene scene = truth_scene();
+  const Scene slow = pv::scene_at_insertion_speed(scene, 0.004);
+  EXPECT_DOUBLE_EQ(slow.insertion.speed_m_per_s, 0.004);
+  EXPECT_DOUBLE_EQ(slow.insertion.withdrawal_speed_m_per_s, 0.004);
+  EXPECT_NE(slow.name, scene.name);
+  EXPECT_THROW(pv::scene_at_insertion_speed(scene, 0.0), std::invalid_argument);
+  EXPECT_THROW(pv::scene_at_insertion_speed(scene, std::nan("")), std::invalid_argument);
+
+  const pv::InsertionCurve elastic = pv::fem_insertion_curve(slow, csv);
+  EXPECT_FALSE(pv::reference_is_rate_dependent(elastic));
+  EXPECT_EQ(elastic.metadata.at("quasi_static"), "true");
+  double v = 0.0;
+  ASSERT_TRUE(elastic.metadata_number("speed_mm_per_s", v));
+  EXPECT_DOUBLE_EQ(v, 4.0);
+
+  Scene relaxing = slow;
+  relaxing.layers[1].material.viscoelastic.terms.push_back({0.3, 2.0});
+  const pv::InsertionCurve viscous = pv::fem_insertion_curve(relaxing, csv);
+  EXPECT_TRUE(pv::reference_is_rate_dependent(viscous));
+  EXPECT_EQ(viscous.metadata.count("quasi_static"), 0u);
+  std::filesystem::remove(csv);
 }
 
 TEST(Calibration, BobyqaImprovesTheFit) {

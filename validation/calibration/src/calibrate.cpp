@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 #include "calibration_parameters.hpp"
@@ -132,9 +133,30 @@ std::pair<std::size_t, std::size_t> withhold_unidentified(const Calibration& c, 
   return {tuned, requested};
 }
 
+/// The distinct insertion speeds (m/s) of the references marked rate_dependent.
+std::vector<double> rate_dependent_speeds(const Calibration& c) {
+  std::vector<double> speeds;
+  for (const ReferenceCurve& r : c.references) {
+    if (!reference_is_rate_dependent(r.curve)) continue;
+    const double v = reference_speed(c.scene, r.curve);
+    bool known = false;
+    for (double s : speeds) known = known || std::abs(s - v) <= 1e-6 * std::max(s, v);
+    if (!known) speeds.push_back(v);
+  }
+  std::sort(speeds.begin(), speeds.end());
+  return speeds;
+}
+
+/// Auto: d h v is told apart from the rate-independent shaft friction (and
+/// from everything else a reference's force has in proportion to the shaft
+/// length) only by how the force changes with the speed, so d is tuned when
+/// rate-dependent references span two or more speeds.
 void decide_damping(const Calibration& c, CalibrationResult& result) {
-  bool rate_info = false;
-  for (const ReferenceCurve& r : c.references) rate_info = rate_info || reference_is_rate_dependent(r.curve);
+  const std::vector<double> speeds = rate_dependent_speeds(c);
+  std::ostringstream listed_text;
+  listed_text.precision(4);
+  for (std::size_t i = 0; i < speeds.size(); ++i) listed_text << (i ? ", " : "") << speeds[i] * 1e3;
+  const std::string listed = listed_text.str();
   switch (c.options.parameters.damping) {
     case DampingPolicy::Fixed:
       result.damping_tuned = false;
@@ -145,10 +167,16 @@ void decide_damping(const Calibration& c, CalibrationResult& result) {
       result.damping_note = "d tuned on request (DampingPolicy::Tune)";
       break;
     case DampingPolicy::Auto:
-      result.damping_tuned = rate_info;
-      result.damping_note = rate_info ? "d tuned: a reference is marked rate_dependent"
-                                      : "d kept fixed: no reference carries rate information (rate_dependent metadata); "
-                                        "a quasi-static reference cannot identify d";
+      result.damping_tuned = speeds.size() >= 2;
+      if (speeds.size() >= 2)
+        result.damping_note = "d tuned: rate-dependent references at " + listed + " mm/s";
+      else if (speeds.size() == 1)
+        result.damping_note = "d kept fixed: rate-dependent references at one speed only (" + listed +
+                              " mm/s); at one speed d h v cannot be told apart from the shaft friction, so d "
+                              "needs references at two or more speeds";
+      else
+        result.damping_note = "d kept fixed: no reference carries rate information (rate_dependent metadata); "
+                              "a quasi-static reference cannot identify d";
       break;
   }
   if (result.damping_tuned && !c.scene.effects.damping) {

@@ -85,12 +85,7 @@ InsertionCurve simulate_insertion_curve(const Scene& scene, const SurfaceCache* 
 // Parameters: what is tuned, in which space, within which bounds
 
 namespace calibration_detail {
-namespace {
 
-// ---------------------------------------------------------------------------
-// The reference's trajectory and the model runs
-
-/// Reference speed: metadata "speed_mm_per_s" if present, else the scene's.
 double reference_speed(const Scene& scene, const InsertionCurve& ref) {
   double v = 0.0;
   if (ref.metadata_number("speed_mm_per_s", v)) {
@@ -99,6 +94,11 @@ double reference_speed(const Scene& scene, const InsertionCurve& ref) {
   }
   return scene.insertion.speed_m_per_s;
 }
+
+namespace {
+
+// ---------------------------------------------------------------------------
+// The reference's trajectory and the model runs
 
 struct ReferenceTrajectory {
   double deepest_m = 0.0;

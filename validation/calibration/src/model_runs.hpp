@@ -16,6 +16,10 @@
 
 namespace puncture::validation::calibration_detail {
 
+/// Insertion speed of a reference (m/s): its metadata "speed_mm_per_s" if
+/// present (std::invalid_argument if not > 0), else the scene's.
+double reference_speed(const Scene& scene, const InsertionCurve& reference);
+
 Scene objective_scene(const Scene& current, const ReferenceCurve& reference, const CalibrationOptions& options,
                       bool with_dwell, double turn_depth_m = std::numeric_limits<double>::infinity());
 

@@ -97,6 +97,9 @@ struct CalibrateOptions {
   /// Puncture depths of the reference (mm), one per layer from the top; empty:
   /// from its state columns, else from its force drops.
   std::vector<double> puncture_depths_mm;
+  /// Insertion speeds (mm/s) of further FEM references of the scene (not with
+  /// --reference): each is the scene inserted and withdrawn at that speed.
+  std::vector<double> fem_speeds_mm_per_s;
   /// Parameters kept at the scene's values: "K", "breakthrough", "cutting",
   /// "friction", "stiffening" (by default each is tuned where its effect is on).
   std::vector<std::string> keep;

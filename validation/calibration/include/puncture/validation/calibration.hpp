@@ -110,10 +110,13 @@ enum class CalibrationMethod { LevenbergMarquardt, Bobyqa, NelderMead, Simulated
 CalibrationMethod parse_calibration_method(const std::string& name);
 const char* to_string(CalibrationMethod method);
 
-/// When the damping d is tuned. Auto: only if a reference has the metadata
-/// line "# rate_dependent: true" (a measured curve, ideally at two or more
-/// speeds); the quasi-static FEM reference has no rate dependence, so d is
-/// kept fixed against it.
+/// When the damping d is tuned. Auto: only if references with the metadata
+/// line "# rate_dependent: true" (measured curves, or the FEM reference of a
+/// viscoelastic scene, fem_reference_curve.hpp) span two or more insertion
+/// speeds (metadata "speed_mm_per_s", else the scene's): at one speed d h v
+/// grows with the shaft length exactly as the friction does, so only the
+/// change with speed tells d apart. An elastic scene's FEM reference is quasi-
+/// static, so d is kept fixed against it.
 enum class DampingPolicy { Auto, Fixed, Tune };
 
 struct TunedParameterSet {
