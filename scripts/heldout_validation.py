@@ -106,10 +106,10 @@ def fmt(v, pattern):
     return "n/a" if v is None else format(v, pattern)
 
 
-def markdown(summary, cases_path, model_path, command):
+def markdown(summary, cases_path, model_path, command, model_note):
     L = ["# Held-out validation of the tuned real-time model\n",
          f"Command: `{command}`, git {provenance.git_revision()}, {provenance.machine()}, {provenance.utc_now()} UTC.\n",
-         f"Model: `{model_path}` (calibrated on the calibration trajectory only). Cases: `{cases_path}`. "
+         f"Model: `{model_path}` ({model_note}). Cases: `{cases_path}`. "
          "Every case but the calibration trajectory is held out: the model was not tuned on it. Acceptance per layer: "
          "pressing and cutting force RMSE <= 10 % of the FEM peak, puncture depth within L, puncture force within "
          f"10 %, deflection RMSE before the breakthrough <= {DEFLECTION_LIMIT:.0%} of the FEM's largest deflection.\n",
@@ -139,13 +139,15 @@ def main():
     ap.add_argument("out_dir")
     ap.add_argument("puncture")
     ap.add_argument("--ranks", type=int, default=2)
+    ap.add_argument("--model-note", default="calibrated on the calibration trajectory only",
+                    help="how the model was calibrated (which references), for the page")
     args = ap.parse_args()
     model = json.load(open(args.model), object_pairs_hook=collections.OrderedDict)
     cases = json.load(open(args.cases))["cases"]
     work = os.path.join("out", "heldout")
     os.makedirs(work, exist_ok=True)
     os.makedirs(args.out_dir, exist_ok=True)
-    summary = {"model": args.model, "cases_file": args.cases, "cases": []}
+    summary = {"model": args.model, "model_note": args.model_note, "cases_file": args.cases, "cases": []}
     for i, case in enumerate(cases):
         scene_path, report, metrics = validate_case(model, case, work, args.puncture, args.ranks,
                                                     f"heldout {i + 1}/{len(cases)}")
@@ -162,7 +164,7 @@ def main():
     summary["provenance"] = {"command": command, "git_revision": provenance.git_revision(),
                              "machine": provenance.machine(), "date_utc": provenance.utc_now()}
     for name, text in (("heldout_summary.json", json.dumps(summary, indent=2) + "\n"),
-                       ("heldout_summary.md", markdown(summary, args.cases, args.model, command))):
+                       ("heldout_summary.md", markdown(summary, args.cases, args.model, command, args.model_note))):
         results_io.write_text(os.path.join(args.out_dir, name), text)
     print("wrote", args.out_dir)
 

@@ -109,8 +109,8 @@ std::string calibration_identifiability_report(const CalibrationResult& r, const
     << "parameters, so per relative change) and approximate standard error (Gauss-Newton covariance "
     << "sigma^2 (J^T J)^-1, in the parameter's unit); a parameter is identified when it is inside its bounds, "
     << "the objective changes with it, and its standard error is below its value (scale). Parameters the "
-    << "reference cannot identify before any fit (no puncture of the layer, too few samples, d without rate "
-    << "information) keep their start values.\n\n"
+    << "reference cannot identify before any fit (no puncture of the layer, too few samples, d without "
+    << "rate-dependent references at two or more speeds) keep their start values.\n\n"
     << calibration_identifiability_table(r);
   return s.str();
 }
