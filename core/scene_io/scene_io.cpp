@@ -126,6 +126,9 @@ ForceMeshParams read_force_mesh(ObjectReader r) {
   p.surface_stiffness_N_per_m = r.number("surface_stiffness_N_per_mm", p.surface_stiffness_N_per_m * kMm) / kMm;
   p.deformed_threshold_m = r.number("deformed_threshold_mm", p.deformed_threshold_m / kMm) * kMm;
   p.node_damping_N_s_per_m = r.number("node_damping_N_s_per_m", p.node_damping_N_s_per_m);
+  p.surface_axial_stiffness_N_per_m =
+      r.number("surface_axial_stiffness_N_per_mm", p.surface_axial_stiffness_N_per_m * kMm) / kMm;
+  p.virtual_stiffening_m = r.number("virtual_stiffening_mm", p.virtual_stiffening_m / kMm) * kMm;
   r.reject_unknown_keys();
   return p;
 }
@@ -549,6 +552,10 @@ void validate_scene(const Scene& s, const std::string& file) {
             fm.deformed_threshold_m / kMm);
     require(fm.node_damping_N_s_per_m >= 0, file, p + "/force_mesh/node_damping_N_s_per_m", ">= 0",
             fm.node_damping_N_s_per_m);
+    require(fm.surface_axial_stiffness_N_per_m >= 0, file, p + "/force_mesh/surface_axial_stiffness_N_per_mm",
+            ">= 0 (0: linear surface springs)", fm.surface_axial_stiffness_N_per_m * kMm);
+    require(fm.virtual_stiffening_m >= 0, file, p + "/force_mesh/virtual_stiffening_mm",
+            ">= 0 (0: linear virtual springs)", fm.virtual_stiffening_m / kMm);
     require(l.damping_N_s_per_m2 >= 0, file, p + "/damping_d_N_s_per_m2", ">= 0", l.damping_N_s_per_m2);
     require(l.resumption_rate > 0 && l.resumption_rate <= 1, file, p + "/resumption_rate", "in (0, 1]",
             l.resumption_rate);
@@ -805,6 +812,11 @@ std::string scene_to_json_text(const Scene& s) {
                        {"surface_stiffness_N_per_mm", l.force_mesh.surface_stiffness_N_per_m * kMm},
                        {"deformed_threshold_mm", l.force_mesh.deformed_threshold_m / kMm},
                        {"node_damping_N_s_per_m", l.force_mesh.node_damping_N_s_per_m}};
+    // The stiffening of the mesh is written only when on (a linear mesh's file stays as it was).
+    if (l.force_mesh.surface_axial_stiffness_N_per_m > 0.0)
+      j["force_mesh"]["surface_axial_stiffness_N_per_mm"] = l.force_mesh.surface_axial_stiffness_N_per_m * kMm;
+    if (l.force_mesh.virtual_stiffening_m > 0.0)
+      j["force_mesh"]["virtual_stiffening_mm"] = l.force_mesh.virtual_stiffening_m / kMm;
     j["damping_d_N_s_per_m2"] = l.damping_N_s_per_m2;
     j["resumption_time_s"] = l.resumption_time_s;
     j["force_law"] = force_law_json(l.force_law);

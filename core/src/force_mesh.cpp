@@ -1,5 +1,7 @@
 #include "puncture/force_mesh.hpp"
 
+#include "fixed_pattern_ldlt.hpp"
+
 #include <Eigen/Geometry>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -25,6 +27,59 @@ const char* to_string(MeshIntegrator integrator) {
     case MeshIntegrator::Implicit: return "implicit";
   }
   return "unknown";
+}
+
+double virtual_spring_force_N(const ForceMeshParams& p, double z) {
+  const double K = p.virtual_stiffness_N_per_m;
+  if (!(p.virtual_stiffening_m > 0.0)) return K * z;
+  const double x = z / p.virtual_stiffening_m;
+  return K * z * (1.0 + x * x);
+}
+
+double virtual_spring_stiffness_N_per_m(const ForceMeshParams& p, double z) {
+  const double K = p.virtual_stiffness_N_per_m;
+  if (!(p.virtual_stiffening_m > 0.0)) return K;
+  const double x = z / p.virtual_stiffening_m;
+  return K * (1.0 + 3.0 * x * x);
+}
+
+double virtual_spring_energy_J(const ForceMeshParams& p, double z) {
+  const double K = p.virtual_stiffness_N_per_m;
+  if (!(p.virtual_stiffening_m > 0.0)) return 0.5 * K * z * z;
+  const double x = z / p.virtual_stiffening_m;
+  return K * z * z * (0.5 + 0.25 * x * x);
+}
+
+double surface_spring_force_N(const ForceMeshParams& p, double delta) {
+  double f = p.surface_stiffness_N_per_m * delta;
+  if (p.surface_axial_stiffness_N_per_m > 0.0) {
+    const double L = p.spacing_L_m;
+    const double s = std::hypot(L, delta);
+    // (s - L) / s = delta^2 / (s (s + L)): no cancellation at small slopes.
+    f += p.surface_axial_stiffness_N_per_m * delta * delta * delta / (s * (s + L));
+  }
+  return f;
+}
+
+double surface_spring_stiffness_N_per_m(const ForceMeshParams& p, double delta) {
+  double k = p.surface_stiffness_N_per_m;
+  if (p.surface_axial_stiffness_N_per_m > 0.0) {
+    const double L = p.spacing_L_m;
+    const double s = std::hypot(L, delta);
+    // d/d delta [delta (1 - L / s)] = 1 - L^3 / s^3 = (s^3 - L^3) / s^3, with s^3 - L^3 = delta^2 (s^2 + s L + L^2) / (s + L).
+    k += p.surface_axial_stiffness_N_per_m * delta * delta * (s * s + s * L + L * L) / ((s + L) * s * s * s);
+  }
+  return k;
+}
+
+double surface_spring_energy_J(const ForceMeshParams& p, double delta) {
+  double e = 0.5 * p.surface_stiffness_N_per_m * delta * delta;
+  if (p.surface_axial_stiffness_N_per_m > 0.0) {
+    const double L = p.spacing_L_m;
+    const double stretch = delta * delta / (std::hypot(L, delta) + L);  // s - L
+    e += 0.5 * p.surface_axial_stiffness_N_per_m * stretch * stretch;
+  }
+  return e;
 }
 
 namespace {
@@ -72,6 +127,10 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   if (!(settings.explicit_safety > 0.0 && settings.explicit_safety <= 1.0))
     throw std::invalid_argument("force mesh: explicit_safety must be in (0, 1]");
   if (settings.max_explicit_substeps < 1) throw std::invalid_argument("force mesh: max_explicit_substeps must be >= 1");
+  if (!(params.surface_axial_stiffness_N_per_m >= 0.0) || !std::isfinite(params.surface_axial_stiffness_N_per_m))
+    throw std::invalid_argument("force mesh: surface_axial_stiffness_N_per_m must be >= 0 and finite");
+  if (!(params.virtual_stiffening_m >= 0.0) || !std::isfinite(params.virtual_stiffening_m))
+    throw std::invalid_argument("force mesh: virtual_stiffening_m must be >= 0 and finite");
 
   const int n = lattice_.node_count();
   const int nf = n - 1;
@@ -125,8 +184,15 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   substeps_ = static_cast<int>(std::min<double>(std::max(1.0, substeps_needed), settings.max_explicit_substeps + 1.0));
   explicit_fallback_ = substeps_needed > settings.max_explicit_substeps;
 
+  nonlinear_ = params.nonlinear();
+  if (nonlinear_ && settings.integrator == MeshIntegrator::Explicit) explicit_fallback_ = true;  // see the header
   use_implicit_ = settings.integrator == MeshIntegrator::Implicit ||
                   (settings.integrator == MeshIntegrator::Explicit && explicit_fallback_);
+  if (nonlinear_) {
+    setup_nonlinear();
+    update_derived();
+    return;
+  }
   if (use_implicit_ && nf > 0) {
     const double shift = mass_kg_ / (dt * dt) + c / dt;
     Eigen::SimplicialLDLT<SparseMatrix> ldlt(free_stiffness(lattice_, K, ks, shift));
@@ -237,6 +303,7 @@ void ForceMesh::reset() {
   z_.setZero();
   v_.setZero();
   predicted_ = false;
+  predicted_z0_ = 0.0;
   update_derived();
 }
 
@@ -303,6 +370,32 @@ void ForceMesh::step_free_nodes(double z0_old, double z0_new) {
 }
 
 void ForceMesh::predict() {
+  if (nonlinear_) {
+    predict_nonlinear(z_[0]);
+    return;
+  }
+  predict_linear();
+}
+
+void ForceMesh::predict_nonlinear(double z0_star) {
+  {
+    // The step solved at contact deflection z0_star, linearised there (see the header).
+    predicted_z0_ = z0_star;
+    solve_nonlinear_step(predicted_z0_);
+    double reaction = virtual_spring_force_N(params_, predicted_z0_);
+    double slope = virtual_spring_stiffness_N_per_m(params_, predicted_z0_);
+    for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k) {
+      const int j = lattice_.neighbours[k];
+      reaction += surface_spring_force_N(params_, predicted_z0_ - pz_[j]);
+      slope += surface_spring_stiffness_N_per_m(params_, predicted_z0_ - pz_[j]) * (1.0 - qz_[j]);
+    }
+    reaction_slope_N_per_m_ = slope;
+    predicted_intercept_N_ = reaction - slope * predicted_z0_;
+    predicted_ = true;
+  }
+}
+
+void ForceMesh::predict_linear() {
   // The step from the committed state with z0 = 0 at its end, in the scratch
   // vectors; the committed state is swapped back in afterwards.
   const double z0_old = z_[0];
@@ -326,9 +419,10 @@ void ForceMesh::commit(double contact_deflection_m) {
   const double z0 = std::max(0.0, contact_deflection_m);
   const double z0_old = z_[0];
   const int n = lattice_.node_count();
+  const double dz0 = z0 - predicted_z0_;  // predicted_z0_ = 0 for a linear mesh
   for (int i = 1; i < n; ++i) {
-    z_[i] = pz_[i] + z0 * qz_[i];
-    v_[i] = pv_[i] + z0 * qv_[i];
+    z_[i] = pz_[i] + dz0 * qz_[i];
+    v_[i] = pv_[i] + dz0 * qv_[i];
   }
   z_[0] = z0;
   v_[0] = (z0 - z0_old) / settings_.time_step_s;
@@ -340,7 +434,9 @@ void ForceMesh::commit(double contact_deflection_m) {
 }
 
 void ForceMesh::advance(double contact_deflection_m) {
-  predict();
+  // A stiffening mesh's step is solved at the prescribed deflection itself (no linearisation error).
+  if (nonlinear_ && std::isfinite(contact_deflection_m)) predict_nonlinear(std::max(0.0, contact_deflection_m));
+  else predict();
   commit(contact_deflection_m);
 }
 
@@ -354,7 +450,203 @@ void ForceMesh::update_derived() {
   max_abs_velocity_m_per_s_ = v_.cwiseAbs().maxCoeff();
 }
 
+ForceMesh::~ForceMesh() = default;
+ForceMesh::ForceMesh(ForceMesh&&) noexcept = default;
+ForceMesh& ForceMesh::operator=(ForceMesh&&) noexcept = default;
+
+ForceMesh::ForceMesh(const ForceMesh& other)
+    : params_(other.params_), settings_(other.settings_), lattice_(other.lattice_) {
+  *this = other;
+}
+
+ForceMesh& ForceMesh::operator=(const ForceMesh& other) {
+  if (this == &other) return *this;
+  std::unique_ptr<detail::FixedPatternLdlt> tangent =
+      other.tangent_ ? std::make_unique<detail::FixedPatternLdlt>(*other.tangent_) : nullptr;
+  // Every member but the factorisation is a value: copy them all, then the factorisation.
+  params_ = other.params_;
+  settings_ = other.settings_;
+  lattice_ = other.lattice_;
+  mass_kg_ = other.mass_kg_;
+  static_stiffness_N_per_m_ = other.static_stiffness_N_per_m_;
+  dt_crit_s_ = other.dt_crit_s_;
+  omega_max_sq_ = other.omega_max_sq_;
+  substeps_ = other.substeps_;
+  explicit_fallback_ = other.explicit_fallback_;
+  use_implicit_ = other.use_implicit_;
+  rest_ = other.rest_;
+  normals_ = other.normals_;
+  positions_ = other.positions_;
+  positions_stale_ = other.positions_stale_;
+  layout_surface_ = other.layout_surface_;
+  frame_origin_ = other.frame_origin_;
+  frame_normal_ = other.frame_normal_;
+  frame_e1_ = other.frame_e1_;
+  frame_e2_ = other.frame_e2_;
+  next_projection_ = other.next_projection_;
+  z_ = other.z_, v_ = other.v_, influence_ = other.influence_, rhs_ = other.rhs_, work_ = other.work_;
+  pz_ = other.pz_, pv_ = other.pv_, qz_ = other.qz_, qv_ = other.qv_;
+  max_abs_deflection_m_ = other.max_abs_deflection_m_;
+  max_abs_velocity_m_per_s_ = other.max_abs_velocity_m_per_s_;
+  predicted_intercept_N_ = other.predicted_intercept_N_;
+  reaction_slope_N_per_m_ = other.reaction_slope_N_per_m_;
+  predicted_z0_ = other.predicted_z0_;
+  predicted_ = other.predicted_;
+  ring_mean_m_ = other.ring_mean_m_;
+  ring_size_ = other.ring_size_;
+  l_col_start_ = other.l_col_start_, l_row_ = other.l_row_, l_val_ = other.l_val_;
+  d_inv_ = other.d_inv_;
+  perm_ = other.perm_;
+  nonlinear_ = other.nonlinear_;
+  tangent_ = std::move(tangent);
+  tangent_values_ = other.tangent_values_;
+  spring_i_ = other.spring_i_, spring_j_ = other.spring_j_;
+  step_mass_term_ = other.step_mass_term_;
+  inertial_target_ = other.inertial_target_;
+  trial_z_ = other.trial_z_, newton_step_ = other.newton_step_;
+  newton_iterations_ = other.newton_iterations_;
+  return *this;
+}
+
+void ForceMesh::setup_nonlinear() {
+  const int n = lattice_.node_count();
+  const int nf = n - 1;
+  const double dt = settings_.time_step_s;
+  step_mass_term_ = use_implicit_ ? mass_kg_ / (dt * dt) + params_.node_damping_N_s_per_m / dt : 0.0;
+  spring_i_.clear();
+  spring_j_.clear();
+  std::vector<std::pair<int, int>> lower;  // free-node indices f = node - 1
+  for (int f = 0; f < nf; ++f) lower.push_back({f, f});
+  for (int i = 1; i < n; ++i)
+    for (int k = lattice_.neighbour_offsets[i]; k < lattice_.neighbour_offsets[i + 1]; ++k) {
+      const int j = lattice_.neighbours[k];
+      if (j > i) {
+        spring_i_.push_back(i);
+        spring_j_.push_back(j);
+        lower.push_back({j - 1, i - 1});
+      }
+    }
+  qz_.setZero(n);
+  qv_.setZero(n);
+  inertial_target_.setZero(std::max(nf, 1));
+  trial_z_.setZero(n);
+  newton_step_.setZero(std::max(nf, 1));
+  tangent_values_.assign(lower.size(), 0.0);
+  if (nf > 0) {
+    tangent_ = std::make_unique<detail::FixedPatternLdlt>();
+    tangent_->analyse(nf, lower);
+  }
+  reaction_slope_N_per_m_ = static_stiffness_N_per_m_;
+}
+
+double ForceMesh::nonlinear_residual(double z0) {
+  const int n = lattice_.node_count();
+  pz_[0] = z0;
+  for (int i = 1; i < n; ++i) {
+    double r = step_mass_term_ * (pz_[i] - inertial_target_[i - 1]) + virtual_spring_force_N(params_, pz_[i]);
+    for (int k = lattice_.neighbour_offsets[i]; k < lattice_.neighbour_offsets[i + 1]; ++k)
+      r += surface_spring_force_N(params_, pz_[i] - pz_[lattice_.neighbours[k]]);
+    rhs_[i - 1] = r;
+  }
+  return n > 1 ? rhs_.cwiseAbs().maxCoeff() : 0.0;
+}
+
+void ForceMesh::factorize_tangent(double z0) {
+  const int n = lattice_.node_count();
+  pz_[0] = z0;
+  for (int i = 1; i < n; ++i) {
+    double d = step_mass_term_ + virtual_spring_stiffness_N_per_m(params_, pz_[i]);
+    for (int k = lattice_.neighbour_offsets[i]; k < lattice_.neighbour_offsets[i + 1]; ++k)
+      d += surface_spring_stiffness_N_per_m(params_, pz_[i] - pz_[lattice_.neighbours[k]]);
+    tangent_values_[i - 1] = d;
+  }
+  const std::size_t diagonal = static_cast<std::size_t>(n - 1);
+  for (std::size_t e = 0; e < spring_i_.size(); ++e)
+    tangent_values_[diagonal + e] = -surface_spring_stiffness_N_per_m(params_, pz_[spring_i_[e]] - pz_[spring_j_[e]]);
+  if (!tangent_->factorize(tangent_values_.data()))
+    throw std::runtime_error("force mesh: the stiffening mesh's tangent is not positive definite (non-finite deflections?)");
+}
+
+void ForceMesh::solve_nonlinear_step(double z0) {
+  const int n = lattice_.node_count();
+  const int nf = n - 1;
+  const double dt = settings_.time_step_s;
+  pz_ = z_;
+  pz_[0] = z0;
+  newton_iterations_ = 0;
+  if (nf == 0) {
+    pv_.setZero();
+    return;
+  }
+  if (use_implicit_) {
+    const double m_dt2 = mass_kg_ / (dt * dt), c_dt = params_.node_damping_N_s_per_m / dt;
+    for (int i = 1; i < n; ++i)
+      inertial_target_[i - 1] = (m_dt2 * (z_[i] + dt * v_[i]) + c_dt * z_[i]) / step_mass_term_;
+  }
+  // Newton on the step equations; the energy is strictly convex, so a
+  // backtracking line search on the residual's max norm keeps every step.
+  // Converged when the full Newton step is below 1e-12 of the deflections or
+  // the residual below 1e-12 of the springs' force at that deflection.
+  double scale = std::max(std::abs(z0), params_.deformed_threshold_m);
+  for (int i = 1; i < n; ++i) scale = std::max(scale, std::abs(z_[i]));
+  const double tolerance_m = 1e-12 * scale;
+  const double force_floor_N = 1e-12 * scale *
+                               (params_.virtual_stiffness_N_per_m + params_.surface_stiffness_N_per_m +
+                                params_.surface_axial_stiffness_N_per_m + step_mass_term_);
+  constexpr int kMaxNewton = 40;
+  constexpr int kMaxCuts = 40;
+  double residual = nonlinear_residual(z0);
+  while (residual > force_floor_N) {
+    if (newton_iterations_ >= kMaxNewton)
+      throw std::runtime_error("force mesh: the stiffening mesh's step did not converge in " +
+                               std::to_string(kMaxNewton) + " Newton iterations (contact deflection " +
+                               std::to_string(z0 * 1e3) + " mm)");
+    factorize_tangent(z0);
+    rhs_ = -rhs_;
+    tangent_->solve(rhs_, newton_step_);
+    ++newton_iterations_;
+    const double step_size = newton_step_.cwiseAbs().maxCoeff();
+    if (!std::isfinite(step_size)) throw std::runtime_error("force mesh: non-finite Newton step in the stiffening mesh");
+    trial_z_ = pz_;
+    double alpha = 1.0;
+    for (int cut = 0;; ++cut) {
+      for (int f = 0; f < nf; ++f) pz_[f + 1] = trial_z_[f + 1] + alpha * newton_step_[f];
+      const double r = nonlinear_residual(z0);
+      if (r <= residual || r <= force_floor_N) {
+        residual = r;
+        break;
+      }
+      if (cut == kMaxCuts)
+        throw std::runtime_error("force mesh: no Newton step of the stiffening mesh lowers its residual (contact "
+                                 "deflection " + std::to_string(z0 * 1e3) + " mm)");
+      alpha *= 0.5;
+    }
+    if (step_size <= tolerance_m) break;
+  }
+  // pz_ converged (rhs_ holds its residual); the tangent there gives the sensitivity dz/dz0.
+  factorize_tangent(z0);
+  rhs_.setZero();
+  for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k) {
+    const int j = lattice_.neighbours[k];
+    rhs_[j - 1] = surface_spring_stiffness_N_per_m(params_, pz_[j] - z0);
+  }
+  tangent_->solve(rhs_, newton_step_);
+  qz_[0] = 1.0;
+  qv_[0] = 0.0;
+  for (int i = 1; i < n; ++i) {
+    qz_[i] = newton_step_[i - 1];
+    qv_[i] = use_implicit_ ? qz_[i] / dt : 0.0;
+    pv_[i] = use_implicit_ ? (pz_[i] - z_[i]) / dt : 0.0;
+  }
+}
+
 double ForceMesh::contact_reaction_N() const {
+  if (nonlinear_) {
+    double f = virtual_spring_force_N(params_, z_[0]);
+    for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
+      f += surface_spring_force_N(params_, z_[0] - z_[lattice_.neighbours[k]]);
+    return f;
+  }
   double f = params_.virtual_stiffness_N_per_m * z_[0];
   for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
     f += params_.surface_stiffness_N_per_m * (z_[0] - z_[lattice_.neighbours[k]]);
@@ -362,6 +654,11 @@ double ForceMesh::contact_reaction_N() const {
 }
 
 double ForceMesh::eq5_force_N() const {
+  if (params_.virtual_stiffening_m > 0.0) {
+    double f = 0.0;
+    for (int i = 0; i < lattice_.node_count(); ++i) f += virtual_spring_force_N(params_, z_[i]);
+    return f;
+  }
   double f = ring_mean_m_[0];
   for (int j = 2; j <= params_.rings_w; ++j) f += 6.0 * (j - 1) * ring_mean_m_[j - 1];
   return params_.virtual_stiffness_N_per_m * f;
@@ -378,10 +675,25 @@ double ForceMesh::kinetic_energy_J() const {
   return 0.5 * mass_kg_ * v_.tail(v_.size() - 1).squaredNorm();
 }
 
-double ForceMesh::virtual_spring_energy_J() const { return 0.5 * params_.virtual_stiffness_N_per_m * z_.squaredNorm(); }
+double ForceMesh::virtual_spring_energy_J() const {
+  if (params_.virtual_stiffening_m > 0.0) {
+    double e = 0.0;
+    for (int i = 0; i < lattice_.node_count(); ++i) e += puncture::virtual_spring_energy_J(params_, z_[i]);
+    return e;
+  }
+  return 0.5 * params_.virtual_stiffness_N_per_m * z_.squaredNorm();
+}
 
 double ForceMesh::surface_spring_energy_J() const {
   double e = 0.0;
+  if (params_.surface_axial_stiffness_N_per_m > 0.0) {
+    for (int i = 0; i < lattice_.node_count(); ++i)
+      for (int k = lattice_.neighbour_offsets[i]; k < lattice_.neighbour_offsets[i + 1]; ++k) {
+        const int j = lattice_.neighbours[k];
+        if (j > i) e += puncture::surface_spring_energy_J(params_, z_[i] - z_[j]);
+      }
+    return e;
+  }
   const int n = lattice_.node_count();
   for (int i = 0; i < n; ++i)
     for (int k = lattice_.neighbour_offsets[i]; k < lattice_.neighbour_offsets[i + 1]; ++k) {

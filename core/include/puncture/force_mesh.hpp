@@ -24,12 +24,31 @@
 // neighbours of the contact node. The deflection of the rings comes out of
 // this system, not from a fall-off curve.
 //
+// Stiffening in the mesh (optional; ForceMeshParams::nonlinear()). The
+// springs may stiffen with their own deformation:
+//   virtual spring:  f_v(z) = K z (1 + (z / z_v)^2)                 (z_v = virtual_stiffening_m)
+//   surface spring:  f_s(delta) = k_s delta + k_a (s - L) delta / s,  s = sqrt(L^2 + delta^2)
+// f_s is the transverse force of the linear membrane spring plus that of an
+// axial spring of stiffness k_a (surface_axial_stiffness_N_per_m) between two
+// nodes L apart in the plane and delta apart along the normal (exact
+// geometry; ~ k_a delta^3 / (2 L^2) at small slopes): a steep tent stretches
+// its springs, which spreads the load outwards, so the tent widens with depth
+// as a tissue surface does. Both laws are odd, convex in energy and strictly
+// increasing, so the tangent stays symmetric positive definite. The step is
+// then solved by Newton's method with a backtracking line search on the
+// residual (tangent refactorised on its fixed sparse pattern, no allocation);
+// the explicit integrator does such a mesh implicitly (explicit_falls_back_to_implicit()).
+// With linear springs every formula below is the paper's.
+//
 // Forces. The surface force on the needle is the elastic reaction at the
 // contact node, F = K z_0 + k_s sum_{j ~ 0} (z_0 - z_j) (N, positive when it
 // resists insertion; the contact node's own inertia and damping are carried
 // by the needle and not included). At equilibrium it equals Eq. (5):
 // F = K dZ_1 + K sum_{j=2..w} 6 (j-1) dZ_j with dZ_j the mean deflection of
-// ring j (global force balance: the Laplacian terms sum to zero).
+// ring j (global force balance: the Laplacian terms sum to zero). With
+// stiffening virtual springs Eq. (5) sums each spring's own force,
+// F = sum_i f_v(z_i), which the same balance makes equal to the reaction
+// (the surface springs are internal and odd in delta).
 //
 // Breakthrough. Ring j counts as deformed when its mean deflection exceeds
 // ForceMeshParams::deformed_threshold_m. deformed_rings() is the largest j
@@ -45,7 +64,12 @@
 // Split step. Every integrator's step is affine in the contact deflection z0
 // prescribed at the end of the step: predict() integrates the free nodes with
 // z0 = 0 at the end of the step, and commit(z0) adds z0 times the unit
-// response (precomputed at construction). In between, predicted_reaction_N(z0)
+// response (precomputed at construction). A stiffening mesh's step is not
+// affine: predict() solves it for the contact deflection of the last commit
+// z0* and linearises it there (the sensitivity dz/dz0 from the converged
+// tangent), commit(z0) takes the linearised state at z0; the error is of
+// order (z0 - z0*)^2, one tick of needle travel squared, and the next
+// predict() solves the true step again. In between, predicted_reaction_N(z0)
 // = intercept + slope z0 is the contact reaction the step would give, so a
 // caller can choose z0 from a force balance (layers in series, see
 // simulator.hpp) before committing. advance(z0) = predict(); commit(z0).
@@ -70,6 +94,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -78,6 +103,19 @@
 #include "puncture/scene.hpp"
 
 namespace puncture {
+
+namespace detail {
+class FixedPatternLdlt;
+}
+
+// --- the springs' laws (N, N/m, J; deflections in m), see the header ---
+double virtual_spring_force_N(const ForceMeshParams& p, double deflection_m);
+double virtual_spring_stiffness_N_per_m(const ForceMeshParams& p, double deflection_m);
+double virtual_spring_energy_J(const ForceMeshParams& p, double deflection_m);
+/// Transverse force of one surface spring whose ends differ in deflection by delta_m.
+double surface_spring_force_N(const ForceMeshParams& p, double delta_m);
+double surface_spring_stiffness_N_per_m(const ForceMeshParams& p, double delta_m);
+double surface_spring_energy_J(const ForceMeshParams& p, double delta_m);
 
 enum class MeshIntegrator { QuasiStatic, Explicit, Implicit };
 
@@ -102,9 +140,16 @@ class ForceMesh {
   /// that returns non-finite positions.
   ForceMesh(const ContactSurface& surface, const SurfacePoint& contact, const ForceMeshParams& params,
             double layer_thickness_m, double density_kg_per_m3, const MeshIntegrationSettings& settings);
+  ~ForceMesh();
+  ForceMesh(ForceMesh&&) noexcept;
+  ForceMesh& operator=(ForceMesh&&) noexcept;
+  ForceMesh(const ForceMesh&);
+  ForceMesh& operator=(const ForceMesh&);
 
   /// Advances one step dt with the contact-node deflection prescribed
   /// (m, into the tissue; negative values are clamped to 0). No allocation.
+  /// A stiffening mesh solves this step at the prescribed deflection (no
+  /// linearisation: predict() + commit() are the split form the layer chain uses).
   /// Throws std::runtime_error if the state becomes non-finite.
   void advance(double contact_deflection_m);
   /// First half of advance(): the step with zero contact deflection at its
@@ -145,8 +190,11 @@ class ForceMesh {
   // --- forces (N, positive resisting insertion) ---
   double contact_reaction_N() const;  ///< elastic reaction at the contact node
   double eq5_force_N() const;         ///< K dZ_1 + K sum_j 6 (j-1) dZ_j (Eq. 5)
-  /// Reaction per unit contact deflection at equilibrium, N/m.
+  /// Reaction per unit contact deflection at equilibrium, N/m (at small
+  /// deflection for a stiffening mesh).
   double static_stiffness_N_per_m() const { return static_stiffness_N_per_m_; }
+  /// Newton iterations of the last predicted step (0 for a linear mesh).
+  int last_newton_iterations() const { return newton_iterations_; }
 
   // --- deformation ---
   int rings() const { return params_.rings_w; }
@@ -201,6 +249,17 @@ class ForceMesh {
   /// Free-node state after one step from (z_, v_) with contact deflection
   /// z0_old -> z0_new, written to (z_, v_) (used at construction for the unit response).
   void step_free_nodes(double z0_old, double z0_new);
+  // --- stiffening mesh ---
+  void setup_nonlinear();
+  void predict_linear();
+  /// predict() of a stiffening mesh: the step solved at contact deflection z0_star and linearised there.
+  void predict_nonlinear(double z0_star);
+  /// Residual of the free nodes' step equations at (pz_, contact z0) into rhs_; returns its max norm.
+  double nonlinear_residual(double z0);
+  /// Tangent of the step equations at pz_ factorised; throws std::runtime_error if not SPD.
+  void factorize_tangent(double z0);
+  /// Solves the step to contact deflection z0 from (z_, v_) into (pz_, pv_), with its sensitivity in (qz_, qv_).
+  void solve_nonlinear_step(double z0);
 
   ForceMeshParams params_;
   MeshIntegrationSettings settings_;
@@ -229,7 +288,18 @@ class ForceMesh {
   double max_abs_velocity_m_per_s_ = 0.0;
   double predicted_intercept_N_ = 0.0;
   double reaction_slope_N_per_m_ = 0.0;
+  double predicted_z0_ = 0.0;  ///< contact deflection the prediction is linearised at (0: linear mesh)
   bool predicted_ = false;
+  // Stiffening mesh: the step's tangent on its fixed pattern (free nodes: diagonal entries 0..nf-1,
+  // then one entry per free-free spring), the springs, scratch vectors.
+  bool nonlinear_ = false;
+  std::unique_ptr<detail::FixedPatternLdlt> tangent_;
+  std::vector<double> tangent_values_;
+  std::vector<int> spring_i_, spring_j_;  ///< free-free springs (node indices, i < j)
+  double step_mass_term_ = 0.0;           ///< m/dt^2 + c/dt (implicit), 0 (quasi-static)
+  Eigen::VectorXd inertial_target_;       ///< z_hat of the step equations (free nodes, index f = node - 1)
+  Eigen::VectorXd trial_z_, newton_step_;
+  int newton_iterations_ = 0;
   Eigen::VectorXd ring_mean_m_;
   Eigen::VectorXd ring_size_;
 

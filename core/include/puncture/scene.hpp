@@ -31,6 +31,15 @@ struct ForceMeshParams {
   double surface_stiffness_N_per_m = 200.0;  ///< k_s: out-of-plane (membrane) stiffness of one surface spring
   double deformed_threshold_m = 0.01e-3;     ///< a ring counts as deformed when its mean deflection exceeds this
   double node_damping_N_s_per_m = 0.05;      ///< viscous damping of each node (dynamics of the mesh)
+  /// k_a: in-plane (stretch) stiffness of one surface spring. A spring of rest
+  /// length L whose ends differ in deflection by delta is stretched to
+  /// sqrt(L^2 + delta^2): its transverse force gains k_a (s - L) delta / s, so
+  /// the mesh stiffens with its own slope (force_mesh.hpp). 0: linear springs.
+  double surface_axial_stiffness_N_per_m = 0.0;
+  /// z_v: the virtual springs stiffen with their own deflection,
+  /// f = K z (1 + (z / z_v)^2) (the tissue under the surface compressed). 0: linear.
+  double virtual_stiffening_m = 0.0;
+  bool nonlinear() const { return surface_axial_stiffness_N_per_m > 0.0 || virtual_stiffening_m > 0.0; }
 };
 
 /// One term of an Ogden law: its share of the initial shear modulus and its

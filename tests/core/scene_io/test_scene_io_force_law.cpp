@@ -101,6 +101,23 @@ TEST(SceneIoForceLaw, RoundTripKeepsEveryForceLawValue) {
   EXPECT_EQ(a.effects.layer_interaction, b.effects.layer_interaction);
 }
 
+TEST(SceneIoForceLaw, MeshStiffeningIsReadInSiUnitsAndWrittenOnlyWhenOn) {
+  json j = default_json();
+  j["layers"][0]["force_mesh"]["surface_axial_stiffness_N_per_mm"] = 2.5;
+  j["layers"][0]["force_mesh"]["virtual_stiffening_mm"] = 1.5;
+  const Scene s = parse_scene(j.dump(), "stiff.json");
+  EXPECT_DOUBLE_EQ(s.layers[0].force_mesh.surface_axial_stiffness_N_per_m, 2500.0);
+  EXPECT_DOUBLE_EQ(s.layers[0].force_mesh.virtual_stiffening_m, 1.5e-3);
+  EXPECT_TRUE(s.layers[0].force_mesh.nonlinear());
+  EXPECT_FALSE(s.layers[1].force_mesh.nonlinear());  // absent: linear
+  const Scene back = parse_scene(scene_to_json_text(s), "back.json");
+  EXPECT_DOUBLE_EQ(back.layers[0].force_mesh.surface_axial_stiffness_N_per_m, 2500.0);
+  EXPECT_DOUBLE_EQ(back.layers[0].force_mesh.virtual_stiffening_m, 1.5e-3);
+  const json written = json::parse(scene_to_json_text(s));
+  EXPECT_FALSE(written["layers"][1]["force_mesh"].contains("virtual_stiffening_mm"));
+  EXPECT_FALSE(written["layers"][1]["force_mesh"].contains("surface_axial_stiffness_N_per_mm"));
+}
+
 TEST(SceneIoForceLaw, RecoveryTimeInSecondsOrFromThePapersRate) {
   json j = default_json();
   j["realtime"]["haptic_rate_Hz"] = 500;
@@ -149,6 +166,12 @@ const BadForceLaw kBad[] = {
      [](json& j) { j["layers"][2]["force_law"]["breakthrough"] = {{"criterion", "rings"}}; },
      "/layers/2/force_law/breakthrough/criterion"},
     {"zero_recovery_time", [](json& j) { j["layers"][1]["resumption_time_s"] = 0.0; }, "/layers/1/resumption_time_s"},
+    {"negative_axial_stiffness", [](json& j) { j["layers"][0]["force_mesh"]["surface_axial_stiffness_N_per_mm"] = -1.0; },
+     "/layers/0/force_mesh/surface_axial_stiffness_N_per_mm"},
+    {"negative_virtual_stiffening", [](json& j) { j["layers"][2]["force_mesh"]["virtual_stiffening_mm"] = -0.5; },
+     "/layers/2/force_mesh/virtual_stiffening_mm"},
+    {"text_virtual_stiffening", [](json& j) { j["layers"][1]["force_mesh"]["virtual_stiffening_mm"] = "soft"; },
+     "/layers/1/force_mesh/virtual_stiffening_mm"},
 };
 
 class SceneIoBadForceLaw : public ::testing::TestWithParam<BadForceLaw> {};
