@@ -117,6 +117,10 @@ int main(int argc, char** argv) {
                             "comma separated; withdrawal at the same speed): with a viscoelastic scene, two or more "
                             "speeds identify the damping d; default: the scene's speed only")
       ->delimiter(',');
+  calibrate_cmd->add_flag("--surface-fit", calibrate.surface_fit,
+                          "First identify each layer's force mesh (K, k_s, k_a, z_v: stiffening in the mesh) from the "
+                          "FEM's force and surface deflection profiles; those layers lose their tip stiffening, and K "
+                          "and the stiffening are kept by the later stages");
   calibrate_cmd->add_option("--keep", calibrate.keep,
                             "Keep at the scene's values: K, breakthrough, cutting, friction, stiffening (comma "
                             "separated); default: tune each whose effect is on")

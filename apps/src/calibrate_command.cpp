@@ -21,6 +21,7 @@
 #include "puncture/validation/metrics.hpp"
 #include "puncture/validation/fem_comparison.hpp"
 #include "puncture/validation/fem_reference_curve.hpp"
+#include "puncture/validation/surface_identification.hpp"
 
 namespace puncture::apps {
 namespace {
@@ -46,6 +47,7 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
   for (std::size_t i = 0; i < options.keep.size(); ++i) c << (i ? "," : " --keep ") << options.keep[i];
   for (std::size_t i = 0; i < options.fem_speeds_mm_per_s.size(); ++i)
     c << (i ? "," : " --fem-speeds ") << options.fem_speeds_mm_per_s[i];
+  if (options.surface_fit) c << " --surface-fit";
   return c.str();
 }
 
@@ -53,7 +55,7 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
 /// --fem-speeds, the FEM references of the scene at those speeds; or the
 /// measured curve. False on the MPI ranks that only help with the FEM.
 bool load_references(const CalibrateOptions& options, const Scene& scene, std::ostream& out,
-                     std::vector<validation::ReferenceCurve>& references) {
+                     std::vector<validation::ReferenceCurve>& references, std::filesystem::path& fem_dir) {
   if (options.reference.empty()) {
     validation::FemReferenceOptions fem;
     if (!options.cache_dir.empty()) fem.cache_dir = options.cache_dir;
@@ -69,11 +71,13 @@ bool load_references(const CalibrateOptions& options, const Scene& scene, std::o
       if (!validation::is_mpi_root()) continue;
       out << "[calibrate] FEM reference " << ref.hash << " at " << s.insertion.speed_m_per_s * 1e3 << " mm/s"
           << (ref.from_cache ? " (from cache)" : " (computed)") << '\n';
+      if (references.empty()) fem_dir = ref.dir;
       references.push_back({validation::fem_insertion_curve(s, ref.dir / "fem_force_depth.csv"), "fem"});
     }
     return validation::is_mpi_root();
   }
   if (!options.fem_speeds_mm_per_s.empty()) throw UsageError("--fem-speeds takes the scene's FEM reference, not --reference");
+  if (options.surface_fit) throw UsageError("--surface-fit needs the scene's FEM reference (its surface profiles), not --reference");
   validation::ReferenceCurve reference;
   reference.curve = validation::read_insertion_curve(options.reference);
   reference.kind = "measured";
@@ -102,6 +106,38 @@ std::vector<std::pair<std::string, const validation::InsertionCurve*>> curve_lis
     curves.push_back({"after" + suffix, &result.model_after[r]});
   }
   return curves;
+}
+
+/// --surface-fit: each layer with FEM surface profiles gets the force mesh
+/// identified from them and no tip stiffening (the mesh carries it); K and
+/// the stiffening are then kept. Returns the identifications for the report.
+std::vector<validation::SurfaceIdentificationResult> fit_surfaces(const std::filesystem::path& fem_dir, Scene& scene,
+                                                                  validation::CalibrationOptions& calibration,
+                                                                  int threads, std::ostream& out) {
+  const validation::FemResultFiles fem = validation::read_fem_result(fem_dir, scene);
+  std::vector<validation::SurfaceIdentificationResult> results;
+  validation::SurfaceIdentificationOptions o;
+  o.threads = threads;
+  o.bound_factor = calibration.bound_factor;
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    Layer& layer = scene.layers[k];
+    const validation::SurfacePressingReference ref = validation::surface_pressing_reference(fem, scene, k);
+    if (ref.size() < 3) {
+      out << "[calibrate] surface fit: layer " << layer.name << ": " << ref.size()
+          << " pressing profile(s) in the FEM, its force mesh stays\n";
+      continue;
+    }
+    results.push_back(validation::identify_force_mesh(layer.force_mesh, layer.thickness_m, layer.density_kg_per_m3, ref, o));
+    layer.force_mesh = results.back().after;
+    layer.force_law.stiffening = StiffeningLaw{};  // the mesh stiffens itself
+    out << "[calibrate] surface fit: layer " << layer.name << ": force RMSE "
+        << results.back().quality_before.force_rmse_relative << " -> " << results.back().quality_after.force_rmse_relative
+        << ", deflection RMSE " << results.back().quality_before.deflection_rmse_relative << " -> "
+        << results.back().quality_after.deflection_rmse_relative << " (" << results.back().status << ")\n";
+  }
+  calibration.parameters.virtual_stiffness = false;
+  calibration.parameters.stiffening = false;
+  return results;
 }
 
 void check_option(bool ok, const std::string& message) {
@@ -160,13 +196,16 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
   std::ostream& out = options.quiet ? quiet : stdout_stream;
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
   return report_errors(err, "", [&]() -> int {
-    const Scene scene = load_scene(scene_path);
+    Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_calibration") : options.output_dir;
     std::vector<validation::ReferenceCurve> references;
-    if (!load_references(options, scene, out, references)) return 0;  // the other ranks only help with the FEM
+    std::filesystem::path fem_dir;
+    if (!load_references(options, scene, out, references, fem_dir)) return 0;  // the other ranks only help with the FEM
     const validation::ReferenceCurve& reference = references.front();
-    const validation::CalibrationOptions calibration = calibration_options(options, scene);
+    validation::CalibrationOptions calibration = calibration_options(options, scene);
+    std::vector<validation::SurfaceIdentificationResult> surfaces;
+    if (options.surface_fit) surfaces = fit_surfaces(fem_dir, scene, calibration, options.threads, out);
     validation::CalibrationProgressCallback progress;
     if (!options.quiet)
       progress = [&](const validation::CalibrationProgress& p) {
@@ -184,11 +223,23 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
     validation::write_tuned_preset(session, name, result, references, calibration);
     // The model curves the objective compared, before and after, for the report.
     session.write_text("calibration_curves.csv", validation::calibration_curves_csv(curve_list(references, result), provenance));
+    if (options.surface_fit)
+      session.write_text("surface_identification.csv", validation::surface_identification_csv(surfaces));
     session.commit();
     const std::string method = options.method + " on " +
                                (options.threads > 0 ? std::to_string(options.threads) : std::string("every")) +
                                " thread(s)";
     std::string md = validation::calibration_summary_markdown(result, scene, reference, provenance, method, calibration_s, name);
+    if (options.surface_fit)
+      md += "\n## Force meshes identified from the FEM's surface (--surface-fit)\n\nBefore the stages below, each "
+            "layer with FEM surface profiles taken while its surface follows the tip had K, k_s, k_a and z_v "
+            "identified from the FEM's tip force and deflection profile together (quasi-static mesh; "
+            "validation/calibration/include/puncture/validation/surface_identification.hpp); those layers carry "
+            "no tip stiffening (the mesh stiffens itself, so Eq. 5 carries the pressing force) and K and the "
+            "stiffening were kept by the stages. Values +- relative standard error (Gauss-Newton); RMSEs before "
+            "-> after, over the FEM's largest force and deflection of those samples; per sample and ring in "
+            "surface_identification.csv.\n\n" +
+            validation::surface_identification_markdown(surfaces);
     for (const std::string& p : validation::run_plot_script("plot_calibration.py", dir, out, err))
       md += "\n![" + p + "](" + p + ")\n";
     io::OutputSession md_session(dir);

@@ -142,8 +142,9 @@ TEST(CalibrateCommand, BadKeepOrPunctureDepthsAreErrorsWithNoOutput) {
   fs::create_directories(ref_dir);
   std::ofstream(ref_dir / "curve.csv") << "depth_mm,force_N\n0,0\n1,0.5\n2,1.0\n";
   // --fem-speeds asks for FEM references of the scene, which a measured --reference replaces.
-  const char* names[] = {"--keep", "--puncture-depths", "--force-weight", "--force-weight", "--fem-speeds"};
-  for (int which = 0; which < 5; ++which) {
+  const char* names[] = {"--keep", "--puncture-depths", "--force-weight", "--force-weight", "--fem-speeds",
+                         "--surface-fit"};
+  for (int which = 0; which < 6; ++which) {
     CalibrateOptions options;
     options.scene = kSourceDir / "scenes" / "default.json";
     options.reference = ref_dir / "curve.csv";
@@ -152,6 +153,7 @@ TEST(CalibrateCommand, BadKeepOrPunctureDepthsAreErrorsWithNoOutput) {
     if (which == 0) options.keep = {"everything"};
     else if (which == 1) options.puncture_depths_mm = {-1.0};
     else if (which == 4) options.fem_speeds_mm_per_s = {3.0};
+    else if (which == 5) options.surface_fit = true;
     else options.force_weight = which == 2 ? -1.0 : std::numeric_limits<double>::quiet_NaN();
     std::ostringstream out, err;
     EXPECT_EQ(calibrate_command(options, out, err), 2) << names[which];

@@ -100,6 +100,11 @@ struct CalibrateOptions {
   /// Insertion speeds (mm/s) of further FEM references of the scene (not with
   /// --reference): each is the scene inserted and withdrawn at that speed.
   std::vector<double> fem_speeds_mm_per_s;
+  /// Identify each layer's force mesh (K, k_s, k_a, z_v) from the FEM's force
+  /// and surface deflection profiles first (surface_identification.hpp); the
+  /// tip stiffening of those layers goes to 0 and K and the stiffening are
+  /// then kept by the later stages.
+  bool surface_fit = false;
   /// Parameters kept at the scene's values: "K", "breakthrough", "cutting",
   /// "friction", "stiffening" (by default each is tuned where its effect is on).
   std::vector<std::string> keep;

@@ -1,0 +1,286 @@
+// identify_force_mesh() and the pressing reference it fits
+// (surface_identification.hpp).
+#include "puncture/validation/surface_identification.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "puncture/contact_surface.hpp"
+#include "puncture/force_mesh.hpp"
+#include "puncture/validation/levenberg_marquardt.hpp"
+
+namespace puncture::validation {
+
+namespace {
+
+double layer_top_depth_m(const Scene& scene, std::size_t k) {
+  double top = 0.0;
+  for (std::size_t j = 0; j < k; ++j) top += scene.layers[j].thickness_m;
+  return top;
+}
+
+/// The FEM's tip force (total force without parts) on the insertion branch at depth_m.
+double fem_tip_force_at(const InsertionCurve& curve, double depth_m) {
+  const std::vector<double>& force = curve.has_parts() ? curve.tip_force_N : curve.force_N;
+  double best = std::numeric_limits<double>::infinity(), value = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < curve.size(); ++i) {
+    if (curve.phase[i] != CurvePhase::Insertion) continue;
+    const double d = std::abs(curve.depth_m[i] - depth_m);
+    if (d < best) best = d, value = force[i];
+  }
+  if (!(best <= 1e-7)) throw std::invalid_argument(curve.source + ": no insertion sample at the profile depth " +
+                                                   std::to_string(depth_m * 1e3) + " mm");
+  return value;
+}
+
+const PlaneSurface& flat_surface() {
+  static const PlaneSurface plane(0.0);
+  return plane;
+}
+
+struct ModelPressing {
+  std::vector<double> force_N;
+  std::vector<std::vector<double>> ring_deflection_m;  ///< [sample][ring - 1]
+};
+
+/// The quasi-static mesh through the samples' contact deflections; false if a step fails.
+bool press(const ForceMeshParams& p, double thickness_m, double density, const SurfacePressingReference& ref,
+           ModelPressing& out) {
+  MeshIntegrationSettings settings;
+  settings.integrator = MeshIntegrator::QuasiStatic;
+  try {
+    ForceMesh mesh(flat_surface(), {Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()}, p, thickness_m, density,
+                   settings);
+    out.force_N.assign(ref.size(), 0.0);
+    out.ring_deflection_m.assign(ref.size(), std::vector<double>(p.rings_w, 0.0));
+    for (std::size_t s = 0; s < ref.size(); ++s) {
+      mesh.advance(ref.contact_deflection_m[s]);
+      out.force_N[s] = mesh.contact_reaction_N();
+      for (int j = 1; j <= p.rings_w; ++j) out.ring_deflection_m[s][j - 1] = mesh.ring_mean_deflection_m(j);
+    }
+  } catch (const std::exception&) {
+    return false;
+  }
+  return true;
+}
+
+/// FEM deflection at ring j's radius (j - 1) L, or NaN outside the profile's radii.
+double fem_deflection_at_ring(const RadialProfile& profile, int ring, double spacing_m) {
+  double uz = 0.0;
+  if (ring < 2 || !interpolate_linear(profile.r_m, profile.uz_m, (ring - 1) * spacing_m, uz))
+    return std::numeric_limits<double>::quiet_NaN();
+  return -uz;
+}
+
+struct Scales {
+  double force_N = 0.0, deflection_m = 0.0;
+  std::size_t forces = 0, deflections = 0;
+};
+
+Scales reference_scales(const SurfacePressingReference& ref, const ForceMeshParams& p) {
+  Scales s;
+  s.forces = ref.size();
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    s.force_N = std::max(s.force_N, std::abs(ref.force_N[i]));
+    for (int j = 2; j <= p.rings_w; ++j) {
+      const double d = fem_deflection_at_ring(ref.profiles[i], j, p.spacing_L_m);
+      if (std::isnan(d)) continue;
+      s.deflection_m = std::max(s.deflection_m, std::abs(d));
+      ++s.deflections;
+    }
+  }
+  return s;
+}
+
+ForceMeshParams params_from(const ForceMeshParams& base, const std::vector<double>& x) {
+  ForceMeshParams p = base;
+  p.virtual_stiffness_N_per_m = std::exp(x[0]);
+  p.surface_stiffness_N_per_m = std::exp(x[1]);
+  p.surface_axial_stiffness_N_per_m = std::exp(x[2]);
+  p.virtual_stiffening_m = std::exp(x[3]);
+  return p;
+}
+
+void residuals_of(const ModelPressing& m, const SurfacePressingReference& ref, const ForceMeshParams& p,
+                  const Scales& s, const SurfaceIdentificationOptions& o, std::vector<double>& r) {
+  r.clear();
+  const double wf = std::sqrt(o.force_weight / static_cast<double>(s.forces));
+  for (std::size_t i = 0; i < ref.size(); ++i) r.push_back(wf * (m.force_N[i] - ref.force_N[i]) / s.force_N);
+  const double wd = s.deflections ? std::sqrt(o.deflection_weight / static_cast<double>(s.deflections)) : 0.0;
+  for (std::size_t i = 0; i < ref.size(); ++i)
+    for (int j = 2; j <= p.rings_w; ++j) {
+      const double d = fem_deflection_at_ring(ref.profiles[i], j, p.spacing_L_m);
+      if (!std::isnan(d)) r.push_back(wd * (m.ring_deflection_m[i][j - 1] - d) / s.deflection_m);
+    }
+}
+
+SurfaceFitQuality quality_of(const ModelPressing& m, const SurfacePressingReference& ref, const ForceMeshParams& p,
+                             const Scales& s) {
+  SurfaceFitQuality q;
+  double sf = 0.0, sd = 0.0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    sf += std::pow(m.force_N[i] - ref.force_N[i], 2);
+    for (int j = 2; j <= p.rings_w; ++j) {
+      const double d = fem_deflection_at_ring(ref.profiles[i], j, p.spacing_L_m);
+      if (!std::isnan(d)) sd += std::pow(m.ring_deflection_m[i][j - 1] - d, 2);
+    }
+  }
+  q.force_rmse_relative = std::sqrt(sf / static_cast<double>(s.forces)) / s.force_N;
+  q.deflection_rmse_relative = s.deflections ? std::sqrt(sd / static_cast<double>(s.deflections)) / s.deflection_m : 0.0;
+  return q;
+}
+
+}  // namespace
+
+SurfacePressingReference surface_pressing_reference(const FemResultFiles& fem, const Scene& scene, std::size_t layer) {
+  if (layer >= scene.layers.size()) throw std::invalid_argument("surface_pressing_reference: no layer " + std::to_string(layer));
+  SurfacePressingReference ref;
+  ref.layer = scene.layers[layer].name;
+  const auto profiles = fem.profiles.find(ref.layer);
+  if (profiles == fem.profiles.end()) return ref;
+  const double top = layer_top_depth_m(scene, layer);
+  const auto broke = fem.puncture_depth_m.find(ref.layer);
+  const double puncture = broke != fem.puncture_depth_m.end() ? broke->second : std::numeric_limits<double>::infinity();
+  for (const RadialProfile& p : profiles->second) {
+    const double z0 = p.depth_m - top;
+    if (!(z0 > 0.0) || p.depth_m >= puncture || p.r_m.size() < 2) continue;
+    if (-p.uz_m.front() < kFollowFraction * z0) break;  // the crack runs ahead of the tip from here on
+    ref.contact_deflection_m.push_back(z0);
+    ref.force_N.push_back(fem_tip_force_at(fem.curve, p.depth_m));
+    ref.profiles.push_back(p);
+  }
+  return ref;
+}
+
+SurfaceIdentificationResult identify_force_mesh(const ForceMeshParams& start, double thickness_m, double density_kg_per_m3,
+                                                const SurfacePressingReference& ref,
+                                                const SurfaceIdentificationOptions& o) {
+  if (ref.size() < 3) throw std::invalid_argument("identify_force_mesh: layer " + ref.layer +
+                                                  ": fewer than 3 pressing profiles in the reference");
+  if (!(o.bound_factor > 1.0)) throw std::invalid_argument("identify_force_mesh: bound_factor must be > 1");
+  SurfaceIdentificationResult result;
+  result.layer = ref.layer;
+  result.before = start;
+  result.parameter_names = {"K", "k_s", "k_a", "z_v"};
+  const Scales scales = reference_scales(ref, start);
+  if (!(scales.force_N > 0.0) || !(scales.deflection_m > 0.0))
+    throw std::invalid_argument("identify_force_mesh: layer " + ref.layer + ": the reference has no force or no deflection");
+
+  const double ks0 = start.surface_stiffness_N_per_m > 0.0 ? start.surface_stiffness_N_per_m : start.virtual_stiffness_N_per_m;
+  const std::vector<double> p0{start.virtual_stiffness_N_per_m, ks0,
+                               start.surface_axial_stiffness_N_per_m > 0.0 ? start.surface_axial_stiffness_N_per_m : ks0,
+                               start.virtual_stiffening_m > 0.0 ? start.virtual_stiffening_m : thickness_m};
+  std::vector<double> x0, lower, upper;
+  for (double v : p0) {
+    x0.push_back(std::log(v));
+    lower.push_back(std::log(v / o.bound_factor));
+    upper.push_back(std::log(v * o.bound_factor));
+  }
+  const ResidualFunction residual = [&](const std::vector<double>& x, std::vector<double>& r) {
+    const ForceMeshParams p = params_from(start, x);
+    ModelPressing m;
+    if (!press(p, thickness_m, density_kg_per_m3, ref, m)) return false;
+    residuals_of(m, ref, p, scales, o, r);
+    return true;
+  };
+
+  ModelPressing before;
+  if (!press(start, thickness_m, density_kg_per_m3, ref, before))
+    throw std::runtime_error("identify_force_mesh: layer " + ref.layer + ": the start mesh cannot be pressed");
+  result.quality_before = quality_of(before, ref, start, scales);
+
+  LevenbergMarquardtOptions lm;
+  lm.max_iterations = 200;
+  lm.max_evaluations = 4000;
+  lm.threads = o.threads;
+  const LevenbergMarquardtResult fit = levenberg_marquardt(residual, x0, lower, upper, lm);
+  result.status = fit.status;
+  result.after = params_from(start, fit.x);
+  ModelPressing after;
+  if (!press(result.after, thickness_m, density_kg_per_m3, ref, after))
+    throw std::runtime_error("identify_force_mesh: layer " + ref.layer + ": the identified mesh cannot be pressed");
+  result.quality_after = quality_of(after, ref, result.after, scales);
+
+  std::vector<double> r0;
+  residual(fit.x, r0);
+  const Eigen::MatrixXd J = fit.jacobian_at_x && fit.jacobian.size() > 0
+                                ? fit.jacobian
+                                : finite_difference_jacobian(residual, fit.x, r0, lower, upper, 1e-3, o.threads);
+  result.statistics = jacobian_statistics(J, Eigen::Map<const Eigen::VectorXd>(r0.data(), static_cast<Eigen::Index>(r0.size())));
+  for (std::size_t i = 0; i < fit.x.size(); ++i) {
+    result.standard_error_ln.push_back(result.statistics.standard_error[static_cast<Eigen::Index>(i)]);
+    result.at_bound.push_back(fit.x[i] <= lower[i] + 1e-6 || fit.x[i] >= upper[i] - 1e-6);
+  }
+
+  result.contact_deflection_m = ref.contact_deflection_m;
+  result.fem_force_N = ref.force_N;
+  result.model_force_N = after.force_N;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    std::vector<double> radius, fem, model;
+    for (int j = 2; j <= result.after.rings_w; ++j) {
+      const double d = fem_deflection_at_ring(ref.profiles[i], j, result.after.spacing_L_m);
+      if (std::isnan(d)) continue;
+      radius.push_back((j - 1) * result.after.spacing_L_m);
+      fem.push_back(d);
+      model.push_back(after.ring_deflection_m[i][j - 1]);
+    }
+    result.ring_radius_m.push_back(radius);
+    result.fem_deflection_m.push_back(fem);
+    result.model_deflection_m.push_back(model);
+  }
+  return result;
+}
+
+namespace {
+
+std::string number(double v, int digits = 4) {
+  std::ostringstream s;
+  s << std::setprecision(digits) << v;
+  return s.str();
+}
+
+std::string with_error(double value, double se_ln, bool at_bound) {
+  std::string s = number(value);
+  if (at_bound) return s + " (**at a bound**)";
+  if (!std::isfinite(se_ln)) return s + " (not determined)";
+  return s + " +- " + number(100.0 * se_ln, 2) + " %";
+}
+
+}  // namespace
+
+std::string surface_identification_markdown(const std::vector<SurfaceIdentificationResult>& results) {
+  std::ostringstream s;
+  s << "| layer | profiles | contact deflection (mm) | K (N/mm) | k_s (N/mm) | k_a (N/mm) | z_v (mm) | force RMSE / peak | "
+       "deflection RMSE / largest | optimiser |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const SurfaceIdentificationResult& r : results) {
+    const ForceMeshParams& a = r.after;
+    const double values[4] = {a.virtual_stiffness_N_per_m * 1e-3, a.surface_stiffness_N_per_m * 1e-3,
+                              a.surface_axial_stiffness_N_per_m * 1e-3, a.virtual_stiffening_m * 1e3};
+    s << "| " << r.layer << " | " << r.contact_deflection_m.size() << " | "
+      << number(r.contact_deflection_m.front() * 1e3, 3) << " - " << number(r.contact_deflection_m.back() * 1e3, 3);
+    for (int i = 0; i < 4; ++i) s << " | " << with_error(values[i], r.standard_error_ln[i], r.at_bound[i]);
+    s << " | " << number(r.quality_before.force_rmse_relative, 3) << " -> " << number(r.quality_after.force_rmse_relative, 3)
+      << " | " << number(r.quality_before.deflection_rmse_relative, 3) << " -> "
+      << number(r.quality_after.deflection_rmse_relative, 3) << " | " << r.status << " |\n";
+  }
+  return s.str();
+}
+
+std::string surface_identification_csv(const std::vector<SurfaceIdentificationResult>& results) {
+  std::ostringstream s;
+  s << "layer,sample,contact_deflection_mm,fem_force_N,model_force_N,r_mm,fem_deflection_mm,model_deflection_mm\n";
+  s << std::setprecision(9);
+  for (const SurfaceIdentificationResult& r : results)
+    for (std::size_t i = 0; i < r.contact_deflection_m.size(); ++i)
+      for (std::size_t j = 0; j < r.ring_radius_m[i].size(); ++j)
+        s << r.layer << ',' << i << ',' << r.contact_deflection_m[i] * 1e3 << ',' << r.fem_force_N[i] << ','
+          << r.model_force_N[i] << ',' << r.ring_radius_m[i][j] * 1e3 << ',' << r.fem_deflection_m[i][j] * 1e3 << ','
+          << r.model_deflection_m[i][j] * 1e3 << '\n';
+  return s.str();
+}
+
+}  // namespace puncture::validation
