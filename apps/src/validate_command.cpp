@@ -47,6 +47,7 @@
 #include "puncture/validation/metrics.hpp"
 #include "run_outputs.hpp"
 #include "puncture/validation/fem_comparison.hpp"
+#include "puncture/validation/puncture_force_shares.hpp"
 #include "puncture/validation/number_format.hpp"
 
 namespace puncture::apps {
@@ -208,6 +209,8 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
       terms.push_back(j);
     }
     metrics["trajectory_terms"] = terms;
+    const std::vector<validation::PunctureForceShares> shares = validation::puncture_force_shares(run.events);
+    metrics["puncture_force_shares"] = validation::puncture_force_shares_json(shares);
     session.write_text("validation_metrics.json", metrics.dump(2) + "\n");
 
     if (vtk) {
@@ -243,7 +246,14 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
     summary_session.write_text("validation_summary.md",
                                validation_summary_markdown(scene, provenance, {reference.hash, reference.from_cache},
                                                            fem, cmp, layers, plots, vtk && !fem.frames.empty(),
-                                                           validation::acceptance_markdown(acceptance, trajectory)));
+                                                           validation::acceptance_markdown(acceptance, trajectory) +
+                                                               "\n## The real-time force at each puncture, by term\n\n"
+                                                               "Eq. 5 on the force mesh's own deflections; the mesh's "
+                                                               "inertia and damping (its reaction minus Eq. 5); the tip "
+                                                               "spring's stiffening; the rest (shaft friction and d h v of "
+                                                               "the layers above). Shares of the force just before the "
+                                                               "break.\n\n" +
+                                                               validation::puncture_force_shares_markdown(shares)));
     summary_session.commit();
 
     out << "\nValidation of " << scene.name << " (FEM reference " << reference.hash.substr(0, 12)

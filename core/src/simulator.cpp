@@ -238,6 +238,11 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   event.depth_m = needle.depth_m();
   event.surface_force_N = surface_force_N;
   event.total_force_N = surface_force_N;  // tick() adds the friction of the layers above
+  if (layer.mesh) {
+    event.eq5_force_N = layer.mesh->eq5_force_N();
+    event.mesh_reaction_N = layer.mesh->contact_reaction_N();
+    if (layer.stiffening) event.tip_stiffening_force_N = stiffening_force_N(*layer.stiffening, layer.deflection_m);
+  }
   events_.push_back(event);               // capacity reserved at construction
   if (layer.mesh && layer.mesh->layout_pending()) {
     // The drawn surface must be complete before it recovers (a break within

@@ -272,3 +272,17 @@ TEST(ForceMeshStiffening, AStepAllocatesNothing) {
   EXPECT_EQ(test::stop_counting_allocations(), 0);
   EXPECT_TRUE(std::isfinite(sum));
 }
+
+TEST(ForceMeshStiffening, ACopyIsIndependent) {
+  // The tangent's factorisation is copied, not shared: a copy steps on its own.
+  ForceMesh original = make_mesh(stiffening_params(5), MeshIntegrator::Implicit);
+  for (int i = 1; i <= 20; ++i) original.advance(1e-4 * i);
+  ForceMesh copy = original;
+  copy.advance(5e-3);
+  original.advance(2.1e-3);
+  ForceMesh again = make_mesh(stiffening_params(5), MeshIntegrator::Implicit);
+  for (int i = 1; i <= 20; ++i) again.advance(1e-4 * i);
+  again.advance(2.1e-3);
+  EXPECT_EQ(original.contact_reaction_N(), again.contact_reaction_N());
+  EXPECT_GT(copy.contact_reaction_N(), original.contact_reaction_N());
+}

@@ -267,3 +267,42 @@ TEST(Simulator, RejectsInconsistentInput) {
   Scene empty;
   EXPECT_THROW(PunctureSimulator(empty, {}), std::invalid_argument);
 }
+
+TEST(Simulator, PunctureEventSplitsTheSurfaceForceByTerm) {
+  // Quasi-static skin that breaks at a critical force. With stiffening in the
+  // mesh, Eq. 5 on the mesh's deflections is the whole surface force (the
+  // reaction at equilibrium); with a linear mesh and a stiffening tip spring,
+  // the tip spring's share is g(z0) at the break, a2 z0^2 + a3 z0^3.
+  for (const bool in_mesh : {true, false}) {
+    Scene scene = test::table2_scene("quasi_static");
+    Layer& skin = scene.layers[0];
+    skin.force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+    skin.force_law.breakthrough.critical_force_N = 0.5;
+    if (in_mesh) {
+      skin.force_mesh.surface_axial_stiffness_N_per_m = 400.0;
+      skin.force_mesh.virtual_stiffening_m = 3e-3;
+    } else {
+      scene.effects.stiffening = true;
+      skin.force_law.stiffening.quadratic_N_per_m2 = 2e3;
+      skin.force_law.stiffening.cubic_N_per_m3 = 5e6;
+    }
+    PunctureSimulator sim(scene, test::plane_surfaces(scene));
+    const ScriptedTrajectory tr(scene.insertion);
+    for (int i = 0; i * 1e-3 <= tr.duration() && sim.puncture_events().empty(); ++i) sim.tick(tr.sample(i * 1e-3));
+    ASSERT_FALSE(sim.puncture_events().empty()) << in_mesh;
+    const PunctureEvent& e = sim.puncture_events().front();
+    EXPECT_GE(e.surface_force_N, 0.5);
+    if (in_mesh) {
+      // The committed state is the step linearised at the last tick's deflection
+      // (10 um of travel here): off equilibrium by O(dz^2).
+      EXPECT_NEAR(e.eq5_force_N, e.mesh_reaction_N, 1e-4 * e.mesh_reaction_N);
+      EXPECT_NEAR(e.eq5_force_N, e.surface_force_N, 1e-3 * e.surface_force_N);  // linearised step: O(dz^2)
+      EXPECT_EQ(e.tip_stiffening_force_N, 0.0);
+    } else {
+      const double z0 = e.depth_m;
+      EXPECT_NEAR(e.tip_stiffening_force_N, 2e3 * z0 * z0 + 5e6 * z0 * z0 * z0, 1e-12);
+      EXPECT_NEAR(e.mesh_reaction_N + e.tip_stiffening_force_N, e.surface_force_N, 1e-9 * e.surface_force_N);
+      EXPECT_LT(e.eq5_force_N, e.surface_force_N);
+    }
+  }
+}

@@ -106,7 +106,23 @@ namespace puncture {
 
 namespace detail {
 class FixedPatternLdlt;
-}
+/// Owns the tangent's factorisation of a stiffening mesh and copies it
+/// deeply, so that ForceMesh keeps its value semantics.
+class TangentFactorization {
+ public:
+  TangentFactorization();
+  ~TangentFactorization();
+  TangentFactorization(const TangentFactorization& other);
+  TangentFactorization& operator=(const TangentFactorization& other);
+  TangentFactorization(TangentFactorization&&) noexcept;
+  TangentFactorization& operator=(TangentFactorization&&) noexcept;
+  void create();
+  FixedPatternLdlt* operator->() const { return ldlt_.get(); }
+
+ private:
+  std::unique_ptr<FixedPatternLdlt> ldlt_;
+};
+}  // namespace detail
 
 // --- the springs' laws (N, N/m, J; deflections in m), see the header ---
 double virtual_spring_force_N(const ForceMeshParams& p, double deflection_m);
@@ -140,11 +156,6 @@ class ForceMesh {
   /// that returns non-finite positions.
   ForceMesh(const ContactSurface& surface, const SurfacePoint& contact, const ForceMeshParams& params,
             double layer_thickness_m, double density_kg_per_m3, const MeshIntegrationSettings& settings);
-  ~ForceMesh();
-  ForceMesh(ForceMesh&&) noexcept;
-  ForceMesh& operator=(ForceMesh&&) noexcept;
-  ForceMesh(const ForceMesh&);
-  ForceMesh& operator=(const ForceMesh&);
 
   /// Advances one step dt with the contact-node deflection prescribed
   /// (m, into the tissue; negative values are clamped to 0). No allocation.
@@ -293,7 +304,7 @@ class ForceMesh {
   // Stiffening mesh: the step's tangent on its fixed pattern (free nodes: diagonal entries 0..nf-1,
   // then one entry per free-free spring), the springs, scratch vectors.
   bool nonlinear_ = false;
-  std::unique_ptr<detail::FixedPatternLdlt> tangent_;
+  detail::TangentFactorization tangent_;
   std::vector<double> tangent_values_;
   std::vector<int> spring_i_, spring_j_;  ///< free-free springs (node indices, i < j)
   double step_mass_term_ = 0.0;           ///< m/dt^2 + c/dt (implicit), 0 (quasi-static)
