@@ -96,3 +96,24 @@ TEST_P(NoAllocationTick, EveryForceLawEffectOffAxisAllocatesNothing) {
   EXPECT_NEAR(sim.force_mesh(0)->rest_positions()(0, 0), 2e-3, 1e-15);  // laid where the needle touched
   EXPECT_NEAR(sim.force_mesh(2)->rest_positions()(1, 0), -1e-3, 1e-15);
 }
+
+// Stiffening in the force meshes (Newton on the fixed-pattern tangent every tick).
+TEST_P(NoAllocationTick, StiffeningMeshesAllocateNothing) {
+  Scene scene = test::table2_scene(GetParam());
+  for (Layer& layer : scene.layers) {
+    layer.force_mesh.surface_axial_stiffness_N_per_m = 300.0;
+    layer.force_mesh.virtual_stiffening_m = 2e-3;
+  }
+  PunctureSimulator sim(scene, test::plane_surfaces(scene));
+  const ScriptedTrajectory tr(scene.insertion);
+  const int ticks = static_cast<int>(tr.duration() / 1e-3);
+  std::vector<NeedleState> states;
+  states.reserve(ticks);
+  for (int i = 0; i < ticks; ++i) states.push_back(tr.sample(i * 1e-3));
+  double sum = 0.0;
+  test::start_counting_allocations();
+  for (const NeedleState& s : states) sum += sim.tick(s).total_force_N;
+  EXPECT_EQ(test::stop_counting_allocations(), 0) << GetParam();
+  EXPECT_TRUE(std::isfinite(sum));
+  EXPECT_EQ(sim.puncture_events().size(), 3u);
+}
