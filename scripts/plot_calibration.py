@@ -7,6 +7,11 @@ Out: DIR/calibration_force_depth.png  force against depth: the reference and the
      real-time model before and after calibration; insertion solid, withdrawal
      dashed (dwell at the deepest point joins them). The axes hold every curve
      (nothing clipped).
+     With DIR/surface_identification.csv (calibrate --surface-fit):
+     DIR/surface_identification.png, per identified layer the FEM's surface
+     deflection (lines) and the identified force mesh's ring deflections
+     (markers) at up to six contact deflections, and the tip force against
+     the contact deflection, FEM and mesh.
 """
 import csv
 import os
@@ -65,7 +70,57 @@ def main(folder):
     os.replace(out + ".part.png", out)
 
 
+def plot_surface_identification(folder):
+    path = os.path.join(folder, "surface_identification.csv")
+    if not os.path.exists(path):
+        return
+    with open(path, newline="") as f:
+        lines = f.readlines()
+    note = lines[0][1:].strip() if lines and lines[0].startswith("#") else ""
+    layers = {}
+    for row in csv.DictReader(l for l in lines if not l.startswith("#")):
+        samples = layers.setdefault(row["layer"], {})
+        s = samples.setdefault(int(row["sample"]), {"z0": float(row["contact_deflection_mm"]),
+                                                    "fem_F": float(row["fem_force_N"]),
+                                                    "model_F": float(row["model_force_N"]), "r": [], "fem": [], "model": []})
+        s["r"].append(float(row["r_mm"]))
+        s["fem"].append(float(row["fem_deflection_mm"]))
+        s["model"].append(float(row["model_deflection_mm"]))
+    if not layers:
+        return
+    fig, axes = plt.subplots(len(layers), 2, figsize=(11, 4 * len(layers)), squeeze=False)
+    for row_axes, (name, samples) in zip(axes, layers.items()):
+        keys = sorted(samples)
+        shown = keys if len(keys) <= 6 else [keys[round(i * (len(keys) - 1) / 5)] for i in range(6)]
+        colours = plt.cm.viridis([i / max(1, len(shown) - 1) for i in range(len(shown))])
+        for c, k in zip(colours, shown):
+            s = samples[k]
+            row_axes[0].plot([0.0] + s["r"], [s["z0"]] + s["fem"], color=c, lw=1.6, label=f"FEM, z0 = {s['z0']:.1f} mm")
+            row_axes[0].plot([0.0] + s["r"], [s["z0"]] + s["model"], "o--", color=c, ms=4, lw=0.8)
+        row_axes[0].set_xlabel("distance from the needle axis r (mm)")
+        row_axes[0].set_ylabel("deflection into the tissue (mm)")
+        row_axes[0].set_title(f"{name}: surface, FEM (lines) and force mesh (markers)")
+        row_axes[0].legend(fontsize=7)
+        row_axes[0].grid(alpha=0.3)
+        z0 = [samples[k]["z0"] for k in keys]
+        row_axes[1].plot(z0, [samples[k]["fem_F"] for k in keys], "-", color="black", label="FEM tip force")
+        row_axes[1].plot(z0, [samples[k]["model_F"] for k in keys], "o", color="tab:blue", ms=4,
+                         label="force mesh (Eq. 5)")
+        row_axes[1].set_xlabel("contact deflection z0 (mm)")
+        row_axes[1].set_ylabel("force (N)")
+        row_axes[1].set_title(f"{name}: pressing force")
+        row_axes[1].legend(fontsize=8)
+        row_axes[1].grid(alpha=0.3)
+    if note:
+        fig.text(0.01, 0.005, note, fontsize=6, color="0.4")
+    fig.tight_layout(rect=(0, 0.02, 1, 1))
+    out = os.path.join(folder, "surface_identification.png")
+    fig.savefig(out + ".part.png", dpi=110)
+    os.replace(out + ".part.png", out)
+
+
 if __name__ == "__main__":
     if len(sys.argv) != 2:
         sys.exit("usage: plot_calibration.py DIR")
     main(sys.argv[1])
+    plot_surface_identification(sys.argv[1])

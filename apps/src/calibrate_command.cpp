@@ -224,7 +224,8 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
     // The model curves the objective compared, before and after, for the report.
     session.write_text("calibration_curves.csv", validation::calibration_curves_csv(curve_list(references, result), provenance));
     if (options.surface_fit)
-      session.write_text("surface_identification.csv", validation::surface_identification_csv(surfaces));
+      session.write_text("surface_identification.csv",
+                         io::provenance_comment_lines(provenance) + validation::surface_identification_csv(surfaces));
     session.commit();
     const std::string method = options.method + " on " +
                                (options.threads > 0 ? std::to_string(options.threads) : std::string("every")) +
