@@ -112,32 +112,72 @@ void ForceMesh::setup_nonlinear() {
   reaction_slope_N_per_m_ = static_stiffness_N_per_m_;
 }
 
+namespace {
+
+/// One surface spring's transverse force and stiffness (surface_spring_force_N
+/// and surface_spring_stiffness_N_per_m in one pass, for the step's loops).
+struct SurfaceSpringLaw {
+  double ks, ka, L;
+  void evaluate(double delta, double& force, double& stiffness) const {
+    force = ks * delta;
+    stiffness = ks;
+    if (ka > 0.0) {
+      const double s = std::sqrt(L * L + delta * delta);
+      const double d2 = delta * delta;
+      force += ka * d2 * delta / (s * (s + L));
+      stiffness += ka * d2 * (s * s + s * L + L * L) / ((s + L) * s * s * s);
+    }
+  }
+};
+
+}  // namespace
+
 double ForceMesh::nonlinear_residual(double z0) {
+  // Node terms, then every spring once (free-free springs, then those to the contact node).
   const int n = lattice_.node_count();
+  const SurfaceSpringLaw law{params_.surface_stiffness_N_per_m, params_.surface_axial_stiffness_N_per_m,
+                             params_.spacing_L_m};
   pz_[0] = z0;
-  for (int i = 1; i < n; ++i) {
-    double r = step_mass_term_ * (pz_[i] - inertial_target_[i - 1]) + virtual_spring_force_N(params_, pz_[i]);
-    for (int k = lattice_.neighbour_offsets[i]; k < lattice_.neighbour_offsets[i + 1]; ++k)
-      r += surface_spring_force_N(params_, pz_[i] - pz_[lattice_.neighbours[k]]);
-    rhs_[i - 1] = r;
+  for (int i = 1; i < n; ++i)
+    rhs_[i - 1] = step_mass_term_ * (pz_[i] - inertial_target_[i - 1]) + virtual_spring_force_N(params_, pz_[i]);
+  double f = 0.0, k = 0.0;
+  for (std::size_t e = 0; e < spring_i_.size(); ++e) {
+    const int i = spring_i_[e], j = spring_j_[e];
+    law.evaluate(pz_[i] - pz_[j], f, k);
+    rhs_[i - 1] += f;
+    rhs_[j - 1] -= f;
+  }
+  for (int q = lattice_.neighbour_offsets[0]; q < lattice_.neighbour_offsets[1]; ++q) {
+    const int i = lattice_.neighbours[q];
+    law.evaluate(pz_[i] - z0, f, k);
+    rhs_[i - 1] += f;
   }
   return n > 1 ? rhs_.cwiseAbs().maxCoeff() : 0.0;
 }
 
 void ForceMesh::factorize_tangent(double z0) {
   const int n = lattice_.node_count();
+  const SurfaceSpringLaw law{params_.surface_stiffness_N_per_m, params_.surface_axial_stiffness_N_per_m,
+                             params_.spacing_L_m};
   pz_[0] = z0;
-  for (int i = 1; i < n; ++i) {
-    double d = step_mass_term_ + virtual_spring_stiffness_N_per_m(params_, pz_[i]);
-    for (int k = lattice_.neighbour_offsets[i]; k < lattice_.neighbour_offsets[i + 1]; ++k)
-      d += surface_spring_stiffness_N_per_m(params_, pz_[i] - pz_[lattice_.neighbours[k]]);
-    tangent_values_[i - 1] = d;
-  }
+  for (int i = 1; i < n; ++i) tangent_values_[i - 1] = step_mass_term_ + virtual_spring_stiffness_N_per_m(params_, pz_[i]);
   const std::size_t diagonal = static_cast<std::size_t>(n - 1);
-  for (std::size_t e = 0; e < spring_i_.size(); ++e)
-    tangent_values_[diagonal + e] = -surface_spring_stiffness_N_per_m(params_, pz_[spring_i_[e]] - pz_[spring_j_[e]]);
+  double f = 0.0, k = 0.0;
+  for (std::size_t e = 0; e < spring_i_.size(); ++e) {
+    const int i = spring_i_[e], j = spring_j_[e];
+    law.evaluate(pz_[i] - pz_[j], f, k);
+    tangent_values_[i - 1] += k;
+    tangent_values_[j - 1] += k;
+    tangent_values_[diagonal + e] = -k;
+  }
+  for (int q = lattice_.neighbour_offsets[0]; q < lattice_.neighbour_offsets[1]; ++q) {
+    const int i = lattice_.neighbours[q];
+    law.evaluate(pz_[i] - z0, f, k);
+    tangent_values_[i - 1] += k;
+  }
   if (!tangent_->factorize(tangent_values_.data()))
     throw std::runtime_error("force mesh: the stiffening mesh's tangent is not positive definite (non-finite deflections?)");
+  tangent_ready_ = true;
 }
 
 void ForceMesh::solve_nonlinear_step(double z0) {
@@ -159,16 +199,18 @@ void ForceMesh::solve_nonlinear_step(double z0) {
   // Newton on the step equations; the energy is strictly convex, so a
   // backtracking line search on the residual's max norm keeps every step.
   // Converged when the full Newton step is below 1e-12 of the deflections or
-  // the residual below 1e-12 of the springs' force at that deflection.
+  // the residual below 1e-10 of the springs' force at that deflection (their
+  // tangent stiffness there times the deflection).
   double scale = std::max(std::abs(z0), params_.deformed_threshold_m);
   for (int i = 1; i < n; ++i) scale = std::max(scale, std::abs(z_[i]));
   const double tolerance_m = 1e-12 * scale;
-  const double force_floor_N = 1e-12 * scale *
-                               (params_.virtual_stiffness_N_per_m + params_.surface_stiffness_N_per_m +
-                                params_.surface_axial_stiffness_N_per_m + step_mass_term_);
+  const double force_floor_N = 1e-10 * scale *
+                               (virtual_spring_stiffness_N_per_m(params_, scale) +
+                                surface_spring_stiffness_N_per_m(params_, scale) + step_mass_term_);
   constexpr int kMaxNewton = 40;
   constexpr int kMaxCuts = 40;
   double residual = nonlinear_residual(z0);
+  double last_step = 0.0;  // full Newton step of the last iteration (m)
   while (residual > force_floor_N) {
     if (newton_iterations_ >= kMaxNewton)
       throw std::runtime_error("force mesh: the stiffening mesh's step did not converge in " +
@@ -194,10 +236,15 @@ void ForceMesh::solve_nonlinear_step(double z0) {
                                  "deflection " + std::to_string(z0 * 1e3) + " mm)");
       alpha *= 0.5;
     }
+    last_step = step_size;
     if (step_size <= tolerance_m) break;
   }
-  // pz_ converged (rhs_ holds its residual); the tangent there gives the sensitivity dz/dz0.
-  factorize_tangent(z0);
+  // pz_ converged (rhs_ holds its residual); the tangent there gives the
+  // sensitivity dz/dz0. The last factorisation is at most one tiny Newton
+  // step (<= 1e-3 of the deflections) away: it is kept then; the predicted
+  // slope is then off by about that fraction of the tangent's change over the
+  // step (a tick of needle travel), and the next predict() solves the true step.
+  if (!tangent_ready_ || last_step > 1e-3 * scale) factorize_tangent(z0);
   rhs_.setZero();
   for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k) {
     const int j = lattice_.neighbours[k];

@@ -311,6 +311,7 @@ class ForceMesh {
   Eigen::VectorXd inertial_target_;       ///< z_hat of the step equations (free nodes, index f = node - 1)
   Eigen::VectorXd trial_z_, newton_step_;
   int newton_iterations_ = 0;
+  bool tangent_ready_ = false;  ///< the tangent has been factorised at least once
   Eigen::VectorXd ring_mean_m_;
   Eigen::VectorXd ring_size_;
 
