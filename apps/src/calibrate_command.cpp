@@ -119,6 +119,8 @@ std::vector<validation::SurfaceIdentificationResult> fit_surfaces(const std::fil
   validation::SurfaceIdentificationOptions o;
   o.threads = threads;
   o.bound_factor = calibration.bound_factor;
+  o.rings_search_radius = 2;  // w from the extent of the FEM's deformed surface
+  o.max_extent_m = 0.5 * scene.sample.diameter_m;
   for (std::size_t k = 0; k < scene.layers.size(); ++k) {
     Layer& layer = scene.layers[k];
     const validation::SurfacePressingReference ref = validation::surface_pressing_reference(fem, scene, k);

@@ -77,6 +77,28 @@ TEST(SurfaceIdentification, RecoversKnownForceMeshParameters) {
   EXPECT_THROW(pv::identify_force_mesh(start, 1e-3, 1000.0, pv::SurfacePressingReference{}), std::invalid_argument);
 }
 
+TEST(SurfaceIdentification, RingCountFromTheExtentOfTheDeformedSurface) {
+  // Profiles of a w = 7 mesh; a start at w = 5 searched over 3..7: the fit
+  // with w = 7 reproduces them, smaller meshes leave the outer rings flat.
+  const ForceMeshParams truth = truth_params();
+  const pv::SurfacePressingReference ref = reference_from(truth);
+  ForceMeshParams start = truth;
+  start.rings_w = 5;
+  start.virtual_stiffness_N_per_m *= 2.0;
+  pv::SurfaceIdentificationOptions o;
+  o.rings_search_radius = 2;
+  const pv::SurfaceIdentificationResult r = pv::identify_force_mesh(start, 1e-3, 1000.0, ref, o);
+  EXPECT_EQ(r.after.rings_w, 7);
+  ASSERT_EQ(r.rings_costs.size(), 5u);
+  EXPECT_EQ(r.rings_costs.front().first, 3);
+  for (const auto& [w, cost] : r.rings_costs)
+    if (w != 7) EXPECT_GT(cost, 100.0 * r.cost) << w;
+  EXPECT_LT(r.quality_after.deflection_rmse_relative, 1e-4);
+  EXPECT_EQ(r.before.rings_w, 5);
+  o.max_extent_m = 9e-3;  // (w - 1) L < 9 mm: w <= 5
+  EXPECT_LE(pv::identify_force_mesh(start, 1e-3, 1000.0, ref, o).after.rings_w, 5);
+}
+
 TEST(SurfaceIdentification, PressingReferenceKeepsProfilesWhileTheSurfaceFollowsTheTip) {
   // Layer 1 (top at 2 mm) of a two-layer scene; profiles at tip depths 3, 4,
   // 5 and 6 mm whose centres follow the tip for the first two only, then a

@@ -49,14 +49,15 @@ struct ModelPressing {
 
 /// The quasi-static mesh through the samples' contact deflections; false if a step fails.
 bool press(const ForceMeshParams& p, double thickness_m, double density, const SurfacePressingReference& ref,
-           ModelPressing& out) {
+           int compare_rings, ModelPressing& out) {
   MeshIntegrationSettings settings;
   settings.integrator = MeshIntegrator::QuasiStatic;
   try {
     ForceMesh mesh(flat_surface(), {Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()}, p, thickness_m, density,
                    settings);
     out.force_N.assign(ref.size(), 0.0);
-    out.ring_deflection_m.assign(ref.size(), std::vector<double>(p.rings_w, 0.0));
+    // Rings beyond the mesh (a smaller w than the compared rings) have no deflection.
+    out.ring_deflection_m.assign(ref.size(), std::vector<double>(std::max(p.rings_w, compare_rings), 0.0));
     for (std::size_t s = 0; s < ref.size(); ++s) {
       mesh.advance(ref.contact_deflection_m[s]);
       out.force_N[s] = mesh.contact_reaction_N();
@@ -81,12 +82,12 @@ struct Scales {
   std::size_t forces = 0, deflections = 0;
 };
 
-Scales reference_scales(const SurfacePressingReference& ref, const ForceMeshParams& p) {
+Scales reference_scales(const SurfacePressingReference& ref, const ForceMeshParams& p, int compare_rings) {
   Scales s;
   s.forces = ref.size();
   for (std::size_t i = 0; i < ref.size(); ++i) {
     s.force_N = std::max(s.force_N, std::abs(ref.force_N[i]));
-    for (int j = 2; j <= p.rings_w; ++j) {
+    for (int j = 2; j <= compare_rings; ++j) {
       const double d = fem_deflection_at_ring(ref.profiles[i], j, p.spacing_L_m);
       if (std::isnan(d)) continue;
       s.deflection_m = std::max(s.deflection_m, std::abs(d));
@@ -106,25 +107,25 @@ ForceMeshParams params_from(const ForceMeshParams& base, const std::vector<doubl
 }
 
 void residuals_of(const ModelPressing& m, const SurfacePressingReference& ref, const ForceMeshParams& p,
-                  const Scales& s, const SurfaceIdentificationOptions& o, std::vector<double>& r) {
+                  const Scales& s, const SurfaceIdentificationOptions& o, int compare_rings, std::vector<double>& r) {
   r.clear();
   const double wf = std::sqrt(o.force_weight / static_cast<double>(s.forces));
   for (std::size_t i = 0; i < ref.size(); ++i) r.push_back(wf * (m.force_N[i] - ref.force_N[i]) / s.force_N);
   const double wd = s.deflections ? std::sqrt(o.deflection_weight / static_cast<double>(s.deflections)) : 0.0;
   for (std::size_t i = 0; i < ref.size(); ++i)
-    for (int j = 2; j <= p.rings_w; ++j) {
+    for (int j = 2; j <= compare_rings; ++j) {
       const double d = fem_deflection_at_ring(ref.profiles[i], j, p.spacing_L_m);
       if (!std::isnan(d)) r.push_back(wd * (m.ring_deflection_m[i][j - 1] - d) / s.deflection_m);
     }
 }
 
 SurfaceFitQuality quality_of(const ModelPressing& m, const SurfacePressingReference& ref, const ForceMeshParams& p,
-                             const Scales& s) {
+                             const Scales& s, int compare_rings) {
   SurfaceFitQuality q;
   double sf = 0.0, sd = 0.0;
   for (std::size_t i = 0; i < ref.size(); ++i) {
     sf += std::pow(m.force_N[i] - ref.force_N[i], 2);
-    for (int j = 2; j <= p.rings_w; ++j) {
+    for (int j = 2; j <= compare_rings; ++j) {
       const double d = fem_deflection_at_ring(ref.profiles[i], j, p.spacing_L_m);
       if (!std::isnan(d)) sd += std::pow(m.ring_deflection_m[i][j - 1] - d, 2);
     }
@@ -156,9 +157,12 @@ SurfacePressingReference surface_pressing_reference(const FemResultFiles& fem, c
   return ref;
 }
 
-SurfaceIdentificationResult identify_force_mesh(const ForceMeshParams& start, double thickness_m, double density_kg_per_m3,
-                                                const SurfacePressingReference& ref,
-                                                const SurfaceIdentificationOptions& o) {
+namespace {
+
+/// K, k_s, k_a, z_v of a mesh with start's w and L, compared over compare_rings rings.
+SurfaceIdentificationResult fit_rings(const ForceMeshParams& start, double thickness_m, double density_kg_per_m3,
+                                      const SurfacePressingReference& ref, const SurfaceIdentificationOptions& o,
+                                      int compare_rings) {
   if (ref.size() < 3) throw std::invalid_argument("identify_force_mesh: layer " + ref.layer +
                                                   ": fewer than 3 pressing profiles in the reference");
   if (!(o.bound_factor > 1.0)) throw std::invalid_argument("identify_force_mesh: bound_factor must be > 1");
@@ -166,7 +170,7 @@ SurfaceIdentificationResult identify_force_mesh(const ForceMeshParams& start, do
   result.layer = ref.layer;
   result.before = start;
   result.parameter_names = {"K", "k_s", "k_a", "z_v"};
-  const Scales scales = reference_scales(ref, start);
+  const Scales scales = reference_scales(ref, start, compare_rings);
   if (!(scales.force_N > 0.0) || !(scales.deflection_m > 0.0))
     throw std::invalid_argument("identify_force_mesh: layer " + ref.layer + ": the reference has no force or no deflection");
 
@@ -183,15 +187,15 @@ SurfaceIdentificationResult identify_force_mesh(const ForceMeshParams& start, do
   const ResidualFunction residual = [&](const std::vector<double>& x, std::vector<double>& r) {
     const ForceMeshParams p = params_from(start, x);
     ModelPressing m;
-    if (!press(p, thickness_m, density_kg_per_m3, ref, m)) return false;
-    residuals_of(m, ref, p, scales, o, r);
+    if (!press(p, thickness_m, density_kg_per_m3, ref, compare_rings, m)) return false;
+    residuals_of(m, ref, p, scales, o, compare_rings, r);
     return true;
   };
 
   ModelPressing before;
-  if (!press(start, thickness_m, density_kg_per_m3, ref, before))
+  if (!press(start, thickness_m, density_kg_per_m3, ref, compare_rings, before))
     throw std::runtime_error("identify_force_mesh: layer " + ref.layer + ": the start mesh cannot be pressed");
-  result.quality_before = quality_of(before, ref, start, scales);
+  result.quality_before = quality_of(before, ref, start, scales, compare_rings);
 
   LevenbergMarquardtOptions lm;
   lm.max_iterations = 200;
@@ -201,9 +205,10 @@ SurfaceIdentificationResult identify_force_mesh(const ForceMeshParams& start, do
   result.status = fit.status;
   result.after = params_from(start, fit.x);
   ModelPressing after;
-  if (!press(result.after, thickness_m, density_kg_per_m3, ref, after))
+  if (!press(result.after, thickness_m, density_kg_per_m3, ref, compare_rings, after))
     throw std::runtime_error("identify_force_mesh: layer " + ref.layer + ": the identified mesh cannot be pressed");
-  result.quality_after = quality_of(after, ref, result.after, scales);
+  result.quality_after = quality_of(after, ref, result.after, scales, compare_rings);
+  result.cost = fit.cost;
 
   std::vector<double> r0;
   residual(fit.x, r0);
@@ -221,7 +226,7 @@ SurfaceIdentificationResult identify_force_mesh(const ForceMeshParams& start, do
   result.model_force_N = after.force_N;
   for (std::size_t i = 0; i < ref.size(); ++i) {
     std::vector<double> radius, fem, model;
-    for (int j = 2; j <= result.after.rings_w; ++j) {
+    for (int j = 2; j <= compare_rings; ++j) {
       const double d = fem_deflection_at_ring(ref.profiles[i], j, result.after.spacing_L_m);
       if (std::isnan(d)) continue;
       radius.push_back((j - 1) * result.after.spacing_L_m);
@@ -233,6 +238,32 @@ SurfaceIdentificationResult identify_force_mesh(const ForceMeshParams& start, do
     result.model_deflection_m.push_back(model);
   }
   return result;
+}
+
+}  // namespace
+
+SurfaceIdentificationResult identify_force_mesh(const ForceMeshParams& start, double thickness_m, double density_kg_per_m3,
+                                                const SurfacePressingReference& ref,
+                                                const SurfaceIdentificationOptions& o) {
+  if (o.rings_search_radius < 0) throw std::invalid_argument("identify_force_mesh: rings_search_radius must be >= 0");
+  std::vector<int> candidates;
+  for (int w = std::max(2, start.rings_w - o.rings_search_radius); w <= start.rings_w + o.rings_search_radius; ++w)
+    if (w == start.rings_w || (w - 1) * start.spacing_L_m < o.max_extent_m) candidates.push_back(w);
+  // Every candidate is compared over the rings of the largest: a mesh smaller
+  // than the FEM's tent leaves its outer rings undeflected.
+  const int compare_rings = candidates.back();
+  SurfaceIdentificationResult best;
+  std::vector<std::pair<int, double>> costs;
+  for (int w : candidates) {
+    ForceMeshParams p = start;
+    p.rings_w = w;
+    SurfaceIdentificationResult r = fit_rings(p, thickness_m, density_kg_per_m3, ref, o, compare_rings);
+    costs.push_back({w, r.cost});
+    if (costs.size() == 1 || r.cost < best.cost) best = std::move(r);
+  }
+  best.before = start;
+  best.rings_costs = costs;
+  return best;
 }
 
 namespace {
@@ -254,14 +285,21 @@ std::string with_error(double value, double se_ln, bool at_bound) {
 
 std::string surface_identification_markdown(const std::vector<SurfaceIdentificationResult>& results) {
   std::ostringstream s;
-  s << "| layer | profiles | contact deflection (mm) | K (N/mm) | k_s (N/mm) | k_a (N/mm) | z_v (mm) | force RMSE / peak | "
-       "deflection RMSE / largest | optimiser |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  s << "| layer | profiles | contact deflection (mm) | w (objective per w) | K (N/mm) | k_s (N/mm) | k_a (N/mm) | z_v (mm) | "
+       "force RMSE / peak | deflection RMSE / largest | optimiser |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const SurfaceIdentificationResult& r : results) {
     const ForceMeshParams& a = r.after;
     const double values[4] = {a.virtual_stiffness_N_per_m * 1e-3, a.surface_stiffness_N_per_m * 1e-3,
                               a.surface_axial_stiffness_N_per_m * 1e-3, a.virtual_stiffening_m * 1e3};
     s << "| " << r.layer << " | " << r.contact_deflection_m.size() << " | "
-      << number(r.contact_deflection_m.front() * 1e3, 3) << " - " << number(r.contact_deflection_m.back() * 1e3, 3);
+      << number(r.contact_deflection_m.front() * 1e3, 3) << " - " << number(r.contact_deflection_m.back() * 1e3, 3) << " | "
+      << a.rings_w;
+    if (r.rings_costs.size() > 1) {
+      s << " (";
+      for (std::size_t i = 0; i < r.rings_costs.size(); ++i)
+        s << (i ? ", " : "") << r.rings_costs[i].first << ": " << number(r.rings_costs[i].second, 3);
+      s << ")";
+    }
     for (int i = 0; i < 4; ++i) s << " | " << with_error(values[i], r.standard_error_ln[i], r.at_bound[i]);
     s << " | " << number(r.quality_before.force_rmse_relative, 3) << " -> " << number(r.quality_after.force_rmse_relative, 3)
       << " | " << number(r.quality_before.deflection_rmse_relative, 3) << " -> "

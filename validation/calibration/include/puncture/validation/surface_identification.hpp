@@ -20,8 +20,8 @@
 //                 sample and ring j >= 2 inside the profile's radii
 //   (F_max, D_max: the largest FEM force and deflection of the samples; n, m
 //   their counts). Levenberg-Marquardt in x = ln p within [p0 / f, f p0] over
-//   K, k_s, k_a (surface_axial_stiffness) and z_v (virtual_stiffening); L and
-//   w stay. A start of 0 for k_a or z_v (linear springs) starts at k_s and at
+//   K, k_s, k_a (surface_axial_stiffness) and z_v (virtual_stiffening); L
+//   stays; w stays or is chosen among w0 +- rings_search_radius (options). A start of 0 for k_a or z_v (linear springs) starts at k_s and at
 //   the layer thickness.
 // Out: parameters before and after, force and deflection RMSE relative to
 //   F_max and D_max before and after, per-sample model and FEM values for the
@@ -29,7 +29,9 @@
 //   correlations) and the optimiser's status.
 #pragma once
 
+#include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "puncture/scene.hpp"
@@ -56,6 +58,12 @@ struct SurfaceIdentificationOptions {
   double deflection_weight = 1.0;
   double bound_factor = 1000.0;
   int threads = 0;  ///< Jacobian columns at once; 0: every core
+  /// w is chosen among w0 - r .. w0 + r (>= 2, (w - 1) L < max_extent_m) by
+  /// the fitted objective, every candidate compared over the rings of the
+  /// largest (rings beyond a smaller mesh count as undeflected): the extent
+  /// of the FEM's deformed surface identifies w. 0: w stays.
+  int rings_search_radius = 0;
+  double max_extent_m = std::numeric_limits<double>::infinity();
 };
 
 struct SurfaceFitQuality {
@@ -72,6 +80,8 @@ struct SurfaceIdentificationResult {
   std::vector<bool> at_bound;
   JacobianStatistics statistics;
   std::string status;
+  double cost = 0.0;                                ///< the fitted objective (sum of squared residuals)
+  std::vector<std::pair<int, double>> rings_costs;  ///< (w, fitted objective) of every candidate w
   // Per sample, for the report: z0, FEM and model force, FEM and model deflection at the rings.
   std::vector<double> contact_deflection_m, fem_force_N, model_force_N;
   std::vector<std::vector<double>> ring_radius_m, fem_deflection_m, model_deflection_m;
