@@ -89,6 +89,7 @@ TEST(SurfaceIdentification, RingCountFromTheExtentOfTheDeformedSurface) {
   o.rings_search_radius = 2;
   const pv::SurfaceIdentificationResult r = pv::identify_force_mesh(start, 1e-3, 1000.0, ref, o);
   EXPECT_EQ(r.after.rings_w, 7);
+  EXPECT_TRUE(r.rings_identified);
   ASSERT_EQ(r.rings_costs.size(), 5u);
   EXPECT_EQ(r.rings_costs.front().first, 3);
   for (const auto& [w, cost] : r.rings_costs)
@@ -97,6 +98,19 @@ TEST(SurfaceIdentification, RingCountFromTheExtentOfTheDeformedSurface) {
   EXPECT_EQ(r.before.rings_w, 5);
   o.max_extent_m = 9e-3;  // (w - 1) L < 9 mm: w <= 5
   EXPECT_LE(pv::identify_force_mesh(start, 1e-3, 1000.0, ref, o).after.rings_w, 5);
+
+  // Profiles that end well inside every candidate mesh (a narrow tent: stiff
+  // virtual springs, no stretch) do not tell w apart: w stays, not identified.
+  ForceMeshParams narrow = truth;
+  narrow.rings_w = 9;
+  narrow.virtual_stiffness_N_per_m = 50.0;
+  narrow.surface_axial_stiffness_N_per_m = 0.0;
+  narrow.virtual_stiffening_m = 0.0;
+  pv::SurfaceIdentificationOptions wide;
+  wide.rings_search_radius = 1;
+  const pv::SurfaceIdentificationResult kept = pv::identify_force_mesh(narrow, 1e-3, 1000.0, reference_from(narrow), wide);
+  EXPECT_FALSE(kept.rings_identified);
+  EXPECT_EQ(kept.after.rings_w, 9);
 }
 
 TEST(SurfaceIdentification, PressingReferenceKeepsProfilesWhileTheSurfaceFollowsTheTip) {

@@ -261,6 +261,18 @@ SurfaceIdentificationResult identify_force_mesh(const ForceMeshParams& start, do
     costs.push_back({w, r.cost});
     if (costs.size() == 1 || r.cost < best.cost) best = std::move(r);
   }
+  // w is identified only when the objective tells the candidates apart: if
+  // they all fit within kRingsTolerance of the best, the extent of the FEM's
+  // deformed surface lies inside every candidate mesh, and w stays at w0.
+  constexpr double kRingsTolerance = 0.02;
+  double worst = best.cost;
+  for (const auto& c : costs) worst = std::max(worst, c.second);
+  best.rings_identified = candidates.size() > 1 && worst > (1.0 + kRingsTolerance) * best.cost;
+  if (candidates.size() > 1 && !best.rings_identified && best.after.rings_w != start.rings_w) {
+    ForceMeshParams p = start;
+    best = fit_rings(p, thickness_m, density_kg_per_m3, ref, o, compare_rings);
+    best.rings_identified = false;
+  }
   best.before = start;
   best.rings_costs = costs;
   return best;
@@ -295,7 +307,7 @@ std::string surface_identification_markdown(const std::vector<SurfaceIdentificat
       << number(r.contact_deflection_m.front() * 1e3, 3) << " - " << number(r.contact_deflection_m.back() * 1e3, 3) << " | "
       << a.rings_w;
     if (r.rings_costs.size() > 1) {
-      s << " (";
+      s << (r.rings_identified ? " identified" : " kept: **not identifiable**, the objective changes by < 2 % over") << " (";
       for (std::size_t i = 0; i < r.rings_costs.size(); ++i)
         s << (i ? ", " : "") << r.rings_costs[i].first << ": " << number(r.rings_costs[i].second, 3);
       s << ")";

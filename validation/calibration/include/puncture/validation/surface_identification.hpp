@@ -61,7 +61,8 @@ struct SurfaceIdentificationOptions {
   /// w is chosen among w0 - r .. w0 + r (>= 2, (w - 1) L < max_extent_m) by
   /// the fitted objective, every candidate compared over the rings of the
   /// largest (rings beyond a smaller mesh count as undeflected): the extent
-  /// of the FEM's deformed surface identifies w. 0: w stays.
+  /// of the FEM's deformed surface identifies w when the objectives differ by
+  /// more than 2 %; otherwise w stays (not identifiable). 0: w stays.
   int rings_search_radius = 0;
   double max_extent_m = std::numeric_limits<double>::infinity();
 };
@@ -82,6 +83,9 @@ struct SurfaceIdentificationResult {
   std::string status;
   double cost = 0.0;                                ///< the fitted objective (sum of squared residuals)
   std::vector<std::pair<int, double>> rings_costs;  ///< (w, fitted objective) of every candidate w
+  /// True when the candidates' objectives differ by more than 2 % (w chosen
+  /// by them); false: they do not tell w apart and w stays at the start's.
+  bool rings_identified = false;
   // Per sample, for the report: z0, FEM and model force, FEM and model deflection at the rings.
   std::vector<double> contact_deflection_m, fem_force_N, model_force_N;
   std::vector<std::vector<double>> ring_radius_m, fem_deflection_m, model_deflection_m;
