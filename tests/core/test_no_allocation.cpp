@@ -31,22 +31,36 @@ TEST(NoAllocation, CounterSeesAnAllocation) {
 
 class NoAllocationTick : public ::testing::TestWithParam<const char*> {};
 
+namespace {
+
+/// The scene's scripted insertion, one state per 1 ms tick, sampled outside
+/// the counted region (NeedleState is plain data).
+std::vector<NeedleState> scripted_states(const Scene& scene) {
+  const ScriptedTrajectory tr(scene.insertion);
+  const int ticks = static_cast<int>(tr.duration() / 1e-3);
+  std::vector<NeedleState> states;
+  states.reserve(ticks);
+  for (int i = 0; i < ticks; ++i) states.push_back(tr.sample(i * 1e-3));
+  return states;
+}
+
+/// Ticks the whole insertion while counting allocations; returns their count.
+long allocations_over_insertion(PunctureSimulator& sim, const std::vector<NeedleState>& states) {
+  double sum = 0.0;
+  test::start_counting_allocations();
+  for (const NeedleState& s : states) sum += sim.tick(s).total_force_N;
+  const long count = test::stop_counting_allocations();
+  EXPECT_TRUE(std::isfinite(sum));
+  return count;
+}
+
+}  // namespace
+
 TEST_P(NoAllocationTick, FullInsertionAllocatesNothing) {
   Scene scene = test::table2_scene(GetParam());
   ASSERT_TRUE(scene.effects.surface_force && scene.effects.damping && scene.effects.resumption);
   PunctureSimulator sim(scene, test::plane_surfaces(scene));
-  const ScriptedTrajectory tr(scene.insertion);
-  const int ticks = static_cast<int>(tr.duration() / 1e-3);
-  // Sample the trajectory outside the counted region (NeedleState is plain data).
-  std::vector<NeedleState> states;
-  states.reserve(ticks);
-  for (int i = 0; i < ticks; ++i) states.push_back(tr.sample(i * 1e-3));
-
-  double sum = 0.0;
-  test::start_counting_allocations();
-  for (const NeedleState& s : states) sum += sim.tick(s).total_force_N;
-  EXPECT_EQ(test::stop_counting_allocations(), 0) << GetParam();
-  EXPECT_TRUE(std::isfinite(sum));
+  EXPECT_EQ(allocations_over_insertion(sim, scripted_states(scene)), 0) << GetParam();
   EXPECT_EQ(sim.puncture_events().size(), 3u);  // the counted ticks did the whole job
 }
 
@@ -105,15 +119,6 @@ TEST_P(NoAllocationTick, StiffeningMeshesAllocateNothing) {
     layer.force_mesh.virtual_stiffening_m = 2e-3;
   }
   PunctureSimulator sim(scene, test::plane_surfaces(scene));
-  const ScriptedTrajectory tr(scene.insertion);
-  const int ticks = static_cast<int>(tr.duration() / 1e-3);
-  std::vector<NeedleState> states;
-  states.reserve(ticks);
-  for (int i = 0; i < ticks; ++i) states.push_back(tr.sample(i * 1e-3));
-  double sum = 0.0;
-  test::start_counting_allocations();
-  for (const NeedleState& s : states) sum += sim.tick(s).total_force_N;
-  EXPECT_EQ(test::stop_counting_allocations(), 0) << GetParam();
-  EXPECT_TRUE(std::isfinite(sum));
+  EXPECT_EQ(allocations_over_insertion(sim, scripted_states(scene)), 0) << GetParam();
   EXPECT_EQ(sim.puncture_events().size(), 3u);
 }
