@@ -148,12 +148,17 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
     const validation::ReferenceEvents fem_events = validation::reference_events(fem.curve, geometry);
     const validation::TrajectoryComparison trajectory =
         validation::compare_trajectory(realtime_curve, fem.curve, fem_events, geometry);
-    const std::vector<validation::LayerAcceptance> acceptance = validation::layer_acceptance(geometry, trajectory);
+    std::vector<validation::LayerAcceptance> acceptance = validation::layer_acceptance(geometry, trajectory);
 
-    // 4-5. Deflection before breakthrough and recovery after it.
+    // 4-5. Deflection before breakthrough and recovery after it, part of the acceptance.
     std::vector<LayerDeflectionComparison> defl(scene.layers.size());
-    for (std::size_t k = 0; k < scene.layers.size(); ++k)
+    std::vector<validation::LayerDeflectionErrors> deflection_errors(scene.layers.size());
+    for (std::size_t k = 0; k < scene.layers.size(); ++k) {
       defl[k] = compare_layer_deflection(scene, k, run, recorder, fem);
+      deflection_errors[k] = {defl[k].compared, defl[k].recovery_compared, defl[k].error.relative_rmse,
+                              defl[k].recovery_error.relative_rmse, "no FEM profile of this layer's top surface"};
+    }
+    validation::add_deflection_acceptance(acceptance, deflection_errors);
 
     // 6. Report files.
     session.write_text("realtime_curve.csv", insertion_curve_csv(realtime_curve, &provenance));
@@ -198,7 +203,9 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
                      {"accepted", a.accepted()},
                      {"pressing_and_cut_force_rmse_relative", check(a.force_rmse)},
                      {"puncture_depth_error_m", check(a.puncture_depth)},
-                     {"puncture_force_error_relative", check(a.puncture_force)}});
+                     {"puncture_force_error_relative", check(a.puncture_force)},
+                     {"deflection_before_relative", check(a.deflection)},
+                     {"deflection_after_relative", check(a.recovery)}});
     }
     metrics["acceptance"] = acc;
     nlohmann::json terms = nlohmann::json::array();

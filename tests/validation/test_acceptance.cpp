@@ -77,3 +77,33 @@ TEST(LayerAcceptance, AModelWithinEveryLimitIsAccepted) {
   strict.max_rmse_relative = 0.05;
   EXPECT_FALSE(layer_acceptance(layers, c, strict)[0].accepted());
 }
+
+TEST(LayerAcceptance, SurfaceDeflectionBeforeAndAfterTheBreakIsPartOfIt) {
+  // A layer within every force limit; then its surface judged too: 10 %
+  // before the break (limit 15 %) and 30 % after it (limit 25 %) fails it,
+  // 20 % after passes; a layer without an FEM surface is not accepted and says why.
+  const std::vector<LayerGeometry> layers = {{"skin", 0.0, 1e-3, 2e-3}, {"fat", 1e-3, 8e-3, 1e-3}};
+  TrajectoryComparison c;
+  for (const char* l : {"skin", "fat"})
+    for (const ObjectiveTerm& t : {term("pressing", l, true, 0.05, 0.1, 3), term("after_puncture", l, true, 0.05, 0.1, 3),
+                                   term("puncture_depth", l, true, 0.1, 1e-4, 1), term("puncture_force", l, true, 0.02, 0.05, 1)})
+      c.terms.push_back(t);
+  std::vector<LayerAcceptance> a = layer_acceptance(layers, c);
+  ASSERT_TRUE(a[0].accepted() && a[1].accepted());
+  std::vector<LayerDeflectionErrors> errors(2);
+  errors[0] = {true, true, 0.10, 0.30, ""};
+  errors[1].note = "no FEM profile of this layer's top surface";
+  add_deflection_acceptance(a, errors);
+  EXPECT_TRUE(a[0].deflection.met);
+  EXPECT_FALSE(a[0].recovery.met);
+  EXPECT_FALSE(a[0].accepted());
+  EXPECT_FALSE(a[1].deflection.available);
+  EXPECT_FALSE(a[1].accepted());
+  errors[0].after_relative = 0.20;
+  add_deflection_acceptance(a, errors);
+  EXPECT_TRUE(a[0].accepted());
+  const std::string md = acceptance_markdown(a, c);
+  EXPECT_NE(md.find("after the break (limit 25 %)"), std::string::npos) << md;
+  EXPECT_NE(md.find("n/a: no FEM profile"), std::string::npos) << md;
+  EXPECT_THROW(add_deflection_acceptance(a, {}), std::invalid_argument);
+}

@@ -1,6 +1,7 @@
 #include "puncture/validation/acceptance.hpp"
 
 #include <cmath>
+#include <stdexcept>
 #include <sstream>
 
 #include "puncture/validation/number_format.hpp"
@@ -63,12 +64,42 @@ std::vector<LayerAcceptance> layer_acceptance(const std::vector<LayerGeometry>& 
   return out;
 }
 
+void add_deflection_acceptance(std::vector<LayerAcceptance>& acceptance, const std::vector<LayerDeflectionErrors>& errors,
+                               const AcceptanceCriteria& criteria) {
+  if (acceptance.size() != errors.size())
+    throw std::invalid_argument("add_deflection_acceptance: one deflection comparison per layer");
+  auto check = [](bool available, double value, double limit, const std::string& note) {
+    AcceptanceCheck c;
+    c.available = available && std::isfinite(value);
+    c.limit = limit;
+    if (c.available) {
+      c.value = value;
+      c.met = value <= limit;
+      c.note = "relative RMSE of the ring deflections";
+    } else {
+      c.note = "n/a: " + (note.empty() ? std::string("surfaces not compared") : note);
+    }
+    return c;
+  };
+  for (std::size_t k = 0; k < acceptance.size(); ++k) {
+    acceptance[k].deflection_judged = true;
+    acceptance[k].deflection = check(errors[k].before_available, errors[k].before_relative,
+                                     criteria.max_deflection_relative, errors[k].note);
+    acceptance[k].recovery = check(errors[k].after_available, errors[k].after_relative, criteria.max_recovery_relative,
+                                   errors[k].note);
+  }
+}
+
 std::string acceptance_markdown(const std::vector<LayerAcceptance>& acceptance, const TrajectoryComparison& comparison,
                                 const AcceptanceCriteria& criteria) {
   std::ostringstream md;
+  const bool judged = !acceptance.empty() && acceptance.front().deflection_judged;
   md << "| layer | force RMSE over pressing and cut / peak (limit " << fmt(100 * criteria.max_rmse_relative) << " %) | puncture depth error "
-     << "(limit L) | puncture force error (limit " << fmt(100 * criteria.max_force_error_relative)
-     << " %) | accepted |\n|---|---|---|---|---|\n";
+     << "(limit L) | puncture force error (limit " << fmt(100 * criteria.max_force_error_relative) << " %) | ";
+  if (judged)
+    md << "deflection RMSE before the break / FEM's largest (limit " << fmt(100 * criteria.max_deflection_relative)
+       << " %) | after the break (limit " << fmt(100 * criteria.max_recovery_relative) << " %) | ";
+  md << "accepted |\n|---|---|---|---|" << (judged ? "---|---|" : "") << "---|\n";
   auto cell = [](const AcceptanceCheck& c, const std::string& value) {
     if (!c.available) return c.note;
     return value + (c.met ? " (met)" : " (**not met**)");
@@ -78,8 +109,11 @@ std::string acceptance_markdown(const std::vector<LayerAcceptance>& acceptance, 
        << cell(a.force_rmse, fmt(100 * a.force_rmse.value) + " % over " + std::to_string(a.rmse_samples) + " samples")
        << " | "
        << cell(a.puncture_depth, fmt(a.puncture_depth.value * 1e3) + " mm (L = " + fmt(a.puncture_depth.limit * 1e3) + " mm)")
-       << " | " << cell(a.puncture_force, fmt(100 * a.puncture_force.value) + " %") << " | "
-       << (a.accepted() ? "yes" : "**no**") << " |\n";
+       << " | " << cell(a.puncture_force, fmt(100 * a.puncture_force.value) + " %") << " | ";
+    if (judged)
+      md << cell(a.deflection, fmt(100 * a.deflection.value) + " %") << " | "
+         << cell(a.recovery, fmt(100 * a.recovery.value) + " %") << " | ";
+    md << (a.accepted() ? "yes" : "**no**") << " |\n";
   }
   md << "\nWhole trajectory (RMSE over the reference's samples, relative to its insertion peak "
      << fmt(comparison.reference_peak_force_N) << " N):\n\n| term | value | error | samples | note |\n|---|---|---|---|---|\n";

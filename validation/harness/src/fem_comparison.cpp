@@ -320,8 +320,10 @@ std::string validation_summary_markdown(const Scene& scene, const io::Provenance
   if (!acceptance_section.empty()) {
     md << "## Acceptance per layer (whole trajectory)\n\n"
           "A layer is accepted when its force RMSE over pressing and cut is at most 10 % of the FEM peak, "
-          "its puncture depth within the layer's force-mesh spacing L of the FEM's, and its puncture force within "
-          "10 % of the FEM's (the FEM's punctures from its state columns).\n\n"
+          "its puncture depth within the layer's force-mesh spacing L of the FEM's, its puncture force within "
+          "10 % of the FEM's (the FEM's punctures from its state columns), and its surface's deflection RMSE at "
+          "most 15 % of the FEM's largest deflection before its breakthrough and 25 % after it (the comparison "
+          "above).\n\n"
        << acceptance_section << "\n";
   }
 
