@@ -233,6 +233,21 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
                                (options.threads > 0 ? std::to_string(options.threads) : std::string("every")) +
                                " thread(s)";
     std::string md = validation::calibration_summary_markdown(result, scene, reference, provenance, method, calibration_s, name);
+    if (references.size() > 1) {
+      // The tables above are of the first reference; the objective sums every reference's.
+      std::ostringstream refs;
+      refs << "\n## Every reference\n\nThe term tables above compare the model with the first reference; the "
+              "calibration's objective is the sum over all of them:\n\n| reference | speed (mm/s) | objective before | "
+              "after |\n|---|---|---|---|\n";
+      for (std::size_t r = 0; r < references.size(); ++r) {
+        const auto speed = references[r].curve.metadata.find("speed_mm_per_s");
+        refs << "| " << references[r].kind << " (" << references[r].curve.source << ") | "
+             << (speed != references[r].curve.metadata.end() ? speed->second : std::string("the scene's")) << " | "
+             << std::setprecision(4) << result.trajectory_before[r].objective << " | " << result.trajectory_after[r].objective
+             << " |\n";
+      }
+      md += refs.str();
+    }
     if (options.surface_fit)
       md += "\n## Force meshes identified from the FEM's surface (--surface-fit)\n\nBefore the stages below, each "
             "layer with FEM surface profiles taken while its surface follows the tip had K, k_s, k_a and z_v "
