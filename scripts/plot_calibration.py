@@ -22,6 +22,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+import results_io  # noqa: E402  (scripts/, beside this file)
+
 
 def main(folder):
     path = os.path.join(folder, "calibration_curves.csv")
@@ -65,9 +67,7 @@ def main(folder):
     if note:
         fig.text(0.01, 0.005, note, fontsize=6, color="0.4")
     fig.tight_layout(rect=(0, 0.03, 1, 1))
-    out = os.path.join(folder, "calibration_force_depth.png")
-    fig.savefig(out + ".part.png", dpi=130)
-    os.replace(out + ".part.png", out)
+    results_io.save_figure(fig, os.path.join(folder, "calibration_force_depth.png"), dpi=130)
 
 
 def plot_surface_identification(folder):
@@ -114,9 +114,7 @@ def plot_surface_identification(folder):
     if note:
         fig.text(0.01, 0.005, note, fontsize=6, color="0.4")
     fig.tight_layout(rect=(0, 0.02, 1, 1))
-    out = os.path.join(folder, "surface_identification.png")
-    fig.savefig(out + ".part.png", dpi=110)
-    os.replace(out + ".part.png", out)
+    results_io.save_figure(fig, os.path.join(folder, "surface_identification.png"), dpi=110)
 
 
 if __name__ == "__main__":

@@ -49,25 +49,38 @@ double virtual_spring_energy_J(const ForceMeshParams& p, double z) {
   return K * z * z * (0.5 + 0.25 * x * x);
 }
 
-double surface_spring_force_N(const ForceMeshParams& p, double delta) {
-  double f = p.surface_stiffness_N_per_m * delta;
-  if (p.surface_axial_stiffness_N_per_m > 0.0) {
-    const double L = p.spacing_L_m;
-    const double s = std::hypot(L, delta);
-    // (s - L) / s = delta^2 / (s (s + L)): no cancellation at small slopes.
-    f += p.surface_axial_stiffness_N_per_m * delta * delta * delta / (s * (s + L));
+namespace {
+
+/// One surface spring's transverse force and stiffness in one pass (the law
+/// of surface_spring_force_N and surface_spring_stiffness_N_per_m, which call
+/// it; the step's loops use it directly). (s - L) / s = delta^2 / (s (s + L))
+/// and 1 - L^3 / s^3 = delta^2 (s^2 + s L + L^2) / ((s + L) s^3): no
+/// cancellation at small slopes.
+struct SurfaceSpringLaw {
+  double ks, ka, L;
+  void evaluate(double delta, double& force, double& stiffness) const {
+    force = ks * delta;
+    stiffness = ks;
+    if (ka > 0.0) {
+      const double s = std::sqrt(L * L + delta * delta);
+      const double d2 = delta * delta;
+      force += ka * d2 * delta / (s * (s + L));
+      stiffness += ka * d2 * (s * s + s * L + L * L) / ((s + L) * s * s * s);
+    }
   }
+};
+
+}  // namespace
+
+double surface_spring_force_N(const ForceMeshParams& p, double delta) {
+  double f = 0.0, k = 0.0;
+  SurfaceSpringLaw{p.surface_stiffness_N_per_m, p.surface_axial_stiffness_N_per_m, p.spacing_L_m}.evaluate(delta, f, k);
   return f;
 }
 
 double surface_spring_stiffness_N_per_m(const ForceMeshParams& p, double delta) {
-  double k = p.surface_stiffness_N_per_m;
-  if (p.surface_axial_stiffness_N_per_m > 0.0) {
-    const double L = p.spacing_L_m;
-    const double s = std::hypot(L, delta);
-    // d/d delta [delta (1 - L / s)] = 1 - L^3 / s^3 = (s^3 - L^3) / s^3, with s^3 - L^3 = delta^2 (s^2 + s L + L^2) / (s + L).
-    k += p.surface_axial_stiffness_N_per_m * delta * delta * (s * s + s * L + L * L) / ((s + L) * s * s * s);
-  }
+  double f = 0.0, k = 0.0;
+  SurfaceSpringLaw{p.surface_stiffness_N_per_m, p.surface_axial_stiffness_N_per_m, p.spacing_L_m}.evaluate(delta, f, k);
   return k;
 }
 
@@ -112,25 +125,6 @@ void ForceMesh::setup_nonlinear() {
   reaction_slope_N_per_m_ = static_stiffness_N_per_m_;
 }
 
-namespace {
-
-/// One surface spring's transverse force and stiffness (surface_spring_force_N
-/// and surface_spring_stiffness_N_per_m in one pass, for the step's loops).
-struct SurfaceSpringLaw {
-  double ks, ka, L;
-  void evaluate(double delta, double& force, double& stiffness) const {
-    force = ks * delta;
-    stiffness = ks;
-    if (ka > 0.0) {
-      const double s = std::sqrt(L * L + delta * delta);
-      const double d2 = delta * delta;
-      force += ka * d2 * delta / (s * (s + L));
-      stiffness += ka * d2 * (s * s + s * L + L * L) / ((s + L) * s * s * s);
-    }
-  }
-};
-
-}  // namespace
 
 double ForceMesh::nonlinear_residual(double z0) {
   // Node terms, then every spring once (free-free springs, then those to the contact node).
@@ -261,21 +255,19 @@ void ForceMesh::solve_nonlinear_step(double z0) {
 }
 
 void ForceMesh::predict_nonlinear(double z0_star) {
-  {
-    // The step solved at contact deflection z0_star, linearised there (see the header).
-    predicted_z0_ = z0_star;
-    solve_nonlinear_step(predicted_z0_);
-    double reaction = virtual_spring_force_N(params_, predicted_z0_);
-    double slope = virtual_spring_stiffness_N_per_m(params_, predicted_z0_);
-    for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k) {
-      const int j = lattice_.neighbours[k];
-      reaction += surface_spring_force_N(params_, predicted_z0_ - pz_[j]);
-      slope += surface_spring_stiffness_N_per_m(params_, predicted_z0_ - pz_[j]) * (1.0 - qz_[j]);
-    }
-    reaction_slope_N_per_m_ = slope;
-    predicted_intercept_N_ = reaction - slope * predicted_z0_;
-    predicted_ = true;
+  // The step solved at contact deflection z0_star, linearised there (see the header).
+  predicted_z0_ = z0_star;
+  solve_nonlinear_step(predicted_z0_);
+  double reaction = virtual_spring_force_N(params_, predicted_z0_);
+  double slope = virtual_spring_stiffness_N_per_m(params_, predicted_z0_);
+  for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k) {
+    const int j = lattice_.neighbours[k];
+    reaction += surface_spring_force_N(params_, predicted_z0_ - pz_[j]);
+    slope += surface_spring_stiffness_N_per_m(params_, predicted_z0_ - pz_[j]) * (1.0 - qz_[j]);
   }
+  reaction_slope_N_per_m_ = slope;
+  predicted_intercept_N_ = reaction - slope * predicted_z0_;
+  predicted_ = true;
 }
 
 }  // namespace puncture

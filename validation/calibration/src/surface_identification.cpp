@@ -77,24 +77,29 @@ double fem_deflection_at_ring(const RadialProfile& profile, int ring, double spa
   return -uz;
 }
 
-struct Scales {
+/// The FEM's deflection at every compared ring of every sample (NaN outside
+/// the profile's radii), found once per fit, and the scales of the residuals.
+struct RingTargets {
+  std::vector<std::vector<double>> fem_m;  ///< [sample][ring - 1], rings 2..compare_rings (ring 1: NaN)
   double force_N = 0.0, deflection_m = 0.0;
   std::size_t forces = 0, deflections = 0;
 };
 
-Scales reference_scales(const SurfacePressingReference& ref, const ForceMeshParams& p, int compare_rings) {
-  Scales s;
-  s.forces = ref.size();
+RingTargets ring_targets(const SurfacePressingReference& ref, double spacing_m, int compare_rings) {
+  RingTargets t;
+  t.forces = ref.size();
   for (std::size_t i = 0; i < ref.size(); ++i) {
-    s.force_N = std::max(s.force_N, std::abs(ref.force_N[i]));
+    t.force_N = std::max(t.force_N, std::abs(ref.force_N[i]));
+    std::vector<double> row(compare_rings, std::numeric_limits<double>::quiet_NaN());
     for (int j = 2; j <= compare_rings; ++j) {
-      const double d = fem_deflection_at_ring(ref.profiles[i], j, p.spacing_L_m);
-      if (std::isnan(d)) continue;
-      s.deflection_m = std::max(s.deflection_m, std::abs(d));
-      ++s.deflections;
+      row[j - 1] = fem_deflection_at_ring(ref.profiles[i], j, spacing_m);
+      if (std::isnan(row[j - 1])) continue;
+      t.deflection_m = std::max(t.deflection_m, std::abs(row[j - 1]));
+      ++t.deflections;
     }
+    t.fem_m.push_back(std::move(row));
   }
-  return s;
+  return t;
 }
 
 ForceMeshParams params_from(const ForceMeshParams& base, const std::vector<double>& x) {
@@ -106,32 +111,27 @@ ForceMeshParams params_from(const ForceMeshParams& base, const std::vector<doubl
   return p;
 }
 
-void residuals_of(const ModelPressing& m, const SurfacePressingReference& ref, const ForceMeshParams& p,
-                  const Scales& s, const SurfaceIdentificationOptions& o, int compare_rings, std::vector<double>& r) {
+void residuals_of(const ModelPressing& m, const SurfacePressingReference& ref, const RingTargets& t,
+                  const SurfaceIdentificationOptions& o, std::vector<double>& r) {
   r.clear();
-  const double wf = std::sqrt(o.force_weight / static_cast<double>(s.forces));
-  for (std::size_t i = 0; i < ref.size(); ++i) r.push_back(wf * (m.force_N[i] - ref.force_N[i]) / s.force_N);
-  const double wd = s.deflections ? std::sqrt(o.deflection_weight / static_cast<double>(s.deflections)) : 0.0;
+  const double wf = std::sqrt(o.force_weight / static_cast<double>(t.forces));
+  for (std::size_t i = 0; i < ref.size(); ++i) r.push_back(wf * (m.force_N[i] - ref.force_N[i]) / t.force_N);
+  const double wd = t.deflections ? std::sqrt(o.deflection_weight / static_cast<double>(t.deflections)) : 0.0;
   for (std::size_t i = 0; i < ref.size(); ++i)
-    for (int j = 2; j <= compare_rings; ++j) {
-      const double d = fem_deflection_at_ring(ref.profiles[i], j, p.spacing_L_m);
-      if (!std::isnan(d)) r.push_back(wd * (m.ring_deflection_m[i][j - 1] - d) / s.deflection_m);
-    }
+    for (std::size_t j = 0; j < t.fem_m[i].size(); ++j)
+      if (!std::isnan(t.fem_m[i][j])) r.push_back(wd * (m.ring_deflection_m[i][j] - t.fem_m[i][j]) / t.deflection_m);
 }
 
-SurfaceFitQuality quality_of(const ModelPressing& m, const SurfacePressingReference& ref, const ForceMeshParams& p,
-                             const Scales& s, int compare_rings) {
+SurfaceFitQuality quality_of(const ModelPressing& m, const SurfacePressingReference& ref, const RingTargets& t) {
   SurfaceFitQuality q;
   double sf = 0.0, sd = 0.0;
   for (std::size_t i = 0; i < ref.size(); ++i) {
     sf += std::pow(m.force_N[i] - ref.force_N[i], 2);
-    for (int j = 2; j <= compare_rings; ++j) {
-      const double d = fem_deflection_at_ring(ref.profiles[i], j, p.spacing_L_m);
-      if (!std::isnan(d)) sd += std::pow(m.ring_deflection_m[i][j - 1] - d, 2);
-    }
+    for (std::size_t j = 0; j < t.fem_m[i].size(); ++j)
+      if (!std::isnan(t.fem_m[i][j])) sd += std::pow(m.ring_deflection_m[i][j] - t.fem_m[i][j], 2);
   }
-  q.force_rmse_relative = std::sqrt(sf / static_cast<double>(s.forces)) / s.force_N;
-  q.deflection_rmse_relative = s.deflections ? std::sqrt(sd / static_cast<double>(s.deflections)) / s.deflection_m : 0.0;
+  q.force_rmse_relative = std::sqrt(sf / static_cast<double>(t.forces)) / t.force_N;
+  q.deflection_rmse_relative = t.deflections ? std::sqrt(sd / static_cast<double>(t.deflections)) / t.deflection_m : 0.0;
   return q;
 }
 
@@ -170,8 +170,8 @@ SurfaceIdentificationResult fit_rings(const ForceMeshParams& start, double thick
   result.layer = ref.layer;
   result.before = start;
   result.parameter_names = {"K", "k_s", "k_a", "z_v"};
-  const Scales scales = reference_scales(ref, start, compare_rings);
-  if (!(scales.force_N > 0.0) || !(scales.deflection_m > 0.0))
+  const RingTargets targets = ring_targets(ref, start.spacing_L_m, compare_rings);
+  if (!(targets.force_N > 0.0) || !(targets.deflection_m > 0.0))
     throw std::invalid_argument("identify_force_mesh: layer " + ref.layer + ": the reference has no force or no deflection");
 
   const double ks0 = start.surface_stiffness_N_per_m > 0.0 ? start.surface_stiffness_N_per_m : start.virtual_stiffness_N_per_m;
@@ -188,14 +188,14 @@ SurfaceIdentificationResult fit_rings(const ForceMeshParams& start, double thick
     const ForceMeshParams p = params_from(start, x);
     ModelPressing m;
     if (!press(p, thickness_m, density_kg_per_m3, ref, compare_rings, m)) return false;
-    residuals_of(m, ref, p, scales, o, compare_rings, r);
+    residuals_of(m, ref, targets, o, r);
     return true;
   };
 
   ModelPressing before;
   if (!press(start, thickness_m, density_kg_per_m3, ref, compare_rings, before))
     throw std::runtime_error("identify_force_mesh: layer " + ref.layer + ": the start mesh cannot be pressed");
-  result.quality_before = quality_of(before, ref, start, scales, compare_rings);
+  result.quality_before = quality_of(before, ref, targets);
 
   LevenbergMarquardtOptions lm;
   lm.max_iterations = 200;
@@ -207,7 +207,7 @@ SurfaceIdentificationResult fit_rings(const ForceMeshParams& start, double thick
   ModelPressing after;
   if (!press(result.after, thickness_m, density_kg_per_m3, ref, compare_rings, after))
     throw std::runtime_error("identify_force_mesh: layer " + ref.layer + ": the identified mesh cannot be pressed");
-  result.quality_after = quality_of(after, ref, result.after, scales, compare_rings);
+  result.quality_after = quality_of(after, ref, targets);
   result.cost = fit.cost;
 
   std::vector<double> r0;
@@ -226,12 +226,11 @@ SurfaceIdentificationResult fit_rings(const ForceMeshParams& start, double thick
   result.model_force_N = after.force_N;
   for (std::size_t i = 0; i < ref.size(); ++i) {
     std::vector<double> radius, fem, model;
-    for (int j = 2; j <= compare_rings; ++j) {
-      const double d = fem_deflection_at_ring(ref.profiles[i], j, result.after.spacing_L_m);
-      if (std::isnan(d)) continue;
-      radius.push_back((j - 1) * result.after.spacing_L_m);
-      fem.push_back(d);
-      model.push_back(after.ring_deflection_m[i][j - 1]);
+    for (std::size_t j = 0; j < targets.fem_m[i].size(); ++j) {
+      if (std::isnan(targets.fem_m[i][j])) continue;
+      radius.push_back(static_cast<double>(j) * result.after.spacing_L_m);
+      fem.push_back(targets.fem_m[i][j]);
+      model.push_back(after.ring_deflection_m[i][j]);
     }
     result.ring_radius_m.push_back(radius);
     result.fem_deflection_m.push_back(fem);
