@@ -65,6 +65,14 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("--cache", cache, "FEM cache directory; default: out/.fem_cache");
   validate_cmd->add_option("--refinement", validate.refinement, "FEM refinement (overrides the scene)")->check(CLI::Range(0, 4));
   validate_cmd->add_option("--degree", validate.degree, "FEM element degree (overrides the scene)")->check(CLI::Range(1, 2));
+  validate_cmd->add_option("--cases", validate.cases,
+                           "Cases file (JSON; validation/cases/default_heldout.json): validate the scene, without "
+                           "retuning, on each case (other speeds, depths, slabs); one report per case and "
+                           "heldout_summary.json / .md");
+  validate_cmd->add_option("--model-note", validate.model_note,
+                           "With --cases: how the model was calibrated (which references), for the summary page");
+  validate_cmd->add_flag("--no-vtk", [&](std::int64_t) { validate.write_vtk = false; },
+                         "CSV, PNG and markdown only (no .vtp, .vtu, validation.pvd)");
   validate_cmd->add_flag("-q,--quiet", validate.quiet, "Nothing on stdout (warnings and errors still on stderr)");
 
   CalibrateOptions calibrate;

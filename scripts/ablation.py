@@ -7,8 +7,8 @@ k_a = z_v = 0), the paper's ring-w breakthrough and no other mechanism; then,
 one at a time, the tuned preset's stiffening (in the mesh: k_a and z_v where
 the surface fit identified them; of the tip spring elsewhere), cutting, shaft
 friction, the critical-force breakthrough (= the tuned preset as calibrated)
-and layer interaction. Each row is validated (`puncture
-validate`, FEM from out/.fem_cache) on every case of the cases file; its tick
+and layer interaction. Each row is validated (`puncture validate SCENE --cases
+CASES_JSON`, FEM from out/.fem_cache) on every case of the cases file; its tick
 cost is the wall time of `puncture run` on the default trajectory (ticks with
 contact: mean and p99).
 
@@ -21,7 +21,6 @@ import json
 import os
 import subprocess
 
-import heldout_validation as hv
 import provenance
 import results_io
 
@@ -58,6 +57,25 @@ def tick_cost(scene_path, puncture, work):
     return t["contact_mean"], t["contact_p99"]
 
 
+def validate_cases(scene_path, cases_path, work, puncture, ranks, label):
+    """`puncture validate` on every case: (held-out summary, {case: validation_metrics.json})."""
+    out = os.path.join(work, "cases")
+    print(f"{label}: puncture validate --cases", flush=True)
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    r = subprocess.run(["mpirun", "--oversubscribe", "-np", str(ranks), puncture, "validate", scene_path,
+                        "--cases", cases_path, "-o", out, "--no-vtk", "-q"], env=env)
+    if r.returncode != 0:
+        raise SystemExit(f"{label}: puncture validate failed (exit {r.returncode})")
+    summary = json.load(open(os.path.join(out, "heldout_summary.json")))
+    metrics = {c["name"]: json.load(open(os.path.join(out, c["name"], "validation_metrics.json")))
+               for c in summary["cases"]}
+    return summary, metrics
+
+
+def fmt(v, pattern):
+    return "n/a" if v is None else format(v, pattern)
+
+
 def mean(values):
     v = [x for x in values if x is not None]
     return sum(v) / len(v) if v else None
@@ -71,7 +89,6 @@ def main():
     args = ap.parse_args()
     tuned = json.load(open(args.tuned), object_pairs_hook=collections.OrderedDict)
     paper = json.load(open(args.paper), object_pairs_hook=collections.OrderedDict)
-    cases = json.load(open(args.cases))["cases"]
     result = []
     for i, (label, scene) in enumerate(rows(tuned, paper)):
         work = os.path.join("out", "ablation", f"row{i}")
@@ -79,12 +96,13 @@ def main():
         base_path = os.path.join(work, "scene.json")
         json.dump(scene, open(base_path, "w"), indent=2, ensure_ascii=False)
         mean_us, p99_us = tick_cost(base_path, args.puncture, work)
+        summary, metrics = validate_cases(base_path, args.cases, work, args.puncture, args.ranks,
+                                          f"ablation row {i + 1} ({label})")
         per_case = []
-        for case in cases:
-            _, _, m = hv.validate_case(scene, case, work, args.puncture, args.ranks, f"ablation row {i + 1} ({label})")
-            layers = hv.layer_rows(m)
-            per_case.append({"case": case["name"], "held_out": bool(case.get("overrides")),
-                             "force_rmse_relative": m["overall"]["force_rmse_relative"],
+        for case in summary["cases"]:
+            layers = case["layers"]
+            per_case.append({"case": case["name"], "held_out": case["held_out"],
+                             "force_rmse_relative": metrics[case["name"]]["overall"]["force_rmse_relative"],
                              "deflection_relative_rmse": mean(l["deflection_relative_rmse"] for l in layers),
                              "layers_accepted": sum(1 for l in layers if l["accepted"]), "layers": len(layers)})
         held = [c for c in per_case if c["held_out"]]
@@ -104,8 +122,8 @@ def main():
          "| model | force RMSE, calibration trajectory (in sample) | force RMSE, held out | deflection RMSE, held out | "
          "layers accepted, held out | tick mean (us) | tick p99 (us) |", "|---|---|---|---|---|---|---|"]
     for r in result:
-        L.append(f"| {r['row']} | {hv.fmt(r['in_sample_force_rmse_relative'], '.3f')} | "
-                 f"{hv.fmt(r['heldout_force_rmse_relative'], '.3f')} | {hv.fmt(r['heldout_deflection_relative_rmse'], '.2f')} | "
+        L.append(f"| {r['row']} | {fmt(r['in_sample_force_rmse_relative'], '.3f')} | "
+                 f"{fmt(r['heldout_force_rmse_relative'], '.3f')} | {fmt(r['heldout_deflection_relative_rmse'], '.2f')} | "
                  f"{r['heldout_layers_accepted']} | {r['tick_contact_mean_us']:.2f} | {r['tick_contact_p99_us']:.2f} |")
     L += ["", "The stiffening, cutting, friction and breakthrough values are the tuned preset's (calibrated with all of them "
           "on), so a row with a mechanism off is that preset without it, not a model refitted without it."]

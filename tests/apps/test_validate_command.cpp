@@ -480,5 +480,79 @@ TEST(ValidateCommand, BadSceneExitsWithTwoAndWritesNothing) {
   fs::remove_all(work);
 }
 
+TEST(ValidateCommand, CasesGiveOneReportPerCaseAndTheHeldOutSummary) {
+  const fs::path work = fresh_dir("validate_cases");
+  fs::create_directories(work);
+  const fs::path scene_file = work / "small.json";
+  std::ofstream(scene_file) << scene_to_json_text(small_scene());
+  std::ofstream(work / "cases.json") << R"({"cases": [{"name": "own"},
+      {"name": "fast", "overrides": {"insertion": {"speed_mm_per_s": 20, "withdrawal_speed_mm_per_s": 20}}}]})";
+  ValidateOptions options;
+  options.scene = scene_file;
+  options.cases = work / "cases.json";
+  options.model_note = "not calibrated";
+  options.output_dir = work / "report";
+  options.cache_dir = work / "cache";
+  options.write_vtk = false;
+  options.quiet = true;
+  std::ostringstream out, err;
+  ASSERT_EQ(validate_command(options, out, err), 0) << err.str();
+  const fs::path dir = options.output_dir;
+  for (const char* c : {"own", "fast"}) {
+    EXPECT_TRUE(fs::is_regular_file(dir / c / "validation_metrics.json")) << c;
+    EXPECT_TRUE(fs::is_regular_file(dir / c / "scene.json")) << c;
+    EXPECT_FALSE(fs::exists(dir / c / "validation.pvd")) << c;  // --no-vtk
+  }
+  // The case's scene is the model's with the override, and its report ran at that speed.
+  const Scene fast = load_scene(dir / "fast" / "scene.json");
+  EXPECT_DOUBLE_EQ(fast.insertion.speed_m_per_s, 0.02);
+  const validation::InsertionCurve curve = validation::read_insertion_curve(dir / "fast" / "realtime_curve.csv");
+  double fastest = 0.0;
+  for (double v : curve.velocity_m_per_s) fastest = std::max(fastest, v);
+  EXPECT_NEAR(fastest, 0.02, 1e-9);
+
+  std::ifstream in(dir / "heldout_summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  ASSERT_EQ(summary["cases"].size(), 2u);
+  EXPECT_EQ(summary["cases"][0]["name"], "own");
+  EXPECT_FALSE(summary["cases"][0]["held_out"].get<bool>());
+  EXPECT_TRUE(summary["cases"][1]["held_out"].get<bool>());
+  EXPECT_EQ(summary["model_note"], "not calibrated");
+  for (const auto& c : summary["cases"]) {
+    ASSERT_EQ(c["layers"].size(), 3u);
+    // Each row agrees with that case's own report.
+    std::ifstream m(dir / c["name"].get<std::string>() / "validation_metrics.json");
+    const nlohmann::json metrics = nlohmann::json::parse(m);
+    for (std::size_t k = 0; k < 3; ++k)
+      EXPECT_EQ(c["layers"][k]["accepted"].get<bool>(), metrics["acceptance"][k]["accepted"].get<bool>());
+  }
+  EXPECT_TRUE(fs::is_regular_file(dir / "heldout_summary.md"));
+  fs::remove_all(work);
+}
+
+TEST(ValidateCommand, BadCasesFileExitsWithTwoAndWritesNothing) {
+  const fs::path work = fresh_dir("validate_bad_cases");
+  fs::create_directories(work);
+  const fs::path scene_file = work / "small.json";
+  std::ofstream(scene_file) << scene_to_json_text(small_scene());
+  // The second case overrides a thickness count the scene does not have:
+  // found before any FEM runs or any report is written.
+  std::ofstream(work / "cases.json") << R"({"cases": [{"name": "own"},
+      {"name": "slab", "overrides": {"layer_thickness_mm": [1, 2]}}]})";
+  ValidateOptions options;
+  options.scene = scene_file;
+  options.cases = work / "cases.json";
+  options.output_dir = work / "report";
+  options.cache_dir = work / "cache";
+  options.quiet = true;
+  std::ostringstream out, err;
+  EXPECT_EQ(validate_command(options, out, err), 2);
+  EXPECT_NE(err.str().find("case slab"), std::string::npos) << err.str();
+  EXPECT_NE(err.str().find("layer_thickness_mm"), std::string::npos) << err.str();
+  EXPECT_FALSE(fs::exists(options.output_dir));
+  EXPECT_FALSE(fs::exists(options.cache_dir));
+  fs::remove_all(work);
+}
+
 }  // namespace
 }  // namespace puncture::apps

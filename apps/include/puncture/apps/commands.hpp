@@ -55,6 +55,10 @@ struct ValidateOptions {
   int degree = -1;                    ///< FEM degree, -1: from the scene
   bool write_vtk = true;              ///< VTK report (.vtp, .vtu, validation.pvd); false: CSV, PNG, md only
   bool quiet = false;
+  /// Cases file (validation_cases.hpp); empty: the scene alone. With cases,
+  /// output_dir holds one report per case and the held-out summary.
+  std::filesystem::path cases;
+  std::string model_note;             ///< with cases: how the model was calibrated, for the summary
 };
 
 /// `puncture validate`: real-time model and FEM reference (cached) on the

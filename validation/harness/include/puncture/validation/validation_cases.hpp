@@ -1,0 +1,86 @@
+// validation_cases.hpp: a set of validation cases (other speeds, depths and
+// holds, other slabs) on which one model scene is validated without retuning
+// (`puncture validate MODEL --cases FILE`), and the held-out summary.
+//
+// Cases file (JSON; validation/cases/default_heldout.json):
+//   {"description": "...",
+//    "cases": [{"name": "speed_3_mm_per_s",                  (required; [A-Za-z0-9_.-]+, unique)
+//               "overrides": {"insertion": {"speed_mm_per_s": 3, ...},   (fields of the scene's /insertion)
+//                             "layer_thickness_mm": [1.2, 5, 30]},       (one per layer, > 0)
+//               "held_out": true,                        (optional; default: overrides not empty)
+//               "rule": "...", "note": "..."}]}          (optional text for the page)
+// A case without overrides is the model's own trajectory (in sample when the
+// model was calibrated on it). read_validation_cases throws
+// std::invalid_argument naming the file and the JSON path of what is wrong.
+//
+// case_scene(model_json_text, model_file, case): the model scene's JSON with
+// the case's overrides, parsed (and so checked) as a scene; its text is
+// returned too, to be written beside the case's report.
+//
+// Held-out summary (heldout_summary.json, the schema of the real-time
+// physics issue plus "misses", "rule", "note"):
+//   {"model", "model_note", "cases_file", "cases": [{"name", "held_out",
+//    "scene", "rule", "note", "layers": [{"layer", "force_rmse_relative",
+//    "deflection_relative_rmse", "deflection_after_break_relative_rmse",
+//    "puncture_depth_error_mm", "puncture_force_error_relative",
+//    "accepted", "misses": [text]}]}], "provenance"}
+// Values that could not be computed are null and named in "misses".
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "puncture/scene.hpp"
+#include "puncture/validation/acceptance.hpp"
+
+namespace puncture::validation {
+
+struct ValidationCase {
+  std::string name;
+  bool held_out = false;
+  nlohmann::json insertion_overrides = nlohmann::json::object();  ///< keys of the scene's /insertion
+  std::vector<double> layer_thickness_mm;                          ///< empty: the model's thicknesses
+  std::string rule, note;
+};
+
+struct ValidationCases {
+  std::string description;
+  std::vector<ValidationCase> cases;
+};
+
+ValidationCases read_validation_cases(const std::filesystem::path& file);
+
+struct CaseScene {
+  Scene scene;
+  std::string json_text;  ///< the scene as validated (model JSON with the overrides)
+};
+/// Throws SceneError (file = "<model_file> (case <name>)") when an override
+/// makes the scene invalid, std::invalid_argument for an override the model
+/// scene does not have (an /insertion key it lacks, a thickness count that
+/// differs from its layers).
+CaseScene case_scene(const std::string& model_json_text, const std::string& model_file, const ValidationCase& c);
+
+/// One case's outcome: the acceptance per layer and the layer metrics JSON of
+/// `puncture validate` (layer_metrics_json, for the puncture depth error).
+struct CaseOutcome {
+  ValidationCase validation_case;
+  std::string scene_file;  ///< where the case's scene was written
+  std::vector<LayerAcceptance> acceptance;
+  nlohmann::json layers = nlohmann::json::array();
+};
+
+/// The "layers" rows of one case (see above).
+nlohmann::json case_layer_rows(const CaseOutcome& outcome);
+/// heldout_summary.json (provenance given as JSON).
+nlohmann::json heldout_summary_json(const std::vector<CaseOutcome>& outcomes, const std::string& model_file,
+                                    const std::string& model_note, const std::string& cases_file,
+                                    const nlohmann::json& provenance);
+/// heldout_summary.md from the summary JSON: one row per case and layer, the
+/// count of held-out layer-cases accepted, each case's rule and note.
+std::string heldout_summary_markdown(const nlohmann::json& summary, const std::string& command,
+                                     const std::string& provenance_line);
+
+}  // namespace puncture::validation

@@ -1,0 +1,246 @@
+#include "puncture/validation/validation_cases.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <optional>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "puncture/scene_io.hpp"
+#include "puncture/validation/number_format.hpp"
+
+namespace puncture::validation {
+
+namespace {
+
+using nlohmann::json;
+
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& pointer, const std::string& what) {
+  throw std::invalid_argument(file.string() + ": " + pointer + ": " + what);
+}
+
+std::string optional_text(const json& c, const char* key, const std::filesystem::path& file,
+                          const std::string& pointer) {
+  if (!c.contains(key)) return {};
+  if (!c[key].is_string()) fail(file, pointer + "/" + key, "must be a string");
+  return c[key].get<std::string>();
+}
+
+ValidationCase read_case(const json& c, const std::filesystem::path& file, const std::string& pointer) {
+  if (!c.is_object()) fail(file, pointer, "a case must be an object");
+  for (auto it = c.begin(); it != c.end(); ++it)
+    if (!std::set<std::string>{"name", "overrides", "held_out", "rule", "note"}.count(it.key()))
+      fail(file, pointer + "/" + it.key(), "unknown key");
+  ValidationCase v;
+  if (!c.contains("name") || !c["name"].is_string()) fail(file, pointer + "/name", "missing or not a string");
+  v.name = c["name"].get<std::string>();
+  if (!std::regex_match(v.name, std::regex("[A-Za-z0-9_.-]+")) || v.name == "." || v.name == "..")
+    fail(file, pointer + "/name", "\"" + v.name + "\" is not a folder name (letters, digits, _ . -)");
+  if (c.contains("overrides")) {
+    const json& o = c["overrides"];
+    const std::string op = pointer + "/overrides";
+    if (!o.is_object()) fail(file, op, "must be an object");
+    for (auto it = o.begin(); it != o.end(); ++it) {
+      if (it.key() == "insertion") {
+        if (!it->is_object()) fail(file, op + "/insertion", "must be an object");
+        for (auto f = it->begin(); f != it->end(); ++f)
+          if (!f->is_number() || !std::isfinite(f->get<double>()))
+            fail(file, op + "/insertion/" + f.key(), "must be a finite number");
+        v.insertion_overrides = *it;
+      } else if (it.key() == "layer_thickness_mm") {
+        if (!it->is_array() || it->empty()) fail(file, op + "/layer_thickness_mm", "must be a non-empty array");
+        for (std::size_t i = 0; i < it->size(); ++i) {
+          const json& t = (*it)[i];
+          if (!t.is_number() || !std::isfinite(t.get<double>()) || !(t.get<double>() > 0.0))
+            fail(file, op + "/layer_thickness_mm/" + std::to_string(i), "must be a positive number (mm)");
+          v.layer_thickness_mm.push_back(t.get<double>());
+        }
+      } else {
+        fail(file, op + "/" + it.key(), "unknown override (insertion, layer_thickness_mm)");
+      }
+    }
+  }
+  const bool overridden = !v.insertion_overrides.empty() || !v.layer_thickness_mm.empty();
+  v.held_out = overridden;
+  if (c.contains("held_out")) {
+    if (!c["held_out"].is_boolean()) fail(file, pointer + "/held_out", "must be true or false");
+    v.held_out = c["held_out"].get<bool>();
+  }
+  v.rule = optional_text(c, "rule", file, pointer);
+  v.note = optional_text(c, "note", file, pointer);
+  return v;
+}
+
+std::optional<double> value_of(const AcceptanceCheck& c) {
+  if (!c.available || !std::isfinite(c.value)) return std::nullopt;
+  return c.value;
+}
+
+json or_null(const std::optional<double>& x) { return x ? json(*x) : json(nullptr); }
+
+std::string miss(const char* label, const AcceptanceCheck& c, double scale, const char* unit) {
+  if (!c.available) return std::string(label) + ": " + (c.note.empty() ? "not available" : c.note);
+  if (c.met) return {};
+  return std::string(label) + " " + significant_digits(c.value * scale, 3) + unit + " beyond " +
+         significant_digits(c.limit * scale, 3) + unit;
+}
+
+std::string fixed(const json& v, int decimals, bool sign = false) {
+  if (!v.is_number()) return "n/a";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(decimals) << (sign ? std::showpos : std::noshowpos) << v.get<double>();
+  return s.str();
+}
+
+}  // namespace
+
+ValidationCases read_validation_cases(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw std::invalid_argument(file.string() + ": cannot open the cases file");
+  json root;
+  try {
+    root = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw std::invalid_argument(file.string() + ": not valid JSON: " + e.what());
+  }
+  if (!root.is_object()) fail(file, "/", "must be an object with \"cases\"");
+  for (auto it = root.begin(); it != root.end(); ++it)
+    if (it.key() != "description" && it.key() != "cases") fail(file, "/" + it.key(), "unknown key");
+  ValidationCases out;
+  if (root.contains("description")) {
+    if (!root["description"].is_string()) fail(file, "/description", "must be a string");
+    out.description = root["description"].get<std::string>();
+  }
+  if (!root.contains("cases") || !root["cases"].is_array() || root["cases"].empty())
+    fail(file, "/cases", "missing or not a non-empty array");
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < root["cases"].size(); ++i) {
+    const std::string pointer = "/cases/" + std::to_string(i);
+    out.cases.push_back(read_case(root["cases"][i], file, pointer));
+    if (!names.insert(out.cases.back().name).second)
+      fail(file, pointer + "/name", "\"" + out.cases.back().name + "\" appears twice");
+  }
+  return out;
+}
+
+CaseScene case_scene(const std::string& model_json_text, const std::string& model_file, const ValidationCase& c) {
+  json s = json::parse(model_json_text);
+  const std::string where = model_file + " (case " + c.name + ")";
+  if (!c.insertion_overrides.empty()) {
+    if (!s.contains("insertion") || !s["insertion"].is_object())
+      throw std::invalid_argument(where + ": the model scene has no /insertion to override");
+    for (auto it = c.insertion_overrides.begin(); it != c.insertion_overrides.end(); ++it) {
+      if (!s["insertion"].contains(it.key()))
+        throw std::invalid_argument(where + ": /insertion/" + it.key() + " is not a field of the model scene");
+      s["insertion"][it.key()] = *it;
+    }
+  }
+  if (!c.layer_thickness_mm.empty()) {
+    if (!s.contains("layers") || !s["layers"].is_array() || s["layers"].size() != c.layer_thickness_mm.size())
+      throw std::invalid_argument(where + ": layer_thickness_mm has " + std::to_string(c.layer_thickness_mm.size()) +
+                                  " values for " +
+                                  std::to_string(s.contains("layers") ? s["layers"].size() : 0) + " layers");
+    for (std::size_t k = 0; k < c.layer_thickness_mm.size(); ++k) s["layers"][k]["thickness_mm"] = c.layer_thickness_mm[k];
+  }
+  s["name"] = s.value("name", std::string("scene")) + "_" + c.name;
+  CaseScene out;
+  out.json_text = s.dump(2) + "\n";
+  out.scene = parse_scene(out.json_text, where);
+  return out;
+}
+
+json case_layer_rows(const CaseOutcome& outcome) {
+  json rows = json::array();
+  for (const LayerAcceptance& a : outcome.acceptance) {
+    json depth_error = nullptr;
+    for (const json& l : outcome.layers)
+      if (l.value("layer", std::string()) == a.layer && l.contains("puncture_depth_error_mm"))
+        depth_error = l["puncture_depth_error_mm"];
+    json misses = json::array();
+    const std::string checks[] = {
+        miss("force RMSE", a.force_rmse, 1.0, ""), miss("puncture depth", a.puncture_depth, 1e3, " mm"),
+        miss("puncture force", a.puncture_force, 1.0, ""),
+        a.deflection_judged ? miss("deflection RMSE before the break", a.deflection, 1.0, "") : "",
+        a.deflection_judged ? miss("deflection RMSE after the break", a.recovery, 1.0, "") : ""};
+    for (const std::string& text : checks)
+      if (!text.empty()) misses.push_back(text);
+    rows.push_back({{"layer", a.layer},
+                    {"force_rmse_relative", or_null(value_of(a.force_rmse))},
+                    {"deflection_relative_rmse", a.deflection_judged ? or_null(value_of(a.deflection)) : json(nullptr)},
+                    {"deflection_after_break_relative_rmse",
+                     a.deflection_judged ? or_null(value_of(a.recovery)) : json(nullptr)},
+                    {"puncture_depth_error_mm", depth_error},
+                    {"puncture_force_error_relative", or_null(value_of(a.puncture_force))},
+                    {"accepted", a.accepted()},
+                    {"misses", misses}});
+  }
+  return rows;
+}
+
+json heldout_summary_json(const std::vector<CaseOutcome>& outcomes, const std::string& model_file,
+                          const std::string& model_note, const std::string& cases_file, const json& provenance) {
+  json cases = json::array();
+  for (const CaseOutcome& o : outcomes) {
+    const ValidationCase& c = o.validation_case;
+    cases.push_back({{"name", c.name},
+                     {"held_out", c.held_out},
+                     {"scene", o.scene_file},
+                     {"rule", c.rule.empty() ? json(nullptr) : json(c.rule)},
+                     {"note", c.note.empty() ? json(nullptr) : json(c.note)},
+                     {"layers", case_layer_rows(o)}});
+  }
+  return {{"model", model_file},
+          {"model_note", model_note},
+          {"cases_file", cases_file},
+          {"cases", cases},
+          {"provenance", provenance}};
+}
+
+std::string heldout_summary_markdown(const json& summary, const std::string& command,
+                                     const std::string& provenance_line) {
+  std::ostringstream md;
+  md << "# Held-out validation of the tuned real-time model\n\n"
+     << "Command: `" << command << "`, " << provenance_line << ".\n\n"
+     << "Model: `" << summary.value("model", std::string()) << "`";
+  const std::string note = summary.value("model_note", std::string());
+  if (!note.empty()) md << " (" << note << ")";
+  md << ". Cases: `" << summary.value("cases_file", std::string())
+     << "`. A case with overrides is held out: the model was not tuned on it. Acceptance per layer: pressing and "
+        "cutting force RMSE <= 10 % of the FEM peak, puncture depth within L, puncture force within 10 %, "
+        "deflection RMSE of the layer's surface <= 15 % of the FEM's largest deflection before the breakthrough "
+        "and <= 25 % after it (the acceptance of `puncture validate`).\n\n"
+     << "| case | held out | layer | force RMSE / peak | deflection RMSE / largest, before the break | after the "
+        "break | puncture depth error (mm) | puncture force error | accepted | what misses |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|\n";
+  std::size_t held = 0, accepted = 0;
+  for (const json& c : summary["cases"]) {
+    const bool held_out = c["held_out"].get<bool>();
+    for (const json& l : c["layers"]) {
+      std::string misses;
+      for (const json& m : l["misses"]) misses += (misses.empty() ? "" : "; ") + m.get<std::string>();
+      md << "| " << c["name"].get<std::string>() << " | " << (held_out ? "yes" : "no (in sample)") << " | "
+         << l["layer"].get<std::string>() << " | " << fixed(l["force_rmse_relative"], 3) << " | "
+         << fixed(l["deflection_relative_rmse"], 2) << " | " << fixed(l["deflection_after_break_relative_rmse"], 2)
+         << " | " << fixed(l["puncture_depth_error_mm"], 2, true) << " | "
+         << fixed(l["puncture_force_error_relative"], 3, true) << " | " << (l["accepted"].get<bool>() ? "yes" : "no")
+         << " | " << (misses.empty() ? "-" : misses) << " |\n";
+      if (held_out) {
+        ++held;
+        if (l["accepted"].get<bool>()) ++accepted;
+      }
+    }
+  }
+  md << "\nHeld out: " << accepted << " of " << held
+     << " layer-cases accepted. Rules for cases that change the slab are in the cases file. Each case's report "
+        "(validation_summary.md, plots, the case's scene.json) is in its folder.\n";
+  for (const json& c : summary["cases"])
+    for (const char* key : {"rule", "note"})
+      if (c.contains(key) && c[key].is_string())
+        md << "\n`" << c["name"].get<std::string>() << "` (" << key << "): " << c[key].get<std::string>() << ".\n";
+  return md.str();
+}
+
+}  // namespace puncture::validation
