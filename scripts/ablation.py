@@ -6,8 +6,8 @@ then the tuned preset's force meshes without their stiffening (linear springs:
 k_a = z_v = 0), the paper's ring-w breakthrough and no other mechanism; then,
 one at a time, the tuned preset's stiffening (in the mesh: k_a and z_v where
 the surface fit identified them; of the tip spring elsewhere), cutting, shaft
-friction, the critical-force breakthrough (= the tuned preset as calibrated)
-and layer interaction. Each row is validated (`puncture validate SCENE --cases
+friction, the critical-force breakthrough, the coupled surfaces (= the tuned
+preset as calibrated) and layer interaction in place of the coupled surfaces. Each row is validated (`puncture validate SCENE --cases
 CASES_JSON`, FEM from out/.fem_cache) on every case of the cases file; its tick
 cost is the wall time of `puncture run` on the default trajectory (ticks with
 contact: mean and p99).
@@ -45,8 +45,11 @@ def rows(tuned, paper):
          variant(base + ["stiffening"], True)),
         ("+ cutting", variant(base + ["stiffening", "cutting"], True)),
         ("+ shaft friction", variant(base + ["stiffening", "cutting", "friction"], True)),
-        ("+ critical-force breakthrough (the tuned preset)", variant(base + ["stiffening", "cutting", "friction"], False)),
-        ("+ layer interaction", variant(base + ["stiffening", "cutting", "friction", "layer_interaction"], False)),
+        ("+ critical-force breakthrough", variant(base + ["stiffening", "cutting", "friction"], False)),
+        ("+ coupled surfaces (the tuned preset)",
+         variant(base + ["stiffening", "cutting", "friction", "coupled_surfaces"], False)),
+        ("+ layer interaction (in place of coupled surfaces)",
+         variant(base + ["stiffening", "cutting", "friction", "layer_interaction"], False)),
     ]
 
 

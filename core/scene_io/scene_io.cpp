@@ -115,7 +115,8 @@ class ObjectReader {
 };
 
 const std::set<std::string> kEffects{"surface_force", "damping",  "resumption", "surface_output",
-                                     "cutting",       "friction", "stiffening", "layer_interaction"};
+                                     "cutting",       "friction", "stiffening", "layer_interaction",
+                                     "coupled_surfaces"};
 const std::set<std::string> kModels{"realtime", "fem"};
 
 ForceMeshParams read_force_mesh(ObjectReader r) {
@@ -423,6 +424,7 @@ Scene read_scene(const json& root, const std::string& file) {
     s.effects.friction = on("friction");
     s.effects.stiffening = on("stiffening");
     s.effects.layer_interaction = on("layer_interaction");
+    s.effects.coupled_surfaces = on("coupled_surfaces");
   }
   if (r.has("haptics")) {
     ObjectReader o(r.raw("haptics"), "/haptics", file);
@@ -682,6 +684,10 @@ void validate_scene(const Scene& s, const std::string& file) {
                          "with the layer_interaction effect every layer below the first needs critical_force or "
                          "critical_energy (the ring rule counts the deflection carried from the layer above)");
     if (s.layers.size() > 16) throw SceneError(file, "/layers", "layer_interaction supports at most 16 layers");
+    if (s.effects.coupled_surfaces)
+      throw SceneError(file, "/effects",
+                       "coupled_surfaces and layer_interaction both move the layers below the needle layer; list "
+                       "one of them");
   }
 
   const Haptics& h = s.haptics;
@@ -882,6 +888,7 @@ std::string scene_to_json_text(const Scene& s) {
   if (s.effects.friction) effects.push_back("friction");
   if (s.effects.stiffening) effects.push_back("stiffening");
   if (s.effects.layer_interaction) effects.push_back("layer_interaction");
+  if (s.effects.coupled_surfaces) effects.push_back("coupled_surfaces");
   root["effects"] = effects;
   root["haptics"] = {{"max_force_N", s.haptics.max_force_N},
                      {"max_force_rate_N_per_s", s.haptics.max_force_rate_N_per_s},

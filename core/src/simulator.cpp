@@ -66,6 +66,46 @@ PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique
   }
   events_.reserve(layers_.size());
   result_.layers.resize(layers_.size());
+  if (scene.effects.coupled_surfaces && scene.effects.surface_force && !interaction_) {
+    std::vector<SurfaceCoupling::LayerGeometry> geometry(layers_.size());
+    Eigen::Index largest = 0;
+    for (std::size_t k = 0; k < layers_.size(); ++k) {
+      if (!layers_[k].mesh) continue;
+      geometry[k] = {&layers_[k].mesh->lattice(), scene.layers[k].force_mesh.spacing_L_m, layers_[k].top_depth_m};
+      largest = std::max<Eigen::Index>(largest, layers_[k].mesh->node_count());
+    }
+    coupling_.emplace(geometry);
+    break_deflection_ = Eigen::VectorXd::Zero(largest);
+    own_deflection_.resize(layers_.size());
+    drawn_deflection_.resize(layers_.size());
+  }
+}
+
+void PunctureSimulator::own_deflection(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const {
+  const LayerModel& layer = layers_[k];
+  const Eigen::Matrix3Xd& pos =
+      layer.resumption && layer.resumption->active() ? layer.resumption->positions() : layer.mesh->positions();
+  const Eigen::Matrix3Xd& rest = layer.mesh->rest_positions();
+  const Eigen::Matrix3Xd& normal = layer.mesh->normals();
+  for (Eigen::Index i = 0; i < pos.cols(); ++i) out(i) = normal.col(i).dot(rest.col(i) - pos.col(i));
+}
+
+void PunctureSimulator::freeze_coupled_baseline(std::size_t k) {
+  if (!coupling_ || k == 0 || !layers_[k].mesh || !layers_[k - 1].mesh) return;
+  auto above = break_deflection_.head(layers_[k - 1].mesh->node_count());
+  own_deflection(k - 1, above);
+  coupling_->freeze_baseline(k, above);
+}
+
+void PunctureSimulator::update_drawn_surfaces() const {
+  if (drawn_tick_ == ticks_) return;
+  for (std::size_t k = 0; k < layers_.size(); ++k) {
+    if (!layers_[k].mesh) continue;
+    own_deflection_[k].resize(layers_[k].mesh->node_count());
+    own_deflection(k, own_deflection_[k]);
+  }
+  coupling_->drawn(own_deflection_, active_, drawn_deflection_);
+  drawn_tick_ = ticks_;
 }
 
 const Eigen::Matrix3Xd& PunctureSimulator::node_rest_positions(std::size_t k) const {
@@ -83,6 +123,15 @@ const Eigen::Matrix3Xd& PunctureSimulator::node_positions(std::size_t k) const {
   if (!layer.mesh) return empty_positions_;
   const Eigen::Matrix3Xd& own =
       layer.resumption && layer.resumption->active() ? layer.resumption->positions() : layer.mesh->positions();
+  if (coupling_) {
+    update_drawn_surfaces();
+    layer.shifted_positions = own;
+    const Eigen::VectorXd& drawn = drawn_deflection_[k];
+    const Eigen::VectorXd& mine = own_deflection_[k];
+    for (Eigen::Index i = 0; i < own.cols(); ++i)
+      if (drawn(i) > mine(i)) layer.shifted_positions.col(i) -= (drawn(i) - mine(i)) * layer.mesh->normals().col(i);
+    return layer.shifted_positions;
+  }
   const double base = k + 1 < layers_.size() ? surface_deflection_m(k + 1) : 0.0;
   if (!interaction_ || base == 0.0) return own;
   // The layer rides on the surface of the layer below, moved by `base` along the normals.
@@ -276,6 +325,7 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
       !std::isfinite(needle.axial_velocity_m_per_s) || !std::isfinite(needle.time_s))
     throw std::invalid_argument("PunctureSimulator::tick: non-finite needle state");
 
+  ++ticks_;  // drawn surfaces of the last tick are stale from here on
   result_.time_s = needle.time_s;
   result_.depth_m = needle.depth_m();
   result_.velocity_m_per_s = needle.axial_velocity_m_per_s;
@@ -325,7 +375,13 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
     record_puncture(needle, surface_force);
     surface_force = 0.0;
     broke = true;
-    if (active_ < n && try_contact(needle) && !layers_[active_].mesh) {
+    const bool touched = active_ < n && try_contact(needle);
+    if (coupling_) {
+      // The layer met at the tip keeps the deformation the pressing left; the broken one rests on it.
+      if (touched && layers_[active_].contact_at_tip) freeze_coupled_baseline(active_);
+      coupling_->clear_baseline(active_ - 1);
+    }
+    if (touched && !layers_[active_].mesh) {
       const LayerModel& layer = layers_[active_];
       result_.layers[active_].contact_deflection_m =
           std::max(0.0, layer.contact.normal.dot(layer.contact.position - needle.tip_position_m));

@@ -20,6 +20,9 @@
 // symmetric about the needle axis Eq. (6)-(7) give R = I, so this differs
 // from the rigid fit only by the sinking translation. shape_matching.hpp
 // keeps Eq. (6)-(7) (shape_matching_goals) for comparison.
+// With Effects::coupled_surfaces the drawn surface is the larger of this
+// recovery and the surface of the layer below (coupled_surfaces.hpp): the
+// broken surface returns towards the deformed layers it rests on.
 //
 // In: rest positions (3 x n, m), recovery time T > 0 (s). All storage is
 // allocated at construction; start() and step() do not allocate.

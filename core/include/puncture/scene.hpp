@@ -285,6 +285,7 @@ struct Effects {
   bool friction = false;           ///< Karnopp shaft friction per punctured layer (Coulomb part; d h v is `damping`)
   bool stiffening = false;         ///< strain-stiffening virtual spring under the tip
   bool layer_interaction = false;  ///< layers in series: a layer pressed by the one above carries the load in its own force mesh
+  bool coupled_surfaces = false;   ///< surfaces drawn as one deformed slab (coupled_surfaces.hpp); changes no force
 };
 
 /// What the haptic device may be sent (the real-time app's stability guard,

@@ -66,6 +66,13 @@
 //      along the normals) and gets its nodes projected onto the curved
 //      surface kLayoutNodesPerTick per tick (a few us each on an SH surface),
 //      so an off-axis contact costs no spike in one tick.
+// Effects::coupled_surfaces (without layer interaction) draws the layers'
+// surfaces as one deformed slab (coupled_surfaces.hpp): the layers below the
+// needle layer follow its surface through the half-space transmission, a
+// layer met at the tip keeps the deformation the pressing left on it, and a
+// broken layer rests on the layer below. It changes node_positions() only,
+// never a force; it is computed when the surfaces are read, not in tick()
+// (except one matrix-vector product at a break, allocation-free).
 // The force meshes are laid out at construction around the point where the
 // scene's insertion axis (x = y = 0, direction -z) crosses each surface; the
 // mesh step is the fixed haptic step 1 / RealtimeSettings::haptic_rate_Hz.
@@ -73,6 +80,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -80,6 +88,7 @@
 
 #include "puncture/contact_surface.hpp"
 #include "puncture/force_mesh.hpp"
+#include "puncture/coupled_surfaces.hpp"
 #include "puncture/layer_chain.hpp"
 #include "puncture/needle.hpp"
 #include "puncture/puncture_force.hpp"
@@ -160,7 +169,8 @@ class PunctureSimulator {
   const Eigen::Matrix3Xd& node_rest_positions(std::size_t k) const;
   /// Current positions: the mesh while the layer is intact, the resumption
   /// after it broke; with layer interaction shifted by the deflection of the
-  /// layers below (not for use inside the haptic loop).
+  /// layers below, with coupled surfaces as drawn by SurfaceCoupling (not for
+  /// use inside the haptic loop).
   const Eigen::Matrix3Xd& node_positions(std::size_t k) const;
   /// 1-based ring index of every node; empty without force meshes.
   const std::vector<int>& node_rings(std::size_t k) const;
@@ -204,6 +214,12 @@ class PunctureSimulator {
   double step_chain(const NeedleState& needle, double transmitted_force_N);
   bool breakthrough(std::size_t k, double surface_force_N);
   void record_puncture(const NeedleState& needle, double surface_force_N);
+  /// Own deflection of layer k's nodes along the inward normals (m) into `out`.
+  void own_deflection(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const;
+  /// Coupled surfaces: layer k was met at the tip after layer k - 1 broke.
+  void freeze_coupled_baseline(std::size_t k);
+  /// Coupled surfaces: the drawn deflections of this tick (computed once per tick).
+  void update_drawn_surfaces() const;
 
   std::vector<LayerModel> layers_;
   std::vector<PunctureEvent> events_;
@@ -219,6 +235,11 @@ class PunctureSimulator {
   std::array<double, kMaxChainLinks> link_deflection_m_{};
   Eigen::Matrix3Xd empty_positions_;
   std::vector<int> empty_rings_;
+  std::optional<SurfaceCoupling> coupling_;  ///< Effects::coupled_surfaces
+  Eigen::VectorXd break_deflection_;         ///< drawn deflection of a layer at its break (largest mesh)
+  std::uint64_t ticks_ = 0;
+  mutable std::uint64_t drawn_tick_ = ~std::uint64_t{0};
+  mutable std::vector<Eigen::VectorXd> own_deflection_, drawn_deflection_;
 };
 
 }  // namespace puncture

@@ -99,6 +99,14 @@ TEST(SceneIoForceLaw, RoundTripKeepsEveryForceLawValue) {
   EXPECT_EQ(a.effects.friction, b.effects.friction);
   EXPECT_EQ(a.effects.stiffening, b.effects.stiffening);
   EXPECT_EQ(a.effects.layer_interaction, b.effects.layer_interaction);
+  // coupled_surfaces (without layer_interaction) is read and written back.
+  json j = with_force_law();
+  j["effects"] = {"surface_force", "resumption", "coupled_surfaces"};
+  const Scene c = parse_scene(j.dump(), "c.json");
+  EXPECT_TRUE(c.effects.coupled_surfaces);
+  EXPECT_FALSE(c.effects.layer_interaction);
+  EXPECT_TRUE(parse_scene(scene_to_json_text(c), "d.json").effects.coupled_surfaces);
+  EXPECT_FALSE(a.effects.coupled_surfaces);
 }
 
 TEST(SceneIoForceLaw, MeshStiffeningIsReadInSiUnitsAndWrittenOnlyWhenOn) {
@@ -165,6 +173,7 @@ const BadForceLaw kBad[] = {
     {"rings_below_with_interaction",
      [](json& j) { j["layers"][2]["force_law"]["breakthrough"] = {{"criterion", "rings"}}; },
      "/layers/2/force_law/breakthrough/criterion"},
+    {"coupled_surfaces_with_interaction", [](json& j) { j["effects"].push_back("coupled_surfaces"); }, "/effects"},
     {"zero_recovery_time", [](json& j) { j["layers"][1]["resumption_time_s"] = 0.0; }, "/layers/1/resumption_time_s"},
     {"negative_axial_stiffness", [](json& j) { j["layers"][0]["force_mesh"]["surface_axial_stiffness_N_per_mm"] = -1.0; },
      "/layers/0/force_mesh/surface_axial_stiffness_N_per_mm"},

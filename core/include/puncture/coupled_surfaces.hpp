@@ -1,0 +1,95 @@
+// coupled_surfaces.hpp: the layers' surfaces drawn as one deformed slab
+// (Effects::coupled_surfaces; used by the simulator, see simulator.hpp).
+//
+// The force of the real-time model comes from the needle layer's force mesh
+// alone; this only decides where the surfaces are drawn (and so what
+// `puncture validate` compares with the FEM's surfaces). Every layer k has its
+// own deflection o_k (m, > 0 into the tissue, per force-mesh node along the
+// inward normal: the mesh while intact, Eq. 8's resumption after it broke).
+// The drawn deflection is a radial profile D_k(r) on one grid shared by all
+// layers (r = 0, dr, ..., the widest mesh; dr = half the finest spacing L), so
+// a layer with a small mesh still carries the deformation of a wide one:
+//   O_k(r)   the own ring means at the rings' mean radii (ring 1 at r = 0),
+//            linear between them, 0 beyond the outer ring;
+//   needle layer a:       D_a = max(O_a, (1 - s) B_a), B_a the baseline it
+//                         was met with, s = min(1, O_a(0) / B_a(0)): the
+//                         layer's own mesh takes the deformation over as it
+//                         is pressed (its deflection is identified against
+//                         the FEM's whole surface deflection, calibrate
+//                         --surface-fit, so adding B_a would count it twice);
+//   a layer k below a:    D_k = max(O_k, T(a -> k) D_a), the half-space
+//                         transmission (surface_transmission.hpp) through the
+//                         depth between the two surfaces (the fat's top
+//                         follows the pressed skin);
+//   a broken layer k < a: D_k = max(O_k, D_{k+1}): it rests on the layer
+//                         below and returns to it, not through it to its rest
+//                         shape (bottom-up);
+//   all broken:           the last layer its own, the ones above rest on it.
+// Baseline: when layer a breaks and the needle meets layer a + 1 below that
+// layer's rest surface (contact at the tip, simulator.hpp), layer a + 1 is
+// where the pressing left it: B_{a+1} = T(a -> a+1) D_a at the break, kept
+// (and taken over, above) while a + 1 is the needle layer.
+// Per node i of layer k (distance rho_i from the axis in the lattice's plane):
+// d_k(i) = max(o_k(i), D_k(rho_i)).
+//
+// In: per layer its hex lattice (nullptr: no force mesh), spacing L (m) and
+// the depth of its top below the first surface (m). The transmission
+// matrices of a geometry are computed once per process (shared cache).
+// freeze_baseline() does not allocate; drawn() is for reading surfaces, not
+// for the haptic tick.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "puncture/hex_lattice.hpp"
+
+namespace puncture {
+
+class SurfaceCoupling {
+ public:
+  struct LayerGeometry {
+    const HexLattice* lattice = nullptr;  ///< nullptr: the layer has no force mesh
+    double spacing_m = 0.0;
+    double top_depth_m = 0.0;
+  };
+  /// Throws std::invalid_argument for a non-positive spacing or layer tops that do not deepen.
+  explicit SurfaceCoupling(const std::vector<LayerGeometry>& layers);
+
+  /// own[k]: own node deflections of layer k (its lattice's size; anything
+  /// for a layer without a mesh). needle_layer == layer count: all broken.
+  /// Writes drawn[k] (node deflections, m).
+  void drawn(const std::vector<Eigen::VectorXd>& own, std::size_t needle_layer,
+             std::vector<Eigen::VectorXd>& drawn) const;
+  /// Layer k (> 0) met at the tip when layer k - 1 broke; own_above: layer
+  /// k - 1's own node deflections at the break. Sets B_k (no allocation).
+  void freeze_baseline(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own_above);
+  /// Layer k is no longer the needle layer where it was met.
+  void clear_baseline(std::size_t k) { has_baseline_[k] = false; }
+  bool has_baseline(std::size_t k) const { return has_baseline_[k]; }
+
+  /// The shared radial grid (m) and a layer's drawn profile on it after drawn().
+  const std::vector<double>& grid_m() const { return grid_; }
+  const Eigen::VectorXd& profile(std::size_t k) const { return profile_[k]; }
+  const std::vector<double>& node_radii_m(std::size_t k) const { return node_radius_[k]; }
+  /// T(a -> k), a < k, on the grid (grid x grid).
+  const Eigen::MatrixXd& transmission(std::size_t a, std::size_t k) const { return *weights_[a][k]; }
+
+ private:
+  /// O_k on the grid into out.
+  void own_profile(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own, Eigen::VectorXd& out) const;
+
+  std::size_t n_ = 0;
+  std::vector<double> grid_;
+  std::vector<const HexLattice*> lattice_;
+  std::vector<std::vector<double>> node_radius_, ring_radius_;
+  std::vector<std::vector<int>> ring_count_;
+  std::vector<std::vector<std::shared_ptr<const Eigen::MatrixXd>>> weights_;
+  std::vector<Eigen::VectorXd> baseline_;
+  std::vector<bool> has_baseline_;
+  mutable std::vector<Eigen::VectorXd> profile_;
+  mutable Eigen::VectorXd ring_means_, scratch_;
+};
+
+}  // namespace puncture

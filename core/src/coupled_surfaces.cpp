@@ -1,0 +1,138 @@
+#include "puncture/coupled_surfaces.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+#include <tuple>
+
+#include "puncture/surface_transmission.hpp"
+
+namespace puncture {
+
+namespace {
+
+/// T on a uniform grid of `points` points spaced `step_m`, for depth_m: the
+/// same geometry gives the same matrix, so it is computed once per process.
+std::shared_ptr<const Eigen::MatrixXd> grid_weights(const std::vector<double>& grid, double depth_m) {
+  static std::mutex mutex;
+  static std::map<std::tuple<std::size_t, long long, long long>, std::shared_ptr<const Eigen::MatrixXd>> cache;
+  const auto key = std::make_tuple(grid.size(), std::llround(grid[1] * 1e12), std::llround(depth_m * 1e12));
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (const auto it = cache.find(key); it != cache.end()) return it->second;
+  }
+  auto w = std::make_shared<const Eigen::MatrixXd>(transmission_weights(grid, grid, depth_m));
+  std::lock_guard<std::mutex> lock(mutex);
+  return cache.emplace(key, std::move(w)).first->second;
+}
+
+/// Linear interpolation on the uniform grid; 0 beyond it.
+double on_grid(const std::vector<double>& grid, const Eigen::VectorXd& values, double r) {
+  const double dr = grid[1];
+  const double x = r / dr;
+  const auto j = static_cast<Eigen::Index>(std::floor(x));
+  if (j + 1 >= values.size()) return j + 1 == values.size() && x == static_cast<double>(j) ? values(j) : 0.0;
+  const double t = x - static_cast<double>(j);
+  return (1.0 - t) * values(j) + t * values(j + 1);
+}
+
+}  // namespace
+
+SurfaceCoupling::SurfaceCoupling(const std::vector<LayerGeometry>& layers)
+    : n_(layers.size()),
+      lattice_(n_, nullptr),
+      node_radius_(n_),
+      ring_radius_(n_),
+      ring_count_(n_),
+      weights_(n_, std::vector<std::shared_ptr<const Eigen::MatrixXd>>(n_)),
+      baseline_(n_),
+      has_baseline_(n_, false),
+      profile_(n_) {
+  double finest = 0.0, widest = 0.0;
+  int most_rings = 1;
+  for (std::size_t k = 0; k < n_; ++k) {
+    const LayerGeometry& g = layers[k];
+    lattice_[k] = g.lattice;
+    if (!g.lattice) continue;
+    if (!(g.spacing_m > 0.0) || !std::isfinite(g.spacing_m))
+      throw std::invalid_argument("SurfaceCoupling: spacing must be > 0");
+    const int nodes = g.lattice->node_count(), w = g.lattice->rings_w;
+    most_rings = std::max(most_rings, w);
+    node_radius_[k].resize(static_cast<std::size_t>(nodes));
+    ring_radius_[k].assign(static_cast<std::size_t>(w), 0.0);
+    ring_count_[k].assign(static_cast<std::size_t>(w), 0);
+    for (int i = 0; i < nodes; ++i) {
+      const double r = g.lattice->planar_position(i, g.spacing_m).norm();
+      const auto ring = static_cast<std::size_t>(g.lattice->ring[static_cast<std::size_t>(i)] - 1);
+      node_radius_[k][static_cast<std::size_t>(i)] = r;
+      ring_radius_[k][ring] += r;
+      ++ring_count_[k][ring];
+    }
+    for (int j = 0; j < w; ++j) ring_radius_[k][static_cast<std::size_t>(j)] /= ring_count_[k][static_cast<std::size_t>(j)];
+    ring_radius_[k][0] = 0.0;
+    finest = finest == 0.0 ? g.spacing_m : std::min(finest, g.spacing_m);
+    widest = std::max(widest, ring_radius_[k].back());
+  }
+  if (finest == 0.0) return;  // no force meshes: nothing to draw
+  const double dr = 0.5 * finest;
+  const auto points = static_cast<std::size_t>(std::ceil(widest / dr)) + 1;
+  grid_.resize(std::max<std::size_t>(points, 2));
+  for (std::size_t g = 0; g < grid_.size(); ++g) grid_[g] = dr * static_cast<double>(g);
+  for (std::size_t a = 0; a < n_; ++a) {
+    profile_[a] = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(grid_.size()));
+    baseline_[a] = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(grid_.size()));
+    for (std::size_t k = a + 1; k < n_; ++k) {
+      const double depth = layers[k].top_depth_m - layers[a].top_depth_m;
+      if (!(depth > 0.0)) throw std::invalid_argument("SurfaceCoupling: layer tops must deepen downwards");
+      if (lattice_[a] && lattice_[k]) weights_[a][k] = grid_weights(grid_, depth);
+    }
+  }
+  ring_means_ = Eigen::VectorXd::Zero(most_rings);
+  scratch_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(grid_.size()));
+}
+
+void SurfaceCoupling::own_profile(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own,
+                                  Eigen::VectorXd& out) const {
+  const std::vector<int>& ring = lattice_[k]->ring;
+  const std::vector<double>& radius = ring_radius_[k];
+  auto means = ring_means_.head(static_cast<Eigen::Index>(radius.size()));
+  means.setZero();
+  for (Eigen::Index i = 0; i < own.size(); ++i) means(ring[static_cast<std::size_t>(i)] - 1) += own(i);
+  for (Eigen::Index j = 0; j < means.size(); ++j) means(j) /= ring_count_[k][static_cast<std::size_t>(j)];
+  for (std::size_t g = 0; g < grid_.size(); ++g)
+    out(static_cast<Eigen::Index>(g)) = profile_value_at(radius, means.data(), grid_[g]);
+}
+
+void SurfaceCoupling::freeze_baseline(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own_above) {
+  if (k == 0 || k >= n_ || !lattice_[k] || !lattice_[k - 1]) return;
+  own_profile(k - 1, own_above, scratch_);
+  if (has_baseline_[k - 1]) scratch_ = scratch_.cwiseMax(baseline_[k - 1]);
+  baseline_[k].noalias() = *weights_[k - 1][k] * scratch_;
+  has_baseline_[k] = true;
+}
+
+void SurfaceCoupling::drawn(const std::vector<Eigen::VectorXd>& own, std::size_t a,
+                            std::vector<Eigen::VectorXd>& d) const {
+  for (std::size_t k = 0; k < n_; ++k)
+    if (lattice_[k]) own_profile(k, own[k], profile_[k]);
+  if (a < n_ && lattice_[a]) {
+    if (has_baseline_[a] && baseline_[a](0) > 0.0) {
+      const double taken_over = std::clamp(profile_[a](0) / baseline_[a](0), 0.0, 1.0);
+      profile_[a] = profile_[a].cwiseMax((1.0 - taken_over) * baseline_[a]);
+    }
+    for (std::size_t k = a + 1; k < n_; ++k)
+      if (lattice_[k]) profile_[k] = profile_[k].cwiseMax(*weights_[a][k] * profile_[a]);
+  }
+  for (std::size_t k = std::min(a, n_ - 1); k-- > 0;)  // broken layers rest on the layer below
+    if (lattice_[k] && lattice_[k + 1]) profile_[k] = profile_[k].cwiseMax(profile_[k + 1]);
+  for (std::size_t k = 0; k < n_; ++k) {
+    if (!lattice_[k]) continue;
+    d[k].resize(own[k].size());
+    for (Eigen::Index i = 0; i < own[k].size(); ++i)
+      d[k](i) = std::max(own[k](i), on_grid(grid_, profile_[k], node_radius_[k][static_cast<std::size_t>(i)]));
+  }
+}
+
+}  // namespace puncture

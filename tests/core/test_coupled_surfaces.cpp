@@ -1,0 +1,268 @@
+// Surfaces drawn as one deformed slab: the half-space transmission
+// (surface_transmission.hpp) against closed forms, brute-force quadrature and
+// an independent Hankel-transform evaluation; SurfaceCoupling's rules
+// (coupled_surfaces.hpp); the simulator with Effects::coupled_surfaces.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "allocation_counter.hpp"
+#include "puncture/coupled_surfaces.hpp"
+#include "puncture/needle.hpp"
+#include "puncture/simulator.hpp"
+#include "puncture/surface_transmission.hpp"
+#include "table2_scene.hpp"
+
+using namespace puncture;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Integral of G_h over the disc of radius R: 1 - h^3 / (R^2 + h^2)^(3/2).
+double disc_fraction(double R, double h) { return 1.0 - h * h * h / std::pow(R * R + h * h, 1.5); }
+
+TEST(SurfaceTransmission, KernelIntegratesToTheClosedFormOverADisc) {
+  for (double h : {0.8e-3, 9.2e-3}) {
+    for (double R : {2e-3, 20e-3}) {
+      const int n = 200000;
+      double sum = 0.0;
+      for (int i = 0; i < n; ++i) {
+        const double rho = (i + 0.5) * R / n;
+        sum += boussinesq_kernel_per_m2(rho, h) * 2.0 * kPi * rho * R / n;
+      }
+      EXPECT_NEAR(sum, disc_fraction(R, h), 1e-7) << h << " " << R;
+    }
+  }
+}
+
+TEST(SurfaceTransmission, RingKernelMatchesTheAngularQuadratureOfTheKernel) {
+  for (double h : {0.5e-3, 4e-3}) {
+    for (double rho : {0.0, 1e-3, 3e-3}) {
+      for (double s : {0.0, 0.9e-3, 3.1e-3, 10e-3}) {
+        const int n = 20000;  // periodic trapezoid: spectrally accurate
+        double sum = 0.0;
+        for (int i = 0; i < n; ++i) {
+          const double t = 2.0 * kPi * i / n;
+          sum += boussinesq_kernel_per_m2(std::sqrt(rho * rho + s * s - 2.0 * rho * s * std::cos(t)), h);
+        }
+        sum *= 2.0 * kPi / n;
+        EXPECT_NEAR(boussinesq_ring_kernel_per_m(rho, s, h), sum, 1e-9 * std::max(1.0, sum))
+            << h << " " << rho << " " << s;
+      }
+    }
+  }
+}
+
+TEST(SurfaceTransmission, UniformDeflectionOverADiscPassesByTheDiscFraction) {
+  const double R = 15e-3, h = 2e-3;
+  std::vector<double> r;
+  for (int j = 0; j <= 30; ++j) r.push_back(R * j / 30.0);
+  const Eigen::MatrixXd W = transmission_weights(r, {0.0}, h);
+  // The profile is 1 up to R and 0 beyond: at the centre the disc fraction
+  // (the last hat's outer half is cut off at R, as the profile is).
+  EXPECT_NEAR(W.row(0).sum(), disc_fraction(R, h), 1e-6);
+  // A narrow kernel (h much smaller than the spacing) passes the profile almost unchanged.
+  const Eigen::MatrixXd near = transmission_weights(r, {5e-3}, 0.05e-3);
+  EXPECT_NEAR(near.row(0).sum(), 1.0, 1e-3);
+}
+
+TEST(SurfaceTransmission, GaussianProfileAgainstTheHankelTransform) {
+  // u(s) = exp(-s^2 / c^2): Hankel transform U(k) = c^2 / 2 exp(-k^2 c^2 / 4);
+  // at depth h: u_h(rho) = integral U(k) (1 + k h) exp(-k h) J0(k rho) k dk,
+  // an evaluation that shares nothing with the real-space kernel.
+  const double c = 3e-3, h = 2e-3;
+  std::vector<double> r;
+  std::vector<double> u;
+  for (int j = 0; j <= 600; ++j) {
+    r.push_back(6.0 * c * j / 600.0);
+    u.push_back(std::exp(-r.back() * r.back() / (c * c)));
+  }
+  const std::vector<double> targets{0.0, 1e-3, 3e-3, 6e-3};
+  const Eigen::MatrixXd W = transmission_weights(r, targets, h);
+  const Eigen::VectorXd values = Eigen::Map<const Eigen::VectorXd>(u.data(), static_cast<Eigen::Index>(u.size()));
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    const int n = 40000;
+    const double kmax = 12.0 / c;
+    double hankel = 0.0;
+    for (int m = 0; m < n; ++m) {
+      const double k = (m + 0.5) * kmax / n;
+      hankel += 0.5 * c * c * std::exp(-k * k * c * c / 4.0) * (1.0 + k * h) * std::exp(-k * h) *
+                std::cyl_bessel_j(0.0, k * targets[i]) * k * kmax / n;
+    }
+    const double real_space = W.row(static_cast<Eigen::Index>(i)).dot(values);
+    EXPECT_NEAR(real_space, hankel, 2e-4) << targets[i];
+    EXPECT_LT(real_space, 1.0);
+  }
+}
+
+TEST(SurfaceTransmission, BadInputIsRejectedAndProfilesInterpolate) {
+  EXPECT_THROW(transmission_weights({0.0, 1e-3}, {0.0}, 0.0), std::invalid_argument);
+  EXPECT_THROW(transmission_weights({1e-3, 2e-3}, {0.0}, 1e-3), std::invalid_argument);
+  EXPECT_THROW(transmission_weights({0.0, 2e-3, 1e-3}, {0.0}, 1e-3), std::invalid_argument);
+  EXPECT_THROW(transmission_weights({0.0, 1e-3}, {-1e-3}, 1e-3), std::invalid_argument);
+  const std::vector<double> r{0.0, 1.0, 3.0};
+  const double u[] = {2.0, 1.0, 0.5};
+  EXPECT_DOUBLE_EQ(profile_value_at(r, u, 0.0), 2.0);
+  EXPECT_DOUBLE_EQ(profile_value_at(r, u, 0.5), 1.5);
+  EXPECT_DOUBLE_EQ(profile_value_at(r, u, 2.0), 0.75);
+  EXPECT_DOUBLE_EQ(profile_value_at(r, u, 3.0), 0.5);
+  EXPECT_DOUBLE_EQ(profile_value_at(r, u, 3.5), 0.0);
+}
+
+// ---------------------------------------------------------------------------
+// SurfaceCoupling
+
+struct TwoLayers {
+  HexLattice top = make_hex_lattice(12), bottom = make_hex_lattice(12);
+  SurfaceCoupling coupling{{{&top, 1e-3, 0.0}, {&bottom, 1e-3, 2e-3}}};
+  std::vector<Eigen::VectorXd> own{Eigen::VectorXd::Zero(top.node_count()),
+                                   Eigen::VectorXd::Zero(bottom.node_count())};
+  std::vector<Eigen::VectorXd> drawn{own};
+};
+
+TEST(SurfaceCoupling, TheLayerBelowFollowsThePressedSurfaceThroughTheLayerBetween) {
+  TwoLayers s;
+  s.own[0].setConstant(1e-3);  // the whole top mesh sunk by 1 mm
+  s.coupling.drawn(s.own, 0, s.drawn);
+  EXPECT_LE((s.drawn[0] - s.own[0]).cwiseAbs().maxCoeff(), 1e-15);
+  // Centre of the layer 2 mm below: the uniform disc of radius 11 mm (the outer
+  // ring) through 2 mm, less the linear fall to 0 over the last half spacing.
+  const double R = 11e-3, h = 2e-3;
+  EXPECT_NEAR(s.drawn[1](0), 1e-3 * disc_fraction(R, h), 0.01e-3);
+  EXPECT_LT(s.drawn[1](0), 1e-3);
+  // Farther out the transmitted deflection falls off (the edge of the loaded disc).
+  EXPECT_LT(s.drawn[1](s.drawn[1].size() - 1), 0.6e-3);
+}
+
+TEST(SurfaceCoupling, ABrokenLayerRestsOnTheLayerBelow) {
+  TwoLayers s;
+  for (Eigen::Index i = 0; i < s.own[1].size(); ++i) s.own[1](i) = 2e-3;  // the needle layer pressed flat
+  s.coupling.drawn(s.own, 1, s.drawn);
+  EXPECT_NEAR(s.drawn[0](0), 2e-3, 1e-15);  // the broken top layer (own 0) rests on it
+  EXPECT_LE((s.drawn[1] - s.own[1]).cwiseAbs().maxCoeff(), 1e-15);
+  // Its own recovery wins where it is deeper than the support.
+  s.own[0](0) = 3e-3;
+  s.coupling.drawn(s.own, 1, s.drawn);
+  EXPECT_DOUBLE_EQ(s.drawn[0](0), 3e-3);
+  // All broken: the last layer as its own, the top one rests on it.
+  s.own[0].setZero();
+  s.own[1].setZero();
+  s.own[1](0) = 1e-3;
+  s.coupling.drawn(s.own, 2, s.drawn);
+  EXPECT_DOUBLE_EQ(s.drawn[1](0), 1e-3);
+  EXPECT_NEAR(s.drawn[0](0), 1e-3, 1e-15);
+}
+
+TEST(SurfaceCoupling, ALayerMetAtTheTipKeepsTheDeformationUntilItsMeshTakesItOver) {
+  TwoLayers s;
+  Eigen::VectorXd at_break(s.top.node_count());
+  at_break.setConstant(1e-3);
+  s.coupling.freeze_baseline(1, at_break);
+  ASSERT_TRUE(s.coupling.has_baseline(1));
+  s.coupling.drawn(s.own, 1, s.drawn);
+  const double baseline_centre = s.drawn[1](0);
+  const Eigen::Index outer = s.own[1].size() / 2;
+  const double baseline_outer = s.drawn[1](outer);
+  EXPECT_NEAR(baseline_centre, 1e-3 * disc_fraction(11e-3, 2e-3), 0.01e-3);
+  EXPECT_GT(baseline_outer, 0.0);
+  // Pressed by half the baseline at its centre: half of the baseline is left.
+  s.own[1](0) = 0.5 * baseline_centre;
+  s.coupling.drawn(s.own, 1, s.drawn);
+  EXPECT_NEAR(s.drawn[1](0), 0.5 * baseline_centre, 1e-12);
+  EXPECT_NEAR(s.drawn[1](outer), 0.5 * baseline_outer, 1e-12);
+  // Pressed beyond it: the mesh alone.
+  s.own[1](0) = 2.0 * baseline_centre;
+  s.coupling.drawn(s.own, 1, s.drawn);
+  EXPECT_EQ(s.drawn[1](0), s.own[1](0));
+  EXPECT_EQ(s.drawn[1](s.own[1].size() - 1), 0.0);
+  s.coupling.clear_baseline(1);
+  s.own[1].setZero();
+  s.coupling.drawn(s.own, 1, s.drawn);
+  EXPECT_EQ(s.drawn[1].cwiseAbs().maxCoeff(), 0.0);
+}
+
+// ---------------------------------------------------------------------------
+// The simulator with coupled surfaces
+
+/// A thin upper layer broken 1.5 mm deep, below the rest surface of the thick
+/// one under it (met at the tip), on planes; quasi-static meshes.
+Scene thin_over_thick(bool coupled) {
+  Scene s;
+  s.name = "thin_over_thick";
+  s.layers.push_back(test::table2_layer("a", 1e-3, 200.0, 0.0, 8, 1e-3, 100.0, 1.0, 0.05));
+  s.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 6, 1e-3, 100.0, 1.0, 0.05));
+  for (Layer& l : s.layers) {
+    l.force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+    l.force_law.breakthrough.critical_force_N = 1e3;
+    l.resumption_time_s = 0.02;
+  }
+  s.layers[0].force_law.breakthrough.critical_force_N = 1.0;
+  s.realtime.integrator = "quasi_static";
+  s.effects.damping = false;
+  s.effects.coupled_surfaces = coupled;
+  return s;
+}
+
+double centre_deflection(const PunctureSimulator& sim, std::size_t k) {
+  return sim.node_rest_positions(k)(2, 0) - sim.node_positions(k)(2, 0);
+}
+
+TEST(CoupledSurfaces, ForcesUnchangedSurfacesDrawnTogether) {
+  PunctureSimulator plain(thin_over_thick(false), test::plane_surfaces(thin_over_thick(false)));
+  PunctureSimulator coupled(thin_over_thick(true), test::plane_surfaces(thin_over_thick(true)));
+  const double dt = 1e-3, v = 0.01;
+  double below_while_pressed = 0.0, top_after_recovery = 0.0, top_plain_after_recovery = 0.0;
+  double break_t = -1.0;
+  for (int i = 0; i < 600; ++i) {
+    NeedleState n;
+    n.time_s = i * dt;
+    n.tip_position_m = Eigen::Vector3d(0.0, 0.0, 0.5e-3 - v * n.time_s);
+    n.axial_velocity_m_per_s = v;
+    const TickResult& a = plain.tick(n);
+    const double force_plain = a.total_force_N;
+    const TickResult& b = coupled.tick(n);
+    ASSERT_EQ(b.total_force_N, force_plain) << "tick " << i;  // the effect changes no force
+    if (coupled.puncture_events().empty()) {
+      below_while_pressed = centre_deflection(coupled, 1);
+      EXPECT_EQ(centre_deflection(plain, 1), 0.0);
+      EXPECT_LE(centre_deflection(coupled, 1), centre_deflection(coupled, 0) + 1e-15);
+    } else if (break_t < 0.0) {
+      break_t = n.time_s;
+    } else if (n.time_s > break_t + 0.05) {  // long after the 20 ms recovery
+      top_after_recovery = centre_deflection(coupled, 0);
+      top_plain_after_recovery = centre_deflection(plain, 0);
+      break;
+    }
+  }
+  ASSERT_GT(break_t, 0.0);
+  ASSERT_EQ(coupled.puncture_events().size(), 1u);
+  const double break_depth = coupled.puncture_events()[0].depth_m;
+  ASSERT_GT(break_depth, 1e-3);  // broken below the lower layer's rest surface
+  // While the thin layer was pressed, the surface below followed it (most of its deflection through 1 mm).
+  EXPECT_GT(below_while_pressed, 0.5 * (break_depth - 1e-3));
+  // After the break and the recovery time the broken layer rests on the
+  // pressed layer below instead of returning to its rest shape through it.
+  EXPECT_EQ(top_plain_after_recovery, 0.0);
+  EXPECT_GT(top_after_recovery, 0.5e-3);
+}
+
+TEST(CoupledSurfaces, TickAllocatesNothing) {
+  Scene scene = thin_over_thick(true);
+  PunctureSimulator sim(scene, test::plane_surfaces(scene));
+  std::vector<NeedleState> states;
+  for (int i = 0; i < 400; ++i) {
+    NeedleState n;
+    n.time_s = i * 1e-3;
+    n.tip_position_m = Eigen::Vector3d(0.0, 0.0, 0.5e-3 - 0.01 * n.time_s);
+    n.axial_velocity_m_per_s = 0.01;
+    states.push_back(n);
+  }
+  test::start_counting_allocations();
+  for (const NeedleState& n : states) sim.tick(n);
+  EXPECT_EQ(test::stop_counting_allocations(), 0);
+  EXPECT_EQ(sim.puncture_events().size(), 1u);  // the break (and its baseline) happened in the counted ticks
+}
+
+}  // namespace
