@@ -18,6 +18,8 @@
 #   results/liver_calibration/   puncture calibrate of the two-layer liver scene against the
 #                                measured Okamura 2004 curve (../shared/data)
 #   results/validation_tuned/    puncture validate of the tuned preset
+#   results/surface_transmission/ how the FEM's layer surfaces move together, beside the
+#                                rules of the coupled_surfaces effect (surface_transmission_study.py)
 #   results/accuracy_cost/       puncture sweep of the tuned preset (real-time knobs
 #                                against the default-resolution FEM)
 # The FEM reference runs once, on RANKS MPI ranks (default 2; about 5 min), and is
@@ -56,6 +58,9 @@ rate=()
 shared="${PUNCTURE_SHARED_DATA_DIR:-$root/../shared/data}"
 "$build/apps/puncture" calibrate scenes/liver_okamura.json -o results/liver_calibration --name liver_tuned \
   --reference "$shared/okamura2004_liver_depth_force.csv" --reference-depth-offset 9.5 --puncture-depths 9.65,9.66
+rm -rf results/validation_tuned  # no frames left from an earlier FEM reference
 "${mpi[@]}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json -o results/validation_tuned
+tuned_fem="$("$py" -c 'import json,sys; print(json.load(open(sys.argv[1]))["fem_reference"]["cache_dir"])' results/validation_tuned/validation_metrics.json)"
+"$py" scripts/surface_transmission_study.py "${tuned_fem%/}" results/tuned_preset/default_tuned.json results/surface_transmission
 "$build/apps/puncture" sweep results/tuned_preset/default_tuned.json --no-fem-knobs -o results/accuracy_cost
-echo "results in results/validation_default, results/validation_paper_table2, results/tuned_preset, results/liver_calibration, results/validation_tuned, results/accuracy_cost"
+echo "results in results/validation_default, results/validation_paper_table2, results/tuned_preset, results/liver_calibration, results/validation_tuned, results/surface_transmission, results/accuracy_cost"
