@@ -48,7 +48,11 @@ SurfaceCoupling::SurfaceCoupling(const std::vector<LayerGeometry>& layers)
       ring_count_(n_),
       weights_(n_, std::vector<std::shared_ptr<const Eigen::MatrixXd>>(n_)),
       baseline_(n_),
+      break_profile_(n_),
+      break_force_N_(n_, 0.0),
+      break_depth_m_(n_, 0.0),
       has_baseline_(n_, false),
+      has_break_(n_, false),
       profile_(n_) {
   double finest = 0.0, widest = 0.0;
   int most_rings = 1;
@@ -83,6 +87,7 @@ SurfaceCoupling::SurfaceCoupling(const std::vector<LayerGeometry>& layers)
   for (std::size_t a = 0; a < n_; ++a) {
     profile_[a] = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(grid_.size()));
     baseline_[a] = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(grid_.size()));
+    break_profile_[a] = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(grid_.size()));
     for (std::size_t k = a + 1; k < n_; ++k) {
       const double depth = layers[k].top_depth_m - layers[a].top_depth_m;
       if (!(depth > 0.0)) throw std::invalid_argument("SurfaceCoupling: layer tops must deepen downwards");
@@ -105,18 +110,57 @@ void SurfaceCoupling::own_profile(std::size_t k, const Eigen::Ref<const Eigen::V
     out(static_cast<Eigen::Index>(g)) = profile_value_at(radius, means.data(), grid_[g]);
 }
 
-void SurfaceCoupling::freeze_baseline(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own_above) {
-  if (k == 0 || k >= n_ || !lattice_[k] || !lattice_[k - 1]) return;
-  own_profile(k - 1, own_above, scratch_);
-  if (has_baseline_[k - 1]) scratch_ = scratch_.cwiseMax(baseline_[k - 1]);
-  baseline_[k].noalias() = *weights_[k - 1][k] * scratch_;
+void SurfaceCoupling::freeze_break(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own_at_break, double force_N,
+                                   double tip_depth_m) {
+  if (k >= n_ || !lattice_[k]) return;
+  Eigen::VectorXd& p = break_profile_[k];
+  own_profile(k, own_at_break, p);
+  if (has_baseline_[k] && baseline_[k](0) > 0.0) {
+    const double taken_over = std::clamp(p(0) / baseline_[k](0), 0.0, 1.0);
+    p = p.cwiseMax((1.0 - taken_over) * baseline_[k]);
+  }
+  break_force_N_[k] = force_N;
+  break_depth_m_[k] = tip_depth_m;
+  has_break_[k] = true;
+}
+
+void SurfaceCoupling::freeze_baseline(std::size_t k) {
+  if (k == 0 || k >= n_ || !lattice_[k] || !lattice_[k - 1] || !has_break_[k - 1]) return;
+  baseline_[k].noalias() = *weights_[k - 1][k] * break_profile_[k - 1];
   has_baseline_[k] = true;
 }
 
-void SurfaceCoupling::drawn(const std::vector<Eigen::VectorXd>& own, std::size_t a,
-                            std::vector<Eigen::VectorXd>& d) const {
+Eigen::VectorXd SurfaceCoupling::transmitted(const Eigen::VectorXd& profile, double depth_m) const {
+  constexpr double first = 0.25e-3, ratio = 1.3;
+  auto level = [&](std::size_t i) -> const Eigen::MatrixXd& {
+    if (ladder_.size() <= i) ladder_.resize(i + 1);
+    if (!ladder_[i]) ladder_[i] = grid_weights(grid_, first * std::pow(ratio, static_cast<double>(i)));
+    return *ladder_[i];
+  };
+  if (!(depth_m > 0.0)) return profile;
+  if (depth_m < first) {
+    const double t = depth_m / first;
+    return (1.0 - t) * profile + t * (level(0) * profile);
+  }
+  const double x = std::log(depth_m / first) / std::log(ratio);
+  const auto i = static_cast<std::size_t>(std::floor(x));
+  const double lo = first * std::pow(ratio, static_cast<double>(i)), hi = lo * ratio;
+  const double t = (depth_m - lo) / (hi - lo);
+  return (1.0 - t) * (level(i) * profile) + t * (level(i + 1) * profile);
+}
+
+void SurfaceCoupling::drawn(const std::vector<Eigen::VectorXd>& own, std::size_t a, std::vector<Eigen::VectorXd>& d,
+                            const LoadAfterBreak* load) const {
   for (std::size_t k = 0; k < n_; ++k)
     if (lattice_[k]) own_profile(k, own[k], profile_[k]);
+  if (load && load->layer < n_ && lattice_[load->layer] && has_break_[load->layer] &&
+      break_force_N_[load->layer] > 0.0) {
+    const std::size_t k = load->layer;
+    const double c = std::max(0.0, load->tip_depth_m - break_depth_m_[k]);
+    const Eigen::VectorXd carried = (load->tip_force_N / break_force_N_[k]) * transmitted(break_profile_[k], c) +
+                                    (load->shaft_force_N / break_force_N_[k]) * transmitted(break_profile_[k], 0.5 * c);
+    profile_[k] = profile_[k].cwiseMax(carried);
+  }
   if (a < n_ && lattice_[a]) {
     if (has_baseline_[a] && baseline_[a](0) > 0.0) {
       const double taken_over = std::clamp(profile_[a](0) / baseline_[a](0), 0.0, 1.0);

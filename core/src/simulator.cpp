@@ -90,11 +90,11 @@ void PunctureSimulator::own_deflection(std::size_t k, Eigen::Ref<Eigen::VectorXd
   for (Eigen::Index i = 0; i < pos.cols(); ++i) out(i) = normal.col(i).dot(rest.col(i) - pos.col(i));
 }
 
-void PunctureSimulator::freeze_coupled_baseline(std::size_t k) {
-  if (!coupling_ || k == 0 || !layers_[k].mesh || !layers_[k - 1].mesh) return;
-  auto above = break_deflection_.head(layers_[k - 1].mesh->node_count());
-  own_deflection(k - 1, above);
-  coupling_->freeze_baseline(k, above);
+void PunctureSimulator::freeze_coupled_break(std::size_t k, double surface_force_N, double tip_depth_m) {
+  if (!coupling_ || !layers_[k].mesh) return;
+  auto own = break_deflection_.head(layers_[k].mesh->node_count());
+  own_deflection(k, own);
+  coupling_->freeze_break(k, own, surface_force_N, tip_depth_m);
 }
 
 void PunctureSimulator::update_drawn_surfaces() const {
@@ -104,7 +104,16 @@ void PunctureSimulator::update_drawn_surfaces() const {
     own_deflection_[k].resize(layers_[k].mesh->node_count());
     own_deflection(k, own_deflection_[k]);
   }
-  coupling_->drawn(own_deflection_, active_, drawn_deflection_);
+  // The layer the tip is in after its break carries the needle's load while no layer below is pressed.
+  SurfaceCoupling::LoadAfterBreak load;
+  const bool loaded = active_ > 0 && (active_ == layers_.size() || !layers_[active_].contact_set);
+  if (loaded) {
+    load.layer = active_ - 1;
+    load.tip_depth_m = result_.depth_m;
+    load.tip_force_N = result_.tip_force_N + result_.layers[active_ - 1].cutting_force_N;
+    load.shaft_force_N = result_.layers[active_ - 1].friction_force_N + result_.layers[active_ - 1].damping_force_N;
+  }
+  coupling_->drawn(own_deflection_, active_, drawn_deflection_, loaded ? &load : nullptr);
   drawn_tick_ = ticks_;
 }
 
@@ -299,6 +308,7 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
     layer.mesh->refine_layout(layer.mesh->node_count());
     if (layer.resumption) layer.resumption->set_rest_positions(layer.mesh->rest_positions());
   }
+  if (coupling_) freeze_coupled_break(active_, surface_force_N, needle.depth_m());
   if (layer.resumption) layer.resumption->start(layer.mesh->positions(), needle.time_s);
   const double tip_axial = needle.tip_position_m.dot(needle.direction);
   layer.front_m = tip_axial;
@@ -378,7 +388,7 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
     const bool touched = active_ < n && try_contact(needle);
     if (coupling_) {
       // The layer met at the tip keeps the deformation the pressing left; the broken one rests on it.
-      if (touched && layers_[active_].contact_at_tip) freeze_coupled_baseline(active_);
+      if (touched && layers_[active_].contact_at_tip) coupling_->freeze_baseline(active_);
       coupling_->clear_baseline(active_ - 1);
     }
     if (touched && !layers_[active_].mesh) {

@@ -159,7 +159,8 @@ TEST(SurfaceCoupling, ALayerMetAtTheTipKeepsTheDeformationUntilItsMeshTakesItOve
   TwoLayers s;
   Eigen::VectorXd at_break(s.top.node_count());
   at_break.setConstant(1e-3);
-  s.coupling.freeze_baseline(1, at_break);
+  s.coupling.freeze_break(0, at_break, 1.0, 1.5e-3);
+  s.coupling.freeze_baseline(1);
   ASSERT_TRUE(s.coupling.has_baseline(1));
   s.coupling.drawn(s.own, 1, s.drawn);
   const double baseline_centre = s.drawn[1](0);
@@ -181,6 +182,41 @@ TEST(SurfaceCoupling, ALayerMetAtTheTipKeepsTheDeformationUntilItsMeshTakesItOve
   s.own[1].setZero();
   s.coupling.drawn(s.own, 1, s.drawn);
   EXPECT_EQ(s.drawn[1].cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(SurfaceCoupling, TheNeedlesLoadHoldsTheBrokenSurfaceAndFadesWithDepthByReciprocity) {
+  TwoLayers s;
+  Eigen::VectorXd at_break(s.bottom.node_count());
+  for (Eigen::Index i = 0; i < at_break.size(); ++i)
+    at_break(i) = 2e-3 * std::exp(-std::pow(s.coupling.node_radii_m(1)[static_cast<std::size_t>(i)] / 3e-3, 2));
+  s.coupling.freeze_break(1, at_break, 2.0, 10e-3);  // broke under 2 N with the tip 10 mm deep
+  SurfaceCoupling::LoadAfterBreak load;
+  load.layer = 1;
+  load.tip_depth_m = 10e-3;
+  load.tip_force_N = 1.0;  // half the force, at the break depth: half the shape
+  s.coupling.drawn(s.own, 2, s.drawn, &load);
+  EXPECT_NEAR(s.drawn[1](0), 0.5 * at_break(0), 1e-3 * at_break(0));
+  EXPECT_NEAR(s.drawn[0](0), s.drawn[1](0), 1e-15);  // the layer above rests on it
+  // The same load 4 mm deeper: T(4 mm) of the break shape, as the grid profile
+  // transmitted through 4 mm gives it (and less than at the break depth).
+  load.tip_depth_m = 14e-3;
+  s.coupling.drawn(s.own, 2, s.drawn, &load);
+  Eigen::VectorXd grid_shape(static_cast<Eigen::Index>(s.coupling.grid_m().size()));
+  for (std::size_t g = 0; g < s.coupling.grid_m().size(); ++g)
+    grid_shape(static_cast<Eigen::Index>(g)) = 2e-3 * std::exp(-std::pow(s.coupling.grid_m()[g] / 3e-3, 2));
+  const Eigen::MatrixXd W = transmission_weights(s.coupling.grid_m(), {0.0}, 4e-3);
+  const double expected = 0.5 * W.row(0).dot(grid_shape);
+  EXPECT_NEAR(s.drawn[1](0), expected, 0.03 * expected);  // ring means and the depth ladder's interpolation
+  EXPECT_LT(s.drawn[1](0), 0.45 * at_break(0));
+  // Shaft friction acts at half the depth: it holds the surface more than the same force at the tip.
+  load.tip_force_N = 0.0;
+  load.shaft_force_N = 1.0;
+  s.coupling.drawn(s.own, 2, s.drawn, &load);
+  EXPECT_GT(s.drawn[1](0), expected);
+  // A load pulling outwards (withdrawal) does not lift the surface above its own.
+  load.shaft_force_N = -1.0;
+  s.coupling.drawn(s.own, 2, s.drawn, &load);
+  EXPECT_EQ(s.drawn[1](0), 0.0);
 }
 
 // ---------------------------------------------------------------------------

@@ -24,7 +24,22 @@
 //   a broken layer k < a: D_k = max(O_k, D_{k+1}): it rests on the layer
 //                         below and returns to it, not through it to its rest
 //                         shape (bottom-up);
-//   all broken:           the last layer its own, the ones above rest on it.
+//   the layer k the tip is in after its break, while no layer below is
+//                         pressed (the last layer once all are broken):
+//                         D_k = max(O_k, (F_tip / F_b) T(c) P_b +
+//                         (F_shaft / F_b) T(c / 2) P_b), P_b its drawn profile
+//                         at the break under the surface force F_b, c how far
+//                         the tip went on past the break, F_tip the force at
+//                         the tip (the cutting force; the next layer's surface
+//                         force), F_shaft the layer's shaft friction and d h v
+//                         (acting along the shaft: at c / 2). By reciprocity
+//                         the surface deflection of a load buried at depth c
+//                         is T(c) of the deflection of the same load on the
+//                         surface, so the needle's load keeps the broken
+//                         surface down and lets it rise as the tip goes deeper
+//                         (results/surface_transmission: within 3-17 % of the
+//                         FEM's muscle top over 2-14 mm past its break); the
+//                         layers above rest on it.
 // Baseline: when layer a breaks and the needle meets layer a + 1 below that
 // layer's rest surface (contact at the tip, simulator.hpp), layer a + 1 is
 // where the pressing left it: B_{a+1} = T(a -> a+1) D_a at the break, kept
@@ -54,19 +69,36 @@ class SurfaceCoupling {
     double spacing_m = 0.0;
     double top_depth_m = 0.0;
   };
+  /// The needle's load on the layer the tip is in after its break.
+  struct LoadAfterBreak {
+    std::size_t layer = 0;
+    double tip_depth_m = 0.0;   ///< below the first surface
+    double tip_force_N = 0.0;   ///< at the tip: cutting, the next layer's surface force
+    double shaft_force_N = 0.0; ///< the layer's shaft friction and d h v
+  };
   /// Throws std::invalid_argument for a non-positive spacing or layer tops that do not deepen.
   explicit SurfaceCoupling(const std::vector<LayerGeometry>& layers);
 
   /// own[k]: own node deflections of layer k (its lattice's size; anything
   /// for a layer without a mesh). needle_layer == layer count: all broken.
   /// Writes drawn[k] (node deflections, m).
-  void drawn(const std::vector<Eigen::VectorXd>& own, std::size_t needle_layer,
-             std::vector<Eigen::VectorXd>& drawn) const;
-  /// Layer k (> 0) met at the tip when layer k - 1 broke; own_above: layer
-  /// k - 1's own node deflections at the break. Sets B_k (no allocation).
-  void freeze_baseline(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own_above);
+  void drawn(const std::vector<Eigen::VectorXd>& own, std::size_t needle_layer, std::vector<Eigen::VectorXd>& drawn,
+             const LoadAfterBreak* load = nullptr) const;
+  /// T(c) P on the grid for any depth c >= 0 (m): linear between the
+  /// transmissions at c = 0.25 mm x 1.3^i (computed once per process), the
+  /// identity blended in below 0.25 mm.
+  Eigen::VectorXd transmitted(const Eigen::VectorXd& profile, double depth_m) const;
+  /// Layer k broke with own node deflections own_at_break under the surface
+  /// force force_N (N), the tip at tip_depth_m below the first surface: keeps
+  /// its drawn profile P_b (no allocation).
+  void freeze_break(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own_at_break, double force_N,
+                    double tip_depth_m);
+  /// Layer k (> 0) met at the tip when layer k - 1 broke (after
+  /// freeze_break(k - 1, ...)): sets B_k = T(k - 1 -> k) P_b (no allocation).
+  void freeze_baseline(std::size_t k);
   /// Layer k is no longer the needle layer where it was met.
   void clear_baseline(std::size_t k) { has_baseline_[k] = false; }
+  bool has_break(std::size_t k) const { return has_break_[k]; }
   bool has_baseline(std::size_t k) const { return has_baseline_[k]; }
 
   /// The shared radial grid (m) and a layer's drawn profile on it after drawn().
@@ -86,8 +118,10 @@ class SurfaceCoupling {
   std::vector<std::vector<double>> node_radius_, ring_radius_;
   std::vector<std::vector<int>> ring_count_;
   std::vector<std::vector<std::shared_ptr<const Eigen::MatrixXd>>> weights_;
-  std::vector<Eigen::VectorXd> baseline_;
-  std::vector<bool> has_baseline_;
+  std::vector<Eigen::VectorXd> baseline_, break_profile_;
+  std::vector<double> break_force_N_, break_depth_m_;
+  std::vector<bool> has_baseline_, has_break_;
+  mutable std::vector<std::shared_ptr<const Eigen::MatrixXd>> ladder_;  ///< T at the ladder depths, filled on use
   mutable std::vector<Eigen::VectorXd> profile_;
   mutable Eigen::VectorXd ring_means_, scratch_;
 };

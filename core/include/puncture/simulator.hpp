@@ -216,8 +216,8 @@ class PunctureSimulator {
   void record_puncture(const NeedleState& needle, double surface_force_N);
   /// Own deflection of layer k's nodes along the inward normals (m) into `out`.
   void own_deflection(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const;
-  /// Coupled surfaces: layer k was met at the tip after layer k - 1 broke.
-  void freeze_coupled_baseline(std::size_t k);
+  /// Coupled surfaces: layer k broke under surface_force_N with the tip at tip_depth_m.
+  void freeze_coupled_break(std::size_t k, double surface_force_N, double tip_depth_m);
   /// Coupled surfaces: the drawn deflections of this tick (computed once per tick).
   void update_drawn_surfaces() const;
 
