@@ -211,6 +211,82 @@ void print_result(std::ostream& out, const Scene& scene, const validation::FemRe
 
 namespace {
 
+/// Steps 3-5: the force-depth metrics, the whole-trajectory comparison with
+/// the acceptance per layer, and the surfaces before and after each break.
+struct Comparison {
+  validation::InsertionCurve realtime_curve;
+  validation::CurveComparison cmp;
+  validation::TrajectoryComparison trajectory;
+  std::vector<validation::LayerAcceptance> acceptance;
+  std::vector<validation::LayerDeflectionComparison> deflection;
+};
+
+Comparison compare_with_fem(const Scene& scene, const RealtimeRun& rt, const validation::FemResultFiles& fem) {
+  using namespace validation;
+  Comparison c;
+  // The model's whole force (d h v included, as it renders) against the FEM's,
+  // per layer on the insertion, then over the whole trajectory (dwell and
+  // withdrawal) with the acceptance per layer.
+  c.realtime_curve = curve_from_run(scene, rt.run, "realtime", /*include_damping=*/true);
+  c.cmp = compare_curves(c.realtime_curve, fem.curve);
+  const std::vector<LayerGeometry> geometry = layer_geometry(scene);
+  c.trajectory = compare_trajectory(c.realtime_curve, fem.curve, reference_events(fem.curve, geometry), geometry);
+  c.acceptance = layer_acceptance(geometry, c.trajectory);
+  // Deflection before breakthrough and recovery after it, part of the acceptance.
+  c.deflection.resize(scene.layers.size());
+  std::vector<LayerDeflectionErrors> errors(scene.layers.size());
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    c.deflection[k] = compare_layer_deflection(scene, k, rt.run, rt.recorder, fem);
+    errors[k] = {c.deflection[k].compared, c.deflection[k].recovery_compared, c.deflection[k].error.relative_rmse,
+                 c.deflection[k].recovery_error.relative_rmse, "no FEM profile of this layer's top surface"};
+  }
+  add_deflection_acceptance(c.acceptance, errors);
+  return c;
+}
+
+/// Step 6 (CSV and JSON): returns the per-layer metrics JSON.
+nlohmann::json write_report_files(io::OutputSession& session, const Scene& scene, const std::string& scene_file,
+                                  const validation::FemReference& reference, const validation::FemResultFiles& fem,
+                                  const Comparison& c, const std::vector<validation::PunctureForceShares>& shares,
+                                  const io::Provenance& provenance) {
+  using namespace validation;
+  session.write_text("realtime_curve.csv", insertion_curve_csv(c.realtime_curve, &provenance));
+  // The FEM's own files, copied; a copy without provenance of its own gets
+  // this command's (with the cache entry it came from).
+  auto with_csv_provenance = [&](const std::string& name) {
+    const std::string text = io::read_text_file(reference.dir / name);
+    if (text.rfind("# command:", 0) == 0) return text;
+    return io::provenance_comment_lines(provenance) + "# copied_from: " + (reference.dir / name).string() + "\n" + text;
+  };
+  session.write_text("fem_force_depth.csv", with_csv_provenance("fem_force_depth.csv"));
+  session.write_text("fem_curve.csv", insertion_curve_csv(fem.curve, &provenance));
+  session.write_text("force_depth_aligned.csv", aligned_curves_csv(c.realtime_curve, fem.curve, provenance));
+  session.write_text("layer_metrics.csv", layer_metrics_csv(scene, c.cmp, c.deflection, provenance));
+  session.write_text("deflection_profiles.csv", deflection_profiles_csv(scene, c.deflection, provenance));
+  session.write_text("fem_recovery_profile.csv", with_csv_provenance("fem_recovery_profile.csv"));
+
+  nlohmann::json metrics;
+  metrics["provenance"] = io::provenance_json(provenance);
+  metrics["scene"] = {{"name", scene.name}, {"file", scene_file}};
+  metrics["fem_reference"] = {{"hash", reference.hash},
+                              {"cache_dir", reference.dir.string()},
+                              {"from_cache", reference.from_cache},
+                              {"summary", fem.summary}};
+  metrics["overall"] = {{"n_compared", c.cmp.n_compared},
+                        {"reference_peak_force_N", c.cmp.reference_peak_force_N},
+                        {"force_rmse_N", c.cmp.force_rmse_N},
+                        {"force_rmse_relative", c.cmp.force_rmse_relative},
+                        {"compared_from_depth_mm", c.cmp.compared_from_depth_m / kMm},
+                        {"compared_to_depth_mm", c.cmp.compared_to_depth_m / kMm}};
+  const nlohmann::json layers = layer_metrics_json(scene, c.cmp, c.deflection);
+  metrics["layers"] = layers;
+  metrics["acceptance"] = acceptance_json(c.acceptance);
+  metrics["trajectory_terms"] = trajectory_terms_json(c.trajectory);
+  metrics["puncture_force_shares"] = puncture_force_shares_json(shares);
+  session.write_text("validation_metrics.json", metrics.dump(2) + "\n");
+  return layers;
+}
+
 /// Steps 1-6 for one scene into `dir`. Returns nothing on the MPI ranks that
 /// only help with the FEM.
 std::optional<SceneValidation> validate_scene(const Scene& scene, const std::string& scene_file,
@@ -244,62 +320,9 @@ std::optional<SceneValidation> validate_scene(const Scene& scene, const std::str
   RealtimeModel model = build_realtime_model(scene);
   const RealtimeRun rt = run_realtime(model, scene, fem, vtk, provenance, session, options, out);
 
-  // 3. Force-depth metrics: the model's whole force (d h v included, as it
-  // renders) against the FEM's, per layer on the insertion, then over the
-  // whole trajectory (dwell and withdrawal) with the acceptance per layer.
-  const InsertionCurve realtime_curve = curve_from_run(scene, rt.run, "realtime", /*include_damping=*/true);
-  const CurveComparison cmp = compare_curves(realtime_curve, fem.curve);
-  const std::vector<LayerGeometry> geometry = layer_geometry(scene);
-  const TrajectoryComparison trajectory =
-      compare_trajectory(realtime_curve, fem.curve, reference_events(fem.curve, geometry), geometry);
-  std::vector<LayerAcceptance> acceptance = layer_acceptance(geometry, trajectory);
-
-  // 4-5. Deflection before breakthrough and recovery after it, part of the acceptance.
-  std::vector<LayerDeflectionComparison> defl(scene.layers.size());
-  std::vector<LayerDeflectionErrors> deflection_errors(scene.layers.size());
-  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
-    defl[k] = compare_layer_deflection(scene, k, rt.run, rt.recorder, fem);
-    deflection_errors[k] = {defl[k].compared, defl[k].recovery_compared, defl[k].error.relative_rmse,
-                            defl[k].recovery_error.relative_rmse, "no FEM profile of this layer's top surface"};
-  }
-  add_deflection_acceptance(acceptance, deflection_errors);
-
-  // 6. Report files.
-  session.write_text("realtime_curve.csv", insertion_curve_csv(realtime_curve, &provenance));
-  // The FEM's own files, copied; a copy without provenance of its own gets
-  // this command's (with the cache entry it came from).
-  auto with_csv_provenance = [&](const std::string& name) {
-    const std::string text = io::read_text_file(reference.dir / name);
-    if (text.rfind("# command:", 0) == 0) return text;
-    return io::provenance_comment_lines(provenance) + "# copied_from: " + (reference.dir / name).string() + "\n" + text;
-  };
-  session.write_text("fem_force_depth.csv", with_csv_provenance("fem_force_depth.csv"));
-  session.write_text("fem_curve.csv", insertion_curve_csv(fem.curve, &provenance));
-  session.write_text("force_depth_aligned.csv", aligned_curves_csv(realtime_curve, fem.curve, provenance));
-  session.write_text("layer_metrics.csv", layer_metrics_csv(scene, cmp, defl, provenance));
-  session.write_text("deflection_profiles.csv", deflection_profiles_csv(scene, defl, provenance));
-  session.write_text("fem_recovery_profile.csv", with_csv_provenance("fem_recovery_profile.csv"));
-
-  nlohmann::json metrics;
-  metrics["provenance"] = io::provenance_json(provenance);
-  metrics["scene"] = {{"name", scene.name}, {"file", scene_file}};
-  metrics["fem_reference"] = {{"hash", reference.hash},
-                              {"cache_dir", reference.dir.string()},
-                              {"from_cache", reference.from_cache},
-                              {"summary", fem.summary}};
-  metrics["overall"] = {{"n_compared", cmp.n_compared},
-                        {"reference_peak_force_N", cmp.reference_peak_force_N},
-                        {"force_rmse_N", cmp.force_rmse_N},
-                        {"force_rmse_relative", cmp.force_rmse_relative},
-                        {"compared_from_depth_mm", cmp.compared_from_depth_m / kMm},
-                        {"compared_to_depth_mm", cmp.compared_to_depth_m / kMm}};
-  const nlohmann::json layers = layer_metrics_json(scene, cmp, defl);
-  metrics["layers"] = layers;
-  metrics["acceptance"] = acceptance_json(acceptance);
-  metrics["trajectory_terms"] = trajectory_terms_json(trajectory);
+  const Comparison c = compare_with_fem(scene, rt, fem);
   const std::vector<PunctureForceShares> shares = puncture_force_shares(rt.run.events);
-  metrics["puncture_force_shares"] = puncture_force_shares_json(shares);
-  session.write_text("validation_metrics.json", metrics.dump(2) + "\n");
+  const nlohmann::json layers = write_report_files(session, scene, scene_file, reference, fem, c, shares, provenance);
   if (vtk) write_vtk_report(session, reference, fem, rt.frames, provenance);
   session.commit();
   progress("data written to " + dir.string());
@@ -309,9 +332,9 @@ std::optional<SceneValidation> validate_scene(const Scene& scene, const std::str
   io::OutputSession summary_session(dir);
   summary_session.write_text(
       "validation_summary.md",
-      validation_summary_markdown(scene, provenance, {reference.hash, reference.from_cache}, fem, cmp, layers, plots,
+      validation_summary_markdown(scene, provenance, {reference.hash, reference.from_cache}, fem, c.cmp, layers, plots,
                                   vtk && !fem.frames.empty(),
-                                  acceptance_markdown(acceptance, trajectory) +
+                                  acceptance_markdown(c.acceptance, c.trajectory) +
                                       "\n## The real-time force at each puncture, by term\n\n"
                                       "Eq. 5 on the force mesh's own deflections; the mesh's "
                                       "inertia and damping (its reaction minus Eq. 5); the tip "
@@ -320,8 +343,8 @@ std::optional<SceneValidation> validate_scene(const Scene& scene, const std::str
                                       "break.\n\n" +
                                       puncture_force_shares_markdown(shares)));
   summary_session.commit();
-  print_result(out, scene, reference, cmp, acceptance, layers, dir);
-  return SceneValidation{acceptance, layers};
+  print_result(out, scene, reference, c.cmp, c.acceptance, layers, dir);
+  return SceneValidation{c.acceptance, layers};
 }
 
 std::string vtk_flag(const ValidateOptions& options) {
