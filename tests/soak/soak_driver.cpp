@@ -146,7 +146,12 @@ SoakReport run_soak(const SoakOptions& o, const std::function<void(double)>& pro
   const std::string path =
       o.scene_path.empty() ? std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json" : o.scene_path;
   nlohmann::json scene_json = nlohmann::json::parse(read_file(path));
-  scene_json["effects"] = known_effects();  // every effect on
+  // Every effect on; coupled_surfaces and layer_interaction exclude each
+  // other, so episodes take turns (three integrators each) with one of them.
+  nlohmann::json effects = nlohmann::json::array();
+  for (const std::string& e : known_effects())
+    if (e != "coupled_surfaces") effects.push_back(e);
+  scene_json["effects"] = effects;
   report.effects = known_effects();
   std::string base_text = scene_json.dump();
   for (const auto& edit : o.scene_edits) edit(base_text);
@@ -165,6 +170,9 @@ SoakReport run_soak(const SoakOptions& o, const std::function<void(double)>& pro
     const int integrator = static_cast<int>(report.episodes % 3);
     nlohmann::json j = nlohmann::json::parse(base_text);
     j["realtime"]["integrator"] = kIntegrators[integrator];
+    if ((report.episodes / 3) % 2 == 1)
+      for (auto& e : j["effects"])
+        if (e == "layer_interaction") e = "coupled_surfaces";
     const Scene scene = parse_scene(j.dump(), path + " (soak episode " + std::to_string(report.episodes) + ")");
     RealtimeModel model = build_realtime_model(scene);
     PunctureSimulator& sim = *model.simulator;
@@ -235,6 +243,11 @@ SoakReport run_soak(const SoakOptions& o, const std::function<void(double)>& pro
         }
       }
     }
+    // The drawn surfaces at the episode's end (coupled or shifted by the chain) are finite.
+    for (std::size_t k = 0; k < n_layers; ++k)
+      if (!sim.node_positions(k).allFinite() && report.failures.size() < 10)
+        report.failures.push_back("episode " + std::to_string(report.episodes) + ": layer " + std::to_string(k) +
+                                  "'s drawn surface is not finite");
     report.punctures += static_cast<long long>(sim.puncture_events().size());
     if (sim.active_layer() == n_layers) ++report.episodes_all_punctured;
     ++report.episodes;
