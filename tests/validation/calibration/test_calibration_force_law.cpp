@@ -151,6 +151,43 @@ TEST(CalibrationForceLaw, RecoversStiffnessCriticalForceCuttingAndFrictionOfTwoL
   EXPECT_TRUE(after.term("cutting_force")->available);
 }
 
+TEST(CalibrationForceLaw, CriticalForceStartsFromTheToughnessNotFromTheReference) {
+  // Layers with a fracture toughness start their critical force at G_c x 2a
+  // (here half the truth for the skin, 1.6 times it for the fat), whatever the
+  // scene says (10 N, far off), and the calibration identifies the truth.
+  const Scene truth = truth_scene(false);
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  Scene start = perturbed(truth);
+  start.needle.tip = "bevel";  // a fracture-energy layer needs a needle that cuts (the real-time model does not see it)
+  const double two_a = 2.0 * start.needle.radius_m;
+  const double toughness_factor[2] = {0.5, 1.6};
+  for (std::size_t k = 0; k < 2; ++k) {
+    puncture::PunctureCriterion& p = start.layers[k].puncture;
+    p.kind = puncture::PunctureCriterion::Kind::FractureEnergy;
+    p.toughness_J_per_m2 = toughness_factor[k] * truth.layers[k].force_law.breakthrough.critical_force_N / two_a;
+    start.layers[k].force_law.breakthrough.critical_force_N = 10.0;
+  }
+  const pv::CalibrationResult r = pv::calibrate(start, ref);
+  expect_recovered(r.tuned_scene, truth, 0.06, "critical force from the toughness");
+  for (std::size_t k = 0; k < 2; ++k)
+    EXPECT_NEAR(truth_of(r.tuned_scene, k).Fc / truth_of(truth, k).Fc, 1.0, 0.03) << "layer " << k;
+  EXPECT_LT(r.objective_after, 1e-3 * r.objective_before);
+  EXPECT_NE(r.critical_force_note.find("skin: G_c x 2a"), std::string::npos) << r.critical_force_note;
+  // Without the toughness the same 10 N start is taken from the reference's puncture force.
+  Scene no_toughness = perturbed(truth);
+  for (std::size_t k = 0; k < 2; ++k) no_toughness.layers[k].force_law.breakthrough.critical_force_N = 10.0;
+  expect_recovered(pv::calibrate(no_toughness, ref).tuned_scene, truth, 0.03, "critical force from the reference");
+  // A scene no ring count makes valid is an error naming why, not a calibration that tuned nothing.
+  Scene invalid = start;
+  invalid.needle.tip = "blunt";
+  try {
+    pv::calibrate(invalid, ref);
+    ADD_FAILURE() << "an invalid scene was calibrated";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("fracture_energy needs a needle that cuts"), std::string::npos) << e.what();
+  }
+}
+
 TEST(CalibrationForceLaw, RecoversThemFromACurveWithDepthAndForceOnly) {
   // The same reference with time, velocity, phases, parts and states all
   // removed: the punctures come from its force drops (the drop at the end

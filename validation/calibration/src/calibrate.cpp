@@ -282,12 +282,14 @@ Scene run_layer_stage(Calibration& c, CalibrationResult& result, const Scene& cu
       for (int w : {rings.front() - dw, rings.front() + dw})
         if (w >= 2) rings.push_back(w);
   std::pair<Scene, double> best{current, std::numeric_limits<double>::infinity()};
+  std::string rejected;
   for (int w : rings) {
     Scene candidate = current;
     candidate.layers[k].force_mesh.rings_w = w;
     try {
       validate_scene(candidate, "calibration candidate");
-    } catch (const SceneError&) {
+    } catch (const SceneError& e) {
+      rejected = e.what();
       continue;  // e.g. the force mesh would leave the sample
     }
     const std::string name = current.layers[k].name + " (w = " + std::to_string(w) + ")" +
@@ -295,6 +297,9 @@ Scene run_layer_stage(Calibration& c, CalibrationResult& result, const Scene& cu
     auto tried = run_ring_candidate(c, result, k, candidate, name, pass == 0);
     if (tried.second < best.second) best = std::move(tried);
   }
+  if (!std::isfinite(best.second) && !rejected.empty())  // not one ring count was a valid scene: say why
+    throw std::invalid_argument("calibrate: layer " + current.layers[k].name + ": no valid scene to tune (" +
+                                rejected + ")");
   return best.first;
 }
 
@@ -443,6 +448,24 @@ void report_identifiability(Calibration& c, CalibrationResult& result) {
   result.identifiability = identifiability_report(whole, withheld, c.options);
 }
 
+/// The critical-force starts of the scaled start (scaled_start.cpp), in words.
+std::string critical_force_start_note(const Calibration& c, const Scene& scene) {
+  if (!c.options.scaled_start) return {};
+  std::ostringstream note;
+  for (const Parameter& p : c.parameters) {
+    if (p.kind != ParamKind::CriticalForce || !c.calibrated(p.layer)) continue;
+    const Layer& l = scene.layers[p.layer];
+    note << (note.tellp() > 0 ? "; " : "") << l.name << ": ";
+    if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy && l.puncture.toughness_J_per_m2 > 0.0)
+      note << "G_c x 2a = " << l.puncture.toughness_J_per_m2 << " J/m^2 x " << 2e3 * scene.needle.radius_m
+           << " mm = " << l.puncture.toughness_J_per_m2 * 2.0 * scene.needle.radius_m
+           << " N (the layer's fracture toughness)";
+    else
+      note << "the reference's puncture force less the model's other terms there (no fracture toughness)";
+  }
+  return note.str();
+}
+
 }  // namespace
 
 CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve>& references,
@@ -459,6 +482,7 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
   check_enough_samples(references.front().curve, result.reference_events.front(),
                        n_tuned + (result.damping_tuned ? c.layers.size() : 0), n_requested);
 
+  result.critical_force_note = critical_force_start_note(c, scene);
   Scene current = scene;
   const int passes = options.passes > 0 ? options.passes
                                         : (scene.effects.layer_interaction && c.layers.size() > 1 ? 2 : 1);

@@ -130,6 +130,8 @@ std::string calibration_summary_markdown(const CalibrationResult& result, const 
      << ".json` (a scene `puncture run` accepts), provenance: `" << name << ".provenance.json`, identifiability: `"
      << name << ".identifiability.md`.\n";
   if (!result.damping_note.empty()) md << "\nDamping d: " << result.damping_note << "\n";
+  if (!result.critical_force_note.empty())
+    md << "\nCritical forces started at (then tuned): " << result.critical_force_note << ".\n";
   if (!result.warnings.empty()) {
     md << "\n## Warnings\n\n";
     for (const std::string& w : result.warnings) md << "- " << w << "\n";

@@ -112,11 +112,27 @@ bool scale_pressing(const StartContext& c, Scene& s, const InsertionCurve& model
   return false;
 }
 
-/// The tip's share of the reference's puncture force: minus the model's
-/// friction and cutting there, taken before the model's own puncture of the
-/// layer when that comes first (its own cut would count otherwise, and a too
-/// low critical force would keep itself).
-void start_critical_force(const StartContext& c, Scene& s, const InsertionCurve& model, const ReferenceEvents& mod_ev) {
+/// A layer whose scene gives its fracture toughness G_c (fracture_energy
+/// puncture criterion, as the FEM reference uses it) starts its critical force
+/// from physics, not from the reference's puncture force: the force whose work
+/// per unit advance opens a crack as wide as the needle, F_c = G_c 2 a (a the
+/// needle radius; the cutting-force estimate of Azar and Hayward 2008 applied
+/// to the first crack). True when it did.
+bool start_critical_force_from_toughness(const StartContext& c, Scene& s) {
+  if (!c.tuned(ParamKind::CriticalForce)) return false;
+  const PunctureCriterion& p = s.layers[c.k].puncture;
+  if (p.kind != PunctureCriterion::Kind::FractureEnergy || !(p.toughness_J_per_m2 > 0.0)) return false;
+  param_ref(s, c.k, ParamKind::CriticalForce) = p.toughness_J_per_m2 * 2.0 * s.needle.radius_m;
+  return true;
+}
+
+/// Otherwise (no G_c, e.g. a measured curve of an unknown tissue): the tip's
+/// share of the reference's puncture force, minus the model's friction and
+/// cutting there, taken before the model's own puncture of the layer when
+/// that comes first (its own cut would count otherwise, and a too low
+/// critical force would keep itself).
+void start_critical_force_from_reference(const StartContext& c, Scene& s, const InsertionCurve& model,
+                                         const ReferenceEvents& mod_ev) {
   if (!c.tuned(ParamKind::CriticalForce) || !c.ref_ev.punctures[c.k].found || !model.has_parts()) return;
   double at = c.ref_ev.punctures[c.k].depth_m;
   if (mod_ev.punctures[c.k].found) at = std::min(at, mod_ev.punctures[c.k].depth_m - 1e-5);
@@ -181,6 +197,7 @@ Scene scaled_start(const Scene& candidate, std::size_t k, const ReferenceCurve& 
   const StartContext c{k, reference, ref_ev, layers, parameters};
   Scene s = candidate;
   const double linear_slope = start_stiffening(c, s);
+  const bool physical_critical_force = start_critical_force_from_toughness(c, s);
   for (int pass = 0; pass < 8; ++pass) {
     InsertionCurve model;
     try {
@@ -190,7 +207,7 @@ Scene scaled_start(const Scene& candidate, std::size_t k, const ReferenceCurve& 
     }
     const ReferenceEvents mod_ev = reference_events(model, layers);  // its own states
     if (scale_pressing(c, s, model, mod_ev, linear_slope, pass >= 2)) break;
-    start_critical_force(c, s, model, mod_ev);
+    if (!physical_critical_force) start_critical_force_from_reference(c, s, model, mod_ev);
     start_cut_and_friction(c, s, model);
     clamp_into_bounds(s, parameters);
   }

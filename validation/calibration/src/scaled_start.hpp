@@ -5,9 +5,11 @@
 // reference: K (and k_s when tuned, keeping K / k_s and so the ring
 // profile) scaled by the ratio of the reference's pressing slope to the
 // model's; the breakthrough parameter scaled to the reference's puncture
-// (threshold by the ratio of the breakthrough deflections, critical force
+// (threshold by the ratio of the breakthrough deflections, critical energy
+// by the squared deflection ratio; the critical force from the layer's
+// fracture toughness, G_c x needle diameter, when the scene gives G_c, else
 // set to the reference's puncture force minus the model's friction and
-// cutting there, critical energy by the squared deflection ratio); then
+// cutting there); then
 // cutting and friction from a least-squares fit of the force difference on
 // the layer's cut (level and slope with the shaft length) and, with a
 // withdrawal, of the withdrawal force inside the layer (friction only).

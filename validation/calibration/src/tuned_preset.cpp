@@ -259,6 +259,7 @@ std::string tuned_preset_provenance_json(const std::string& name, const Calibrat
   j["objective_before"] = result.objective_before;
   j["objective_after"] = result.objective_after;
   j["damping"] = {{"tuned", result.damping_tuned}, {"note", result.damping_note}};
+  j["critical_force_start"] = result.critical_force_note;
   j["tuned_parameters"] = tuned_parameters_json(result);
   j["identifiability"] = identifiability_json(result.identifiability);
   j["warnings"] = result.warnings;

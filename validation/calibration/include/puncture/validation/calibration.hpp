@@ -286,6 +286,10 @@ struct CalibrationResult {
   int evaluations = 0;
   bool damping_tuned = false;
   std::string damping_note;
+  /// Where each tuned critical force started: G_c x 2a from the layer's
+  /// fracture toughness (a scene with the fracture_energy puncture criterion),
+  /// else the reference's puncture force (scaled start).
+  std::string critical_force_note;
   std::vector<CalibrationStageRecord> stages;
   std::vector<std::string> calibrated_layers;
   /// At the tuned values, on the whole objective (every term, every
