@@ -452,9 +452,10 @@ void report_identifiability(Calibration& c, CalibrationResult& result) {
 std::string critical_force_start_note(const Calibration& c, const Scene& scene) {
   if (!c.options.scaled_start) return {};
   std::ostringstream note;
-  for (const Parameter& p : c.parameters) {
-    if (p.kind != ParamKind::CriticalForce || !c.calibrated(p.layer)) continue;
-    const Layer& l = scene.layers[p.layer];
+  for (std::size_t k : c.layers) {
+    const std::vector<ParamKind> kinds = layer_kinds(scene, k, c.options.parameters, nullptr);
+    if (std::find(kinds.begin(), kinds.end(), ParamKind::CriticalForce) == kinds.end()) continue;
+    const Layer& l = scene.layers[k];
     note << (note.tellp() > 0 ? "; " : "") << l.name << ": ";
     if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy && l.puncture.toughness_J_per_m2 > 0.0)
       note << "G_c x 2a = " << l.puncture.toughness_J_per_m2 << " J/m^2 x " << 2e3 * scene.needle.radius_m
