@@ -40,7 +40,11 @@ double on_grid(const std::vector<double>& grid, const Eigen::VectorXd& values, d
 
 }  // namespace
 
-SurfaceCoupling::SurfaceCoupling(const std::vector<LayerGeometry>& layers)
+namespace {
+constexpr double kFirstLevel_m = 0.25e-3, kLevelRatio = 1.3;
+}
+
+SurfaceCoupling::SurfaceCoupling(const std::vector<LayerGeometry>& layers, double slab_depth_m)
     : n_(layers.size()),
       lattice_(n_, nullptr),
       node_radius_(n_),
@@ -95,7 +99,12 @@ SurfaceCoupling::SurfaceCoupling(const std::vector<LayerGeometry>& layers)
     }
   }
   ring_means_ = Eigen::VectorXd::Zero(most_rings);
-  scratch_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(grid_.size()));
+  const auto g = static_cast<Eigen::Index>(grid_.size());
+  scratch_ = carried_ = level_lo_ = level_hi_ = Eigen::VectorXd::Zero(g);
+  for (double c = kFirstLevel_m;; c *= kLevelRatio) {
+    ladder_.push_back(grid_weights(grid_, c));
+    if (c >= slab_depth_m) break;
+  }
 }
 
 void SurfaceCoupling::own_profile(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own,
@@ -130,23 +139,28 @@ void SurfaceCoupling::freeze_baseline(std::size_t k) {
   has_baseline_[k] = true;
 }
 
-Eigen::VectorXd SurfaceCoupling::transmitted(const Eigen::VectorXd& profile, double depth_m) const {
-  constexpr double first = 0.25e-3, ratio = 1.3;
-  auto level = [&](std::size_t i) -> const Eigen::MatrixXd& {
-    if (ladder_.size() <= i) ladder_.resize(i + 1);
-    if (!ladder_[i]) ladder_[i] = grid_weights(grid_, first * std::pow(ratio, static_cast<double>(i)));
-    return *ladder_[i];
-  };
-  if (!(depth_m > 0.0)) return profile;
-  if (depth_m < first) {
-    const double t = depth_m / first;
-    return (1.0 - t) * profile + t * (level(0) * profile);
+void SurfaceCoupling::transmitted(const Eigen::VectorXd& profile, double depth_m, Eigen::VectorXd& out) const {
+  if (!(depth_m > 0.0) || ladder_.empty()) {
+    out = profile;
+    return;
   }
-  const double x = std::log(depth_m / first) / std::log(ratio);
-  const auto i = static_cast<std::size_t>(std::floor(x));
-  const double lo = first * std::pow(ratio, static_cast<double>(i)), hi = lo * ratio;
+  if (depth_m < kFirstLevel_m) {
+    const double t = depth_m / kFirstLevel_m;
+    level_hi_.noalias() = *ladder_[0] * profile;
+    out = (1.0 - t) * profile + t * level_hi_;
+    return;
+  }
+  const double x = std::log(depth_m / kFirstLevel_m) / std::log(kLevelRatio);
+  const auto i = std::min(static_cast<std::size_t>(std::floor(x)), ladder_.size() - 1);
+  if (i + 1 >= ladder_.size()) {  // beyond the slab: the deepest level
+    out.noalias() = *ladder_.back() * profile;
+    return;
+  }
+  const double lo = kFirstLevel_m * std::pow(kLevelRatio, static_cast<double>(i)), hi = lo * kLevelRatio;
   const double t = (depth_m - lo) / (hi - lo);
-  return (1.0 - t) * (level(i) * profile) + t * (level(i + 1) * profile);
+  level_lo_.noalias() = *ladder_[i] * profile;
+  level_hi_.noalias() = *ladder_[i + 1] * profile;
+  out = (1.0 - t) * level_lo_ + t * level_hi_;
 }
 
 void SurfaceCoupling::drawn(const std::vector<Eigen::VectorXd>& own, std::size_t a, std::vector<Eigen::VectorXd>& d,
@@ -157,9 +171,10 @@ void SurfaceCoupling::drawn(const std::vector<Eigen::VectorXd>& own, std::size_t
       break_force_N_[load->layer] > 0.0) {
     const std::size_t k = load->layer;
     const double c = std::max(0.0, load->tip_depth_m - break_depth_m_[k]);
-    const Eigen::VectorXd carried = (load->tip_force_N / break_force_N_[k]) * transmitted(break_profile_[k], c) +
-                                    (load->shaft_force_N / break_force_N_[k]) * transmitted(break_profile_[k], 0.5 * c);
-    profile_[k] = profile_[k].cwiseMax(carried);
+    transmitted(break_profile_[k], c, carried_);
+    transmitted(break_profile_[k], 0.5 * c, scratch_);
+    carried_ = (load->tip_force_N / break_force_N_[k]) * carried_ + (load->shaft_force_N / break_force_N_[k]) * scratch_;
+    profile_[k] = profile_[k].cwiseMax(carried_);
   }
   if (a < n_ && lattice_[a]) {
     if (has_baseline_[a] && baseline_[a](0) > 0.0) {
@@ -167,13 +182,16 @@ void SurfaceCoupling::drawn(const std::vector<Eigen::VectorXd>& own, std::size_t
       profile_[a] = profile_[a].cwiseMax((1.0 - taken_over) * baseline_[a]);
     }
     for (std::size_t k = a + 1; k < n_; ++k)
-      if (lattice_[k]) profile_[k] = profile_[k].cwiseMax(*weights_[a][k] * profile_[a]);
+      if (lattice_[k]) {
+        carried_.noalias() = *weights_[a][k] * profile_[a];
+        profile_[k] = profile_[k].cwiseMax(carried_);
+      }
   }
   for (std::size_t k = std::min(a, n_ - 1); k-- > 0;)  // broken layers rest on the layer below
     if (lattice_[k] && lattice_[k + 1]) profile_[k] = profile_[k].cwiseMax(profile_[k + 1]);
   for (std::size_t k = 0; k < n_; ++k) {
     if (!lattice_[k]) continue;
-    d[k].resize(own[k].size());
+    d[k].resize(own[k].size());  // sized by the caller: no allocation
     for (Eigen::Index i = 0; i < own[k].size(); ++i)
       d[k](i) = std::max(own[k](i), on_grid(grid_, profile_[k], node_radius_[k][static_cast<std::size_t>(i)]));
   }

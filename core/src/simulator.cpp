@@ -74,10 +74,13 @@ PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique
       geometry[k] = {&layers_[k].mesh->lattice(), scene.layers[k].force_mesh.spacing_L_m, layers_[k].top_depth_m};
       largest = std::max<Eigen::Index>(largest, layers_[k].mesh->node_count());
     }
-    coupling_.emplace(geometry);
+    coupling_.emplace(geometry, scene.total_thickness_m());
     break_deflection_ = Eigen::VectorXd::Zero(largest);
     own_deflection_.resize(layers_.size());
     drawn_deflection_.resize(layers_.size());
+    for (std::size_t k = 0; k < layers_.size(); ++k)
+      if (layers_[k].mesh)  // sized once: drawing the surfaces allocates nothing
+        own_deflection_[k] = drawn_deflection_[k] = Eigen::VectorXd::Zero(layers_[k].mesh->node_count());
   }
 }
 

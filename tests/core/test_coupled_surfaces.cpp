@@ -116,7 +116,7 @@ TEST(SurfaceTransmission, BadInputIsRejectedAndProfilesInterpolate) {
 
 struct TwoLayers {
   HexLattice top = make_hex_lattice(12), bottom = make_hex_lattice(12);
-  SurfaceCoupling coupling{{{&top, 1e-3, 0.0}, {&bottom, 1e-3, 2e-3}}};
+  SurfaceCoupling coupling{{{&top, 1e-3, 0.0}, {&bottom, 1e-3, 2e-3}}, 20e-3};
   std::vector<Eigen::VectorXd> own{Eigen::VectorXd::Zero(top.node_count()),
                                    Eigen::VectorXd::Zero(bottom.node_count())};
   std::vector<Eigen::VectorXd> drawn{own};
@@ -299,6 +299,37 @@ TEST(CoupledSurfaces, TickAllocatesNothing) {
   for (const NeedleState& n : states) sim.tick(n);
   EXPECT_EQ(test::stop_counting_allocations(), 0);
   EXPECT_EQ(sim.puncture_events().size(), 1u);  // the break (and its baseline) happened in the counted ticks
+}
+
+TEST(CoupledSurfaces, ReadingTheSurfacesAllocatesNothing) {
+  // The real-time app copies the drawn surfaces for its view from the haptic
+  // thread: pressing, the layer met at the tip, the broken one resting on it,
+  // and, with the lower layer broken too, the load after the last break.
+  Scene scene = thin_over_thick(true);
+  scene.layers[1].force_law.breakthrough.critical_force_N = 1.5;
+  scene.layers[1].force_law.cutting_force_N = 0.5;
+  scene.effects.cutting = true;
+  PunctureSimulator sim(scene, test::plane_surfaces(scene));
+  std::vector<NeedleState> states;
+  for (int i = 0; i < 1500; ++i) {
+    NeedleState n;
+    n.time_s = i * 1e-3;
+    n.tip_position_m = Eigen::Vector3d(0.0, 0.0, 0.5e-3 - 0.01 * n.time_s);
+    n.axial_velocity_m_per_s = 0.01;
+    states.push_back(n);
+  }
+  long allocations = 0;
+  double deepest_after_all_broke = 0.0;
+  for (const NeedleState& n : states) {
+    sim.tick(n);
+    test::start_counting_allocations();
+    for (std::size_t k = 0; k < sim.layer_count(); ++k) sim.node_positions(k);
+    allocations += test::stop_counting_allocations();
+    if (sim.active_layer() == sim.layer_count()) deepest_after_all_broke = centre_deflection(sim, 1);
+  }
+  EXPECT_EQ(allocations, 0);
+  ASSERT_EQ(sim.puncture_events().size(), 2u);
+  EXPECT_GT(deepest_after_all_broke, 0.0);  // the cutting load holds the broken lower surface down
 }
 
 }  // namespace

@@ -74,11 +74,12 @@ TEST(HapticLoop, CountersSeeAnAllocation) {
   allocations = 0;
 }
 
-TEST(HapticLoop, NoAllocationInTheHapticPath) {
-  const std::string text = testing::short_insertion_scene_text();
+/// One whole scripted cycle, a fresh-tissue swap and the next insertion with a
+/// view snapshot every tick: nothing in the haptic path allocates.
+void expect_no_allocation_in_the_haptic_path(const std::string& text, const std::string& name) {
   const Scene scene = parse_scene(text, "short_insertion.json");
   const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
-  const fs::path dir = fs::path(PUNCTURE_BINARY_DIR) / "test_output" / "realtime" / "no_alloc";
+  const fs::path dir = fs::path(PUNCTURE_BINARY_DIR) / "test_output" / "realtime" / name;
   fs::create_directories(dir);
 
   ModelSupplier models([&] { return std::make_unique<RealtimeModel>(build_realtime_model(scene)); });
@@ -114,6 +115,18 @@ TEST(HapticLoop, NoAllocationInTheHapticPath) {
   EXPECT_FALSE(capture.update());
   recorder.finish();
   models.finish();
+}
+
+TEST(HapticLoop, NoAllocationInTheHapticPath) {
+  expect_no_allocation_in_the_haptic_path(testing::short_insertion_scene_text(), "no_alloc");
+}
+
+TEST(HapticLoop, NoAllocationWithCoupledSurfacesInTheView) {
+  // The view's snapshot reads the drawn surfaces in the haptic thread.
+  Scene scene = parse_scene(testing::short_insertion_scene_text(), "short_insertion.json");
+  scene.effects.coupled_surfaces = true;
+  scene.effects.layer_interaction = false;
+  expect_no_allocation_in_the_haptic_path(scene_to_json_text(scene), "no_alloc_coupled");
 }
 
 TEST(HapticLoop, NoAllocationWithTheUdpAndMouseDevices) {

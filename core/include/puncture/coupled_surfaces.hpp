@@ -49,9 +49,10 @@
 //
 // In: per layer its hex lattice (nullptr: no force mesh), spacing L (m) and
 // the depth of its top below the first surface (m). The transmission
-// matrices of a geometry are computed once per process (shared cache).
-// freeze_baseline() does not allocate; drawn() is for reading surfaces, not
-// for the haptic tick.
+// matrices of a geometry are computed once per process (shared cache), at
+// construction. Nothing after construction allocates (drawn() runs in the
+// real-time app's haptic thread when it copies the surfaces for the view),
+// given drawn's output vectors sized to the lattices.
 #pragma once
 
 #include <Eigen/Core>
@@ -76,18 +77,21 @@ class SurfaceCoupling {
     double tip_force_N = 0.0;   ///< at the tip: cutting, the next layer's surface force
     double shaft_force_N = 0.0; ///< the layer's shaft friction and d h v
   };
-  /// Throws std::invalid_argument for a non-positive spacing or layer tops that do not deepen.
-  explicit SurfaceCoupling(const std::vector<LayerGeometry>& layers);
+  /// slab_depth_m: how deep the tip can go below the first surface (sets
+  /// the deepest transmission level). Throws std::invalid_argument for a
+  /// non-positive spacing or layer tops that do not deepen.
+  SurfaceCoupling(const std::vector<LayerGeometry>& layers, double slab_depth_m);
 
   /// own[k]: own node deflections of layer k (its lattice's size; anything
   /// for a layer without a mesh). needle_layer == layer count: all broken.
   /// Writes drawn[k] (node deflections, m).
   void drawn(const std::vector<Eigen::VectorXd>& own, std::size_t needle_layer, std::vector<Eigen::VectorXd>& drawn,
              const LoadAfterBreak* load = nullptr) const;
-  /// T(c) P on the grid for any depth c >= 0 (m): linear between the
-  /// transmissions at c = 0.25 mm x 1.3^i (computed once per process), the
-  /// identity blended in below 0.25 mm.
-  Eigen::VectorXd transmitted(const Eigen::VectorXd& profile, double depth_m) const;
+  /// out = T(c) P on the grid for any depth c >= 0 (m): linear between the
+  /// transmissions at c = 0.25 mm x 1.3^i (made at construction up to the
+  /// slab's depth, once per process), the identity blended in below 0.25 mm,
+  /// the deepest level beyond. No allocation.
+  void transmitted(const Eigen::VectorXd& profile, double depth_m, Eigen::VectorXd& out) const;
   /// Layer k broke with own node deflections own_at_break under the surface
   /// force force_N (N), the tip at tip_depth_m below the first surface: keeps
   /// its drawn profile P_b (no allocation).
@@ -121,7 +125,8 @@ class SurfaceCoupling {
   std::vector<Eigen::VectorXd> baseline_, break_profile_;
   std::vector<double> break_force_N_, break_depth_m_;
   std::vector<bool> has_baseline_, has_break_;
-  mutable std::vector<std::shared_ptr<const Eigen::MatrixXd>> ladder_;  ///< T at the ladder depths, filled on use
+  std::vector<std::shared_ptr<const Eigen::MatrixXd>> ladder_;  ///< T at the ladder depths
+  mutable Eigen::VectorXd carried_, level_lo_, level_hi_;
   mutable std::vector<Eigen::VectorXd> profile_;
   mutable Eigen::VectorXd ring_means_, scratch_;
 };
