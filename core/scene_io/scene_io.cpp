@@ -315,14 +315,21 @@ ComparisonSettings read_comparison(ObjectReader r, const std::string& file) {
   return c;
 }
 
-Layer read_layer(ObjectReader r, const std::string& file, bool& has_resumption_time) {
+/// resumption_rate: the paper's eta_r per haptic step if the layer gives one
+/// (0 if not), converted to resumption_time_s by the scene reader.
+Layer read_layer(ObjectReader r, const std::string& file, bool& has_resumption_time, double& resumption_rate) {
   Layer l;
   l.name = r.string("name");
   l.thickness_m = r.number("thickness_mm") * kMm;
   l.density_kg_per_m3 = r.number("density_kg_per_m3", l.density_kg_per_m3);
   l.force_mesh = read_force_mesh(ObjectReader(r.raw("force_mesh"), r.child("force_mesh"), file));
   l.damping_N_s_per_m2 = r.number("damping_d_N_s_per_m2");
-  l.resumption_rate = r.number("resumption_rate", l.resumption_rate);
+  resumption_rate = 0.0;
+  if (r.has("resumption_rate")) {
+    resumption_rate = r.number("resumption_rate");
+    if (!(resumption_rate > 0 && resumption_rate <= 1))
+      r.fail(r.child("resumption_rate"), "in (0, 1] (got " + describe(resumption_rate) + ")");
+  }
   has_resumption_time = r.has("resumption_time_s");
   l.resumption_time_s = r.number("resumption_time_s", l.resumption_time_s);
   if (r.has("force_law")) l.force_law = read_force_law(ObjectReader(r.raw("force_law"), r.child("force_law"), file), file);
@@ -346,6 +353,7 @@ Scene read_scene(const json& root, const std::string& file) {
   s.description = r.string("description", "");
   s.source_path = file;
   std::vector<bool> resumption_time_given;
+  std::vector<double> resumption_rate;  // eta_r per haptic step as given (0: not given)
 
   {
     ObjectReader o(r.raw("sample"), "/sample", file);
@@ -365,8 +373,11 @@ Scene read_scene(const json& root, const std::string& file) {
     if (!layers.is_array()) r.fail("/layers", "must be an array of layer objects");
     for (std::size_t i = 0; i < layers.size(); ++i) {
       bool has_time = false;
-      s.layers.push_back(read_layer(ObjectReader(layers[i], "/layers/" + std::to_string(i), file), file, has_time));
+      double rate = 0.0;
+      s.layers.push_back(
+          read_layer(ObjectReader(layers[i], "/layers/" + std::to_string(i), file), file, has_time, rate));
       resumption_time_given.push_back(has_time);
+      resumption_rate.push_back(rate);
     }
   }
   {
@@ -438,16 +449,14 @@ Scene read_scene(const json& root, const std::string& file) {
   }
   r.reject_unknown_keys();
   // Recovery time in seconds: given, or the paper's eta_r per haptic step at
-  // this file's haptic rate (so that it no longer changes with the rate);
-  // eta_r is kept consistent for reports.
+  // this file's haptic rate (so that it no longer changes with the rate).
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     Layer& l = s.layers[i];
     const std::string p = "/layers/" + std::to_string(i);
     if (resumption_time_given[i]) {
       if (!(l.resumption_time_s > 0)) r.fail(p + "/resumption_time_s", "must be > 0 (got " + describe(l.resumption_time_s) + ")");
-      if (s.realtime.haptic_rate_Hz > 0) l.resumption_rate = std::min(1.0, 1.0 / (l.resumption_time_s * s.realtime.haptic_rate_Hz));
-    } else if (l.resumption_rate > 0 && s.realtime.haptic_rate_Hz > 0) {
-      l.resumption_time_s = 1.0 / (l.resumption_rate * s.realtime.haptic_rate_Hz);
+    } else if (resumption_rate[i] > 0 && s.realtime.haptic_rate_Hz > 0) {
+      l.resumption_time_s = 1.0 / (resumption_rate[i] * s.realtime.haptic_rate_Hz);
     }
   }
   validate_scene(s, file);
@@ -559,8 +568,6 @@ void validate_scene(const Scene& s, const std::string& file) {
     require(fm.virtual_stiffening_m >= 0, file, p + "/force_mesh/virtual_stiffening_mm",
             ">= 0 (0: linear virtual springs)", fm.virtual_stiffening_m / kMm);
     require(l.damping_N_s_per_m2 >= 0, file, p + "/damping_d_N_s_per_m2", ">= 0", l.damping_N_s_per_m2);
-    require(l.resumption_rate > 0 && l.resumption_rate <= 1, file, p + "/resumption_rate", "in (0, 1]",
-            l.resumption_rate);
     require(l.resumption_time_s > 0 && std::isfinite(l.resumption_time_s), file, p + "/resumption_time_s", "> 0",
             l.resumption_time_s);
     validate_force_law(l.force_law, file, p + "/force_law", l.thickness_m);

@@ -83,7 +83,7 @@ TEST(FemReferenceHash, IgnoresRealtimeOnlyFields) {
       {"L", [](Scene& s) { s.layers[2].force_mesh.spacing_L_m *= 1.5; }},
       {"d", [](Scene& s) { s.layers[0].damping_N_s_per_m2 *= 3; }},
       {"surface stiffness", [](Scene& s) { s.layers[0].force_mesh.surface_stiffness_N_per_m *= 2; }},
-      {"resumption rate", [](Scene& s) { s.layers[1].resumption_rate = 0.2; }},
+      {"resumption time", [](Scene& s) { s.layers[1].resumption_time_s = 0.2; }},
       {"sh_degree", [](Scene& s) { s.realtime.sh_degree = 24; }},
       {"integrator", [](Scene& s) { s.realtime.integrator = "explicit"; }},
       {"haptic rate", [](Scene& s) { s.realtime.haptic_rate_Hz = 2000; }},

@@ -190,11 +190,11 @@ struct Layer {
   /// d: damping per unit inserted needle length, N s / m^2 (Table 1 reads
   /// F = d h v; see core/README.md for why this unit).
   double damping_N_s_per_m2 = 3000.0;
-  double resumption_rate = 0.05;  ///< eta_r of Eq. (8): drop of the recovery factor per haptic step (as read; see resumption_time_s)
   /// Time (s) in which a broken surface returns to its rest shape (Eq. 8 with
   /// eta falling linearly in time). What the simulator uses: independent of the
-  /// haptic rate. A scene file giving only resumption_rate sets it to
-  /// 1 / (eta_r x haptic rate of that file).
+  /// haptic rate. A scene file giving only the paper's eta_r
+  /// (`resumption_rate`, the drop of the recovery factor per haptic step) sets
+  /// it to 1 / (eta_r x haptic rate of that file) when it is read.
   double resumption_time_s = 0.02;
   ForceLaw force_law;
   ContinuumMaterial material;

@@ -174,6 +174,7 @@ const BadForceLaw kBad[] = {
      [](json& j) { j["layers"][2]["force_law"]["breakthrough"] = {{"criterion", "rings"}}; },
      "/layers/2/force_law/breakthrough/criterion"},
     {"coupled_surfaces_with_interaction", [](json& j) { j["effects"].push_back("coupled_surfaces"); }, "/effects"},
+    {"recovery_rate_above_one", [](json& j) { j["layers"][0]["resumption_rate"] = 1.5; }, "/layers/0/resumption_rate"},
     {"zero_recovery_time", [](json& j) { j["layers"][1]["resumption_time_s"] = 0.0; }, "/layers/1/resumption_time_s"},
     {"negative_axial_stiffness", [](json& j) { j["layers"][0]["force_mesh"]["surface_axial_stiffness_N_per_mm"] = -1.0; },
      "/layers/0/force_mesh/surface_axial_stiffness_N_per_mm"},
