@@ -119,15 +119,18 @@ void SurfaceCoupling::own_profile(std::size_t k, const Eigen::Ref<const Eigen::V
     out(static_cast<Eigen::Index>(g)) = profile_value_at(radius, means.data(), grid_[g]);
 }
 
+void SurfaceCoupling::add_faded_baseline(std::size_t k, Eigen::VectorXd& profile) const {
+  if (!has_baseline_[k] || !(baseline_[k](0) > 0.0)) return;
+  const double taken_over = std::clamp(profile(0) / baseline_[k](0), 0.0, 1.0);  // s of the header
+  profile = profile.cwiseMax((1.0 - taken_over) * baseline_[k]);
+}
+
 void SurfaceCoupling::freeze_break(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own_at_break, double force_N,
                                    double tip_depth_m) {
   if (k >= n_ || !lattice_[k]) return;
   Eigen::VectorXd& p = break_profile_[k];
   own_profile(k, own_at_break, p);
-  if (has_baseline_[k] && baseline_[k](0) > 0.0) {
-    const double taken_over = std::clamp(p(0) / baseline_[k](0), 0.0, 1.0);
-    p = p.cwiseMax((1.0 - taken_over) * baseline_[k]);
-  }
+  add_faded_baseline(k, p);
   break_force_N_[k] = force_N;
   break_depth_m_[k] = tip_depth_m;
   has_break_[k] = true;
@@ -177,10 +180,7 @@ void SurfaceCoupling::drawn(const std::vector<Eigen::VectorXd>& own, std::size_t
     profile_[k] = profile_[k].cwiseMax(carried_);
   }
   if (a < n_ && lattice_[a]) {
-    if (has_baseline_[a] && baseline_[a](0) > 0.0) {
-      const double taken_over = std::clamp(profile_[a](0) / baseline_[a](0), 0.0, 1.0);
-      profile_[a] = profile_[a].cwiseMax((1.0 - taken_over) * baseline_[a]);
-    }
+    add_faded_baseline(a, profile_[a]);
     for (std::size_t k = a + 1; k < n_; ++k)
       if (lattice_[k]) {
         carried_.noalias() = *weights_[a][k] * profile_[a];

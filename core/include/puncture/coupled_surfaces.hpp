@@ -113,6 +113,8 @@ class SurfaceCoupling {
   const Eigen::MatrixXd& transmission(std::size_t a, std::size_t k) const { return *weights_[a][k]; }
 
  private:
+  /// profile = max(profile, (1 - s) B_k) for the needle layer met at the tip (no allocation).
+  void add_faded_baseline(std::size_t k, Eigen::VectorXd& profile) const;
   /// O_k on the grid into out.
   void own_profile(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own, Eigen::VectorXd& out) const;
 
