@@ -114,28 +114,25 @@ def main():
              "the tissue, of each layer's top surface (the material surface at its rest depth). The half-space "
              "transmission is the kernel of core/coupled_surfaces.hpp, evaluated here by plain quadrature.\n",
              f"## 1. While the {names[0]} is pressed: the surfaces below it\n", header, rule]
-    pressed = [d for d in (2.0, 4.0, 6.0, 8.0) if d in by_depth]
-    for d in pressed:
-        rs, us = surface_profile(by_depth[d], tops[0])
-        lines.append(f"| {d:.1f} | {names[0]} top (FEM) | {row(np.interp(RADII_MM, rs, us))} |")
-        for k in (1, 2):
-            rt, ut = surface_profile(by_depth[d], tops[k])
-            h = tops[k] - tops[0]
-            lines.append(f"| {d:.1f} | {names[k]} top (FEM) | {row(np.interp(RADII_MM, rt, ut))} |")
-            lines.append(f"| {d:.1f} | {names[k]} top: transmission through {h:.1f} mm | "
-                         f"{row([transmitted(rs, us, x, h) for x in RADII_MM])} |")
+
+    def source_and_targets(depths, source, targets, through):
+        """The source layer's top, then each target's top beside its transmission from the source."""
+        for d in depths:
+            if d not in by_depth:
+                continue
+            rs, us = surface_profile(by_depth[d], tops[source])
+            lines.append(f"| {d:.1f} | {names[source]} top (FEM) | {row(np.interp(RADII_MM, rs, us))} |")
+            for k in targets:
+                rt, ut = surface_profile(by_depth[d], tops[k])
+                h = abs(tops[k] - tops[source])
+                lines.append(f"| {d:.1f} | {names[k]} top (FEM) | {row(np.interp(RADII_MM, rt, ut))} |")
+                lines.append(f"| {d:.1f} | {names[k]} top: transmission {through} {h:.1f} mm | "
+                             f"{row([transmitted(rs, us, x, h) for x in RADII_MM])} |")
+
+    source_and_targets((2.0, 4.0, 6.0, 8.0), 0, (1, 2), "through")
     lines += ["", f"## 2. After the {names[0]} and the {names[1]} broke: the broken surfaces over the pressed "
               f"{names[2]}\n", header, rule]
-    after = [d for d in (11.4, 13.4, 18.4, 28.4) if d in by_depth]
-    for d in after:
-        rs, us = surface_profile(by_depth[d], tops[2])
-        lines.append(f"| {d:.1f} | {names[2]} top (FEM) | {row(np.interp(RADII_MM, rs, us))} |")
-        for k in (1, 0):
-            rt, ut = surface_profile(by_depth[d], tops[k])
-            h = tops[2] - tops[k]
-            lines.append(f"| {d:.1f} | {names[k]} top (FEM) | {row(np.interp(RADII_MM, rt, ut))} |")
-            lines.append(f"| {d:.1f} | {names[k]} top: transmission up through {h:.1f} mm | "
-                         f"{row([transmitted(rs, us, x, h) for x in RADII_MM])} |")
+    source_and_targets((11.4, 13.4, 18.4, 28.4), 2, (1, 0), "up through")
     # 3. The last layer after its break, held by the needle's load (reciprocity).
     rows = [l for l in open(os.path.join(fem_dir, "fem_force_depth.csv")) if not l.startswith("#")]
     head = rows[0].strip().split(",")

@@ -67,6 +67,16 @@ std::string fmt(double x, int precision = 10) {
   return validation::significant_digits(x, precision);
 }
 
+/// VTK output asked for and built (without VTK: CSV, PNG and markdown only).
+bool writes_vtk(const ValidateOptions& options) {
+#ifdef PUNCTURE_HAVE_VTK
+  return options.write_vtk;
+#else
+  (void)options;
+  return false;
+#endif
+}
+
 /// What one scene's validation leaves for a held-out summary.
 struct SceneValidation {
   std::vector<validation::LayerAcceptance> acceptance;
@@ -293,11 +303,7 @@ std::optional<SceneValidation> validate_scene(const Scene& scene, const std::str
                                               const std::filesystem::path& dir, const std::string& command_line,
                                               const ValidateOptions& options, std::ostream& out, std::ostream& err) {
   using namespace validation;
-#ifdef PUNCTURE_HAVE_VTK
-  const bool vtk = options.write_vtk;
-#else
-  const bool vtk = false;  // this build has no VTK: CSV, PNG and markdown only
-#endif
+  const bool vtk = writes_vtk(options);
   const io::Provenance provenance = io::make_provenance(command_line);
   auto progress = [&](const std::string& line) { out << "[validate] " << line << '\n' << std::flush; };
   progress("scene " + scene_file);
@@ -347,14 +353,7 @@ std::optional<SceneValidation> validate_scene(const Scene& scene, const std::str
   return SceneValidation{c.acceptance, layers};
 }
 
-std::string vtk_flag(const ValidateOptions& options) {
-#ifdef PUNCTURE_HAVE_VTK
-  return options.write_vtk ? "" : " --no-vtk";
-#else
-  (void)options;
-  return " --no-vtk";
-#endif
-}
+std::string vtk_flag(const ValidateOptions& options) { return writes_vtk(options) ? "" : " --no-vtk"; }
 
 /// --cases: the model scene with each case's overrides, one report per case,
 /// then the held-out summary. Every case is checked before the first FEM runs.
@@ -362,20 +361,17 @@ int validate_cases(const ValidateOptions& options, const std::filesystem::path& 
                    std::ostream& err) {
   validation::ValidationCases cases;
   std::vector<validation::CaseScene> scenes;
+  const Scene model = load_scene(model_path);  // the model itself must be valid
   try {
     cases = validation::read_validation_cases(options.cases);
-    const Scene model = load_scene(model_path);  // the model itself must be valid
     const std::string model_text = io::read_text_file(model_path);
     for (const validation::ValidationCase& c : cases.cases)
       scenes.push_back(validation::case_scene(model_text, model_path.string(), c));
-  } catch (const SceneError&) {
-    throw;
-  } catch (const std::invalid_argument& e) {
+  } catch (const std::invalid_argument& e) {  // SceneError is a runtime_error: it passes through
     throw InputError(e.what());  // the cases file, or an override the model scene does not have
   }
-  const std::filesystem::path dir = options.output_dir.empty()
-                                        ? std::filesystem::path("out") / (load_scene(model_path).name + "_cases")
-                                        : options.output_dir;
+  const std::filesystem::path dir =
+      options.output_dir.empty() ? std::filesystem::path("out") / (model.name + "_cases") : options.output_dir;
   const std::string command_line = "puncture validate " + model_path.string() + " --cases " +
                                    options.cases.string() + " -o " + dir.string() + vtk_flag(options);
   std::vector<validation::CaseOutcome> outcomes;

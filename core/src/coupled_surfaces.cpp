@@ -13,8 +13,10 @@ namespace puncture {
 
 namespace {
 
-/// T on a uniform grid of `points` points spaced `step_m`, for depth_m: the
-/// same geometry gives the same matrix, so it is computed once per process.
+constexpr double kFirstLevel_m = 0.25e-3, kLevelRatio = 1.3;  // transmission ladder: 0.25 mm x 1.3^i
+
+/// T on the grid for depth_m: the same grid and depth give the same matrix,
+/// so it is computed once per process.
 std::shared_ptr<const Eigen::MatrixXd> grid_weights(const std::vector<double>& grid, double depth_m) {
   static std::mutex mutex;
   static std::map<std::tuple<std::size_t, long long, long long>, std::shared_ptr<const Eigen::MatrixXd>> cache;
@@ -28,10 +30,10 @@ std::shared_ptr<const Eigen::MatrixXd> grid_weights(const std::vector<double>& g
   return cache.emplace(key, std::move(w)).first->second;
 }
 
-/// Linear interpolation on the uniform grid; 0 beyond it.
+/// profile_value_at on the uniform grid, found in O(1) instead of by search
+/// (every node of every layer, whenever the surfaces are read); 0 beyond it.
 double on_grid(const std::vector<double>& grid, const Eigen::VectorXd& values, double r) {
-  const double dr = grid[1];
-  const double x = r / dr;
+  const double x = r / grid[1];
   const auto j = static_cast<Eigen::Index>(std::floor(x));
   if (j + 1 >= values.size()) return j + 1 == values.size() && x == static_cast<double>(j) ? values(j) : 0.0;
   const double t = x - static_cast<double>(j);
@@ -39,10 +41,6 @@ double on_grid(const std::vector<double>& grid, const Eigen::VectorXd& values, d
 }
 
 }  // namespace
-
-namespace {
-constexpr double kFirstLevel_m = 0.25e-3, kLevelRatio = 1.3;
-}
 
 SurfaceCoupling::SurfaceCoupling(const std::vector<LayerGeometry>& layers, double slab_depth_m)
     : n_(layers.size()),

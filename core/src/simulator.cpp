@@ -84,10 +84,14 @@ PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique
   }
 }
 
+const Eigen::Matrix3Xd& PunctureSimulator::own_positions(std::size_t k) const {
+  const LayerModel& layer = layers_[k];
+  return layer.resumption && layer.resumption->active() ? layer.resumption->positions() : layer.mesh->positions();
+}
+
 void PunctureSimulator::own_deflection(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const {
   const LayerModel& layer = layers_[k];
-  const Eigen::Matrix3Xd& pos =
-      layer.resumption && layer.resumption->active() ? layer.resumption->positions() : layer.mesh->positions();
+  const Eigen::Matrix3Xd& pos = own_positions(k);
   const Eigen::Matrix3Xd& rest = layer.mesh->rest_positions();
   const Eigen::Matrix3Xd& normal = layer.mesh->normals();
   for (Eigen::Index i = 0; i < pos.cols(); ++i) out(i) = normal.col(i).dot(rest.col(i) - pos.col(i));
@@ -102,11 +106,8 @@ void PunctureSimulator::freeze_coupled_break(std::size_t k, double surface_force
 
 void PunctureSimulator::update_drawn_surfaces() const {
   if (drawn_tick_ == ticks_) return;
-  for (std::size_t k = 0; k < layers_.size(); ++k) {
-    if (!layers_[k].mesh) continue;
-    own_deflection_[k].resize(layers_[k].mesh->node_count());
-    own_deflection(k, own_deflection_[k]);
-  }
+  for (std::size_t k = 0; k < layers_.size(); ++k)
+    if (layers_[k].mesh) own_deflection(k, own_deflection_[k]);  // sized at construction
   // The layer the tip is in after its break carries the needle's load while no layer below is pressed.
   SurfaceCoupling::LoadAfterBreak load;
   const bool loaded = active_ > 0 && (active_ == layers_.size() || !layers_[active_].contact_set);
@@ -133,8 +134,7 @@ double PunctureSimulator::surface_deflection_m(std::size_t k) const {
 const Eigen::Matrix3Xd& PunctureSimulator::node_positions(std::size_t k) const {
   const LayerModel& layer = layers_[k];
   if (!layer.mesh) return empty_positions_;
-  const Eigen::Matrix3Xd& own =
-      layer.resumption && layer.resumption->active() ? layer.resumption->positions() : layer.mesh->positions();
+  const Eigen::Matrix3Xd& own = own_positions(k);
   if (coupling_) {
     update_drawn_surfaces();
     layer.shifted_positions = own;

@@ -241,6 +241,19 @@ Scene thin_over_thick(bool coupled) {
   return s;
 }
 
+/// The needle going down at 10 mm/s from 0.5 mm above the first surface, one state per 1 ms tick.
+std::vector<NeedleState> descent(int ticks) {
+  std::vector<NeedleState> states;
+  for (int i = 0; i < ticks; ++i) {
+    NeedleState n;
+    n.time_s = i * 1e-3;
+    n.tip_position_m = Eigen::Vector3d(0.0, 0.0, 0.5e-3 - 0.01 * n.time_s);
+    n.axial_velocity_m_per_s = 0.01;
+    states.push_back(n);
+  }
+  return states;
+}
+
 double centre_deflection(const PunctureSimulator& sim, std::size_t k) {
   return sim.node_rest_positions(k)(2, 0) - sim.node_positions(k)(2, 0);
 }
@@ -248,14 +261,11 @@ double centre_deflection(const PunctureSimulator& sim, std::size_t k) {
 TEST(CoupledSurfaces, ForcesUnchangedSurfacesDrawnTogether) {
   PunctureSimulator plain(thin_over_thick(false), test::plane_surfaces(thin_over_thick(false)));
   PunctureSimulator coupled(thin_over_thick(true), test::plane_surfaces(thin_over_thick(true)));
-  const double dt = 1e-3, v = 0.01;
   double below_while_pressed = 0.0, top_after_recovery = 0.0, top_plain_after_recovery = 0.0;
   double break_t = -1.0;
-  for (int i = 0; i < 600; ++i) {
-    NeedleState n;
-    n.time_s = i * dt;
-    n.tip_position_m = Eigen::Vector3d(0.0, 0.0, 0.5e-3 - v * n.time_s);
-    n.axial_velocity_m_per_s = v;
+  const std::vector<NeedleState> states = descent(600);
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    const NeedleState& n = states[i];
     const TickResult& a = plain.tick(n);
     const double force_plain = a.total_force_N;
     const TickResult& b = coupled.tick(n);
@@ -287,14 +297,7 @@ TEST(CoupledSurfaces, ForcesUnchangedSurfacesDrawnTogether) {
 TEST(CoupledSurfaces, TickAllocatesNothing) {
   Scene scene = thin_over_thick(true);
   PunctureSimulator sim(scene, test::plane_surfaces(scene));
-  std::vector<NeedleState> states;
-  for (int i = 0; i < 400; ++i) {
-    NeedleState n;
-    n.time_s = i * 1e-3;
-    n.tip_position_m = Eigen::Vector3d(0.0, 0.0, 0.5e-3 - 0.01 * n.time_s);
-    n.axial_velocity_m_per_s = 0.01;
-    states.push_back(n);
-  }
+  const std::vector<NeedleState> states = descent(400);
   test::start_counting_allocations();
   for (const NeedleState& n : states) sim.tick(n);
   EXPECT_EQ(test::stop_counting_allocations(), 0);
@@ -310,14 +313,7 @@ TEST(CoupledSurfaces, ReadingTheSurfacesAllocatesNothing) {
   scene.layers[1].force_law.cutting_force_N = 0.5;
   scene.effects.cutting = true;
   PunctureSimulator sim(scene, test::plane_surfaces(scene));
-  std::vector<NeedleState> states;
-  for (int i = 0; i < 1500; ++i) {
-    NeedleState n;
-    n.time_s = i * 1e-3;
-    n.tip_position_m = Eigen::Vector3d(0.0, 0.0, 0.5e-3 - 0.01 * n.time_s);
-    n.axial_velocity_m_per_s = 0.01;
-    states.push_back(n);
-  }
+  const std::vector<NeedleState> states = descent(1500);
   long allocations = 0;
   double deepest_after_all_broke = 0.0;
   for (const NeedleState& n : states) {

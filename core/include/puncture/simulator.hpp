@@ -72,7 +72,8 @@
 // layer met at the tip keeps the deformation the pressing left on it, and a
 // broken layer rests on the layer below. It changes node_positions() only,
 // never a force; it is computed when the surfaces are read, not in tick()
-// (except one matrix-vector product at a break, allocation-free).
+// (except the broken surface's profile and one matrix-vector product at a
+// break, allocation-free).
 // The force meshes are laid out at construction around the point where the
 // scene's insertion axis (x = y = 0, direction -z) crosses each surface; the
 // mesh step is the fixed haptic step 1 / RealtimeSettings::haptic_rate_Hz.
@@ -214,6 +215,8 @@ class PunctureSimulator {
   double step_chain(const NeedleState& needle, double transmitted_force_N);
   bool breakthrough(std::size_t k, double surface_force_N);
   void record_puncture(const NeedleState& needle, double surface_force_N);
+  /// Layer k's own node positions: its mesh while intact, its resumption after it broke (needs a mesh).
+  const Eigen::Matrix3Xd& own_positions(std::size_t k) const;
   /// Own deflection of layer k's nodes along the inward normals (m) into `out`.
   void own_deflection(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const;
   /// Coupled surfaces: layer k broke under surface_force_N with the tip at tip_depth_m.
@@ -236,7 +239,7 @@ class PunctureSimulator {
   Eigen::Matrix3Xd empty_positions_;
   std::vector<int> empty_rings_;
   std::optional<SurfaceCoupling> coupling_;  ///< Effects::coupled_surfaces
-  Eigen::VectorXd break_deflection_;         ///< drawn deflection of a layer at its break (largest mesh)
+  Eigen::VectorXd break_deflection_;         ///< own deflection of a layer at its break (sized to the largest mesh)
   std::uint64_t ticks_ = 0;
   mutable std::uint64_t drawn_tick_ = ~std::uint64_t{0};
   mutable std::vector<Eigen::VectorXd> own_deflection_, drawn_deflection_;
