@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -31,6 +32,38 @@ std::map<fs::path, CleanupKind>& registry() {
   return r;
 }
 std::atomic<bool> installed{false};
+// Threads waiting for the registry: once the watcher holds it for good, a
+// writer that waits here has closed every file it staged before.
+std::atomic<int> waiting_for_registry{0};
+
+using Entries = std::vector<std::pair<fs::path, CleanupKind>>;
+
+// Removes the files and trees of `entries`, then the directories among them
+// that are empty (deepest first). Returns the number of files and trees that
+// existed and were removed.
+std::size_t remove_entries(const Entries& entries) {
+  std::size_t removed = 0;
+  std::vector<fs::path> dirs;
+  for (const auto& [path, kind] : entries) {
+    std::error_code ec;
+    if (kind == CleanupKind::File) {
+      if (fs::remove(path, ec)) ++removed;
+    } else if (kind == CleanupKind::Tree) {
+      const auto n = fs::remove_all(path, ec);
+      if (n != static_cast<std::uintmax_t>(-1) && n > 0) ++removed;
+    } else {
+      dirs.push_back(path);
+    }
+  }
+  std::sort(dirs.begin(), dirs.end(), [](const fs::path& a, const fs::path& b) {
+    return a.string().size() > b.string().size();
+  });
+  for (const fs::path& d : dirs) {
+    std::error_code ec;
+    fs::remove(d, ec);
+  }
+  return removed;
+}
 
 sigset_t watched_signals() {
   sigset_t set;
@@ -52,7 +85,18 @@ void watcher() {
   int sig = 0;
   while (sigwait(&set, &sig) != 0) {
   }
-  const std::size_t removed = run_cleanup_now();
+  // The registry stays locked until the process ends, so no file is staged
+  // after the first pass. A file registered just before it may be created
+  // just after it (stage() registers, then the caller opens the file): a
+  // second pass once the writer is blocked on the registry (every file it
+  // staged is then closed), or after at most one second, removes it.
+  std::unique_lock<std::mutex> hold(registry_mutex());
+  const Entries entries(registry().begin(), registry().end());
+  const std::size_t removed = remove_entries(entries);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  while (waiting_for_registry.load() == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  remove_entries(entries);
   char message[160];
   std::snprintf(message, sizeof message, "\ninterrupted by signal %d (%s): removed %zu staged file(s); nothing was committed\n",
                 sig, sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "SIGHUP", removed);
@@ -68,6 +112,14 @@ void watcher() {
   ::_exit(128 + sig);
 }
 
+// Locks the registry, counting the wait (see waiting_for_registry).
+std::unique_lock<std::mutex> lock_registry() {
+  ++waiting_for_registry;
+  std::unique_lock<std::mutex> lock(registry_mutex());
+  --waiting_for_registry;
+  return lock;
+}
+
 }  // namespace
 
 void install_interrupt_cleanup() {
@@ -80,40 +132,20 @@ void install_interrupt_cleanup() {
 bool interrupt_cleanup_installed() { return installed.load(); }
 
 void register_cleanup(const fs::path& path, CleanupKind kind) {
-  std::lock_guard<std::mutex> lock(registry_mutex());
+  const auto lock = lock_registry();
   registry()[path] = kind;
 }
 
 void unregister_cleanup(const fs::path& path) {
-  std::lock_guard<std::mutex> lock(registry_mutex());
+  const auto lock = lock_registry();
   registry().erase(path);
 }
 
 std::size_t run_cleanup_now() {
-  std::lock_guard<std::mutex> lock(registry_mutex());
-  std::size_t removed = 0;
-  std::vector<fs::path> dirs;
-  for (const auto& [path, kind] : registry()) {
-    std::error_code ec;
-    if (kind == CleanupKind::File) {
-      if (fs::remove(path, ec)) ++removed;
-    } else if (kind == CleanupKind::Tree) {
-      const auto n = fs::remove_all(path, ec);
-      if (n != static_cast<std::uintmax_t>(-1) && n > 0) ++removed;
-    } else {
-      dirs.push_back(path);
-    }
-  }
-  // Deepest directories first; a directory that still holds files stays.
-  std::sort(dirs.begin(), dirs.end(), [](const fs::path& a, const fs::path& b) {
-    return a.string().size() > b.string().size();
-  });
-  for (const fs::path& d : dirs) {
-    std::error_code ec;
-    fs::remove(d, ec);
-  }
+  const auto lock = lock_registry();
+  const Entries entries(registry().begin(), registry().end());
   registry().clear();
-  return removed;
+  return remove_entries(entries);
 }
 
 bool is_stale_staging_name(const std::string& name) {
