@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "puncture/cutting.hpp"
+#include "puncture/shaft_forces.hpp"
 #include "puncture/stiffening.hpp"
 
 namespace puncture {
@@ -333,60 +333,50 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   }
 }
 
-const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
-  if (!needle.tip_position_m.allFinite() || !needle.direction.allFinite() ||
-      !std::isfinite(needle.axial_velocity_m_per_s) || !std::isfinite(needle.time_s))
-    throw std::invalid_argument("PunctureSimulator::tick: non-finite needle state");
-
-  ++ticks_;  // drawn surfaces of the last tick are stale from here on
-  result_.time_s = needle.time_s;
-  result_.depth_m = needle.depth_m();
-  result_.velocity_m_per_s = needle.axial_velocity_m_per_s;
-  for (LayerTickResult& r : result_.layers) r = LayerTickResult{};
-  const std::size_t n = layers_.size();
-  const double tip_axial_m = needle.tip_position_m.dot(needle.direction);
-
-  // 1. Resumption of the layers broken in earlier ticks.
+void PunctureSimulator::resume_broken_layers(double time_s) {
   for (std::size_t k = 0; k < active_; ++k)
-    if (layers_[k].resumption) layers_[k].resumption->step(needle.time_s);
+    if (layers_[k].resumption) layers_[k].resumption->step(time_s);
+}
 
-  // 2. Contact of the needle layer (a tip that starts below the first
-  // surface is in contact at once).
+void PunctureSimulator::update_needle_contact(const NeedleState& needle) {
+  // A tip that starts below the first surface is in contact at once.
   if (first_tick_) layers_[0].tip_contact_from_m = -std::numeric_limits<double>::infinity();
-  if (active_ < n && !layers_[active_].contact_set) try_contact(needle);
+  if (active_ < layers_.size() && !layers_[active_].contact_set) try_contact(needle);
   if (first_tick_) layers_[0].tip_contact_from_m = std::numeric_limits<double>::infinity();
   first_tick_ = false;
+}
 
-  // Cutting force of the punctured layer the tip is in: until the next layer
-  // is touched, or, when that layer was met at the break (contact at the
-  // tip, the broken layer squeezed between them), while the tip presses it.
-  auto cutting = [&]() {
-    if (!cutting_on_ || active_ == 0) return 0.0;
-    if (active_ < n && layers_[active_].contact_set && !layers_[active_].contact_at_tip) return 0.0;
-    LayerModel& p = layers_[active_ - 1];
-    const double f = cutting_force_N(p.law.cutting_force_N, p.law.cutting_release_m, p.front_m, tip_axial_m);
-    p.front_m = std::max(p.front_m, tip_axial_m);
-    return f;
-  };
-  double cut = cutting();
+double PunctureSimulator::crack_force(double tip_axial_m) {
+  // The punctured layer the tip is in is cut until the next layer is touched,
+  // or, when that layer was met at the break (contact at the tip, the broken
+  // layer squeezed between them), while the tip presses it.
+  if (!cutting_on_ || active_ == 0) return 0.0;
+  const std::size_t n = layers_.size();
+  const NextLayerContact next = active_ == n || !layers_[active_].contact_set ? NextLayerContact::None
+                                : layers_[active_].contact_at_tip          ? NextLayerContact::MetAtTip
+                                                                           : NextLayerContact::Touched;
+  LayerModel& p = layers_[active_ - 1];
+  return open_crack_force_N(p.law, p.front_m, tip_axial_m, next);
+}
 
-  // 3. The chain under the needle (or the needle layer alone).
-  double surface_force = 0.0;
-  if (active_ < n) {
-    if (layers_[active_].mesh) {
-      surface_force = step_chain(needle, interaction_ ? cut : 0.0);
-    } else if (layers_[active_].contact_set) {
-      const LayerModel& layer = layers_[active_];
-      const double d = layer.contact.normal.dot(layer.contact.position - needle.tip_position_m);
-      result_.layers[active_].contact_deflection_m = std::max(0.0, d);
-    }
+double PunctureSimulator::press_needle_layer(const NeedleState& needle, double transmitted_force_N) {
+  if (active_ >= layers_.size()) return 0.0;
+  if (layers_[active_].mesh) return step_chain(needle, transmitted_force_N);
+  if (layers_[active_].contact_set) {
+    const LayerModel& layer = layers_[active_];
+    const double d = layer.contact.normal.dot(layer.contact.position - needle.tip_position_m);
+    result_.layers[active_].contact_deflection_m = std::max(0.0, d);
   }
+  return 0.0;
+}
 
-  // 4. Breakthrough; the next layer becomes the needle layer in the same tick.
+bool PunctureSimulator::break_through(const NeedleState& needle, double surface_force_N) {
+  const std::size_t n = layers_.size();
   bool broke = false;
-  while (active_ < n && layers_[active_].contact_set && breakthrough(active_, surface_force)) {
-    record_puncture(needle, surface_force);
-    surface_force = 0.0;
+  // The next layer becomes the needle layer in the same tick.
+  while (active_ < n && layers_[active_].contact_set && breakthrough(active_, surface_force_N)) {
+    record_puncture(needle, surface_force_N);
+    surface_force_N = 0.0;
     broke = true;
     const bool touched = active_ < n && try_contact(needle);
     if (coupling_) {
@@ -406,36 +396,35 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
     layers_[active_].state = out.contact_deflection_m > 0.0 ? LayerState::Pressed : LayerState::Untouched;
     out.state = layers_[active_].state;
   }
-  if (broke) cut = cutting();  // the crack through the layer that just broke starts at the tip
-  if (active_ > 0) result_.layers[active_ - 1].cutting_force_N = cut;
+  return broke;
+}
 
-  // 5. Shaft friction and damping of the punctured layers.
-  double friction_total = 0.0;
+double PunctureSimulator::shaft_friction_and_damping(const NeedleState& needle) {
+  double total = 0.0;
   for (std::size_t k = 0; k < active_; ++k) {
     LayerTickResult& out = result_.layers[k];
     LayerModel& layer = layers_[k];
     out.state = LayerState::Punctured;
-    if (!damping_on_ && !layer.friction) continue;
-    out.shaft_length_m = shaft_length_in_layer_m(result_.depth_m, layer.top_depth_m, layer.thickness_m);
-    if (layer.friction)
-      out.friction_force_N = layer.friction->update(needle.axial_velocity_m_per_s, result_.depth_m) * out.shaft_length_m;
-    if (damping_on_)
-      out.damping_force_N =
-          puncture_damping_force_N(layer.damping_N_s_per_m2, out.shaft_length_m, needle.axial_velocity_m_per_s);
-    friction_total += out.friction_force_N + out.damping_force_N;
+    const LayerShaftForce shaft =
+        punctured_layer_shaft_force(layer.top_depth_m, layer.thickness_m, layer.friction ? &*layer.friction : nullptr,
+                                    damping_on_, layer.damping_N_s_per_m2, needle);
+    out.shaft_length_m = shaft.shaft_length_m;
+    out.friction_force_N = shaft.friction_N;
+    out.damping_force_N = shaft.damping_N;
+    total += out.friction_force_N + out.damping_force_N;
   }
-  result_.tip_force_N = surface_force;
-  result_.cutting_force_N = cut;
-  result_.friction_force_N = friction_total;
-  result_.total_force_N = surface_force + cut + friction_total;
-  if (broke)
-    for (PunctureEvent& e : events_)
-      if (e.time_s == needle.time_s)
-        for (int k = 0; k < e.layer; ++k)
-          e.total_force_N += result_.layers[k].damping_force_N + result_.layers[k].friction_force_N;
+  return total;
+}
 
-  // 6. Meshes laid at a new contact point get their nodes projected onto the
-  // surface a few per tick (only the drawn surface depends on it).
+void PunctureSimulator::add_shaft_forces_to_events(double time_s) {
+  for (PunctureEvent& e : events_)
+    if (e.time_s == time_s)
+      for (int k = 0; k < e.layer; ++k)
+        e.total_force_N += result_.layers[k].damping_force_N + result_.layers[k].friction_force_N;
+}
+
+void PunctureSimulator::refine_pending_layouts() {
+  // Only the drawn surface depends on the layout.
   int budget = kLayoutNodesPerTick;
   for (LayerModel& layer : layers_) {
     if (budget <= 0) break;
@@ -446,6 +435,44 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
     if (!layer.mesh->layout_pending() && layer.resumption && !layer.resumption->active())
       layer.resumption->set_rest_positions(layer.mesh->rest_positions());
   }
+}
+
+const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
+  if (!needle.tip_position_m.allFinite() || !needle.direction.allFinite() ||
+      !std::isfinite(needle.axial_velocity_m_per_s) || !std::isfinite(needle.time_s))
+    throw std::invalid_argument("PunctureSimulator::tick: non-finite needle state");
+
+  ++ticks_;  // drawn surfaces of the last tick are stale from here on
+  result_.time_s = needle.time_s;
+  result_.depth_m = needle.depth_m();
+  result_.velocity_m_per_s = needle.axial_velocity_m_per_s;
+  for (LayerTickResult& r : result_.layers) r = LayerTickResult{};
+  const double tip_axial_m = needle.tip_position_m.dot(needle.direction);
+
+  // 1. Resumption of the layers broken in earlier ticks.
+  resume_broken_layers(needle.time_s);
+  // 2. Contact of the needle layer; the crack ahead of the tip.
+  update_needle_contact(needle);
+  double cut = crack_force(tip_axial_m);
+  // 3. The chain under the needle (or the needle layer alone).
+  double surface_force = press_needle_layer(needle, interaction_ ? cut : 0.0);
+  // 4. Breakthrough: the crack through the layer that just broke starts at the tip.
+  const bool broke = break_through(needle, surface_force);
+  if (broke) {
+    surface_force = 0.0;
+    cut = crack_force(tip_axial_m);
+  }
+  if (active_ > 0) result_.layers[active_ - 1].cutting_force_N = cut;
+  // 5. Shaft friction and damping of the punctured layers.
+  const double friction_total = shaft_friction_and_damping(needle);
+  result_.tip_force_N = surface_force;
+  result_.cutting_force_N = cut;
+  result_.friction_force_N = friction_total;
+  result_.total_force_N = surface_force + cut + friction_total;
+  if (broke) add_shaft_forces_to_events(needle.time_s);
+  // 6. Meshes laid at a new contact point get their nodes projected onto the
+  // surface a few per tick.
+  refine_pending_layouts();
 
   if (!std::isfinite(result_.total_force_N))
     throw std::runtime_error("PunctureSimulator::tick: the needle force became non-finite at t = " +

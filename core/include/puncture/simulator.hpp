@@ -215,6 +215,22 @@ class PunctureSimulator {
   double step_chain(const NeedleState& needle, double transmitted_force_N);
   bool breakthrough(std::size_t k, double surface_force_N);
   void record_puncture(const NeedleState& needle, double surface_force_N);
+  /// The tick's phases (tick() calls them in this order; see the header comment).
+  void resume_broken_layers(double time_s);
+  void update_needle_contact(const NeedleState& needle);
+  /// Cutting force of the deepest punctured layer (shaft_forces.hpp), its crack front advanced.
+  double crack_force(double tip_axial_m);
+  /// Chain under the needle stepped; returns the needle layer's surface force.
+  double press_needle_layer(const NeedleState& needle, double transmitted_force_N);
+  /// Layers breaking under surface_force_N (several in one tick if the next is met already broken);
+  /// true if any broke.
+  bool break_through(const NeedleState& needle, double surface_force_N);
+  /// Friction and damping of every punctured layer; returns their sum (N).
+  double shaft_friction_and_damping(const NeedleState& needle);
+  /// Puncture events of this tick: their total force includes the layers above's shaft forces.
+  void add_shaft_forces_to_events(double time_s);
+  /// Meshes laid at a new contact point get a few more nodes projected onto the surface.
+  void refine_pending_layouts();
   /// Layer k's own node positions: its mesh while intact, its resumption after it broke (needs a mesh).
   const Eigen::Matrix3Xd& own_positions(std::size_t k) const;
   /// Own deflection of layer k's nodes along the inward normals (m) into `out`.

@@ -8,10 +8,9 @@
 #include <optional>
 #include <stdexcept>
 
-#include "puncture/cutting.hpp"
 #include "puncture/needle.hpp"
 #include "puncture/puncture_force.hpp"
-#include "puncture/shaft_friction.hpp"
+#include "puncture/shaft_forces.hpp"
 
 namespace puncture::validation {
 
@@ -32,6 +31,63 @@ double quantile(std::vector<double> values, double p) {
   return values[lo] + (position - static_cast<double>(lo)) * (values[hi] - values[lo]);
 }
 
+namespace {
+
+/// The shaft forces of the force law, the same for every compared model: the
+/// rule of the haptic tick (core shaft_forces.hpp) on the model's layer
+/// states and contacts, with friction state and crack fronts kept here. A
+/// layer is met at the tip when the layer above breaks with the tip below its
+/// rest surface (without layer interaction).
+class ShaftForcesOfModel {
+ public:
+  explicit ShaftForcesOfModel(const Scene& scene)
+      : scene_(scene), friction_(scene.layers.size()), front_m_(scene.layers.size(), 0.0),
+        met_at_break_(scene.layers.size(), 0) {
+    if (scene.effects.friction)
+      for (std::size_t k = 0; k < scene.layers.size(); ++k) friction_[k].emplace(scene.layers[k].force_law.friction);
+  }
+
+  /// Friction, damping and cutting (N) after the model's step to `needle`.
+  double force_N(const comparison::ComparisonModel& model, const std::vector<LayerState>& states,
+                 const NeedleState& needle) {
+    const std::size_t n_layers = states.size();
+    double post = 0.0;
+    std::size_t punctured = 0;  // layers punctured from the top
+    for (std::size_t k = 0; k < n_layers; ++k) {
+      if (states[k] == LayerState::Punctured && punctured == k) ++punctured;
+      if (states[k] != LayerState::Punctured) continue;
+      const LayerShaftForce f =
+          punctured_layer_shaft_force(scene_.layer_top_depth_m(k), scene_.layers[k].thickness_m,
+                                      friction_[k] ? &*friction_[k] : nullptr, scene_.effects.damping,
+                                      scene_.layers[k].damping_N_s_per_m2, needle);
+      post += f.friction_N + f.damping_N;
+    }
+    const double tip_axial_m = needle.tip_position_m.dot(needle.direction);
+    for (std::size_t k = punctured_before_; k < punctured; ++k) {
+      front_m_[k] = tip_axial_m;
+      if (k + 1 < n_layers && !scene_.effects.layer_interaction && needle.depth_m() > scene_.layer_top_depth_m(k + 1))
+        met_at_break_[k + 1] = 1;
+    }
+    punctured_before_ = std::max(punctured_before_, punctured);
+    if (scene_.effects.cutting && punctured > 0) {
+      const NextLayerContact next = punctured == n_layers || !model.layer_touched(punctured) ? NextLayerContact::None
+                                    : met_at_break_[punctured]                               ? NextLayerContact::MetAtTip
+                                                                                             : NextLayerContact::Touched;
+      post += open_crack_force_N(scene_.layers[punctured - 1].force_law, front_m_[punctured - 1], tip_axial_m, next);
+    }
+    return post;
+  }
+
+ private:
+  const Scene& scene_;
+  std::vector<std::optional<KarnoppFriction>> friction_;
+  std::vector<double> front_m_;
+  std::vector<char> met_at_break_;
+  std::size_t punctured_before_ = 0;
+};
+
+}  // namespace
+
 ModelRun run_comparison_model(comparison::ComparisonModel& model, const Scene& scene, const ModelRunOptions& options) {
   ModelRun run;
   run.model = model.name();
@@ -47,19 +103,7 @@ ModelRun run_comparison_model(comparison::ComparisonModel& model, const Scene& s
   long next_progress = 0;
   const auto start = std::chrono::steady_clock::now();
   const std::size_t n_layers = scene.layers.size();
-  // Shaft forces of the force law, the same for every model (as the
-  // simulator computes them, core/simulator.hpp steps 5-6): per punctured
-  // layer Karnopp friction phi h and damping d h v; the cutting force of the
-  // last punctured layer while the next one is untouched, or while it is
-  // pressed when it was met at the break (the tip below its rest surface
-  // then, without layer interaction), from the crack front (the deepest tip
-  // position since that layer broke).
-  std::vector<std::optional<KarnoppFriction>> friction(n_layers);
-  if (scene.effects.friction)
-    for (std::size_t k = 0; k < n_layers; ++k) friction[k].emplace(scene.layers[k].force_law.friction);
-  std::vector<double> front_m(n_layers, 0.0);
-  std::vector<char> met_at_break(n_layers, 0);
-  std::size_t punctured_before = 0;
+  ShaftForcesOfModel shaft(scene);
   for (long i = 0; i < n_steps; ++i) {
     const double t = static_cast<double>(i) * dt;
     const NeedleState needle = trajectory.sample(t);
@@ -77,30 +121,8 @@ ModelRun run_comparison_model(comparison::ComparisonModel& model, const Scene& s
     run.velocity_m_per_s.push_back(needle.axial_velocity_m_per_s);
     run.contact_force_N.push_back(force);
     std::vector<LayerState> states(n_layers);
-    double post = 0.0;
-    std::size_t punctured = 0;  // layers punctured from the top
-    for (std::size_t k = 0; k < n_layers; ++k) {
-      states[k] = model.layer_state(k);
-      if (states[k] == LayerState::Punctured && punctured == k) ++punctured;
-      if (states[k] != LayerState::Punctured) continue;
-      const double h = shaft_length_in_layer_m(needle.depth_m(), scene.layer_top_depth_m(k), scene.layers[k].thickness_m);
-      if (friction[k]) post += friction[k]->update(needle.axial_velocity_m_per_s, needle.depth_m()) * h;
-      if (scene.effects.damping)
-        post += puncture_damping_force_N(scene.layers[k].damping_N_s_per_m2, h, needle.axial_velocity_m_per_s);
-    }
-    const double tip_axial_m = needle.tip_position_m.dot(needle.direction);
-    for (std::size_t k = punctured_before; k < punctured; ++k) {
-      front_m[k] = tip_axial_m;
-      if (k + 1 < n_layers && !scene.effects.layer_interaction && needle.depth_m() > scene.layer_top_depth_m(k + 1))
-        met_at_break[k + 1] = 1;
-    }
-    punctured_before = std::max(punctured_before, punctured);
-    if (scene.effects.cutting && punctured > 0 &&
-        (punctured == n_layers || states[punctured] == LayerState::Untouched || met_at_break[punctured])) {
-      const ForceLaw& law = scene.layers[punctured - 1].force_law;
-      post += cutting_force_N(law.cutting_force_N, law.cutting_release_m, front_m[punctured - 1], tip_axial_m);
-      front_m[punctured - 1] = std::max(front_m[punctured - 1], tip_axial_m);
-    }
+    for (std::size_t k = 0; k < n_layers; ++k) states[k] = model.layer_state(k);
+    const double post = shaft.force_N(model, states, needle);
     run.states.push_back(states);
     run.post_puncture_force_N.push_back(post);
     while (next_profile < profile_depths.size() && needle.axial_velocity_m_per_s > 0.0 &&

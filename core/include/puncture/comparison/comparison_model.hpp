@@ -56,6 +56,9 @@ class ComparisonModel {
   /// Advances to the needle state (one haptic step). Returns the contact force (N).
   virtual double step(const NeedleState& needle) = 0;
   virtual LayerState layer_state(std::size_t layer) const = 0;
+  /// True once the needle touches the layer (its contact is set), also on the
+  /// step where its deflection is still 0 and its state Untouched.
+  virtual bool layer_touched(std::size_t layer) const { return layer_state(layer) != LayerState::Untouched; }
   /// Deflection (m, > 0 into the tissue, i.e. -u_z) of the layer's top surface
   /// at the radii r (m) from the needle axis, mean over the azimuth.
   virtual std::vector<double> surface_deflection_m(std::size_t layer, const std::vector<double>& r_m) const = 0;

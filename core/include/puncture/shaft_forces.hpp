@@ -1,0 +1,51 @@
+// shaft_forces.hpp: the forces the force law adds behind the tip once layers
+// are punctured, as one rule that the haptic tick (simulator.cpp, step 5) and
+// the comparison harness (validation/comparison, for every compared model)
+// both call.
+//
+// Per punctured layer with h (m) of shaft inside it (shaft_length_in_layer_m)
+// and axial velocity v (m/s, > 0 inserting), forces on the needle in N,
+// positive resisting insertion:
+//     friction  phi h      (Effects::friction, shaft_friction.hpp)
+//     damping   d h v      (Effects::damping, the seed's Table 1)
+// The deepest punctured layer is cut (Effects::cutting, cutting.hpp) while
+// its crack is open: every layer is punctured, or the next layer is not yet
+// touched, or the next layer was met at the tip when this one broke (the tip
+// below its rest surface: the broken layer is squeezed between them and the
+// crack goes on while the tip presses the next layer).
+#pragma once
+
+#include "puncture/needle.hpp"
+#include "puncture/scene.hpp"
+#include "puncture/shaft_friction.hpp"
+
+namespace puncture {
+
+/// The shaft forces of one punctured layer.
+struct LayerShaftForce {
+  double shaft_length_m = 0.0;  ///< h; 0 when neither friction nor damping is on
+  double friction_N = 0.0;      ///< phi h
+  double damping_N = 0.0;       ///< d h v
+};
+
+/// Friction (updated: `friction` keeps its stick / presliding state; nullptr
+/// when friction is off) and damping (damping_N_s_per_m2 d, used when
+/// damping_on) of a punctured layer whose top lies top_depth_m below the skin
+/// surface, thickness thickness_m, for the needle state `needle`.
+LayerShaftForce punctured_layer_shaft_force(double top_depth_m, double thickness_m, KarnoppFriction* friction,
+                                            bool damping_on, double damping_N_s_per_m2, const NeedleState& needle);
+
+/// What the tip meets below the deepest punctured layer.
+enum class NextLayerContact {
+  None,      ///< every layer is punctured, or the next one is not touched yet
+  MetAtTip,  ///< touched below its rest surface when the layer above broke
+  Touched    ///< touched at its surface
+};
+
+/// Cutting force (N) of the deepest punctured layer with force law `law` and
+/// crack front front_m (m along the needle axis; advanced to the tip while
+/// the crack is open) for the tip at tip_axial_m: cutting_force_N of
+/// cutting.hpp while the crack is open (next != Touched), else 0.
+double open_crack_force_N(const ForceLaw& law, double& front_m, double tip_axial_m, NextLayerContact next);
+
+}  // namespace puncture

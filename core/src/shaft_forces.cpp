@@ -1,0 +1,29 @@
+#include "puncture/shaft_forces.hpp"
+
+#include <algorithm>
+
+#include "puncture/cutting.hpp"
+#include "puncture/puncture_force.hpp"
+
+namespace puncture {
+
+LayerShaftForce punctured_layer_shaft_force(double top_depth_m, double thickness_m, KarnoppFriction* friction,
+                                            bool damping_on, double damping_N_s_per_m2, const NeedleState& needle) {
+  LayerShaftForce out;
+  if (!damping_on && !friction) return out;
+  const double depth_m = needle.depth_m();
+  out.shaft_length_m = shaft_length_in_layer_m(depth_m, top_depth_m, thickness_m);
+  if (friction) out.friction_N = friction->update(needle.axial_velocity_m_per_s, depth_m) * out.shaft_length_m;
+  if (damping_on)
+    out.damping_N = puncture_damping_force_N(damping_N_s_per_m2, out.shaft_length_m, needle.axial_velocity_m_per_s);
+  return out;
+}
+
+double open_crack_force_N(const ForceLaw& law, double& front_m, double tip_axial_m, NextLayerContact next) {
+  if (next == NextLayerContact::Touched) return 0.0;
+  const double f = cutting_force_N(law.cutting_force_N, law.cutting_release_m, front_m, tip_axial_m);
+  front_m = std::max(front_m, tip_axial_m);
+  return f;
+}
+
+}  // namespace puncture

@@ -1,0 +1,66 @@
+// The shaft-force rule shared by the haptic tick and the comparison harness
+// (shaft_forces.hpp), against hand values of phi h, d h v and the crack law.
+#include <gtest/gtest.h>
+
+#include "puncture/shaft_forces.hpp"
+
+using namespace puncture;
+
+namespace {
+
+NeedleState needle_at(double depth_m, double velocity_m_per_s) {
+  NeedleState n;
+  n.tip_position_m = Eigen::Vector3d(0.0, 0.0, -depth_m);
+  n.axial_velocity_m_per_s = velocity_m_per_s;
+  return n;
+}
+
+}  // namespace
+
+TEST(ShaftForces, FrictionAndDampingOfAPuncturedLayerAreThePaperTerms) {
+  // Layer from 2 mm to 10 mm, tip at 6 mm: h = 4 mm inside it.
+  ShaftFrictionLaw law;
+  law.static_N_per_m = 300.0;
+  law.dynamic_N_per_m = 200.0;
+  KarnoppFriction friction(law);
+  const double d = 500.0;  // N s / m^2
+  const LayerShaftForce f = punctured_layer_shaft_force(2e-3, 8e-3, &friction, true, d, needle_at(6e-3, 0.01));
+  EXPECT_DOUBLE_EQ(f.shaft_length_m, 4e-3);
+  EXPECT_NEAR(f.friction_N, 200.0 * 4e-3, 1e-12);    // sliding in: f_d h
+  EXPECT_NEAR(f.damping_N, 500.0 * 4e-3 * 0.01, 1e-15);  // d h v
+
+  // Tip below the layer: the whole thickness; withdrawing reverses friction.
+  const LayerShaftForce out = punctured_layer_shaft_force(2e-3, 8e-3, &friction, true, d, needle_at(15e-3, -0.01));
+  EXPECT_DOUBLE_EQ(out.shaft_length_m, 8e-3);
+  EXPECT_NEAR(out.friction_N, -200.0 * 8e-3, 1e-12);
+  EXPECT_NEAR(out.damping_N, -500.0 * 8e-3 * 0.01, 1e-15);
+}
+
+TEST(ShaftForces, NothingWhenFrictionAndDampingAreOff) {
+  const LayerShaftForce f = punctured_layer_shaft_force(0.0, 5e-3, nullptr, false, 1e3, needle_at(4e-3, 0.01));
+  EXPECT_EQ(f.shaft_length_m, 0.0);
+  EXPECT_EQ(f.friction_N, 0.0);
+  EXPECT_EQ(f.damping_N, 0.0);
+  const LayerShaftForce damping_only = punctured_layer_shaft_force(0.0, 5e-3, nullptr, true, 1e3, needle_at(4e-3, 0.01));
+  EXPECT_EQ(damping_only.friction_N, 0.0);
+  EXPECT_NEAR(damping_only.damping_N, 1e3 * 4e-3 * 0.01, 1e-15);
+}
+
+TEST(ShaftForces, CrackIsCutWhileOpenAndReleasesOnRetraction) {
+  ForceLaw law;
+  law.cutting_force_N = 1.5;
+  law.cutting_release_m = 0.2e-3;
+  double front = 5e-3;
+  // Open (next layer untouched): the front follows the tip, the force is C.
+  EXPECT_DOUBLE_EQ(open_crack_force_N(law, front, 6e-3, NextLayerContact::None), 1.5);
+  EXPECT_DOUBLE_EQ(front, 6e-3);
+  // Backing off by half the release distance: half the force, front kept.
+  EXPECT_NEAR(open_crack_force_N(law, front, 5.9e-3, NextLayerContact::MetAtTip), 0.75, 1e-9);
+  EXPECT_DOUBLE_EQ(front, 6e-3);
+  // The next layer touched at its surface: the crack is closed, no force, front kept.
+  EXPECT_EQ(open_crack_force_N(law, front, 7e-3, NextLayerContact::Touched), 0.0);
+  EXPECT_DOUBLE_EQ(front, 6e-3);
+  // Re-opened (met at the tip: the broken layer squeezed between): C again at the new front.
+  EXPECT_DOUBLE_EQ(open_crack_force_N(law, front, 7e-3, NextLayerContact::MetAtTip), 1.5);
+  EXPECT_DOUBLE_EQ(front, 7e-3);
+}
