@@ -338,7 +338,6 @@ struct Scene {
   Insertion insertion;
   RealtimeSettings realtime;
   FemSettings fem;
-  std::vector<std::string> models{"realtime"};  ///< which models a run uses: "realtime", "fem"
   Effects effects;
   Haptics haptics;  ///< optional "haptics" object of the scene file
   ComparisonSettings comparison;

@@ -69,7 +69,6 @@ TEST(SceneIo, RoundTripThroughJsonText) {
   }
   EXPECT_DOUBLE_EQ(a.insertion.speed_m_per_s, b.insertion.speed_m_per_s);
   EXPECT_EQ(a.realtime.integrator, b.realtime.integrator);
-  EXPECT_EQ(a.models, b.models);
 }
 
 TEST(SceneIo, MalformedJsonNamesTheFile) {
@@ -118,7 +117,7 @@ const BadCase kBadCases[] = {
     {"unknown_key", [](json& j) { j["layers"][0]["thicknes_mm"] = 1.0; }, "/layers/0/thicknes_mm"},
     {"unknown_top_key", [](json& j) { j["colour"] = "red"; }, "/colour"},
     {"unknown_effect", [](json& j) { j["effects"].push_back("bleeding"); }, "/effects/6"},
-    {"unknown_model", [](json& j) { j["models"] = {"bem"}; }, "/models/0"},
+    {"removed_models_field", [](json& j) { j["models"] = {"realtime"}; }, "/models"},
     {"missing_thickness", [](json& j) { j["layers"][0].erase("thickness_mm"); }, "/layers/0/thickness_mm"},
     {"missing_needle", [](json& j) { j.erase("needle"); }, "/needle"},
     {"string_for_number", [](json& j) { j["needle"]["radius_mm"] = "thin"; }, "/needle/radius_mm"},

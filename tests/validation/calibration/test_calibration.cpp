@@ -49,7 +49,6 @@ Scene truth_scene() {
     "insertion": { "start_height_mm": 1.0, "speed_mm_per_s": 10.0, "target_depth_mm": 12.0,
                    "dwell_s": 0.0, "withdrawal_speed_mm_per_s": 50.0, "angle_deg": 0.0 },
     "realtime": { "sh_degree": 8, "haptic_rate_Hz": 5000, "integrator": "quasi_static", "frame_rate_Hz": 10 },
-    "models": ["realtime"],
     "effects": ["surface_force", "damping", "resumption"]
   })";
   return puncture::parse_scene(json, "calibration_truth");

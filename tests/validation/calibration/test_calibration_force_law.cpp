@@ -50,7 +50,6 @@ Scene truth_scene(bool interaction) {
     "insertion": { "start_height_mm": 0.5, "speed_mm_per_s": 10.0, "target_depth_mm": 9.0,
                    "dwell_s": 0.2, "withdrawal_speed_mm_per_s": 20.0, "angle_deg": 0.0 },
     "realtime": { "sh_degree": 8, "haptic_rate_Hz": 5000, "integrator": "quasi_static", "frame_rate_Hz": 10 },
-    "models": ["realtime"],
     "effects": ["surface_force", "resumption", "cutting", "friction"EFFECTS]
   })";
   json.replace(json.find("EFFECTS"), 7, interaction ? ", \"layer_interaction\"" : "");

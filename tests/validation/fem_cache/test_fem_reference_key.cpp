@@ -79,7 +79,6 @@ std::vector<json> perturbations(const std::string& pointer, const json& v) {
     if (numeric) out.push_back(scaled);
     dropped.erase(dropped.size() - 1);
     out.push_back(dropped);
-    if (key == "models") out.push_back(json{"realtime", "fem"});
   }
   return out;
 }

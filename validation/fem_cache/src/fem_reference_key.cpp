@@ -58,7 +58,6 @@ const std::vector<std::string>& realtime_only_fields() {
       "/layers/*/puncture/source",
       "/layers/*/shaft_friction/source",
       "/realtime",
-      "/models",
       "/effects",
       "/haptics",
       "/comparison",                  // the comparison models' tetrahedral mesh and integrator
