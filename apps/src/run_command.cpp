@@ -19,7 +19,9 @@
 #include "puncture/scene_io.hpp"
 #include "puncture/scene_limits.hpp"
 #include "puncture/validation/plausibility.hpp"
-#include "run_outputs.hpp"
+#ifdef PUNCTURE_HAVE_VTK  // frames are VTK files
+#include "puncture/io/realtime_frames.hpp"
+#endif
 
 namespace puncture::apps {
 
@@ -176,9 +178,9 @@ int run_command(const RunOptions& options, std::ostream& stdout_stream, std::ost
     FrameCallback on_frame;
 #ifdef PUNCTURE_HAVE_VTK
     const bool frames = options.write_frames && scene.effects.surface_output;
-    std::optional<FrameWriter> writer;
+    std::optional<io::FrameWriter> writer;
     if (frames) {
-      FrameWriterOptions frame_options;
+      io::FrameWriterOptions frame_options;
       frame_options.provenance = &provenance;
       writer.emplace(session, model, scene, frame_options);
     }

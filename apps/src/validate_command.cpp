@@ -50,11 +50,13 @@
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/acceptance.hpp"
 #include "puncture/validation/metrics.hpp"
-#include "run_outputs.hpp"
 #include "puncture/validation/fem_comparison.hpp"
 #include "puncture/validation/puncture_force_shares.hpp"
 #include "puncture/validation/number_format.hpp"
 #include "puncture/validation/validation_cases.hpp"
+#ifdef PUNCTURE_HAVE_VTK  // frames are VTK files
+#include "puncture/io/realtime_frames.hpp"
+#endif
 
 namespace puncture::apps {
 
@@ -100,9 +102,9 @@ RealtimeRun run_realtime(RealtimeModel& model, const Scene& scene, const validat
   RealtimeRun result{{}, RingRecorder(scene), {}};
   std::vector<double> frame_times = vtk ? fem.frame_times_s : std::vector<double>{};
 #ifdef PUNCTURE_HAVE_VTK
-  std::optional<FrameWriter> writer;
+  std::optional<io::FrameWriter> writer;
   if (!frame_times.empty()) {
-    FrameWriterOptions fw;
+    io::FrameWriterOptions fw;
     fw.provenance = &provenance;
     fw.directory = "realtime";
     fw.pvd_name.clear();
