@@ -286,7 +286,7 @@ bool PunctureSimulator::breakthrough(std::size_t k, double surface_force_N) {
   return false;
 }
 
-void PunctureSimulator::record_puncture(const NeedleState& needle, double surface_force_N) {
+void PunctureSimulator::record_puncture(const NeedleState& needle, double surface_force_N, double cutting_force_N) {
   LayerModel& layer = layers_[active_];
   LayerTickResult& out = result_.layers[active_];
   layer.state = LayerState::Punctured;
@@ -298,7 +298,8 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   event.time_s = needle.time_s;
   event.depth_m = needle.depth_m();
   event.surface_force_N = surface_force_N;
-  event.total_force_N = surface_force_N;  // tick() adds the friction of the layers above
+  event.cutting_force_N = cutting_force_N;
+  event.total_force_N = surface_force_N + cutting_force_N;  // tick() adds the shaft forces of the layers above
   if (layer.mesh) {
     event.eq5_force_N = layer.mesh->eq5_force_N();
     event.mesh_reaction_N = layer.mesh->contact_reaction_N();
@@ -370,13 +371,15 @@ double PunctureSimulator::press_needle_layer(const NeedleState& needle, double t
   return 0.0;
 }
 
-bool PunctureSimulator::break_through(const NeedleState& needle, double surface_force_N) {
+bool PunctureSimulator::break_through(const NeedleState& needle, double surface_force_N, double cutting_force_N) {
   const std::size_t n = layers_.size();
   bool broke = false;
   // The next layer becomes the needle layer in the same tick.
   while (active_ < n && layers_[active_].contact_set && breakthrough(active_, surface_force_N)) {
-    record_puncture(needle, surface_force_N);
+    record_puncture(needle, surface_force_N, cutting_force_N);
     surface_force_N = 0.0;
+    // A further break in this tick is felt with the crack of the layer that just broke, opened at the tip.
+    cutting_force_N = cutting_on_ ? layers_[active_ - 1].law.cutting_force_N : 0.0;
     broke = true;
     const bool touched = active_ < n && try_contact(needle);
     if (coupling_) {
@@ -457,7 +460,7 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   // 3. The chain under the needle (or the needle layer alone).
   double surface_force = press_needle_layer(needle, interaction_ ? cut : 0.0);
   // 4. Breakthrough: the crack through the layer that just broke starts at the tip.
-  const bool broke = break_through(needle, surface_force);
+  const bool broke = break_through(needle, surface_force, cut);
   if (broke) {
     surface_force = 0.0;
     cut = crack_force(tip_axial_m);

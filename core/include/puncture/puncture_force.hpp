@@ -54,7 +54,8 @@ struct PunctureEvent {
   double time_s = 0.0;
   double depth_m = 0.0;         ///< tip depth below the undeformed skin surface
   double surface_force_N = 0.0; ///< the layer's surface force at breakthrough
-  double total_force_N = 0.0;   ///< needle force just before the surface gave way: surface force + damping of the layers above
+  double total_force_N = 0.0;   ///< needle force just before the surface gave way: surface force + cutting + shaft forces of the layers above
+  double cutting_force_N = 0.0; ///< cutting force of the open crack above (the broken layer squeezed between, shaft_forces.hpp) at the break
   // The surface force by term, at the break (N; 0 without a force mesh):
   double eq5_force_N = 0.0;            ///< Eq. 5 on the mesh's own deflections (ForceMesh::eq5_force_N)
   double mesh_reaction_N = 0.0;        ///< the mesh's contact reaction (Eq. 5 + the mesh's inertia and damping)

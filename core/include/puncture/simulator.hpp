@@ -214,7 +214,7 @@ class PunctureSimulator {
   /// Returns the needle layer's surface force (0 without contact).
   double step_chain(const NeedleState& needle, double transmitted_force_N);
   bool breakthrough(std::size_t k, double surface_force_N);
-  void record_puncture(const NeedleState& needle, double surface_force_N);
+  void record_puncture(const NeedleState& needle, double surface_force_N, double cutting_force_N);
   /// The tick's phases (tick() calls them in this order; see the header comment).
   void resume_broken_layers(double time_s);
   void update_needle_contact(const NeedleState& needle);
@@ -224,7 +224,8 @@ class PunctureSimulator {
   double press_needle_layer(const NeedleState& needle, double transmitted_force_N);
   /// Layers breaking under surface_force_N (several in one tick if the next is met already broken);
   /// true if any broke.
-  bool break_through(const NeedleState& needle, double surface_force_N);
+  /// cutting_force_N: the crack force the needle feels at the first break (crack_force()).
+  bool break_through(const NeedleState& needle, double surface_force_N, double cutting_force_N);
   /// Friction and damping of every punctured layer; returns their sum (N).
   double shaft_friction_and_damping(const NeedleState& needle);
   /// Puncture events of this tick: their total force includes the layers above's shaft forces.

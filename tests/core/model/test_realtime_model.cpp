@@ -74,3 +74,32 @@ TEST(RealtimeModel, DefaultScenePuncturesSkinFatMuscleInOrder) {
 
 }  // namespace
 }  // namespace puncture
+
+namespace puncture {
+namespace {
+
+TEST(RealtimeModel, PunctureEventForceIsTheNeedleForceJustBeforeTheBreak) {
+  // The physical force law: each layer below the skin is met at the tip and
+  // pressed while the crack above is still cut, so the force at its break
+  // holds that cutting force (and the shaft forces above), not its surface
+  // force alone. The event's total must be the force the needle felt on the
+  // tick before the break, within one tick of travel.
+  const Scene s = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default_force_law.json");
+  RealtimeModel m = build_realtime_model(s);
+  const ScriptedRunResult run = run_scripted_insertion(m, s);
+  ASSERT_EQ(run.events.size(), s.layers.size());
+  int with_cutting = 0;
+  for (const PunctureEvent& e : run.events) {
+    std::size_t i = 0;
+    while (i < run.ticks.size() && run.ticks[i].time_s < e.time_s) ++i;
+    ASSERT_GT(i, 0u);
+    const TickResult& before = run.ticks[i - 1];
+    EXPECT_NEAR(e.total_force_N, before.total_force_N, 0.02 * before.total_force_N + 0.01) << e.layer_name;
+    EXPECT_NEAR(e.cutting_force_N, before.cutting_force_N, 1e-9) << e.layer_name;
+    with_cutting += e.cutting_force_N > 0.0;
+  }
+  EXPECT_GE(with_cutting, 1) << "no layer broke while the crack above was cut: the test checks nothing new";
+}
+
+}  // namespace
+}  // namespace puncture

@@ -15,7 +15,8 @@ std::vector<PunctureForceShares> puncture_force_shares(const std::vector<Punctur
     s.eq5_N = e.eq5_force_N;
     s.mesh_dynamics_N = e.mesh_reaction_N - e.eq5_force_N;
     s.tip_stiffening_N = e.tip_stiffening_force_N;
-    s.other_N = s.total_N - s.eq5_N - s.mesh_dynamics_N - s.tip_stiffening_N;
+    s.cutting_N = e.cutting_force_N;
+    s.other_N = s.total_N - s.eq5_N - s.mesh_dynamics_N - s.tip_stiffening_N - s.cutting_N;
     out.push_back(s);
   }
   return out;
@@ -29,12 +30,13 @@ std::string puncture_force_shares_markdown(const std::vector<PunctureForceShares
       << " %)";
     return c.str();
   };
-  m << "| layer | depth (mm) | force at the break | Eq. 5 | mesh dynamics | tip stiffening | shaft and rest |\n"
-       "|---|---|---|---|---|---|---|\n";
+  m << "| layer | depth (mm) | force at the break | Eq. 5 | mesh dynamics | tip stiffening | cutting above | shaft and rest |\n"
+       "|---|---|---|---|---|---|---|---|\n";
   for (const PunctureForceShares& s : shares)
     m << "| " << s.layer << " | " << std::fixed << std::setprecision(2) << s.depth_m * 1e3 << " | " << std::setprecision(3)
       << s.total_N << " N | " << cell(s.eq5_N, s.total_N) << " | " << cell(s.mesh_dynamics_N, s.total_N) << " | "
-      << cell(s.tip_stiffening_N, s.total_N) << " | " << cell(s.other_N, s.total_N) << " |\n";
+      << cell(s.tip_stiffening_N, s.total_N) << " | " << cell(s.cutting_N, s.total_N) << " | "
+      << cell(s.other_N, s.total_N) << " |\n";
   return m.str();
 }
 
@@ -47,6 +49,7 @@ nlohmann::json puncture_force_shares_json(const std::vector<PunctureForceShares>
                  {"eq5_N", s.eq5_N},
                  {"mesh_dynamics_N", s.mesh_dynamics_N},
                  {"tip_stiffening_N", s.tip_stiffening_N},
+                 {"cutting_above_N", s.cutting_N},
                  {"shaft_and_rest_N", s.other_N},
                  {"eq5_share", s.eq5_share()}});
   return a;

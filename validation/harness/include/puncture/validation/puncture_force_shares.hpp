@@ -8,7 +8,9 @@
 //      mesh_dynamics  the mesh's contact reaction minus Eq. 5 (its nodes'
 //                  inertia and damping; 0 at equilibrium)
 //      tip_stiffening g(z0) of the tip spring
-//      other       total - (the three above): the shaft (friction and d h v
+//      cutting     the open crack of the layer above (its cutting force while
+//                  the layer under the tip is pressed: met at the break)
+//      other       total - (the four above): the shaft (friction and d h v
 //                  of the layers above) and the prediction's linearisation
 //      with each share = term / total; as a markdown table and as JSON.
 #pragma once
@@ -25,7 +27,7 @@ namespace puncture::validation {
 struct PunctureForceShares {
   std::string layer;
   double depth_m = 0.0;
-  double total_N = 0.0, eq5_N = 0.0, mesh_dynamics_N = 0.0, tip_stiffening_N = 0.0, other_N = 0.0;
+  double total_N = 0.0, eq5_N = 0.0, mesh_dynamics_N = 0.0, tip_stiffening_N = 0.0, cutting_N = 0.0, other_N = 0.0;
   double eq5_share() const { return total_N != 0.0 ? eq5_N / total_N : 0.0; }
 };
 
