@@ -514,3 +514,45 @@ TEST(CalibrationForceLaw, ParametersTheReferenceCannotIdentifyKeepTheirStartValu
     if (w.find("layer fat: critical_force tuned on request although") != std::string::npos) ++requested;
   EXPECT_EQ(requested, 1);
 }
+
+namespace {
+
+/// Every n-th sample of a curve (as a reference sampled at the FEM's load steps).
+pv::InsertionCurve every_nth_sample(const pv::InsertionCurve& c, std::size_t n) {
+  pv::InsertionCurve out = c;
+  auto keep = [&](auto& v) {
+    using V = std::decay_t<decltype(v)>;
+    V kept;
+    for (std::size_t i = 0; i < v.size(); i += n) kept.push_back(v[i]);
+    v = std::move(kept);
+  };
+  keep(out.time_s), keep(out.depth_m), keep(out.velocity_m_per_s), keep(out.force_N), keep(out.phase);
+  for (auto& states : out.layer_states) keep(states);
+  if (out.has_parts()) keep(out.tip_force_N), keep(out.cutting_force_N), keep(out.friction_force_N);
+  return out;
+}
+
+}  // namespace
+
+TEST(CalibrationForceLaw, CuttingOfALayerWhoseCutIsTooShortIsIdentifiedByThePunctureOfTheLayerMetAtTheTip) {
+  // The fat breaks 0.2 mm after the skin (a small critical force); the fat is
+  // met at the tip, so the skin's crack is cut while the fat is pressed. At
+  // 0.1 mm per reference sample (half the FEM's load step) the skin's own cut
+  // has too few samples: its cutting force is identified by the fat's puncture force
+  // and depth in the fat's stage, not kept at its start.
+  Scene truth = truth_scene(false);
+  truth.layers[0].thickness_m = 0.6e-3;  // thinner than the skin's deflection at its break
+  truth.layers[1].force_law.breakthrough.critical_force_N = 0.02;
+  const pv::InsertionCurve dense = pv::simulate_insertion_curve(truth);
+  const pv::InsertionCurve ref = every_nth_sample(dense, 50);  // 5 kHz at 10 mm/s: 0.1 mm
+  const auto skin = pv::puncture_event(ref, "skin"), fat = pv::puncture_event(ref, "fat");
+  ASSERT_TRUE(skin.found && fat.found);
+  ASSERT_LT(fat.depth_m - skin.depth_m, 0.45e-3) << "the fat must break right after the skin (" << (fat.depth_m - skin.depth_m) * 1e3 << " mm)";
+  ASSERT_GT(skin.depth_m, truth.layers[0].thickness_m) << "the fat must be met at the tip";
+  const pv::CalibrationResult r = pv::calibrate(perturbed(truth), ref);
+  EXPECT_NEAR(truth_of(r.tuned_scene, 0).cut / truth_of(truth, 0).cut, 1.0, 0.05)
+      << "the skin's cutting force (start " << truth_of(perturbed(truth), 0).cut << " N)";
+  bool said = false;
+  for (const std::string& w : r.warnings) said = said || w.find("cutting_force identified in layer fat's stage") != std::string::npos;
+  EXPECT_TRUE(said) << "the calibration does not say where the skin's cutting force was identified";
+}

@@ -105,10 +105,34 @@ void find_reference_events(Calibration& c, CalibrationResult& result) {
   }
 }
 
-/// Why the references cannot identify a parameter; "" when they can, or
-/// when the user asked to tune it anyway (keep_unidentifiable_at_start off).
-std::string withheld_reason(const Calibration& c, std::size_t k, ParamKind kind) {
-  return c.options.keep_unidentifiable_at_start ? unidentified_reason(c.identifiable[k], kind) : std::string();
+/// True when layer k (k >= 1) is met at the tip when the layer above breaks in
+/// the first reference (its puncture deeper than k's rest top, without layer
+/// interaction): the crack above stays open while k is pressed
+/// (shaft_forces.hpp), so the cutting force of layer k - 1 is felt over k's
+/// pressing, however short its own cut.
+bool met_at_tip(const Calibration& c, const CalibrationResult& result, std::size_t k) {
+  if (k == 0 || k >= c.geometry.size() || c.scene.effects.layer_interaction) return false;
+  const auto& above = result.reference_events.front().punctures[k - 1];
+  return above.found && above.depth_m > c.geometry[k].top_depth_m;
+}
+
+/// Layer k's stage also tunes the cutting force of the layer above when k is
+/// met at the tip (see above) and punctured in the reference: k's puncture
+/// force is then that cutting force + k's critical force + the shaft forces,
+/// at a depth k's critical force sets, so k's puncture depth and force
+/// identify both, however few samples the cut above has.
+bool tunes_cutting_above(const Calibration& c, const CalibrationResult& result, std::size_t k) {
+  return c.options.parameters.cutting && c.scene.effects.cutting && k > 0 && c.calibrated(k - 1) &&
+         met_at_tip(c, result, k) && c.identifiable[k].punctured;
+}
+
+/// Why the references cannot identify a parameter; "" when they can (a
+/// cutting force also when the layer below identifies it, tunes_cutting_above),
+/// or when the user asked to tune it anyway (keep_unidentifiable_at_start off).
+std::string withheld_reason(const Calibration& c, const CalibrationResult& result, std::size_t k, ParamKind kind) {
+  if (!c.options.keep_unidentifiable_at_start) return {};
+  if (kind == ParamKind::Cutting && tunes_cutting_above(c, result, k + 1)) return {};
+  return unidentified_reason(c.identifiable[k], kind);
 }
 
 /// Warns for each requested parameter the references cannot identify (it
@@ -120,6 +144,15 @@ std::pair<std::size_t, std::size_t> withhold_unidentified(const Calibration& c, 
     for (ParamKind kind : layer_kinds(c.scene, k, c.options.parameters)) {
       ++requested;
       const std::string why = unidentified_reason(c.identifiable[k], kind);
+      if (!why.empty() && kind == ParamKind::Cutting && tunes_cutting_above(c, result, k + 1)) {
+        result.warnings.push_back("layer " + c.scene.layers[k].name + ": cutting_force identified in layer " +
+                                  c.scene.layers[k + 1].name + "'s stage (" + why + ", but " +
+                                  c.scene.layers[k + 1].name + " is met at the tip when " + c.scene.layers[k].name +
+                                  " breaks, so this crack is cut while it is pressed: its puncture force and depth "
+                                  "identify this cutting force)");
+        ++tuned;
+        continue;
+      }
       if (!why.empty())
         result.warnings.push_back(
             "layer " + c.scene.layers[k].name + ": " + info(kind).name +
@@ -127,7 +160,7 @@ std::pair<std::size_t, std::size_t> withhold_unidentified(const Calibration& c, 
                  ? " kept at its start value (" + std::to_string(param_value(c.scene, k, kind) * info(kind).to_unit) +
                        " " + info(kind).unit + "): " + why
                  : " tuned on request although " + why));
-      if (withheld_reason(c, k, kind).empty()) ++tuned;
+      if (withheld_reason(c, result, k, kind).empty()) ++tuned;
     }
   }
   return {tuned, requested};
@@ -255,6 +288,12 @@ std::pair<Scene, double> run_ring_candidate(Calibration& c, CalibrationResult& r
   for (ParamKind kind : layer_kinds(candidate, k, c.options.parameters,
                                     c.options.keep_unidentifiable_at_start ? &c.identifiable[k] : nullptr))
     stage.parameters.push_back(c.parameter(k, kind));
+  if (tunes_cutting_above(c, result, k)) {
+    const Parameter above = c.parameter(k - 1, ParamKind::Cutting);
+    if (std::none_of(stage.parameters.begin(), stage.parameters.end(),
+                     [&](const Parameter& p) { return p.layer == above.layer && p.kind == above.kind; }))
+      stage.parameters.push_back(above);
+  }
   if (stage.parameters.size() > static_cast<std::size_t>(kMaxParameters))
     throw std::invalid_argument("calibrate: too many parameters in one stage");
   CalibrationStageRecord rec;
@@ -440,7 +479,7 @@ void report_identifiability(Calibration& c, CalibrationResult& result) {
   std::vector<WithheldParameter> withheld;
   for (std::size_t k : c.layers)
     for (ParamKind kind : layer_kinds(c.scene, k, c.options.parameters)) {
-      const std::string why = withheld_reason(c, k, kind);
+      const std::string why = withheld_reason(c, result, k, kind);
       if (!why.empty()) withheld.push_back({k, kind, why});
     }
   if (!result.damping_tuned && c.scene.effects.damping)
