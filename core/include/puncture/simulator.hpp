@@ -54,11 +54,14 @@
 //      Without a force mesh (surface_force off) a layer breaks as soon as the
 //      tip passes its contact point;
 //   5. cutting: the last punctured layer, while the tip is inside it, adds
-//      the cutting force (cutting.hpp): until the next layer is touched, or,
+//      the cutting force (cutting.hpp, through shaft_forces.hpp, the rule the
+//      comparison harness also calls; a PunctureEvent's total force holds
+//      it): until the next layer is touched, or,
 //      when the next layer was met at the break (contact at the tip, the
 //      broken layer squeezed between them), while the tip presses it (the
 //      FEM's tip force and cohesive cutting force act together there);
-//   6. every punctured layer adds its shaft friction phi h (shaft_friction.hpp)
+//   6. every punctured layer adds its shaft friction phi h (shaft_friction.hpp,
+//      through shaft_forces.hpp)
 //      and the damping force d h v (Table 1), with h the shaft length inside
 //      the layer's depth range [top, top + thickness] of the scene;
 //   7. a mesh laid out anew (step 2) starts in the tangent plane of the
