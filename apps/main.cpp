@@ -44,10 +44,17 @@ struct CommandLine {
 #endif
 };
 
+/// The options of a command on a scene: the scene file, the output
+/// directory (help text `output_help`) and, with_cache, the FEM cache.
+void add_scene_options(CLI::App* cmd, CommandLine& c, const std::string& output_help, bool with_cache) {
+  cmd->add_option("scene", c.scene, "Scene file (JSON); default: scenes/default.json");
+  cmd->add_option("-o,--output", c.output, output_help);
+  if (with_cache) cmd->add_option("--cache", c.cache, "FEM cache directory; default: out/.fem_cache");
+}
+
 CLI::App* add_run(CLI::App& app, CommandLine& c) {
   CLI::App* run_cmd = app.add_subcommand("run", "Run the real-time model along the scene's scripted insertion");
-  run_cmd->add_option("scene", c.scene, "Scene file (JSON); default: scenes/default.json");
-  run_cmd->add_option("-o,--output", c.output, "Output directory; default: out/<scene name>");
+  add_scene_options(run_cmd, c, "Output directory; default: out/<scene name>", false);
   run_cmd->add_flag("--no-frames", [&c](std::int64_t) { c.run.write_frames = false; }, "Do not write VTK frames");
   run_cmd->add_flag("-q,--quiet", c.run.quiet, "Nothing on stdout (warnings and errors still on stderr)");
   return run_cmd;
@@ -55,8 +62,7 @@ CLI::App* add_run(CLI::App& app, CommandLine& c) {
 
 CLI::App* add_fem(CLI::App& app, CommandLine& c) {
   CLI::App* fem_cmd = app.add_subcommand("fem", "Run the deal.II FEM reference along the same insertion (MPI-aware)");
-  fem_cmd->add_option("scene", c.scene, "Scene file (JSON); default: scenes/default.json");
-  fem_cmd->add_option("-o,--output", c.output, "Output directory; default: out/<scene name>_fem");
+  add_scene_options(fem_cmd, c, "Output directory; default: out/<scene name>_fem", false);
   fem_cmd->add_option("--refinement", c.fem.refinement, "Global refinements (overrides the scene)")->check(CLI::Range(0, 4));
   fem_cmd->add_option("--degree", c.fem.degree, "Element degree 1 (Q1) or 2 (Q2) (overrides the scene)")->check(CLI::Range(1, 2));
   fem_cmd->add_flag("--no-vtu", [&c](std::int64_t) { c.fem.write_vtu = false; }, "Do not write .vtu field output");
@@ -69,9 +75,7 @@ CLI::App* add_fem(CLI::App& app, CommandLine& c) {
 
 CLI::App* add_validate(CLI::App& app, CommandLine& c) {
   CLI::App* validate_cmd = app.add_subcommand("validate", "Real-time model against the FEM reference on the same insertion");
-  validate_cmd->add_option("scene", c.scene, "Scene file (JSON); default: scenes/default.json");
-  validate_cmd->add_option("-o,--output", c.output, "Report directory; default: out/<scene name>_validation");
-  validate_cmd->add_option("--cache", c.cache, "FEM cache directory; default: out/.fem_cache");
+  add_scene_options(validate_cmd, c, "Report directory; default: out/<scene name>_validation", true);
   validate_cmd->add_option("--refinement", c.validate.refinement, "FEM refinement (overrides the scene)")->check(CLI::Range(0, 4));
   validate_cmd->add_option("--degree", c.validate.degree, "FEM element degree (overrides the scene)")->check(CLI::Range(1, 2));
   validate_cmd->add_option("--cases", c.validate.cases,
@@ -88,12 +92,10 @@ CLI::App* add_validate(CLI::App& app, CommandLine& c) {
 
 CLI::App* add_calibrate(CLI::App& app, CommandLine& c) {
   CLI::App* calibrate_cmd = app.add_subcommand("calibrate", "Tune the force law per layer (K, breakthrough, cutting, friction, stiffening; optionally w, L, k_s, d); write a preset");
-  calibrate_cmd->add_option("scene", c.scene, "Scene file (JSON); default: scenes/default.json");
+  add_scene_options(calibrate_cmd, c, "Output directory; default: out/<scene name>_calibration", true);
   calibrate_cmd->add_option("--reference", c.reference,
                             "Measured insertion curve (CSV with depth_mm and force_N at least; see "
                             "validation/README.md); default: the scene's FEM reference (cached)");
-  calibrate_cmd->add_option("-o,--output", c.output, "Output directory; default: out/<scene name>_calibration");
-  calibrate_cmd->add_option("--cache", c.cache, "FEM cache directory; default: out/.fem_cache");
   calibrate_cmd->add_option("--method", c.calibrate.method,
                             "levenberg_marquardt (default), nelder_mead, bobyqa or simulated_annealing")
       ->check(CLI::IsMember({"levenberg_marquardt", "nelder_mead", "bobyqa", "simulated_annealing"}));
@@ -139,6 +141,10 @@ CLI::App* add_calibrate(CLI::App& app, CommandLine& c) {
                           "First identify each layer's force mesh (K, k_s, k_a, z_v: stiffening in the mesh) from the "
                           "FEM's force and surface deflection profiles; those layers lose their tip stiffening, and K "
                           "and the stiffening are kept by the later stages");
+  calibrate_cmd->add_flag("--cutting-from-next-puncture", c.calibrate.cutting_from_next_puncture,
+                          "Tune the cutting force of a layer whose next layer is met at the tip in that layer's stage, "
+                          "from its puncture force and depth (however short the cut; off by default, see "
+                          "validation/calibration/README.md)");
   calibrate_cmd->add_option("--keep", c.calibrate.keep,
                             "Keep at the scene's values: K, breakthrough, cutting, friction, stiffening (comma "
                             "separated); default: tune each whose effect is on")
@@ -149,9 +155,7 @@ CLI::App* add_calibrate(CLI::App& app, CommandLine& c) {
 
 CLI::App* add_sweep(CLI::App& app, CommandLine& c) {
   CLI::App* sweep_cmd = app.add_subcommand("sweep", "What accuracy costs in time: every fidelity knob against the finest FEM");
-  sweep_cmd->add_option("scene", c.scene, "Scene file (JSON); default: scenes/default.json");
-  sweep_cmd->add_option("-o,--output", c.output, "Output directory; default: out/<scene name>_accuracy_cost");
-  sweep_cmd->add_option("--cache", c.cache, "FEM cache directory; default: out/.fem_cache");
+  add_scene_options(sweep_cmd, c, "Output directory; default: out/<scene name>_accuracy_cost", true);
   sweep_cmd->add_flag("--no-fem-knobs", [&c](std::int64_t) { c.sweep.include_fem_knobs = false; },
                       "Do not sweep FEM refinement and degree");
   sweep_cmd->add_flag("-q,--quiet", c.sweep.quiet, "Nothing on stdout (warnings and errors still on stderr)");
@@ -170,10 +174,8 @@ CLI::App* add_grade(CLI::App& app, CommandLine& c) {
 #ifdef PUNCTURE_HAVE_COMPARE
 CLI::App* add_compare(CLI::App& app, CommandLine& c) {
   CLI::App* compare_cmd = app.add_subcommand("compare", "Comparison models of both papers against the FEM, graded (Sec. 3.3)");
-  compare_cmd->add_option("scene", c.scene, "Scene file (JSON); default: scenes/default.json");
+  add_scene_options(compare_cmd, c, "Output directory; default: out/<scene name>_comparison", true);
   compare_cmd->add_option("--models", c.compare.models, "Models (comma separated); default: all")->delimiter(',');
-  compare_cmd->add_option("-o,--output", c.output, "Output directory; default: out/<scene name>_comparison");
-  compare_cmd->add_option("--cache", c.cache, "FEM cache directory; default: out/.fem_cache");
   compare_cmd->add_option("--weights", c.compare.weights, "Delphi weights file; default: scenes/delphi_weights.json");
   compare_cmd->add_option("--identify", c.compare.identify, "Identify the mass-spring stiffnesses: simulated_annealing,isres")
       ->delimiter(',');

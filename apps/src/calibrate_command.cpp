@@ -48,6 +48,7 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
   for (std::size_t i = 0; i < options.fem_speeds_mm_per_s.size(); ++i)
     c << (i ? "," : " --fem-speeds ") << options.fem_speeds_mm_per_s[i];
   if (options.surface_fit) c << " --surface-fit";
+  if (options.cutting_from_next_puncture) c << " --cutting-from-next-puncture";
   return c.str();
 }
 
@@ -171,6 +172,7 @@ validation::CalibrationOptions calibration_options(const CalibrateOptions& optio
   c.layers = options.layers;
   c.threads = options.threads;
   c.keep_unidentifiable_at_start = !options.tune_unidentifiable;
+  c.cutting_from_next_puncture = options.cutting_from_next_puncture;
   c.stage_turn_margin_m = options.stage_turn_margin_mm * 1e-3;
   check_option(std::isfinite(options.bound_factor) && options.bound_factor > 1.0, "--bound-factor must be a finite number > 1");
   c.bound_factor = options.bound_factor;

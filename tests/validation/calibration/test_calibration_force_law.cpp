@@ -549,9 +549,14 @@ TEST(CalibrationForceLaw, CuttingOfALayerWhoseCutIsTooShortIsIdentifiedByThePunc
   ASSERT_TRUE(skin.found && fat.found);
   ASSERT_LT(fat.depth_m - skin.depth_m, 0.45e-3) << "the fat must break right after the skin (" << (fat.depth_m - skin.depth_m) * 1e3 << " mm)";
   ASSERT_GT(skin.depth_m, truth.layers[0].thickness_m) << "the fat must be met at the tip";
-  const pv::CalibrationResult r = pv::calibrate(perturbed(truth), ref);
+  pv::CalibrationOptions options;
+  options.cutting_from_next_puncture = true;
+  const pv::CalibrationResult r = pv::calibrate(perturbed(truth), ref, options);
   EXPECT_NEAR(truth_of(r.tuned_scene, 0).cut / truth_of(truth, 0).cut, 1.0, 0.05)
       << "the skin's cutting force (start " << truth_of(perturbed(truth), 0).cut << " N)";
+  // Without the option it keeps its start value, with the reason.
+  const pv::CalibrationResult kept = pv::calibrate(perturbed(truth), ref);
+  EXPECT_DOUBLE_EQ(truth_of(kept.tuned_scene, 0).cut, truth_of(perturbed(truth), 0).cut);
   bool said = false;
   for (const std::string& w : r.warnings) said = said || w.find("cutting_force identified in layer fat's stage") != std::string::npos;
   EXPECT_TRUE(said) << "the calibration does not say where the skin's cutting force was identified";

@@ -122,7 +122,8 @@ bool met_at_tip(const Calibration& c, const CalibrationResult& result, std::size
 /// at a depth k's critical force sets, so k's puncture depth and force
 /// identify both, however few samples the cut above has.
 bool tunes_cutting_above(const Calibration& c, const CalibrationResult& result, std::size_t k) {
-  return c.options.parameters.cutting && c.scene.effects.cutting && k > 0 && c.calibrated(k - 1) &&
+  return c.options.cutting_from_next_puncture && c.options.parameters.cutting && c.scene.effects.cutting && k > 0 &&
+         c.calibrated(k - 1) &&
          met_at_tip(c, result, k) && c.identifiable[k].punctured;
 }
 

@@ -109,6 +109,8 @@ struct CalibrateOptions {
   /// tip stiffening of those layers goes to 0 and K and the stiffening are
   /// then kept by the later stages.
   bool surface_fit = false;
+  /// CalibrationOptions::cutting_from_next_puncture.
+  bool cutting_from_next_puncture = false;
   /// Parameters kept at the scene's values: "K", "breakthrough", "cutting",
   /// "friction", "stiffening" (by default each is tuned where its effect is on).
   std::vector<std::string> keep;

@@ -173,6 +173,13 @@ struct CalibrationOptions {
   /// --tune-unidentifiable`): they are tuned and left where the optimiser
   /// left them, with a warning each.
   bool keep_unidentifiable_at_start = true;
+  /// A layer whose next layer is met at the tip (the crack stays open while
+  /// that layer is pressed) gets its cutting force tuned in the next layer's
+  /// stage, identified by that layer's puncture force and depth, however
+  /// short its own cut (`puncture calibrate --cutting-from-next-puncture`).
+  /// Off by default: on the default slab it fits the calibration trajectory's
+  /// punctures closer but holds out worse (results/experiments/cutting_from_next_puncture).
+  bool cutting_from_next_puncture = false;
   /// Per-layer stages run the model down to the end of their compared depth
   /// range plus this margin and turn there (not to the reference's deepest
   /// sample); the joint stage runs the whole trajectory. <= 0: always whole.
