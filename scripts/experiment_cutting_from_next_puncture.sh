@@ -42,9 +42,11 @@ def rows(s):
 a, b = rows(old), rows(new)
 def count(r, held):
     return sum(1 for l in r.values() if l["accepted"] and l["held_out"] == held)
+cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "unknown CPU")
+machine = f"{platform.node()} ({cpu}, {os.cpu_count()} cores)"
 lines = ["# Experiment: the cutting force of a layer identified by the next layer's puncture", "",
          f"Made by `bash scripts/experiment_cutting_from_next_puncture.sh` at git {rev} on "
-         f"{platform.node()}, {datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%dT%H:%M:%SZ')}.", "",
+         f"{machine}, {datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%dT%H:%M:%SZ')}.", "",
          "The tuned preset's two calibration steps with `--cutting-from-next-puncture`: a layer whose next layer "
          "is met at the tip gets its cutting force tuned in that layer's stage, from that layer's puncture force "
          "and depth (on the FEM's 0.2 mm load steps the skin's own cut has too few samples, so by default its "
