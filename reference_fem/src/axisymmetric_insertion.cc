@@ -35,6 +35,7 @@
 #include <puncture/meshing/axisymmetric_slab_mesh.hpp>
 
 #include "insertion_common.hpp"
+#include "axisymmetric_insertion_run.hpp"
 
 namespace puncture::fem {
 
@@ -42,16 +43,10 @@ namespace {
 
 using insertion::format_double;
 using insertion::LayerState;
+using axisymmetric_insertion::LayerLaws;
+using axisymmetric_insertion::TrajectoryPoint;
 
 constexpr double kPi = 3.14159265358979323846;
-
-/// One point of the needle's trajectory: time, tip depth (m below the skin
-/// surface; negative above it) and phase.
-struct TrajectoryPoint {
-  double time_s;
-  double depth_m;
-  const char* phase;
-};
 
 /// The scene's trajectory as the list of step end points: the approach to the
 /// surface in one step, insertion in steps of load_step, the dwell in steps
@@ -90,15 +85,6 @@ std::vector<TrajectoryPoint> trajectory(const Scene& scene, double stop_depth_m)
   }
   return out;
 }
-
-/// Per-layer materials (the long-term laws of viscoelastic layers), Prony
-/// series (empty: elastic), crack laws and friction from the scene.
-struct LayerLaws {
-  std::vector<LayerMaterial> materials;
-  std::vector<std::vector<PronyTerm>> prony;
-  std::vector<LayerCrack> cracks;
-  std::vector<FrictionCoefficients> friction;
-};
 
 /// The layer's long-term law: its material, scaled by the relaxed fraction
 /// g_inf when the scene's modulus is the instantaneous one (nu kept, so the
@@ -180,89 +166,9 @@ int checked_element_degree(const Scene& scene, const FemRunOptions& options) {
   return degree;
 }
 
-/// One row of fem_force_depth.csv.
-struct Row {
-  double time_s, depth_m, velocity_m_per_s, force_N, tip_N, cutting_N, friction_N, tip_stretch;
-  std::string phase;
-  std::vector<LayerState> states;
-};
+}  // namespace
 
-/// A converged step of the needle: where it started in time, how far the tip
-/// went (m, > 0 inward) and the cutting force over it (N).
-struct StepAdvance {
-  double t0_s;
-  double advance_m;
-  double cutting_N;
-  int newton_iterations;
-};
-
-/// The axisymmetric insertion on rank 0: the mesh and the solver, the state of
-/// the layers along the way, what is recorded, and the steps of the algorithm.
-class AxisymmetricInsertionRun {
- public:
-  /// Checks the scene, builds the mesh and the solver, fills the model part of
-  /// `summary` and creates the output directory.
-  AxisymmetricInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm, FemRunSummary& summary);
-  /// Walks the needle along the whole trajectory, step by step.
-  void walk_trajectory();
-  /// Writes the CSV files, the Newton log, the PVD collection and the summary.
-  void write_outputs();
-
- private:
-  std::optional<StepAdvance> advance_needle(std::size_t k);
-  void cut_step(const AxisymmetricNewtonReport& report, const std::string& phase, double d0, double d1);
-  void detect_punctures();
-  bool tip_reached_top(std::size_t i) const;
-  bool layer_breaks(std::size_t i, double force_N, bool first_intact) const;
-  void open_crack(std::size_t i);
-  void record_puncture(std::size_t i, double force_after_N);
-  void record_step(const std::string& phase, const StepAdvance& step);
-  void record(const std::string& phase, double velocity, double cutting_N);
-  void add_energy_totals();
-  void describe_model(MPI_Comm comm);
-  void place_needle(double depth);
-  int pressed_layer() const;
-  bool crack_through_top(std::size_t i) const;
-  insertion::SurfaceProfile layer_top_profile(std::size_t layer) const;
-  void write_frame(double time);
-  std::string force_depth_csv() const;
-  void write_pvd() const;
-  nlohmann::json summary_json() const;
-  void log(const std::string& s) const {
-    if (options_.verbose) std::cout << s << std::endl;
-  }
-
-  // What the scene asks for.
-  const Scene& scene_;
-  const FemRunOptions& options_;
-  FemRunSummary& summary_;
-  const std::chrono::steady_clock::time_point wall_start_ = std::chrono::steady_clock::now();
-  const int degree_;
-  const int refinement_;
-  const bool cutting_;  // a bevel or hollow tip (else a flat punch)
-  const std::size_t n_layers_;
-  const double a_;  // needle radius (m)
-  // Mesh and solver.
-  const meshing::AxisymmetricSlabMesh mesh_;
-  const LayerLaws laws_;
-  AxisymmetricSolver solver_;
-  // Outputs being collected.
-  const std::filesystem::path out_dir_;
-  const std::vector<TrajectoryPoint> plan_;
-  const int frame_every_;
-  std::vector<Row> rows_;
-  insertion::InsertionRecords records_;
-  std::vector<std::pair<double, std::string>> frames_;  // (time, file name)
-  // State of the layers.
-  std::vector<LayerState> states_;
-  std::vector<double> peak_force_, peak_depth_, peak_time_;
-  std::vector<insertion::SurfaceProfile> peak_profile_;
-  // State of the walk.
-  double depth_, time_ = 0.0;
-  double fraction_ = 1.0;  // of the planned step, grows back after cuts
-  int step_index_ = 0;
-  double last_advance_ = 0.0;  // depth change of the last converged step (for the predictor)
-};
+namespace axisymmetric_insertion {
 
 constexpr double kMinStepFraction = 1.0 / 256.0;
 
@@ -481,61 +387,6 @@ void AxisymmetricInsertionRun::record_puncture(std::size_t i, double force_after
   write_frame(time_);
 }
 
-// Records a converged step: its row, every other step the pressed layer's
-// surface, a frame every frame_every steps, progress every 10 steps.
-void AxisymmetricInsertionRun::record_step(const std::string& phase, const StepAdvance& step) {
-  const double t0 = step.t0_s, t1 = time_;
-  const double velocity = phase == "dwell" ? 0.0 : (t1 > t0 ? step.advance_m / (t1 - t0) : 0.0);
-  record(phase, velocity, step.cutting_N);
-  const int p = pressed_layer();
-  if (p >= 0 && states_[p] == LayerState::Pressed && step_index_ % 2 == 0)
-    records_.add_surface_profile(step_index_, depth_, layer_top_profile(p), scene_.layers[p].name);
-  if (step_index_ % frame_every_ == 0) write_frame(time_);
-  if (options_.verbose && step_index_ % 10 == 0) {
-    std::ostringstream m;
-    m << "  step " << step_index_ << "  " << phase << "  depth " << std::fixed << std::setprecision(3)
-      << depth_ * 1e3 << " mm  force " << std::setprecision(4) << rows_.back().force_N << " N (friction "
-      << rows_.back().friction_N << " N)  newton " << step.newton_iterations;
-    log(m.str());
-  }
-}
-
-// One row of the force-depth curve (CSV and summary): the needle force split
-// into tip, cutting and friction, the tip stretch, the layer states.
-void AxisymmetricInsertionRun::record(const std::string& phase, double velocity, double cutting_N) {
-  const NeedleForce f = solver_.needle_force();
-  const int p = pressed_layer();
-  double stretch = 1.0;
-  if (p >= 0 && f.nodes_in_contact > 0)
-    stretch = solver_.max_principal_stretch(p, 2.0 * a_, -depth_ - 2.0 * a_, -depth_ + 2.0 * a_);
-  const double total = f.nodes_in_contact > 0 ? f.total_N : 0.0;
-  const double friction = f.nodes_in_contact > 0 ? f.friction_N : 0.0;
-  rows_.push_back({time_, depth_, velocity, total, total - friction - cutting_N, cutting_N, friction, stretch, phase,
-                   states_});
-  summary_.time_s.push_back(time_);
-  summary_.depth_m.push_back(depth_);
-  summary_.force_N.push_back(total);
-  summary_.tip_force_N.push_back(total - friction - cutting_N);
-  summary_.cutting_force_N.push_back(cutting_N);
-  summary_.friction_force_N.push_back(friction);
-  summary_.phase.push_back(phase);
-  if (total > summary_.peak_force_N) {
-    summary_.peak_force_N = total;
-    summary_.peak_force_depth_m = depth_;
-  }
-}
-
-// Energies of the run: crack, stabilisation, and the needle's work over the
-// insertion (trapezoid rule on force x depth).
-void AxisymmetricInsertionRun::add_energy_totals() {
-  summary_.cohesive_dissipation_J = solver_.cohesive_dissipation_J();
-  summary_.stabilization_dissipation_J = solver_.stabilization_dissipation_J();
-  for (std::size_t k = 1; k < rows_.size(); ++k)
-    if (rows_[k].phase == "insertion")
-      summary_.needle_work_J +=
-          0.5 * (rows_[k].force_N + rows_[k - 1].force_N) * (rows_[k].depth_m - rows_[k - 1].depth_m);
-}
-
 // Puts the needle (a cutting needle or the flat punch) at tip depth `depth`.
 void AxisymmetricInsertionRun::place_needle(double depth) {
   if (cutting_) {
@@ -564,97 +415,9 @@ bool AxisymmetricInsertionRun::crack_through_top(std::size_t i) const {
   return solver_.crack_front_depth_m(static_cast<int>(i)) >= top + margin - 1e-12;
 }
 
-// u_z(r) along the reference top of a layer.
-insertion::SurfaceProfile AxisymmetricInsertionRun::layer_top_profile(std::size_t layer) const {
-  return solver_.vertical_displacement_along(-scene_.layer_top_depth_m(layer));
-}
+}  // namespace axisymmetric_insertion
 
-// Writes one VTU frame of the meridian plane (if VTU output is asked for).
-void AxisymmetricInsertionRun::write_frame(double time) {
-  if (!options_.write_files || !options_.write_vtu) return;
-  std::ostringstream name;
-  name << "fem_fields_" << std::setw(4) << std::setfill('0') << frames_.size() << ".vtu";
-  io::write_file_atomically_with(out_dir_ / name.str(),
-                                 [&](const std::filesystem::path& staged) { solver_.write_vtu(staged.string()); });
-  frames_.emplace_back(time, name.str());
-  summary_.files_written.push_back(name.str());
-}
-
-// Writes the outputs (wall time first, so the summary reports it).
-void AxisymmetricInsertionRun::write_outputs() {
-  summary_.wall_time_s = insertion::seconds_since(wall_start_);
-  if (!options_.write_files) return;
-  insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
-  write_pvd();
-  insertion::list_text_outputs(summary_.files_written);
-  io::write_file_atomically(out_dir_ / "fem_summary.json", summary_json().dump(2) + "\n");
-}
-
-// fem_force_depth.csv: one line per recorded row.
-std::string AxisymmetricInsertionRun::force_depth_csv() const {
-  std::ostringstream csv;
-  csv << insertion::force_depth_header(
-      "time_s,depth_mm,velocity_mm_per_s,force_N,tip_force_N,cutting_force_N,friction_force_N,tip_stretch,phase",
-      scene_);
-  for (const Row& r : rows_) {
-    csv << format_double(r.time_s) << "," << format_double(r.depth_m * 1e3) << ","
-        << format_double(r.velocity_m_per_s * 1e3) << "," << format_double(r.force_N) << ","
-        << format_double(r.tip_N) << "," << format_double(r.cutting_N) << "," << format_double(r.friction_N) << ","
-        << format_double(r.tip_stretch) << "," << r.phase;
-    insertion::append_layer_states(csv, r.states);
-    csv << "\n";
-  }
-  return csv.str();
-}
-
-// fem_fields.pvd: the collection of the VTU frames (if any were written),
-// spelt as this reference always wrote it: no byte order, no group, times
-// with 9 significant digits (format_double).
-void AxisymmetricInsertionRun::write_pvd() const {
-  if (frames_.empty()) return;
-  std::vector<io::PvdEntry> entries;
-  for (const auto& [t, name] : frames_) entries.push_back({t, 0, name});
-  io::PvdFormat format;
-  format.byte_order_attribute.clear();
-  format.group_attribute = false;
-  format.time_digits = 9;
-  io::write_pvd_file(out_dir_ / "fem_fields.pvd", entries, nullptr, format);
-  summary_.files_written.push_back("fem_fields.pvd");
-}
-
-// fem_summary.json: the model, the peak, the energies, the counts, the
-// timings, the punctures and the files.
-nlohmann::json AxisymmetricInsertionRun::summary_json() const {
-  nlohmann::json j;
-  j["status"] = "ok";
-  j["scene"] = scene_.name;
-  j["geometry"] = "axisymmetric";
-  j["n_dofs"] = summary_.n_dofs;
-  j["assembly_threads"] = summary_.assembly_threads;
-  j["n_cells"] = summary_.n_cells;
-  j["n_ranks_used"] = 1;
-  j["element_degree"] = degree_;
-  j["refinement"] = refinement_;
-  j["tip_element_size_mm"] = mesh_.tip_element_size_m * 1e3;
-  j["crack_radius_mm"] = mesh_.crack_radius_m * 1e3;
-  j["elements_through_layer"] = mesh_.elements_through_layer;
-  j["load_step_mm"] = scene_.fem.load_step_m * 1e3;
-  j["peak_force_N"] = summary_.peak_force_N;
-  j["peak_force_depth_mm"] = summary_.peak_force_depth_m * 1e3;
-  j["cohesive_dissipation_J"] = summary_.cohesive_dissipation_J;
-  j["stabilization_dissipation_J"] = summary_.stabilization_dissipation_J;
-  j["needle_work_insertion_J"] = summary_.needle_work_J;
-  j["load_steps"] = summary_.load_steps;
-  j["step_cuts"] = summary_.step_cuts;
-  j["steps_accepted_at_stall"] = summary_.steps_accepted_at_stall;
-  j["newton_iterations"] = summary_.newton_iterations;
-  j["wall_time_s"] = summary_.wall_time_s;
-  j["solve_time_s"] = summary_.solve_time_s;
-  j["warnings"] = summary_.warnings;
-  j["punctures"] = insertion::punctures_json(summary_.punctures, /*with_stretch=*/false);
-  j["files"] = summary_.files_written;
-  return j;
-}
+namespace {
 
 // What rank 0 sends the other ranks: the error (empty if none) and the curve.
 nlohmann::json outcome_to_json(const std::string& error, const FemRunSummary& summary) {
@@ -720,7 +483,7 @@ FemRunSummary run_axisymmetric_insertion(const Scene& scene, const FemRunOptions
   if (dealii::Utilities::MPI::this_mpi_process(comm) == 0) {
     try {
       widen_cpu_affinity();
-      AxisymmetricInsertionRun run(scene, options, comm, summary);  // mesh and solver
+      axisymmetric_insertion::AxisymmetricInsertionRun run(scene, options, comm, summary);  // mesh and solver
       run.walk_trajectory();  // per step: advance, detect punctures, record
       run.write_outputs();
     } catch (const std::exception& e) {

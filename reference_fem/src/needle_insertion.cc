@@ -29,6 +29,7 @@
 #include <puncture/fem/finite_strain_solver.hpp>
 
 #include "insertion_common.hpp"
+#include "slab_insertion_run.hpp"
 
 namespace puncture::fem {
 
@@ -38,15 +39,11 @@ namespace {
 
 using insertion::format_double;
 using insertion::LayerState;
+using slab_insertion::Node;
+using slab_insertion::SlabDiscretisation;
+using slab_insertion::Tria;
 
 constexpr types::boundary_id kTop = 0, kBase = 1, kLateral = 2;
-
-/// A node (support point) with its three displacement dofs.
-struct Node {
-  Point<3> X;
-  types::global_dof_index dof[3] = {0, 0, 0};
-  double r() const { return std::hypot(X[0], X[1]); }
-};
 
 /// Groups the locally relevant dof points into nodes, keyed by position.
 std::vector<Node> group_nodes(const std::vector<DofPoint>& points, double length_scale) {
@@ -64,12 +61,6 @@ std::vector<Node> group_nodes(const std::vector<DofPoint>& points, double length
   for (auto& [k, n] : by_key) out.push_back(n);
   return out;
 }
-
-struct Row {
-  double time_s, depth_m, velocity_m_per_s, force_N;
-  double tip_stretch;  ///< max principal stretch at the tip in the pressed layer (1: no contact)
-  std::vector<LayerState> states;
-};
 
 }  // namespace
 
@@ -107,14 +98,6 @@ void build_slab_triangulation(const Scene& scene, const meshing::SlabMeshOptions
 }
 
 namespace {
-
-using Tria = parallel::distributed::Triangulation<3>;
-
-/// Element degree and global refinements of the 3D reference.
-struct SlabDiscretisation {
-  int degree;
-  int refinement;
-};
 
 /// The scene checks of the 3D reference; returns its discretisation.
 SlabDiscretisation checked_discretisation(const Scene& scene, const FemRunOptions& options) {
@@ -181,117 +164,9 @@ SolverSettings solver_settings(const Scene& scene, const FemRunOptions& options,
   return settings;
 }
 
-/// What a sub-step started from: restored when it is undone to bisect toward
-/// a puncture (the contact set also when its solve fails).
-struct SubStepStart {
-  double depth_m;
-  double last_advance_m;
-  bool predictor_valid;
-  std::map<std::size_t, std::array<double, 2>> contact;
-  std::vector<LayerState> states;
-  FiniteStrainSolver::Snapshot snapshot;
-};
+}  // namespace
 
-/// The pressed layer's puncture criterion after a sub-step.
-struct PunctureCheck {
-  double force_N;
-  double stretch;
-  bool breaks;
-};
-
-/// The 3D insertion (flat punch, removal of a layer column at puncture): the
-/// slab and the solver, the contact set and the layer states, what is
-/// recorded, and the steps of the algorithm. Every rank runs it.
-class SlabInsertionRun {
- public:
-  /// Checks the scene, creates the output directory, builds the slab, the
-  /// solver, the boundary conditions and the node sets.
-  SlabInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm);
-  /// Runs the insertion and writes the outputs (also when it fails).
-  FemRunSummary run();
-
- private:
-  void advance_to(double step_target);
-  double next_trial_depth(double step_target, double increment) const;
-  SubStepStart sub_step_start() const;
-  double cut_sub_step(const SubStepStart& start, double trial_depth, double advance, const NewtonReport& report);
-  bool accept_sub_step(double trial_depth, double advance);
-  PunctureCheck check_puncture();
-  void undo_for_bisection(const SubStepStart& start);
-  void puncture_current_layer(double force, double stretch);
-  PunctureEvent record_before_puncture(std::size_t layer, double force, double stretch);
-  void open_hole(std::size_t layer);
-  void release_needle(std::size_t layer, double force);
-  void spring_back(const std::string& layer_name);
-  void record_after_puncture(std::size_t layer, PunctureEvent event);
-  void record_load_step(int step);
-  bool solve_at(double depth, NewtonReport& report, double predictor_scale);
-  void find_node_sets();
-  void describe_model();
-  double u_of(const Node& n, unsigned c) const { return solver_.displacement(n.dof[c]); }
-  bool any_contact() const;
-  void apply_targets(double z_tip);
-  bool join_reached_nodes(double z_tip);
-  double needle_force() const;
-  double tip_stretch(std::size_t layer) const;
-  insertion::SurfaceProfile surface_profile(std::size_t layer) const;
-  void record_row(double depth, double force, double stretch);
-  void write_frame(double depth);
-  void write_outputs(const std::string& status, const std::string& error);
-  std::string force_depth_csv() const;
-  nlohmann::json summary_json(const std::string& status, const std::string& error) const;
-  void log(const std::string& s) const {
-    if (root_ && options_.verbose) std::cout << s << std::endl;
-  }
-
-  // What the scene asks for.
-  const std::chrono::steady_clock::time_point wall_start_ = std::chrono::steady_clock::now();
-  const Scene& scene_;
-  const FemRunOptions& options_;
-  const MPI_Comm comm_;
-  const bool root_;
-  const SlabDiscretisation disc_;
-  const std::size_t n_layers_;
-  const double needle_radius_;
-  const double thickness_;
-  const double tol_;  // position tolerance (m)
-  const double speed_;
-  const double start_height_;
-  const double final_depth_;
-  const std::filesystem::path out_dir_;
-  // Slab and solver.
-  const std::unique_ptr<Tria> tria_;
-  const SolverSettings settings_;
-  FiniteStrainSolver solver_;
-  FemRunSummary summary_;
-  // Boundary conditions and node sets.
-  std::map<types::global_dof_index, double> fixed_;
-  std::vector<Node> nodes_;
-  std::vector<double> interface_z_;
-  // Per layer: every node of its top interface (profiles) and those under the needle.
-  std::vector<std::vector<std::size_t>> interface_nodes_, tip_nodes_;
-  // Contact and layer state.
-  std::map<std::size_t, std::array<double, 2>> contact_;  // joined node -> held lateral displacement
-  std::vector<LayerState> states_;
-  std::size_t current_layer_ = 0;  // first layer not punctured
-  bool solution_is_stale_ = true;  // the state differs from the last solved one
-  // Records.
-  insertion::InsertionRecords records_;
-  std::vector<Row> rows_;
-  std::unique_ptr<FieldOutputSeries> fields_;
-  // Load stepping.
-  const double load_step_;
-  // Puncture depths are located by bisection to within `resolution_`: a step
-  // after which the criterion holds is undone and halved until it is short.
-  const double resolution_;
-  const int n_steps_;
-  const int vtu_stride_;
-  double depth_;
-  int record_index_ = 0;
-  double last_advance_ = 0.0;     // depth change of the last converged step in contact
-  bool predictor_valid_ = false;  // that step pressed the current layer like the next one will
-  double crossing_upper_ = std::numeric_limits<double>::infinity();  // criterion known to hold here
-};
+namespace slab_insertion {
 
 SlabInsertionRun::SlabInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm)
     : scene_(scene),
@@ -504,20 +379,6 @@ void SlabInsertionRun::puncture_current_layer(double force, double stretch) {
   record_after_puncture(layer, std::move(event));
 }
 
-// The puncture event at its peak, its row and the surface before breakthrough.
-PunctureEvent SlabInsertionRun::record_before_puncture(std::size_t layer, double force, double stretch) {
-  PunctureEvent event;
-  event.layer = int(layer);
-  event.layer_name = scene_.layers[layer].name;
-  event.depth_m = depth_;
-  event.force_N = force;
-  event.max_stretch = stretch;
-  event.time_s = (depth_ + start_height_) / speed_;
-  record_row(depth_, force, stretch);
-  records_.add_recovery_profile(layer, "before", depth_, surface_profile(layer));
-  return event;
-}
-
 // Removes the layer's material along the needle path (cells with centre
 // inside the needle radius become void; their internal force is kept as a
 // frozen load for the spring-back homotopy).
@@ -573,43 +434,6 @@ void SlabInsertionRun::spring_back(const std::string& layer_name) {
     lambda = next;
   }
   solver_.set_anchor_springs({});
-}
-
-// After the spring-back: the force on the next layer (if touched), the
-// surface after breakthrough, the event, its row and a frame.
-void SlabInsertionRun::record_after_puncture(std::size_t layer, PunctureEvent event) {
-  const bool touching = any_contact();
-  event.force_after_N = touching ? needle_force() : 0.0;
-  if (current_layer_ < n_layers_ && touching) states_[current_layer_] = LayerState::Pressed;
-  records_.add_recovery_profile(layer, "after", depth_, surface_profile(layer));
-  summary_.punctures.push_back(event);
-  log("  PUNCTURE of " + event.layer_name + " at depth " + format_double(depth_ * 1e3, 5) + " mm, force " +
-      format_double(event.force_N, 5) + " N -> " + format_double(event.force_after_N, 5) + " N");
-  const double stretch_after = current_layer_ < n_layers_ && touching ? tip_stretch(current_layer_) : 1.0;
-  record_row(depth_, event.force_after_N, stretch_after);
-  write_frame(depth_);
-}
-
-// The end of a load step: its row, the pressed surface, a frame every
-// vtu_stride steps (and the last), a progress line.
-void SlabInsertionRun::record_load_step(int step) {
-  const bool touching = any_contact();
-  const double force = touching ? needle_force() : 0.0;
-  const double stretch = touching && current_layer_ < n_layers_ ? tip_stretch(current_layer_) : 1.0;
-  if (!std::isfinite(force)) throw std::runtime_error("fem: non-finite needle force");
-  // (A puncture at the end of the step already recorded this depth.)
-  if (!(rows_.back().depth_m == depth_ && rows_.back().force_N == force)) record_row(depth_, force, stretch);
-  ++record_index_;
-  if (current_layer_ < n_layers_)
-    records_.add_surface_profile(record_index_, depth_, surface_profile(current_layer_),
-                                 scene_.layers[current_layer_].name);
-  if (step % vtu_stride_ == 0 || step == n_steps_) write_frame(depth_);
-  std::ostringstream s;
-  s << "  step " << std::setw(4) << step << "/" << n_steps_ << "  depth " << std::fixed << std::setprecision(3)
-    << depth_ * 1e3 << " mm  force " << std::setprecision(5) << force << " N  tip stretch "
-    << std::setprecision(4) << stretch << "  contact " << contact_.size() << "  newton(total) "
-    << summary_.newton_iterations;
-  log(s.str());
 }
 
 // Solves at tip depth `depth`, joining reached nodes until none is left.
@@ -695,109 +519,7 @@ double SlabInsertionRun::tip_stretch(std::size_t layer) const {
   });
 }
 
-// u_z(r) of a layer's top interface, averaged over nodes at the same r (rank 0 gets it).
-insertion::SurfaceProfile SlabInsertionRun::surface_profile(std::size_t layer) const {
-  std::vector<std::pair<double, double>> local;
-  const IndexSet owned = solver_.dof_handler().locally_owned_dofs();
-  for (const std::size_t n : interface_nodes_[layer])
-    if (owned.is_element(nodes_[n].dof[2])) local.emplace_back(nodes_[n].r(), u_of(nodes_[n], 2));
-  const auto all = Utilities::MPI::gather(comm_, local, 0);
-  std::map<long long, std::pair<double, int>> by_r;
-  std::map<long long, double> r_of;
-  for (const auto& part : all)
-    for (const auto& [r, uz] : part) {
-      const long long key = std::llround(r / (1e-7 * thickness_));
-      auto& acc = by_r[key];
-      acc.first += uz;
-      acc.second += 1;
-      r_of[key] = r;
-    }
-  insertion::SurfaceProfile profile;
-  for (const auto& [key, acc] : by_r) profile.emplace_back(r_of[key], acc.first / acc.second);
-  return profile;
-}
-
-// One row of the force-depth curve (CSV and summary).
-void SlabInsertionRun::record_row(double depth, double force, double stretch) {
-  const double time = (depth + start_height_) / speed_;
-  rows_.push_back({time, depth, speed_, force, stretch, states_});
-  summary_.time_s.push_back(time);
-  summary_.depth_m.push_back(depth);
-  summary_.force_N.push_back(force);
-  if (force > summary_.peak_force_N) {
-    summary_.peak_force_N = force;
-    summary_.peak_force_depth_m = depth;
-  }
-}
-
-// Writes one frame of the fields (collective; if VTU output is asked for).
-void SlabInsertionRun::write_frame(double depth) {
-  if (!fields_) return;
-  const auto names = fields_->write_frame(solver_, (depth + start_height_) / speed_);
-  if (root_) summary_.files_written.insert(summary_.files_written.end(), names.begin(), names.end());
-}
-
-// Writes the PVD collection, then (rank 0) the CSV files, the Newton log and
-// the summary with `status` ("completed" or "failed") and `error`.
-void SlabInsertionRun::write_outputs(const std::string& status, const std::string& error) {
-  if (!options_.write_files) return;
-  if (fields_ && root_) summary_.files_written.push_back(fields_->write_collection());
-  else if (fields_) fields_->write_collection();
-  if (!root_) return;
-  insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
-  insertion::list_text_outputs(summary_.files_written);
-  summary_.wall_time_s = insertion::seconds_since(wall_start_);
-  io::write_file_atomically(out_dir_ / "fem_summary.json", summary_json(status, error).dump(2) + "\n");
-}
-
-// fem_force_depth.csv: one line per recorded row.
-std::string SlabInsertionRun::force_depth_csv() const {
-  std::ostringstream csv;
-  csv << insertion::force_depth_header("time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch", scene_);
-  for (const auto& r : rows_) {
-    csv << format_double(r.time_s) << "," << format_double(r.depth_m * 1e3) << ","
-        << format_double(r.velocity_m_per_s * 1e3) << "," << format_double(r.force_N) << ","
-        << format_double(r.tip_stretch, 6);
-    insertion::append_layer_states(csv, r.states);
-    csv << "\n";
-  }
-  return csv.str();
-}
-
-// fem_summary.json: the model, the peak, the counts, the timings, the
-// punctures and the files.
-nlohmann::json SlabInsertionRun::summary_json(const std::string& status, const std::string& error) const {
-  nlohmann::json j;
-  j["status"] = status;
-  if (!error.empty()) j["error"] = error;
-  j["scene"] = scene_.name;
-  j["n_dofs"] = summary_.n_dofs;
-  j["n_cells"] = summary_.n_cells;
-  j["n_ranks"] = summary_.n_ranks;
-  j["element_degree"] = disc_.degree;
-  j["refinement"] = disc_.refinement;
-  j["formulation"] = options_.formulation;
-  j["load_step_mm"] = load_step_ * 1e3;
-  j["final_depth_mm"] = final_depth_ * 1e3;
-  j["note"] = "quasi-static; the FEM stops at the target depth (no dwell, no withdrawal)";
-  j["warnings"] = summary_.warnings;
-  j["peak_force_N"] = summary_.peak_force_N;
-  j["peak_force_depth_mm"] = summary_.peak_force_depth_m * 1e3;
-  j["load_steps"] = summary_.load_steps;
-  j["step_cuts"] = summary_.step_cuts;
-  j["puncture_bisections"] = summary_.bisections;
-  j["spring_back_stages"] = summary_.spring_back_stages;
-  j["puncture_depth_resolution_mm"] = resolution_ * 1e3;
-  j["newton_iterations"] = summary_.newton_iterations;
-  j["linear_iterations"] = summary_.linear_iterations;
-  j["wall_time_s"] = summary_.wall_time_s;
-  j["solve_time_s"] = summary_.solve_time_s;
-  j["punctures"] = insertion::punctures_json(summary_.punctures, /*with_stretch=*/true);
-  j["files"] = summary_.files_written;
-  return j;
-}
-
-}  // namespace
+}  // namespace slab_insertion
 
 FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& options, MPI_Comm comm) {
   std::string geometry = scene.fem.geometry;
@@ -813,7 +535,7 @@ FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& opti
     else if (l.material.viscoelastic.enabled())
       throw std::invalid_argument("fem: the 3d reference has no viscoelastic layers (layer '" + l.name +
                                   "', material.viscoelastic); use geometry axisymmetric");
-  SlabInsertionRun run(scene, options, comm);  // slab, solver, node sets
+  slab_insertion::SlabInsertionRun run(scene, options, comm);  // slab, solver, node sets
   return run.run();  // per load step: advance, detect puncture, open the hole, release, record; write
 }
 

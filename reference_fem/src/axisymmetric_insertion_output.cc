@@ -1,0 +1,155 @@
+// axisymmetric_insertion_output.cc: what the axisymmetric insertion run records (each
+// step's row, energies, the layers' top profiles, frames) and writes (CSV files, PVD, the
+// summary JSON); the algorithm is in axisymmetric_insertion.cc.
+#include "axisymmetric_insertion_run.hpp"
+
+namespace puncture::fem::axisymmetric_insertion {
+
+// Records a converged step: its row, every other step the pressed layer's
+// surface, a frame every frame_every steps, progress every 10 steps.
+void AxisymmetricInsertionRun::record_step(const std::string& phase, const StepAdvance& step) {
+  const double t0 = step.t0_s, t1 = time_;
+  const double velocity = phase == "dwell" ? 0.0 : (t1 > t0 ? step.advance_m / (t1 - t0) : 0.0);
+  record(phase, velocity, step.cutting_N);
+  const int p = pressed_layer();
+  if (p >= 0 && states_[p] == LayerState::Pressed && step_index_ % 2 == 0)
+    records_.add_surface_profile(step_index_, depth_, layer_top_profile(p), scene_.layers[p].name);
+  if (step_index_ % frame_every_ == 0) write_frame(time_);
+  if (options_.verbose && step_index_ % 10 == 0) {
+    std::ostringstream m;
+    m << "  step " << step_index_ << "  " << phase << "  depth " << std::fixed << std::setprecision(3)
+      << depth_ * 1e3 << " mm  force " << std::setprecision(4) << rows_.back().force_N << " N (friction "
+      << rows_.back().friction_N << " N)  newton " << step.newton_iterations;
+    log(m.str());
+  }
+}
+
+// One row of the force-depth curve (CSV and summary): the needle force split
+// into tip, cutting and friction, the tip stretch, the layer states.
+void AxisymmetricInsertionRun::record(const std::string& phase, double velocity, double cutting_N) {
+  const NeedleForce f = solver_.needle_force();
+  const int p = pressed_layer();
+  double stretch = 1.0;
+  if (p >= 0 && f.nodes_in_contact > 0)
+    stretch = solver_.max_principal_stretch(p, 2.0 * a_, -depth_ - 2.0 * a_, -depth_ + 2.0 * a_);
+  const double total = f.nodes_in_contact > 0 ? f.total_N : 0.0;
+  const double friction = f.nodes_in_contact > 0 ? f.friction_N : 0.0;
+  rows_.push_back({time_, depth_, velocity, total, total - friction - cutting_N, cutting_N, friction, stretch, phase,
+                   states_});
+  summary_.time_s.push_back(time_);
+  summary_.depth_m.push_back(depth_);
+  summary_.force_N.push_back(total);
+  summary_.tip_force_N.push_back(total - friction - cutting_N);
+  summary_.cutting_force_N.push_back(cutting_N);
+  summary_.friction_force_N.push_back(friction);
+  summary_.phase.push_back(phase);
+  if (total > summary_.peak_force_N) {
+    summary_.peak_force_N = total;
+    summary_.peak_force_depth_m = depth_;
+  }
+}
+
+// Energies of the run: crack, stabilisation, and the needle's work over the
+// insertion (trapezoid rule on force x depth).
+void AxisymmetricInsertionRun::add_energy_totals() {
+  summary_.cohesive_dissipation_J = solver_.cohesive_dissipation_J();
+  summary_.stabilization_dissipation_J = solver_.stabilization_dissipation_J();
+  for (std::size_t k = 1; k < rows_.size(); ++k)
+    if (rows_[k].phase == "insertion")
+      summary_.needle_work_J +=
+          0.5 * (rows_[k].force_N + rows_[k - 1].force_N) * (rows_[k].depth_m - rows_[k - 1].depth_m);
+}
+
+// u_z(r) along the reference top of a layer.
+insertion::SurfaceProfile AxisymmetricInsertionRun::layer_top_profile(std::size_t layer) const {
+  return solver_.vertical_displacement_along(-scene_.layer_top_depth_m(layer));
+}
+
+// Writes one VTU frame of the meridian plane (if VTU output is asked for).
+void AxisymmetricInsertionRun::write_frame(double time) {
+  if (!options_.write_files || !options_.write_vtu) return;
+  std::ostringstream name;
+  name << "fem_fields_" << std::setw(4) << std::setfill('0') << frames_.size() << ".vtu";
+  io::write_file_atomically_with(out_dir_ / name.str(),
+                                 [&](const std::filesystem::path& staged) { solver_.write_vtu(staged.string()); });
+  frames_.emplace_back(time, name.str());
+  summary_.files_written.push_back(name.str());
+}
+
+// Writes the outputs (wall time first, so the summary reports it).
+void AxisymmetricInsertionRun::write_outputs() {
+  summary_.wall_time_s = insertion::seconds_since(wall_start_);
+  if (!options_.write_files) return;
+  insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
+  write_pvd();
+  insertion::list_text_outputs(summary_.files_written);
+  io::write_file_atomically(out_dir_ / "fem_summary.json", summary_json().dump(2) + "\n");
+}
+
+// fem_force_depth.csv: one line per recorded row.
+std::string AxisymmetricInsertionRun::force_depth_csv() const {
+  std::ostringstream csv;
+  csv << insertion::force_depth_header(
+      "time_s,depth_mm,velocity_mm_per_s,force_N,tip_force_N,cutting_force_N,friction_force_N,tip_stretch,phase",
+      scene_);
+  for (const Row& r : rows_) {
+    csv << format_double(r.time_s) << "," << format_double(r.depth_m * 1e3) << ","
+        << format_double(r.velocity_m_per_s * 1e3) << "," << format_double(r.force_N) << ","
+        << format_double(r.tip_N) << "," << format_double(r.cutting_N) << "," << format_double(r.friction_N) << ","
+        << format_double(r.tip_stretch) << "," << r.phase;
+    insertion::append_layer_states(csv, r.states);
+    csv << "\n";
+  }
+  return csv.str();
+}
+
+// fem_fields.pvd: the collection of the VTU frames (if any were written),
+// spelt as this reference always wrote it: no byte order, no group, times
+// with 9 significant digits (format_double).
+void AxisymmetricInsertionRun::write_pvd() const {
+  if (frames_.empty()) return;
+  std::vector<io::PvdEntry> entries;
+  for (const auto& [t, name] : frames_) entries.push_back({t, 0, name});
+  io::PvdFormat format;
+  format.byte_order_attribute.clear();
+  format.group_attribute = false;
+  format.time_digits = 9;
+  io::write_pvd_file(out_dir_ / "fem_fields.pvd", entries, nullptr, format);
+  summary_.files_written.push_back("fem_fields.pvd");
+}
+
+// fem_summary.json: the model, the peak, the energies, the counts, the
+// timings, the punctures and the files.
+nlohmann::json AxisymmetricInsertionRun::summary_json() const {
+  nlohmann::json j;
+  j["status"] = "ok";
+  j["scene"] = scene_.name;
+  j["geometry"] = "axisymmetric";
+  j["n_dofs"] = summary_.n_dofs;
+  j["assembly_threads"] = summary_.assembly_threads;
+  j["n_cells"] = summary_.n_cells;
+  j["n_ranks_used"] = 1;
+  j["element_degree"] = degree_;
+  j["refinement"] = refinement_;
+  j["tip_element_size_mm"] = mesh_.tip_element_size_m * 1e3;
+  j["crack_radius_mm"] = mesh_.crack_radius_m * 1e3;
+  j["elements_through_layer"] = mesh_.elements_through_layer;
+  j["load_step_mm"] = scene_.fem.load_step_m * 1e3;
+  j["peak_force_N"] = summary_.peak_force_N;
+  j["peak_force_depth_mm"] = summary_.peak_force_depth_m * 1e3;
+  j["cohesive_dissipation_J"] = summary_.cohesive_dissipation_J;
+  j["stabilization_dissipation_J"] = summary_.stabilization_dissipation_J;
+  j["needle_work_insertion_J"] = summary_.needle_work_J;
+  j["load_steps"] = summary_.load_steps;
+  j["step_cuts"] = summary_.step_cuts;
+  j["steps_accepted_at_stall"] = summary_.steps_accepted_at_stall;
+  j["newton_iterations"] = summary_.newton_iterations;
+  j["wall_time_s"] = summary_.wall_time_s;
+  j["solve_time_s"] = summary_.solve_time_s;
+  j["warnings"] = summary_.warnings;
+  j["punctures"] = insertion::punctures_json(summary_.punctures, /*with_stretch=*/false);
+  j["files"] = summary_.files_written;
+  return j;
+}
+
+}  // namespace puncture::fem::axisymmetric_insertion

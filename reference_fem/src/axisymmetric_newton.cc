@@ -1,0 +1,298 @@
+// axisymmetric_newton.cc: one load step of the AxisymmetricSolver read as the algorithm:
+// start the step, evaluate an iterate, update the punch contact, Newton direction, line
+// search, accept or fail (axisymmetric_solver.hpp).
+#include <puncture/fem/axisymmetric_solver.hpp>
+#include <puncture/fem/kinematics.hpp>
+
+#include <deal.II/base/function.h>
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/sparse_direct.h>
+#include <deal.II/numerics/vector_tools.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cmath>
+#include <iomanip>
+#include <exception>
+#include <iostream>
+#include <thread>
+#include <limits>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+
+#include "axisymmetric_cell.hpp"
+
+namespace puncture::fem {
+using namespace dealii;
+using axisymmetric_cell::CellState;
+using axisymmetric_cell::DisplacementGradients;
+using axisymmetric_cell::ViscousCell;
+using axisymmetric_cell::evaluate_cell;
+using axisymmetric_cell::kTwoPi;
+using axisymmetric_cell::n_pressure_modes;
+
+/// What the phases of one solve_step share.
+struct AxisymmetricSolver::Step {
+  AxisymmetricNewtonReport report;
+  Vector<double> u_start;                 ///< the last converged solution (restored on failure)
+  std::vector<char> punch_contact_start;  ///< the flat punch's contact set at the start
+  std::vector<double> punch_hold_start;   ///< and its held u_R
+  std::vector<char> released_in_step;     ///< punch nodes released for a tensile reaction (free for the step)
+  AffineConstraints<double> constraints;  ///< the Newton increment's constraints at solution_
+  SparseDirectUMFPACK direct;
+  Vector<double> du, trial;               ///< Newton direction; the line search's state
+  double max_free = 0.0;                  ///< largest free residual of the step so far (N)
+  int contact_changes = 0;                ///< changes of the punch contact set so far
+  std::vector<double> history;            ///< free residual per iteration (stall detection)
+};
+
+/// One Newton iterate (the state solution_).
+struct AxisymmetricSolver::Iterate {
+  double free = 0.0;   ///< free residual (N)
+  double gap = 0.0;    ///< largest prescribed punch displacement not yet reached (m)
+  double scale = 0.0;  ///< force scale of the convergence test (N)
+  bool stalled = false, strict = false, converged = false;
+  double assemble_s = 0.0, solve_s = 0.0;
+  std::ostringstream line;  ///< the iterate's line of the Newton log
+};
+
+AxisymmetricNewtonReport AxisymmetricSolver::solve_step(double predictor_scale) {
+  Step step;
+  start_step(step, predictor_scale);
+  for (int it = 0;; ++it) {
+    Iterate x;
+    if (const Failure why = evaluate_iterate(step, it, x)) return fail_step(step, *why);
+    if (x.converged) {
+      // Flat punch: release nodes pulled by the face (tensile reaction) and
+      // take in the nodes it reaches; if the contact set changed, go on.
+      const bool released = release_pulled_punch_nodes(step.released_in_step, x.scale);
+      const bool joined = update_punch_contact(step.released_in_step);
+      if (!released && !joined) return accept_step(step, x, it);
+      if (++step.contact_changes > 50) return fail_step(step, "flat punch contact set does not settle");
+      x.line << "  (punch contact set changed)";
+      step.report.table.push_back(x.line.str());
+      continue;
+    }
+    if (const Failure why = give_up_reason(it, x)) {
+      step.report.table.push_back(x.line.str());
+      step.report.iterations = it;
+      return fail_step(step, *why);
+    }
+    if (const Failure why = newton_direction(step, x)) return fail_step(step, *why);
+    double alpha = 0.0;
+    if (const Failure why = line_search(step, x, alpha)) return fail_step(step, *why);
+    x.line << "  alpha " << std::defaultfloat << alpha << "  t_assemble " << std::setprecision(3) << x.assemble_s
+           << " s  t_solve " << x.solve_s << " s";
+    step.report.table.push_back(x.line.str());
+    if (settings_.verbose) std::cout << "      " << step.report.table.back() << std::endl;
+    solution_ = step.trial;
+  }
+}
+
+void AxisymmetricSolver::start_step(Step& step, double predictor_scale) {
+  step.u_start = solution_;
+  step_start_ = step.u_start;
+  step.punch_contact_start = punch_contact_;
+  step.punch_hold_start = punch_lateral_hold_;
+  if (predictor_scale > 0.0 && last_increment_.linfty_norm() > 0.0) {
+    solution_.add(predictor_scale, last_increment_);
+    if (!assemble(solution_, false)) solution_ = step.u_start;
+  }
+  step.released_in_step.assign(contact_nodes_.size(), 0);
+  update_punch_contact(step.released_in_step);
+  step.du.reinit(solution_.size());
+  step.trial.reinit(solution_.size());
+}
+
+AxisymmetricSolver::Failure AxisymmetricSolver::evaluate_iterate(Step& step, int it, Iterate& x) {
+  debug_contacts_ = settings_.verbose && std::getenv("PUNCTURE_FEM_DEBUG_CONTACT") != nullptr;
+  make_constraints(solution_, step.constraints);
+  const auto t_assemble = std::chrono::steady_clock::now();
+  if (!assemble(solution_, true)) return "inverted or non-finite state";
+  debug_contacts_ = false;
+  x.assemble_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_assemble).count();
+  const AffineConstraints<double>& constraints = step.constraints;
+  x.free = free_residual_norm(constraints);
+  for (std::size_t i = 0; i < solution_.size(); ++i)
+    if (constraints.is_inhomogeneously_constrained(i))
+      x.gap = std::max(x.gap, std::abs(constraints.get_inhomogeneity(i)));
+  step.max_free = std::max(step.max_free, x.free);
+  double reaction = std::abs(force_trial_.total_N);
+  for (std::size_t i = 0; i < solution_.size(); ++i)
+    if (constraints.is_constrained(i)) reaction = std::max(reaction, std::abs(residual_(i)));
+  x.scale = std::max({reaction, step.max_free, 1e-300});
+  step.report.residual_N = x.free;
+  step.report.force_scale_N = x.scale;
+  if (!std::isfinite(x.free)) return "non-finite residual";
+  x.stalled = check_stall(step.history, x.free);
+  const bool gap_closed = x.gap <= 1e-12 * std::max(1e-3, punch_radius_m_);
+  x.strict = x.free <= settings_.newton_tolerance * x.scale || x.free <= settings_.absolute_residual_floor_N;
+  const bool loose = x.stalled && x.free <= settings_.stall_acceptance_tolerance * x.scale;
+  x.converged = gap_closed && (x.strict || loose);
+  write_iterate_line(it, x);
+  return std::nullopt;
+}
+
+bool AxisymmetricSolver::check_stall(std::vector<double>& history, double free) const {
+  // Stall: the best residual of the last stall_window iterations is not
+  // below stall_factor x the best before them.
+  history.push_back(free);
+  const int window = settings_.stall_window;
+  if (window <= 0 || static_cast<int>(history.size()) <= window) return false;
+  const double before = *std::min_element(history.begin(), history.end() - window);
+  const double recent = *std::min_element(history.end() - window, history.end());
+  return recent > settings_.stall_factor * before;
+}
+
+void AxisymmetricSolver::write_iterate_line(int it, Iterate& x) const {
+  int sliding = 0, damaged = 0, broken = 0, closed = 0;
+  for (const auto& h : friction_trial_) sliding += h.sliding ? 1 : 0;
+  for (std::size_t k = 0; k < cohesive_points_.size(); ++k) {
+    damaged += cohesive_trial_[k].damage > 0.0 ? 1 : 0;
+    broken += cohesive_trial_[k].damage >= 1.0 ? 1 : 0;
+    closed += (cohesive_trial_[k].damage > 0.0 &&
+               solution_(cohesive_points_[k].outer_r) < solution_(cohesive_points_[k].core_r)) ? 1 : 0;
+  }
+  x.line << std::setw(4) << it << "  |R_free| " << std::scientific << std::setprecision(3) << x.free << " N  scale "
+         << x.scale << " N  F_needle " << force_trial_.total_N << " N  contact " << force_trial_.nodes_in_contact
+         << " sliding " << sliding << " damaged " << damaged << " broken " << broken << " closed " << closed;
+}
+
+bool AxisymmetricSolver::release_pulled_punch_nodes(std::vector<char>& released_in_step, double scale) {
+  bool released = false;
+  if (cutting_) return released;
+  for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
+    if (!punch_contact_[i] || tied_slave(i)) continue;
+    // A tied pair of crack nodes carries its reaction together.
+    const int p = contact_nodes_[i].partner;
+    double reaction = residual_(contact_nodes_[i].dof_z);
+    if (p >= 0 && tied_slave(static_cast<std::size_t>(p))) reaction += residual_(contact_nodes_[p].dof_z);
+    if (reaction > 1e-6 * scale) {  // R_z > 0: the face would pull the node
+      if (settings_.verbose)
+        std::cout << "      punch releases node R=" << contact_nodes_[i].R << " reaction " << reaction << std::endl;
+      punch_contact_[i] = 0;
+      released_in_step[i] = 1;
+      if (p >= 0 && tied_slave(static_cast<std::size_t>(p))) punch_contact_[p] = 0;
+      released = true;
+    }
+  }
+  return released;
+}
+
+bool AxisymmetricSolver::update_punch_contact(const std::vector<char>& released_in_step) {
+  // Flat punch: top nodes within the punch radius that the face has reached
+  // join; a node released for a tensile reaction stays free for this step.
+  bool changed = false;
+  if (cutting_) return changed;
+  for (std::size_t i = 0; i < contact_nodes_.size(); ++i) {
+    const ContactNode& nd = contact_nodes_[i];
+    if (punch_contact_[i] || released_in_step[i] || !nd.on_top || nd.R > punch_radius_m_ * (1 + 1e-9) ||
+        tied_slave(i))
+      continue;
+    if (nd.Z + solution_(nd.dof_z) >= punch_z_m_) {
+      punch_contact_[i] = 1;
+      punch_lateral_hold_[i] = solution_(nd.dof_r);
+      if (nd.partner >= 0 && tied_slave(static_cast<std::size_t>(nd.partner))) punch_contact_[nd.partner] = 1;
+      changed = true;
+    }
+  }
+  return changed;
+}
+
+AxisymmetricSolver::Failure AxisymmetricSolver::give_up_reason(int it, const Iterate& x) const {
+  if (it >= settings_.max_newton_iterations) return "no convergence in " + std::to_string(it) + " Newton iterations";
+  if (!x.stalled) return std::nullopt;
+  std::ostringstream why;
+  why << "Newton stalls: |R_free| " << std::scientific << std::setprecision(3) << x.free << " N did not fall by "
+      << std::defaultfloat << 100.0 * (1.0 - settings_.stall_factor) << " % in " << settings_.stall_window
+      << " iterations";
+  return why.str();
+}
+
+AxisymmetricSolver::Failure AxisymmetricSolver::newton_direction(Step& step, Iterate& x) {
+  // Linear system K du = -R with the increment constraints condensed in
+  // (UMFPACK takes the nonsymmetric tangent of sliding friction).
+  rhs_ = residual_;
+  rhs_ *= -1.0;
+  const auto t_solve = std::chrono::steady_clock::now();
+  system_matrix_.copy_from(tangent_);
+  step.constraints.condense(system_matrix_, rhs_);
+  try {
+    step.direct.initialize(system_matrix_);
+    step.direct.vmult(step.du, rhs_);
+  } catch (const std::exception& e) {
+    return std::string("sparse direct solve failed: ") + e.what();
+  }
+  x.solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_solve).count();
+  step.constraints.distribute(step.du);
+  if (!std::isfinite(step.du.l2_norm())) return "non-finite Newton update";
+  return std::nullopt;
+}
+
+AxisymmetricSolver::Failure AxisymmetricSolver::line_search(Step& step, const Iterate& x, double& alpha) {
+  // Backtracking: the first of alpha = 1, 1/2, 1/4, ... whose free residual
+  // falls enough (any admissible one while the punch gap closes), else the
+  // best admissible one.
+  double best_alpha = -1.0, best_free = std::numeric_limits<double>::infinity();
+  alpha = 1.0;
+  for (int h = 0; h <= settings_.max_line_search_halvings; ++h, alpha *= 0.5) {
+    step.trial = solution_;
+    step.trial.add(alpha, step.du);
+    if (!assemble(step.trial, false)) continue;
+    AffineConstraints<double> tc;
+    make_constraints(step.trial, tc);
+    const double trial_free = free_residual_norm(tc);
+    if (!std::isfinite(trial_free)) continue;
+    if (x.gap > 0.0 || trial_free < (1.0 - 1e-4 * alpha) * x.free || trial_free <= settings_.absolute_residual_floor_N)
+      return std::nullopt;
+    if (trial_free < best_free) {
+      best_free = trial_free;
+      best_alpha = alpha;
+    }
+  }
+  if (best_alpha < 0.0) return "line search: every trial state is inverted or non-finite";
+  alpha = best_alpha;
+  step.trial = solution_;
+  step.trial.add(alpha, step.du);
+  return std::nullopt;
+}
+
+AxisymmetricNewtonReport AxisymmetricSolver::accept_step(Step& step, const Iterate& x, int it) {
+  AxisymmetricNewtonReport& report = step.report;
+  report.accepted_at_stall = !x.strict;
+  report.table.push_back(x.line.str() +
+                         (x.strict ? "  converged" : "  converged (stalled below the acceptance tolerance)"));
+  if (settings_.verbose) std::cout << "      " << report.table.back() << std::endl;
+  report.converged = true;
+  report.iterations = it;
+  last_increment_ = solution_;
+  last_increment_ -= step.u_start;
+  commit();
+  update_penalties();
+  return report;
+}
+
+AxisymmetricNewtonReport AxisymmetricSolver::fail_step(Step& step, const std::string& why) {
+  solution_ = step.u_start;
+  punch_contact_ = step.punch_contact_start;
+  punch_lateral_hold_ = step.punch_hold_start;
+  cohesive_trial_ = cohesive_committed_;
+  friction_trial_ = friction_committed_;
+  assemble(solution_, true);
+  step.report.converged = false;
+  step.report.failure = why;
+  if (settings_.verbose) std::cout << "      newton failed: " << why << std::endl;
+  return step.report;
+}
+
+}  // namespace puncture::fem

@@ -1,0 +1,167 @@
+// slab_insertion_run.hpp (internal to puncture_fem): the 3D reference's insertion run
+// (SlabInsertionRun, needle_insertion.cc: the algorithm; slab_insertion_output.cc: what it
+// records and writes), with the node sets and rows it keeps.
+#pragma once
+
+#include <puncture/fem/needle_insertion.hpp>
+#include <deal.II/distributed/tria.h>
+#include <deal.II/base/mpi.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/grid/manifold_lib.h>
+#include <deal.II/grid/tria.h>
+#include <deal.II/numerics/vector_tools.h>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <puncture/fem/field_output.hpp>
+#include <puncture/fem/finite_strain_solver.hpp>
+#include "insertion_common.hpp"
+
+namespace puncture::fem::slab_insertion {
+
+using namespace dealii;
+using insertion::format_double;
+using insertion::LayerState;
+using Tria = parallel::distributed::Triangulation<3>;
+
+/// A node (support point) with its three displacement dofs.
+struct Node {
+  Point<3> X;
+  types::global_dof_index dof[3] = {0, 0, 0};
+  double r() const { return std::hypot(X[0], X[1]); }
+};
+
+struct Row {
+  double time_s, depth_m, velocity_m_per_s, force_N;
+  double tip_stretch;  ///< max principal stretch at the tip in the pressed layer (1: no contact)
+  std::vector<LayerState> states;
+};
+
+/// Element degree and global refinements of the 3D reference.
+struct SlabDiscretisation {
+  int degree;
+  int refinement;
+};
+
+/// What a sub-step started from: restored when it is undone to bisect toward
+/// a puncture (the contact set also when its solve fails).
+struct SubStepStart {
+  double depth_m;
+  double last_advance_m;
+  bool predictor_valid;
+  std::map<std::size_t, std::array<double, 2>> contact;
+  std::vector<LayerState> states;
+  FiniteStrainSolver::Snapshot snapshot;
+};
+
+/// The pressed layer's puncture criterion after a sub-step.
+struct PunctureCheck {
+  double force_N;
+  double stretch;
+  bool breaks;
+};
+
+/// The 3D insertion (flat punch, removal of a layer column at puncture): the
+/// slab and the solver, the contact set and the layer states, what is
+/// recorded, and the steps of the algorithm. Every rank runs it.
+class SlabInsertionRun {
+ public:
+  /// Checks the scene, creates the output directory, builds the slab, the
+  /// solver, the boundary conditions and the node sets.
+  SlabInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm);
+  /// Runs the insertion and writes the outputs (also when it fails).
+  FemRunSummary run();
+
+ private:
+  void advance_to(double step_target);
+  double next_trial_depth(double step_target, double increment) const;
+  SubStepStart sub_step_start() const;
+  double cut_sub_step(const SubStepStart& start, double trial_depth, double advance, const NewtonReport& report);
+  bool accept_sub_step(double trial_depth, double advance);
+  PunctureCheck check_puncture();
+  void undo_for_bisection(const SubStepStart& start);
+  void puncture_current_layer(double force, double stretch);
+  PunctureEvent record_before_puncture(std::size_t layer, double force, double stretch);
+  void open_hole(std::size_t layer);
+  void release_needle(std::size_t layer, double force);
+  void spring_back(const std::string& layer_name);
+  void record_after_puncture(std::size_t layer, PunctureEvent event);
+  void record_load_step(int step);
+  bool solve_at(double depth, NewtonReport& report, double predictor_scale);
+  void find_node_sets();
+  void describe_model();
+  double u_of(const Node& n, unsigned c) const { return solver_.displacement(n.dof[c]); }
+  bool any_contact() const;
+  void apply_targets(double z_tip);
+  bool join_reached_nodes(double z_tip);
+  double needle_force() const;
+  double tip_stretch(std::size_t layer) const;
+  insertion::SurfaceProfile surface_profile(std::size_t layer) const;
+  void record_row(double depth, double force, double stretch);
+  void write_frame(double depth);
+  void write_outputs(const std::string& status, const std::string& error);
+  std::string force_depth_csv() const;
+  nlohmann::json summary_json(const std::string& status, const std::string& error) const;
+  void log(const std::string& s) const {
+    if (root_ && options_.verbose) std::cout << s << std::endl;
+  }
+
+  // What the scene asks for.
+  const std::chrono::steady_clock::time_point wall_start_ = std::chrono::steady_clock::now();
+  const Scene& scene_;
+  const FemRunOptions& options_;
+  const MPI_Comm comm_;
+  const bool root_;
+  const SlabDiscretisation disc_;
+  const std::size_t n_layers_;
+  const double needle_radius_;
+  const double thickness_;
+  const double tol_;  // position tolerance (m)
+  const double speed_;
+  const double start_height_;
+  const double final_depth_;
+  const std::filesystem::path out_dir_;
+  // Slab and solver.
+  const std::unique_ptr<Tria> tria_;
+  const SolverSettings settings_;
+  FiniteStrainSolver solver_;
+  FemRunSummary summary_;
+  // Boundary conditions and node sets.
+  std::map<types::global_dof_index, double> fixed_;
+  std::vector<Node> nodes_;
+  std::vector<double> interface_z_;
+  // Per layer: every node of its top interface (profiles) and those under the needle.
+  std::vector<std::vector<std::size_t>> interface_nodes_, tip_nodes_;
+  // Contact and layer state.
+  std::map<std::size_t, std::array<double, 2>> contact_;  // joined node -> held lateral displacement
+  std::vector<LayerState> states_;
+  std::size_t current_layer_ = 0;  // first layer not punctured
+  bool solution_is_stale_ = true;  // the state differs from the last solved one
+  // Records.
+  insertion::InsertionRecords records_;
+  std::vector<Row> rows_;
+  std::unique_ptr<FieldOutputSeries> fields_;
+  // Load stepping.
+  const double load_step_;
+  // Puncture depths are located by bisection to within `resolution_`: a step
+  // after which the criterion holds is undone and halved until it is short.
+  const double resolution_;
+  const int n_steps_;
+  const int vtu_stride_;
+  double depth_;
+  int record_index_ = 0;
+  double last_advance_ = 0.0;     // depth change of the last converged step in contact
+  bool predictor_valid_ = false;  // that step pressed the current layer like the next one will
+  double crossing_upper_ = std::numeric_limits<double>::infinity();  // criterion known to hold here
+};
+
+}  // namespace puncture::fem::slab_insertion
