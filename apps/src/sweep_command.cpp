@@ -24,6 +24,7 @@
 //   5. accuracy_cost.csv, accuracy_cost.md (table + provenance), accuracy_cost.json,
 //      pareto.png (scripts/plot_sweep.py: error against time, log axes).
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -65,6 +66,98 @@ struct FemKnob {
 /// The default FEM part: what finishes in about a quarter of an hour on 2 cores.
 const std::vector<FemKnob> kFemKnobs{{0, 1}, {0, 2}, {1, 1}};
 
+/// One FEM setting's reference: the cached run, its curve and summary.
+struct FemResult {
+  FemKnob knob;
+  validation::FemReference ref;
+  validation::InsertionCurve curve;
+  nlohmann::json summary;
+};
+
+/// The FEM references at every FEM setting of the sweep (cached).
+std::vector<FemResult> fem_references(const Scene& scene, const SweepOptions& options, std::ostream& out,
+                                      const std::function<void(const std::string&)>& progress) {
+  const std::vector<FemKnob> knobs =
+      options.include_fem_knobs ? kFemKnobs : std::vector<FemKnob>{{scene.fem.refinement, scene.fem.element_degree}};
+  std::vector<FemResult> results;
+  for (const FemKnob& k : knobs) {
+    progress("FEM refinement " + std::to_string(k.refinement) + " Q" + std::to_string(k.degree));
+    validation::FemReferenceOptions fo;
+    if (!options.cache_dir.empty()) fo.cache_dir = options.cache_dir;
+    fo.refinement = k.refinement;
+    fo.degree = k.degree;
+    fo.write_vtu = false;
+    fo.verbose = !options.quiet;
+    FemResult r{k, validation::obtain_fem_reference(scene, fo, out), {}, {}};
+    r.curve = validation::read_insertion_curve(r.ref.dir / "fem_force_depth.csv");
+    r.summary = nlohmann::json::parse(io::read_text_file(r.ref.dir / "fem_summary.json"));
+    results.push_back(std::move(r));
+  }
+  return results;
+}
+
+std::string fem_name(const FemResult& r) {
+  return "FEM refinement " + std::to_string(r.knob.refinement) + " Q" + std::to_string(r.knob.degree) + ", " +
+         fmt(r.summary.value("n_dofs", 0.0), 10) + " DoFs";
+}
+
+/// One row per FEM setting against the finest.
+void add_fem_rows(const Scene& scene, const std::vector<FemResult>& fem, const FemResult& finest,
+                  std::vector<SweepRow>& rows) {
+  for (const FemResult& r : fem) {
+    SweepRow row;
+    row.model = "fem";
+    row.knob = "refinement_degree";
+    row.value = "r" + std::to_string(r.knob.refinement) + "_Q" + std::to_string(r.knob.degree);
+    row.baseline = r.knob.refinement == scene.fem.refinement && r.knob.degree == scene.fem.element_degree;
+    row.time_kind = "FEM wall time per load step";
+    row.n_dofs = r.summary.value("n_dofs", 0.0);
+    const double steps = r.summary.value("load_steps", 0.0);
+    row.time_per_step_s = steps > 0 ? r.summary.value("wall_time_s", 0.0) / steps : kNaN;
+    validation::fill_sweep_errors(row, r.curve, finest.curve);
+    rows.push_back(row);
+  }
+}
+
+/// accuracy_cost.csv, .json, the plots and accuracy_cost.md in dir.
+void write_sweep_outputs(const Scene& scene, const std::filesystem::path& scene_path, const std::filesystem::path& dir,
+                         const SweepOptions& options, const std::vector<SweepRow>& rows,
+                         const std::vector<FemResult>& fem, const FemResult& finest, std::ostream& out,
+                         std::ostream& err) {
+  std::string command_line = "puncture sweep " + scene_path.string() + " -o " + dir.string();
+  if (!options.include_fem_knobs) command_line += " --no-fem-knobs";
+  const io::Provenance provenance = io::make_provenance(command_line);
+  io::OutputSession session(dir);
+  session.write_text("accuracy_cost.csv", validation::sweep_table_csv(rows, provenance));
+  nlohmann::json j;
+  j["provenance"] = io::provenance_json(provenance);
+  j["scene"] = {{"name", scene.name}, {"file", scene_path.string()}};
+  j["reference"] = {{"description", fem_name(finest)}, {"hash", finest.ref.hash}};
+  j["cost"] = "real-time: time_per_step_s = mean and time_p99_s = 99th percentile of the tick wall time over the "
+              "ticks with contact (tip below the skin surface or a layer pressed); FEM: wall time per load step";
+  nlohmann::json fem_json = nlohmann::json::array();
+  for (const FemResult& r : fem) fem_json.push_back({{"hash", r.ref.hash}, {"summary", r.summary}});
+  j["fem_runs"] = fem_json;
+  session.write_text("accuracy_cost.json", j.dump(2) + "\n");
+  session.commit();
+  const std::vector<std::string> plots = validation::run_plot_script("plot_sweep.py", dir, out, err);
+  io::OutputSession md_session(dir);
+  md_session.write_text("accuracy_cost.md",
+                        validation::sweep_table_markdown(scene, rows, fem_name(finest), provenance, plots));
+  md_session.commit();
+}
+
+void print_sweep_table(const std::vector<SweepRow>& rows, const std::string& reference,
+                       const std::filesystem::path& dir, std::ostream& out) {
+  out << "\nAccuracy against cost (" << rows.size() << " variants; reference " << reference << ")\n";
+  for (const SweepRow& r : rows)
+    out << "  " << std::left << std::setw(9) << r.model << std::setw(18) << r.knob << std::setw(14) << r.value
+        << std::right << " force RMSE " << std::setw(10) << fmt(r.force_rmse_N, 4) << " N   depth error "
+        << std::setw(9) << fmt(r.puncture_depth_error_mm, 4) << " mm   step " << fmt(r.time_per_step_s, 4) << " s"
+        << (r.status == "ok" ? "" : "   " + r.status) << '\n';
+  out << "Table: " << (dir / "accuracy_cost.md").string() << '\n';
+}
+
 }  // namespace
 
 int sweep_command(const SweepOptions& options, std::ostream& stdout_stream, std::ostream& err) {
@@ -75,96 +168,27 @@ int sweep_command(const SweepOptions& options, std::ostream& stdout_stream, std:
     const Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_accuracy_cost") : options.output_dir;
-    auto progress = [&](const std::string& line) {
-      out << "[sweep] " << line << '\n' << std::flush;
-    };
-    std::vector<SweepRow> rows;
-
-    // 2. FEM settings; the finest (most DoFs) is the reference.
-    std::vector<FemKnob> fem_knobs = options.include_fem_knobs ? kFemKnobs
-                                                               : std::vector<FemKnob>{{scene.fem.refinement,
-                                                                                       scene.fem.element_degree}};
-    struct FemResult {
-      FemKnob knob;
-      validation::FemReference ref;
-      validation::InsertionCurve curve;
-      nlohmann::json summary;
-    };
-    std::vector<FemResult> fem_results;
-    for (const FemKnob& k : fem_knobs) {
-      progress("FEM refinement " + std::to_string(k.refinement) + " Q" + std::to_string(k.degree));
-      validation::FemReferenceOptions fo;
-      if (!options.cache_dir.empty()) fo.cache_dir = options.cache_dir;
-      fo.refinement = k.refinement;
-      fo.degree = k.degree;
-      fo.write_vtu = false;
-      fo.verbose = !options.quiet;
-      FemResult r{k, validation::obtain_fem_reference(scene, fo, out), {}, {}};
-      r.curve = validation::read_insertion_curve(r.ref.dir / "fem_force_depth.csv");
-      r.summary = nlohmann::json::parse(io::read_text_file(r.ref.dir / "fem_summary.json"));
-      fem_results.push_back(std::move(r));
-    }
+    auto progress = [&](const std::string& line) { out << "[sweep] " << line << '\n' << std::flush; };
+    // 1. FEM settings; the finest (most DoFs) is the reference.
+    const std::vector<FemResult> fem = fem_references(scene, options, out, progress);
     if (!validation::is_mpi_root()) return 0;  // the other ranks only help with the FEM
-    const auto finest_it = std::max_element(fem_results.begin(), fem_results.end(), [](const auto& a, const auto& b) {
+    const FemResult& finest = *std::max_element(fem.begin(), fem.end(), [](const auto& a, const auto& b) {
       return a.summary.value("n_dofs", 0.0) < b.summary.value("n_dofs", 0.0);
     });
-    const FemResult& finest = *finest_it;
-    const std::string finest_name = "FEM refinement " + std::to_string(finest.knob.refinement) + " Q" +
-                                    std::to_string(finest.knob.degree) + ", " +
-                                    fmt(finest.summary.value("n_dofs", 0.0), 10) + " DoFs";
-    progress("reference: finest " + finest_name);
-    for (const FemResult& r : fem_results) {
-      SweepRow row;
-      row.model = "fem";
-      row.knob = "refinement_degree";
-      row.value = "r" + std::to_string(r.knob.refinement) + "_Q" + std::to_string(r.knob.degree);
-      row.baseline = r.knob.refinement == scene.fem.refinement && r.knob.degree == scene.fem.element_degree;
-      row.time_kind = "FEM wall time per load step";
-      row.n_dofs = r.summary.value("n_dofs", 0.0);
-      const double steps = r.summary.value("load_steps", 0.0);
-      row.time_per_step_s = steps > 0 ? r.summary.value("wall_time_s", 0.0) / steps : kNaN;
-      validation::fill_sweep_errors(row, r.curve, finest.curve);
-      rows.push_back(row);
-    }
-
-    // 3. Real-time knobs, one at a time.
-    const validation::InsertionCurve& reference = finest.curve;
-    for (SweepRow& row : validation::sweep_realtime_knobs(scene, reference, [&](const std::string& knob, const std::string& value) {
+    progress("reference: finest " + fem_name(finest));
+    std::vector<SweepRow> rows;
+    add_fem_rows(scene, fem, finest, rows);
+    // 2. Real-time knobs, one at a time, against the finest FEM.
+    for (SweepRow& row : validation::sweep_realtime_knobs(scene, finest.curve, [&](const std::string& knob,
+                                                                                   const std::string& value) {
            progress("real-time " + knob + " = " + value);
          })) {
       if (row.status != "ok") out << "[sweep]   " << row.status << '\n';
       rows.push_back(std::move(row));
     }
-
-    // 5. Outputs.
-    std::string command_line = "puncture sweep " + scene_path.string() + " -o " + dir.string();
-    if (!options.include_fem_knobs) command_line += " --no-fem-knobs";
-    const io::Provenance provenance = io::make_provenance(command_line);
-    io::OutputSession session(dir);
-    session.write_text("accuracy_cost.csv", validation::sweep_table_csv(rows, provenance));
-    nlohmann::json j;
-    j["provenance"] = io::provenance_json(provenance);
-    j["scene"] = {{"name", scene.name}, {"file", scene_path.string()}};
-    j["reference"] = {{"description", finest_name}, {"hash", finest.ref.hash}};
-    j["cost"] = "real-time: time_per_step_s = mean and time_p99_s = 99th percentile of the tick wall time over the "
-                "ticks with contact (tip below the skin surface or a layer pressed); FEM: wall time per load step";
-    nlohmann::json fem_json = nlohmann::json::array();
-    for (const FemResult& r : fem_results) fem_json.push_back({{"hash", r.ref.hash}, {"summary", r.summary}});
-    j["fem_runs"] = fem_json;
-    session.write_text("accuracy_cost.json", j.dump(2) + "\n");
-    session.commit();
-    const std::vector<std::string> plots = validation::run_plot_script("plot_sweep.py", dir, out, err);
-    io::OutputSession md_session(dir);
-    md_session.write_text("accuracy_cost.md", validation::sweep_table_markdown(scene, rows, finest_name, provenance, plots));
-    md_session.commit();
-
-    out << "\nAccuracy against cost (" << rows.size() << " variants; reference " << finest_name << ")\n";
-    for (const SweepRow& r : rows)
-      out << "  " << std::left << std::setw(9) << r.model << std::setw(18) << r.knob << std::setw(14) << r.value
-          << std::right << " force RMSE " << std::setw(10) << fmt(r.force_rmse_N, 4) << " N   depth error "
-          << std::setw(9) << fmt(r.puncture_depth_error_mm, 4) << " mm   step " << fmt(r.time_per_step_s, 4) << " s"
-          << (r.status == "ok" ? "" : "   " + r.status) << '\n';
-    out << "Table: " << (dir / "accuracy_cost.md").string() << '\n';
+    // 3. Outputs.
+    write_sweep_outputs(scene, scene_path, dir, options, rows, fem, finest, out, err);
+    print_sweep_table(rows, fem_name(finest), dir, out);
     return 0;
   });
 }
