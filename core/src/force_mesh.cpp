@@ -56,9 +56,11 @@ SparseMatrix free_stiffness(const HexLattice& lat, double K, double ks, double d
 
 }  // namespace
 
-ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact, const ForceMeshParams& params,
-                     double layer_thickness_m, double density_kg_per_m3, const MeshIntegrationSettings& settings)
-    : params_(params), settings_(settings), lattice_(make_hex_lattice(params.rings_w)) {
+namespace {
+
+/// The constructor's argument checks (std::invalid_argument naming the value).
+void check_mesh_arguments(const ForceMeshParams& params, double layer_thickness_m, double density_kg_per_m3,
+                          const MeshIntegrationSettings& settings) {
   require_positive(params.virtual_stiffness_N_per_m, "virtual_stiffness_N_per_m (K)");
   require_positive(params.spacing_L_m, "spacing_L_m (L)");
   require_positive(params.deformed_threshold_m, "deformed_threshold_m");
@@ -76,12 +78,15 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
     throw std::invalid_argument("force mesh: surface_axial_stiffness_N_per_m must be >= 0 and finite");
   if (!(params.virtual_stiffening_m >= 0.0) || !std::isfinite(params.virtual_stiffening_m))
     throw std::invalid_argument("force mesh: virtual_stiffening_m must be >= 0 and finite");
+}
 
+}  // namespace
+
+ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact, const ForceMeshParams& params,
+                     double layer_thickness_m, double density_kg_per_m3, const MeshIntegrationSettings& settings)
+    : params_(params), settings_(settings), lattice_(make_hex_lattice(params.rings_w)) {
+  check_mesh_arguments(params, layer_thickness_m, density_kg_per_m3, settings);
   const int n = lattice_.node_count();
-  const int nf = n - 1;
-  const double K = params.virtual_stiffness_N_per_m;
-  const double ks = params.surface_stiffness_N_per_m;
-  const double c = params.node_damping_N_s_per_m;
   const double L = params.spacing_L_m;
   mass_kg_ = density_kg_per_m3 * layer_thickness_m * 0.5 * std::sqrt(3.0) * L * L;
 
@@ -94,14 +99,30 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   v_.setZero(n);
   pz_.setZero(n);
   pv_.setZero(n);
-  rhs_.setZero(nf);
-  work_.setZero(nf);
+  rhs_.setZero(n - 1);
+  work_.setZero(n - 1);
   ring_mean_m_.setZero(params.rings_w);
   ring_size_.setZero(params.rings_w);
   for (int i = 0; i < n; ++i) ring_size_[lattice_.ring[i] - 1] += 1.0;
 
-  // --- unit-deflection influence vector: K_ff u_f = b ---
-  influence_.setZero(n);
+  compute_static_influence();
+  choose_integration();
+  if (nonlinear_) {
+    setup_nonlinear();
+    update_derived();
+    return;
+  }
+  if (use_implicit_ && n > 1) factor_implicit_system();
+  compute_unit_step_response();
+  update_derived();
+}
+
+void ForceMesh::compute_static_influence() {
+  // Unit-deflection influence vector: K_ff u_f = b.
+  const int nf = lattice_.node_count() - 1;
+  const double K = params_.virtual_stiffness_N_per_m;
+  const double ks = params_.surface_stiffness_N_per_m;
+  influence_.setZero(nf + 1);
   influence_[0] = 1.0;
   if (nf > 0) {
     Eigen::VectorXd b = Eigen::VectorXd::Zero(nf);
@@ -115,8 +136,14 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   static_stiffness_N_per_m_ = K;
   for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
     static_stiffness_N_per_m_ += ks * (1.0 - influence_[lattice_.neighbours[k]]);
+}
 
-  // --- explicit stability: Gershgorin bound on omega_max^2 ---
+void ForceMesh::choose_integration() {
+  // Explicit stability: Gershgorin bound on omega_max^2.
+  const int n = lattice_.node_count();
+  const double K = params_.virtual_stiffness_N_per_m;
+  const double ks = params_.surface_stiffness_N_per_m;
+  const double c = params_.node_damping_N_s_per_m;
   int max_degree = 0;
   for (int i = 1; i < n; ++i) max_degree = std::max(max_degree, lattice_.neighbour_count(i));
   omega_max_sq_ = (K + 2.0 * ks * max_degree) / mass_kg_;
@@ -124,43 +151,44 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   // Root of omega^2 dt^2 + 2 (c/m) dt = 4 (Jury condition of the damped symplectic Euler step).
   dt_crit_s_ = (-cm + std::sqrt(cm * cm + 4.0 * omega_max_sq_)) / omega_max_sq_;
   if (c > 0.0) dt_crit_s_ = std::min(dt_crit_s_, 2.0 / cm);
-  const double dt = settings.time_step_s;
-  const double substeps_needed = std::ceil(dt / (settings.explicit_safety * dt_crit_s_));
-  substeps_ = static_cast<int>(std::min<double>(std::max(1.0, substeps_needed), settings.max_explicit_substeps + 1.0));
-  explicit_fallback_ = substeps_needed > settings.max_explicit_substeps;
+  const double dt = settings_.time_step_s;
+  const double substeps_needed = std::ceil(dt / (settings_.explicit_safety * dt_crit_s_));
+  substeps_ = static_cast<int>(std::min<double>(std::max(1.0, substeps_needed), settings_.max_explicit_substeps + 1.0));
+  explicit_fallback_ = substeps_needed > settings_.max_explicit_substeps;
+  nonlinear_ = params_.nonlinear();
+  if (nonlinear_ && settings_.integrator == MeshIntegrator::Explicit) explicit_fallback_ = true;  // see the header
+  use_implicit_ = settings_.integrator == MeshIntegrator::Implicit ||
+                  (settings_.integrator == MeshIntegrator::Explicit && explicit_fallback_);
+}
 
-  nonlinear_ = params.nonlinear();
-  if (nonlinear_ && settings.integrator == MeshIntegrator::Explicit) explicit_fallback_ = true;  // see the header
-  use_implicit_ = settings.integrator == MeshIntegrator::Implicit ||
-                  (settings.integrator == MeshIntegrator::Explicit && explicit_fallback_);
-  if (nonlinear_) {
-    setup_nonlinear();
-    update_derived();
-    return;
+void ForceMesh::factor_implicit_system() {
+  const int nf = lattice_.node_count() - 1;
+  const double dt = settings_.time_step_s;
+  const double c = params_.node_damping_N_s_per_m;
+  const double shift = mass_kg_ / (dt * dt) + c / dt;
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt(
+      free_stiffness(lattice_, params_.virtual_stiffness_N_per_m, params_.surface_stiffness_N_per_m, shift));
+  if (ldlt.info() != Eigen::Success)
+    throw std::runtime_error("force mesh: implicit system matrix could not be factorised");
+  // Copy the factors into plain arrays so that a step is allocation-free.
+  // Strictly below the (unit) diagonal, column by column in row order.
+  SparseMatrix Lm = ldlt.matrixL();
+  Lm.makeCompressed();
+  l_col_start_.assign(1, 0);
+  l_row_.clear();
+  l_val_.clear();
+  for (int j = 0; j < nf; ++j) {
+    for (SparseMatrix::InnerIterator it(Lm, j); it; ++it)
+      if (it.row() > j) l_row_.push_back(static_cast<int>(it.row())), l_val_.push_back(it.value());
+    l_col_start_.push_back(static_cast<int>(l_row_.size()));
   }
-  if (use_implicit_ && nf > 0) {
-    const double shift = mass_kg_ / (dt * dt) + c / dt;
-    Eigen::SimplicialLDLT<SparseMatrix> ldlt(free_stiffness(lattice_, K, ks, shift));
-    if (ldlt.info() != Eigen::Success)
-      throw std::runtime_error("force mesh: implicit system matrix could not be factorised");
-    // Copy the factors into plain arrays so that a step is allocation-free.
-    // Strictly below the (unit) diagonal, column by column in row order.
-    SparseMatrix Lm = ldlt.matrixL();
-    Lm.makeCompressed();
-    l_col_start_.assign(1, 0);
-    l_row_.clear();
-    l_val_.clear();
-    for (int j = 0; j < nf; ++j) {
-      for (SparseMatrix::InnerIterator it(Lm, j); it; ++it)
-        if (it.row() > j) l_row_.push_back(static_cast<int>(it.row())), l_val_.push_back(it.value());
-      l_col_start_.push_back(static_cast<int>(l_row_.size()));
-    }
-    d_inv_ = ldlt.vectorD().cwiseInverse();
-    perm_.resize(nf);
-    for (int k = 0; k < nf; ++k) perm_[k] = ldlt.permutationP().indices()[k];
-  }
+  d_inv_ = ldlt.vectorD().cwiseInverse();
+  perm_.resize(nf);
+  for (int k = 0; k < nf; ++k) perm_[k] = ldlt.permutationP().indices()[k];
+}
 
-  // --- unit response of one step: z0 = 0 -> 1 from rest (the step is affine in z0) ---
+void ForceMesh::compute_unit_step_response() {
+  // One step from rest with z0 = 0 -> 1 (the step is affine in z0).
   step_free_nodes(0.0, 1.0);
   qz_ = z_;
   qv_ = v_;
@@ -168,10 +196,9 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   qv_[0] = 0.0;
   z_.setZero();
   v_.setZero();
-  reaction_slope_N_per_m_ = K;
+  reaction_slope_N_per_m_ = params_.virtual_stiffness_N_per_m;
   for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
-    reaction_slope_N_per_m_ += ks * (1.0 - qz_[lattice_.neighbours[k]]);
-  update_derived();
+    reaction_slope_N_per_m_ += params_.surface_stiffness_N_per_m * (1.0 - qz_[lattice_.neighbours[k]]);
 }
 
 void ForceMesh::set_frame(const SurfacePoint& contact) {

@@ -262,6 +262,13 @@ class ForceMesh {
   void step_free_nodes(double z0_old, double z0_new);
   // --- stiffening mesh ---
   void setup_nonlinear();
+  // The constructor's phases (linear mesh): the static influence vector and
+  // stiffness; explicit stability, substeps and the integrator; the implicit
+  // system's LDLT factors in plain arrays; the unit response of one step.
+  void compute_static_influence();
+  void choose_integration();
+  void factor_implicit_system();
+  void compute_unit_step_response();
   void predict_linear();
   /// predict() of a stiffening mesh: the step solved at contact deflection z0_star and linearised there.
   void predict_nonlinear(double z0_star);
