@@ -82,9 +82,10 @@ void StageObjective::record(const double* x, double f) {
   std::lock_guard<std::mutex> lock(mutex_);
   ++evaluations_;
   if (in_.total_evaluations) ++*in_.total_evaluations;
-  if (f < best_) {
+  const std::vector<double> candidate(x, x + parameters.size());
+  if (better(f, candidate)) {
     best_ = f;
-    best_x_.assign(x, x + parameters.size());
+    best_x_ = candidate;
   }
   if (in_.progress && *in_.progress)
     (*in_.progress)(CalibrationProgress{in_.total_evaluations ? *in_.total_evaluations : evaluations_, best_, f, name_});
@@ -92,7 +93,14 @@ void StageObjective::record(const double* x, double f) {
 
 void StageObjective::offer(const std::vector<double>& x, double f) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (f < best_) best_ = f, best_x_ = x;
+  if (better(f, x)) best_ = f, best_x_ = x;
+}
+
+bool StageObjective::better(double f, const std::vector<double>& x) const {
+  // Equal objectives (a parameter the objective does not see) are decided by
+  // the smaller x, not by which thread recorded first: the best point does
+  // not depend on the order of parallel evaluations.
+  return f < best_ || (f == best_ && !best_x_.empty() && x < best_x_);
 }
 
 bool StageObjective::set_layout(const std::vector<double>& x) {

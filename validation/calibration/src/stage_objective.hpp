@@ -73,6 +73,9 @@ class StageObjective {
   void offer(const std::vector<double>& x, double f);
 
  private:
+  /// True if (f, x) beats the best so far: a lower f, or the same f at a
+  /// lexicographically smaller x (call under mutex_, as record and offer do).
+  bool better(double f, const std::vector<double>& x) const;
   StageInputs in_;
   std::string name_;
   std::vector<std::vector<std::pair<std::string, std::size_t>>> layout_;  ///< per reference: term label, residual count
