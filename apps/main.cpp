@@ -180,6 +180,13 @@ CLI::App* add_compare(CLI::App& app, CommandLine& c) {
   compare_cmd->add_option("--identify", c.compare.identify, "Identify the mass-spring stiffnesses: simulated_annealing,isres")
       ->delimiter(',');
   compare_cmd->add_option("--identify-evaluations", c.compare.identify_evaluations, "Model runs per identification (40)");
+  compare_cmd->add_option("--cases", c.compare.cases,
+                          "Judge every model, identified on the scene's trajectory, on these held-out cases "
+                          "(e.g. validation/cases/default_heldout.json)");
+  compare_cmd->add_flag("--scene-parameters", c.compare.scene_parameters,
+                        "No identification against the FEM: the scene's moduli and breakthrough rules");
+  compare_cmd->add_flag("--critical-forces-only", c.compare.critical_forces_only,
+                        "Identify the layers' critical forces only, not their stiffness factors");
   compare_cmd->add_option("--frames", c.compare.frames, "ParaView frames per model (20; 0: none)");
   compare_cmd->add_flag("--no-vtk", [&c](std::int64_t) { c.compare.write_vtk = false; }, "No VTK output");
   compare_cmd->add_flag("-q,--quiet", c.compare.quiet, "No progress output");

@@ -12,10 +12,13 @@
 //   1. check the options; load the scene and the Delphi weights file;
 //   2. obtain the FEM reference (cache or solve; MPI ranks other than 0 stop
 //      after it);
-//   3. write_model_comparison: the CGAL mesh if a volumetric model needs it,
-//      every model run, the optional mass-spring identification, metrics
-//      against the FEM, grading and the report files;
-//   4. one summary line per model on `out`.
+//   3. with --cases, the FEM reference of every case (the scene with the
+//      case's overrides);
+//   4. write_model_comparison: the tetrahedral mesh if a volumetric model
+//      needs it, every model's critical forces identified against the FEM,
+//      every model run, the optional mass-spring identification, the held-out
+//      cases, metrics against the FEM, grading and the report files;
+//   5. one summary line per model on `out`.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -26,10 +29,12 @@
 #include "command_errors.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/comparison/model_factory.hpp"
+#include "puncture/io/atomic_file.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/comparison_report.hpp"
 #include "puncture/validation/fem_reference.hpp"
 #include "puncture/validation/number_format.hpp"
+#include "puncture/validation/validation_cases.hpp"
 
 namespace puncture::apps {
 
@@ -65,6 +70,32 @@ void check_options(const CompareOptions& options, const std::vector<std::string>
   if (options.frames < 0) throw std::invalid_argument("--frames must be >= 0");
 }
 
+/// --cases: each case's FEM reference (the scene with the case's overrides;
+/// cache or solve). Every case is checked before the first FEM runs.
+std::vector<validation::ComparisonCase> case_references(const std::filesystem::path& scene_path,
+                                                        const std::filesystem::path& cases_path,
+                                                        const validation::FemReferenceOptions& fem_options,
+                                                        std::ostream& out) {
+  validation::ValidationCases cases;
+  std::vector<Scene> scenes;
+  try {
+    cases = validation::read_validation_cases(cases_path);
+    const std::string scene_text = io::read_text_file(scene_path);
+    for (const validation::ValidationCase& c : cases.cases)
+      scenes.push_back(validation::case_scene(scene_text, scene_path.string(), c).scene);
+  } catch (const std::invalid_argument& e) {  // SceneError is a runtime_error: it passes through
+    throw InputError(e.what());
+  }
+  std::vector<validation::ComparisonCase> references;
+  for (std::size_t i = 0; i < cases.cases.size(); ++i) {
+    out << "[compare] FEM reference of case " << i + 1 << "/" << cases.cases.size() << ": " << cases.cases[i].name
+        << "\n" << std::flush;
+    const validation::FemReference fem = validation::obtain_fem_reference(scenes[i], fem_options, out);
+    references.push_back({cases.cases[i], {fem.dir, fem.hash, fem.from_cache}});
+  }
+  return references;
+}
+
 /// The command as given: every option that changes the outputs (provenance).
 std::string compare_command_line(const CompareOptions& options, const std::filesystem::path& scene_path,
                                  const std::filesystem::path& dir) {
@@ -76,6 +107,9 @@ std::string compare_command_line(const CompareOptions& options, const std::files
   if (!options.identify.empty())
     command_line += " --identify " + joined(options.identify, ",") + " --identify-evaluations " +
                     std::to_string(options.identify_evaluations);
+  if (options.scene_parameters) command_line += " --scene-parameters";
+  if (options.critical_forces_only) command_line += " --critical-forces-only";
+  if (!options.cases.empty()) command_line += " --cases " + options.cases.string();
   if (options.frames != CompareOptions{}.frames) command_line += " --frames " + std::to_string(options.frames);
   if (!options.write_vtk) command_line += " --no-vtk";
   return command_line;
@@ -90,6 +124,13 @@ void print_summary(const validation::ComparisonOutcome& outcome, const CompareOp
         << std::setw(8) << shown(outcome.metrics[i].force_rmse_relative) << " of the FEM peak, step p99 "
         << std::setw(9) << shown(outcome.metrics[i].step_time_p99_s * 1e3) << " ms, score "
         << shown(outcome.grade.final_scores[i]) << " (rank " << outcome.grade.rank[i] << ")\n";
+  if (!outcome.heldout_metrics.empty()) {
+    out << "Ranking on the held-out cases:\n";
+    for (std::size_t i = 0; i < outcome.heldout_metrics.size(); ++i)
+      out << "  " << std::left << std::setw(26) << outcome.heldout_metrics[i].model << std::right << " force RMSE "
+          << std::setw(8) << shown(outcome.heldout_metrics[i].force_rmse_relative) << " of the FEM peak, score "
+          << shown(outcome.heldout_grade.final_scores[i]) << " (rank " << outcome.heldout_grade.rank[i] << ")\n";
+  }
   out << "Outputs in " << dir.string() << "/ (comparison.md, comparison.csv, ranking.csv"
       << (options.write_vtk ? ", comparison.pvd" : "") << ")\n";
 }
@@ -118,10 +159,16 @@ int compare_command(const CompareOptions& options, std::ostream& out, std::ostre
     if (!options.cache_dir.empty()) fem_options.cache_dir = options.cache_dir;
     fem_options.verbose = !options.quiet;
     const validation::FemReference reference = validation::obtain_fem_reference(scene, fem_options, out);
+    if (!options.cases.empty()) {
+      report.cases = case_references(scene_path, options.cases, fem_options, out);
+      report.cases_file = options.cases.string();
+    }
     if (!validation::is_mpi_root()) return 0;
 
     report.identify = options.identify;
     report.identify_evaluations = options.identify_evaluations;
+    report.identify_models = !options.scene_parameters;
+    report.identify_stiffness = !options.critical_forces_only;
     report.frames = options.frames;
     report.write_vtk = options.write_vtk;
     report.quiet = options.quiet;

@@ -301,6 +301,7 @@ ComparisonSettings read_comparison(ObjectReader r, const std::string& file) {
   ComparisonSettings c;
   if (r.has("mesh")) {
     ObjectReader m(r.raw("mesh"), r.child("mesh"), file);
+    c.mesh.kind = m.string("kind", c.mesh.kind);
     c.mesh.size_at_axis_m = m.number("size_at_axis_mm", c.mesh.size_at_axis_m / kMm) * kMm;
     c.mesh.size_far_m = m.number("size_far_mm", c.mesh.size_far_m / kMm) * kMm;
     c.mesh.grading = m.number("grading", c.mesh.grading);
@@ -316,6 +317,11 @@ ComparisonSettings read_comparison(ObjectReader r, const std::string& file) {
     c.prony_g = number_list(v, "prony_g");
     c.prony_tau_s = number_list(v, "prony_tau_s");
     v.reject_unknown_keys();
+  }
+  if (r.has("stiffness_scale")) c.stiffness_scale = number_list(r, "stiffness_scale");
+  if (r.has("prescribed_puncture_depths_mm")) {
+    c.prescribed_puncture_depths_m = number_list(r, "prescribed_puncture_depths_mm");
+    for (double& d : c.prescribed_puncture_depths_m) d *= kMm;
   }
   if (r.has("mass_spring_stiffness_scale")) c.mass_spring_stiffness_scale = number_list(r, "mass_spring_stiffness_scale");
   r.reject_unknown_keys();

@@ -283,6 +283,8 @@ void validate_haptics(const Haptics& h, const std::string& file) {
 /// The comparison models' mesh, integrator and identified stiffness scales.
 void validate_comparison(const Scene& s, const std::string& file) {
   const ComparisonSettings& c = s.comparison;
+  if (c.mesh.kind != "extruded" && c.mesh.kind != "delaunay")
+    throw SceneError(file, "/comparison/mesh/kind", "unknown mesh kind '" + c.mesh.kind + "' (known: extruded, delaunay)");
   require(c.mesh.size_at_axis_m > 0, file, "/comparison/mesh/size_at_axis_mm", "> 0", c.mesh.size_at_axis_m / kMm);
   require(c.mesh.size_far_m >= c.mesh.size_at_axis_m, file, "/comparison/mesh/size_far_mm", ">= size_at_axis_mm",
           c.mesh.size_far_m / kMm);
@@ -303,6 +305,20 @@ void validate_comparison(const Scene& s, const std::string& file) {
     require(c.prony_tau_s[i] > 0, file, "/comparison/viscoelastic/prony_tau_s/" + std::to_string(i), "> 0",
             c.prony_tau_s[i]);
   }
+  if (!c.stiffness_scale.empty() && c.stiffness_scale.size() != s.layers.size())
+    throw SceneError(file, "/comparison/stiffness_scale",
+                     "must have one entry per layer (" + std::to_string(s.layers.size()) + ")");
+  for (std::size_t i = 0; i < c.stiffness_scale.size(); ++i)
+    require(c.stiffness_scale[i] > 0 && std::isfinite(c.stiffness_scale[i]), file,
+            "/comparison/stiffness_scale/" + std::to_string(i), "> 0", c.stiffness_scale[i]);
+  if (c.prescribed_puncture_depths_m.size() > s.layers.size())
+    throw SceneError(file, "/comparison/prescribed_puncture_depths_mm",
+                     "must have at most one entry per layer (" + std::to_string(s.layers.size()) + ")");
+  for (std::size_t i = 0; i < c.prescribed_puncture_depths_m.size(); ++i)
+    require(c.prescribed_puncture_depths_m[i] > 0 && std::isfinite(c.prescribed_puncture_depths_m[i]) &&
+                (i == 0 || c.prescribed_puncture_depths_m[i] >= c.prescribed_puncture_depths_m[i - 1]),
+            file, "/comparison/prescribed_puncture_depths_mm/" + std::to_string(i), "> 0 and not decreasing",
+            c.prescribed_puncture_depths_m[i] / kMm);
   if (!c.mass_spring_stiffness_scale.empty() && c.mass_spring_stiffness_scale.size() != s.layers.size())
     throw SceneError(file, "/comparison/mass_spring_stiffness_scale",
                      "must have one entry per layer (" + std::to_string(s.layers.size()) + ")");

@@ -142,7 +142,8 @@ json effects_json(const Effects& e) {
 
 json comparison_json(const ComparisonSettings& c) {
   json comparison = {{"mesh",
-                      {{"size_at_axis_mm", c.mesh.size_at_axis_m / kMm},
+                      {{"kind", c.mesh.kind},
+                       {"size_at_axis_mm", c.mesh.size_at_axis_m / kMm},
                        {"size_far_mm", c.mesh.size_far_m / kMm},
                        {"grading", c.mesh.grading}}},
                      {"integrator", c.integrator},
@@ -151,6 +152,12 @@ json comparison_json(const ComparisonSettings& c) {
                      {"mass_damping_per_s", c.mass_damping_per_s},
                      {"stiffness_damping_s", c.stiffness_damping_s},
                      {"viscoelastic", {{"prony_g", c.prony_g}, {"prony_tau_s", c.prony_tau_s}}}};
+  if (!c.stiffness_scale.empty()) comparison["stiffness_scale"] = c.stiffness_scale;
+  if (!c.prescribed_puncture_depths_m.empty()) {
+    std::vector<double> mm;
+    for (double d : c.prescribed_puncture_depths_m) mm.push_back(d / kMm);
+    comparison["prescribed_puncture_depths_mm"] = mm;
+  }
   if (!c.mass_spring_stiffness_scale.empty()) comparison["mass_spring_stiffness_scale"] = c.mass_spring_stiffness_scale;
   return comparison;
 }

@@ -169,6 +169,9 @@ TEST(CompareCommand, TableRankingCurvesAndSeriesOnASmallSlab) {
   options.output_dir = dir / "out";
   options.cache_dir = dir / "cache";
   options.models = {"realtime", "shf", "bem", "mass_tensor", "fem"};
+  // The scene's own moduli and rules (identified, the linear models would fit
+  // the piecewise linear synthetic reference exactly: no error to recompute).
+  options.scene_parameters = true;
   options.frames = 2;
   options.quiet = true;
   std::ostringstream out, err;
@@ -246,6 +249,83 @@ TEST(CompareCommand, TableRankingCurvesAndSeriesOnASmallSlab) {
   EXPECT_NE(text.str().find("no cutting/friction columns"), std::string::npos);
   EXPECT_NE(text.str().find("Ranking"), std::string::npos);
   fs::remove_all(dir);
+}
+
+/// The column `name` of every data row of a CSV file (header first, '#' lines skipped).
+std::vector<std::string> csv_column(const fs::path& file, const std::string& name, std::vector<std::string>* first = nullptr) {
+  std::ifstream in(file);
+  std::string line;
+  std::vector<std::string> columns, values;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> fields;
+    std::istringstream s(line);
+    std::string f;
+    while (std::getline(s, f, ',')) fields.push_back(f);
+    if (columns.empty()) {
+      columns = fields;
+      continue;
+    }
+    const std::size_t c = static_cast<std::size_t>(std::find(columns.begin(), columns.end(), name) - columns.begin());
+    values.push_back(c < fields.size() ? fields[c] : "");
+    if (first) first->push_back(fields[0]);
+  }
+  return values;
+}
+
+TEST(CompareCommand, ModelsBreakWhereTheFemDoesAndAreJudgedOnHeldOutCases) {
+  // Every comparison model's critical forces are identified on the scene's
+  // trajectory: the synthetic FEM breaks the skin at 1.2 mm and the fat at
+  // 2.5 mm, so every model does (within a step of needle travel, 10 um); then
+  // every model, unchanged, runs a held-out case (3 mm/s) against that case's
+  // FEM, and the ranking of comparison.md is the held-out one.
+  const fs::path dir = fresh_dir("compare_heldout");
+  const Scene scene = small_scene();
+  const fs::path scene_file = dir / "small.json";
+  std::ofstream(scene_file) << scene_to_json_text(scene);
+  write_synthetic_reference(load_scene(scene_file), dir / "cache");
+  Scene slow = load_scene(scene_file);
+  slow.insertion.speed_m_per_s = 3e-3;
+  write_synthetic_reference(slow, dir / "cache");
+  const fs::path cases_file = dir / "cases.json";
+  std::ofstream(cases_file) << R"({"description": "test", "cases": [{"name": "calibration", "overrides": {}},
+      {"name": "slow", "overrides": {"insertion": {"speed_mm_per_s": 3.0}}}]})";
+  CompareOptions options;
+  options.scene = scene_file;
+  options.output_dir = dir / "out";
+  options.cache_dir = dir / "cache";
+  options.models = {"realtime", "shf", "bem", "mass_tensor", "fem"};
+  options.cases = cases_file;
+  options.frames = 0;
+  options.write_vtk = false;
+  options.quiet = true;
+  std::ostringstream out, err;
+  ASSERT_EQ(compare_command(options, out, err), 0) << err.str();
+  std::vector<std::string> models;
+  const std::vector<std::string> skin = csv_column(options.output_dir / "comparison.csv", "skin_puncture_mm", &models);
+  const std::vector<std::string> fat = csv_column(options.output_dir / "comparison.csv", "fat_puncture_mm");
+  ASSERT_EQ(models.size(), 5u);
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    if (models[i] == "realtime" || models[i] == "fem") continue;  // the real-time model keeps its own rules
+    EXPECT_NEAR(std::stod(skin[i]), 1.2, 0.011) << models[i];
+    EXPECT_NEAR(std::stod(fat[i]), 2.5, 0.011) << models[i];
+    EXPECT_TRUE(fs::exists(options.output_dir / "identified" / (models[i] + ".json"))) << models[i];
+    const Scene identified = load_scene(options.output_dir / "identified" / (models[i] + ".json"));
+    EXPECT_EQ(identified.layers[0].force_law.breakthrough.kind, BreakthroughCriterion::Kind::CriticalForce);
+  }
+  // Held out: one row per model (not the FEM) for the one held-out case.
+  std::vector<std::string> heldout_cases;
+  const std::vector<std::string> heldout_models =
+      csv_column(options.output_dir / "heldout.csv", "model", &heldout_cases);
+  EXPECT_EQ(heldout_models, (std::vector<std::string>{"realtime", "shf", "bem", "mass_tensor"}));
+  for (const std::string& c : heldout_cases) EXPECT_EQ(c, "slow");
+  EXPECT_TRUE(fs::exists(options.output_dir / "ranking_heldout.csv"));
+  std::ifstream md(options.output_dir / "comparison.md");
+  std::stringstream text;
+  text << md.rdbuf();
+  EXPECT_NE(text.str().find("## Ranking on the held-out cases"), std::string::npos);
+  EXPECT_NE(text.str().find("## Every model identified against the FEM"), std::string::npos);
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 
 TEST(CompareCommand, BadInputFailsCleanly) {

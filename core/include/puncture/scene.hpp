@@ -301,10 +301,13 @@ struct Haptics {
   double device_max_stiffness_N_per_m = 1020.0;  ///< largest stiffness the device renders (data sheet)
 };
 
-/// Tetrahedral mesh of the slab for the comparison models (meshing/tet):
+/// Tetrahedral mesh of the slab for the comparison models (meshing/):
 /// the target edge length grows from size_at_axis at the needle radius by
 /// `grading` per unit radial distance, up to size_far.
 struct ComparisonMeshSettings {
+  /// "extruded": plan triangulation extruded through the layers
+  /// (extruded_tet_slab_mesh.hpp); "delaunay": CGAL Mesh_3 (tet_slab_mesh.hpp).
+  std::string kind = "extruded";
   double size_at_axis_m = 1.0e-3;  ///< tetrahedron size at the needle
   double size_far_m = 8e-3;        ///< largest tetrahedron size, far from the axis
   double grading = 0.5;            ///< growth of the size per metre of distance from the needle radius
@@ -326,6 +329,15 @@ struct ComparisonSettings {
   /// Per layer factor on the mass-spring stiffnesses (empty: all 1); set by
   /// the parameter identification against the FEM.
   std::vector<double> mass_spring_stiffness_scale;
+  /// Per layer factor on the Young's modulus every continuum comparison model
+  /// (SHF, BEM, mass-spring, tensor-mass) reads (empty: all 1); set by
+  /// `puncture compare`'s identification against the FEM.
+  std::vector<double> stiffness_scale;
+  /// Per layer from the top (fewer entries: the rest by their rules): the
+  /// comparison models break layer k when the tip reaches this depth (m),
+  /// whatever its rule; replays a reference's punctures (the identification
+  /// of `puncture compare` uses it). Empty: every layer by its rule.
+  std::vector<double> prescribed_puncture_depths_m;
 };
 
 struct Scene {

@@ -14,8 +14,12 @@ namespace puncture::comparison {
 
 std::vector<LayerElasticity> layer_elasticity(const Scene& scene) {
   std::vector<LayerElasticity> out;
-  for (const Layer& l : scene.layers)
-    out.push_back({l.material.youngs_modulus_Pa, l.material.poisson_ratio, l.density_kg_per_m3});
+  const std::vector<double>& scale = scene.comparison.stiffness_scale;
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    const Layer& l = scene.layers[k];
+    const double s = k < scale.size() ? scale[k] : 1.0;
+    out.push_back({s * l.material.youngs_modulus_Pa, l.material.poisson_ratio, l.density_kg_per_m3});
+  }
   return out;
 }
 

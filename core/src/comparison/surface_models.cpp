@@ -24,9 +24,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 LinearSurfaceModel::LinearSurfaceModel(const Scene& scene) : scene_(&scene) {
   for (std::size_t k = 0; k < scene.layers.size(); ++k)
-    layers_.push_back(LayerRuntime{scene.layer_top_depth_m(k), 0.0,
-                                   RingBreakthroughCriterion(scene.layers[k].force_mesh), {}, LayerState::Untouched,
-                                   false, 0.0, 0.0});
+    layers_.push_back(LayerRuntime{scene.layer_top_depth_m(k), 0.0, LayerBreakthroughRule::of(scene, k), {},
+                                   LayerState::Untouched, false, 0.0, 0.0});
 }
 
 void LinearSurfaceModel::finish_setup(const std::vector<double>& stiffness) {
@@ -36,7 +35,7 @@ void LinearSurfaceModel::finish_setup(const std::vector<double>& stiffness) {
     if (!(stiffness[k] > 0.0) || !std::isfinite(stiffness[k]))
       throw std::runtime_error(name() + ": non-positive stiffness for layer \"" + scene_->layers[k].name + "\"");
     std::map<double, double> by_radius;  // the lattice repeats every radius six times
-    for (double r : layer.criterion.point_radii_m()) {
+    for (double r : layer.breakthrough.rings().point_radii_m()) {
       const double key = std::round(r * 1e12) / 1e12;
       auto it = by_radius.find(key);
       if (it == by_radius.end()) it = by_radius.emplace(key, unit_deflection(k, r)).first;
@@ -56,12 +55,18 @@ double LinearSurfaceModel::step(const NeedleState& needle) {
       layer.contact_started = true;
       layer.contact_depth_m = contact;
       layer.state = LayerState::Pressed;
+      layer.breakthrough.start(contact);
     }
     layer.indentation_m = std::max(0.0, depth - layer.contact_depth_m);
-    std::vector<double> deflection(layer.ring_unit_deflection.size());
-    for (std::size_t i = 0; i < deflection.size(); ++i)
-      deflection[i] = layer.indentation_m * layer.ring_unit_deflection[i];
-    if (!layer.criterion.broken(deflection)) return layer.stiffness_N_per_m * layer.indentation_m;
+    const double force = layer.stiffness_N_per_m * layer.indentation_m;
+    layer.breakthrough.advance(depth, force);
+    std::vector<double> deflection;
+    if (layer.breakthrough.needs_deflection()) {
+      deflection.resize(layer.ring_unit_deflection.size());
+      for (std::size_t i = 0; i < deflection.size(); ++i)
+        deflection[i] = layer.indentation_m * layer.ring_unit_deflection[i];
+    }
+    if (needle.axial_velocity_m_per_s < 0.0 || !layer.breakthrough.broken(force, deflection)) return force;
     layer.state = LayerState::Punctured;
     layer.indentation_m = 0.0;
     activation_depth_m_ = depth;

@@ -126,14 +126,14 @@ VolumetricNeedleModel::VolumetricNeedleModel(const Scene& scene, std::shared_ptr
     for (int i = 0; i < 4; ++i) in_layer[static_cast<std::size_t>(mesh_->layer[t])][mesh_->tets[t][i]] = 1;
   for (int k = 0; k < n_layers; ++k) {
     const double top = -scene.layer_top_depth_m(static_cast<std::size_t>(k));
-    RingBreakthroughCriterion criterion(scene.layers[static_cast<std::size_t>(k)].force_mesh);
-    LayerSurfaceProbe probe(*mesh_, k, top, criterion.points_m());
+    const LayerBreakthroughRule breakthrough = LayerBreakthroughRule::of(scene, static_cast<std::size_t>(k));
+    LayerSurfaceProbe probe(*mesh_, k, top, breakthrough.rings().points_m());
     for (std::size_t i = 0; i < probe.size(); ++i)
       if (!probe.found(i))
         throw std::invalid_argument("VolumetricNeedleModel: ring point " + std::to_string(i) + " of layer \"" +
                                     scene.layers[static_cast<std::size_t>(k)].name +
                                     "\" is not on the layer's top face of the mesh");
-    layers_.push_back(LayerRuntime{top, {}, LayerState::Untouched, false, criterion, probe, {}});
+    layers_.push_back(LayerRuntime{top, {}, LayerState::Untouched, false, breakthrough, probe, {}});
     for (int a = 0; a < nodes_; ++a) {
       const Eigen::Vector3d p = mesh_->points_m.col(a);
       if (in_layer[static_cast<std::size_t>(k)][static_cast<std::size_t>(a)] &&
@@ -175,13 +175,16 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
   }
   while (active_ < layers_.size()) {
     LayerRuntime& layer = layers_[active_];
+    bool started_now = false;
     for (int a : layer.candidates) {
       if (dof_[static_cast<std::size_t>(a)] != Dof::Free) continue;
       if (y_[3 * a + 2] < z_tip) continue;  // the tip has not reached this node
       if (!layer.contact_started) {
+        started_now = true;
         layer.baseline_m = layer.ring_probe.deflection_m(y_, mesh_->points_m);
         layer.contact_started = true;
         layer.state = LayerState::Pressed;
+        layer.breakthrough.start(-z_tip);
       }
       snap = std::max(snap, y_[3 * a + 2] - z_tip);
       y_[3 * a + 2] = z_tip;
@@ -189,10 +192,18 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
       dof_[static_cast<std::size_t>(a)] = Dof::Contact;
       changed = true;
     }
-    if (!layer.contact_started || withdrawing) break;  // layers break only while the needle advances
-    std::vector<double> deflection = layer.ring_probe.deflection_m(y_, mesh_->points_m);
-    for (std::size_t i = 0; i < deflection.size(); ++i) deflection[i] -= layer.baseline_m[i];
-    if (!layer.criterion.broken(deflection)) break;
+    // Layers break only while the needle advances, and not on the step their
+    // contact starts: a surface put onto the tip from above is brought to
+    // equilibrium below first (its force before that is the snap's).
+    if (!layer.contact_started || withdrawing || started_now) break;
+    std::vector<double> deflection;
+    if (layer.breakthrough.needs_deflection()) {
+      deflection = layer.ring_probe.deflection_m(y_, mesh_->points_m);
+      for (std::size_t i = 0; i < deflection.size(); ++i) deflection[i] -= layer.baseline_m[i];
+    }
+    const double force = layer.breakthrough.needs_force() ? contact_force_N() : 0.0;
+    layer.breakthrough.advance(-z_tip, force);
+    if (!layer.breakthrough.broken(force, deflection)) break;
     puncture_active_layer();
     changed = true;
   }

@@ -174,3 +174,65 @@ TEST(SphericalHarmonicModel, HigherDegreeLocalisesTheDeformation) {
 
 }  // namespace
 }  // namespace puncture::comparison
+
+namespace puncture::comparison {
+namespace {
+
+/// Depth of the first step at which layer k is punctured (-1 if never), and
+/// the force on the step before.
+struct FirstPuncture {
+  double depth_m = -1.0;
+  double force_before_N = 0.0;
+};
+FirstPuncture first_puncture(LinearSurfaceModel& model, const Scene& scene, std::size_t k) {
+  ScriptedTrajectory trajectory(scene.insertion);
+  FirstPuncture p;
+  double last_force = 0.0;
+  for (double t = 0.0; t < trajectory.insertion_end_s(); t += 1e-3) {
+    const NeedleState needle = trajectory.sample(t);
+    const double force = model.step(needle);
+    if (model.layer_state(k) == LayerState::Punctured) {
+      p.depth_m = needle.depth_m();
+      p.force_before_N = last_force;
+      return p;
+    }
+    last_force = force;
+  }
+  return p;
+}
+
+TEST(BoundaryElementModel, BreaksAtTheLayersCriticalForce) {
+  // Linear layer: F = S (depth - contact); with a critical force F_c the skin
+  // breaks on the first step with S (depth - 0) >= F_c, i.e. at
+  // depth = F_c / S (+ at most one step of needle travel, 10 um). F_c: the
+  // force at 4 mm of the BEM's stiffness (checked against Sneddon above).
+  Scene scene = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json");
+  const double S = BoundaryElementModel(scene).stiffness_N_per_m(0);
+  const double critical = S * 4e-3;
+  scene.layers[0].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+  scene.layers[0].force_law.breakthrough.critical_force_N = critical;
+  BoundaryElementModel bem(scene);
+  const FirstPuncture p = first_puncture(bem, scene, 0);
+  ASSERT_GT(p.depth_m, 0.0);
+  EXPECT_GE(p.depth_m, critical / S - 1e-12);
+  EXPECT_LE(p.depth_m, critical / S + 1.1e-5);
+  EXPECT_LT(p.force_before_N, critical);
+}
+
+TEST(BoundaryElementModel, BreaksAtTheLayersCriticalWork) {
+  // The work of F = S z from contact to z is S z^2 / 2 (the trapezoidal rule
+  // is exact for a linear force): the skin breaks at z = sqrt(2 W_c / S).
+  Scene scene = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json");
+  scene.layers[0].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalEnergy;
+  const double S = BoundaryElementModel(scene).stiffness_N_per_m(0);
+  const double critical = 0.5 * S * 4e-3 * 4e-3;  // the work at 4 mm
+  scene.layers[0].force_law.breakthrough.critical_energy_J = critical;
+  BoundaryElementModel bem(scene);
+  const double z = std::sqrt(2.0 * critical / S);
+  const FirstPuncture p = first_puncture(bem, scene, 0);
+  EXPECT_GE(p.depth_m, z - 1e-12);
+  EXPECT_LE(p.depth_m, z + 1.1e-5);
+}
+
+}  // namespace
+}  // namespace puncture::comparison

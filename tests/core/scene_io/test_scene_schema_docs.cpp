@@ -47,6 +47,8 @@ Scene scene_with_every_block() {
   l.material.ogden_terms = {{0.5, 10.0}, {0.5, 2.0}};
   l.material.viscoelastic.terms = {{0.3, 1.0}};
   s.comparison.mass_spring_stiffness_scale.assign(s.layers.size(), 1.0);
+  s.comparison.stiffness_scale.assign(s.layers.size(), 1.0);
+  s.comparison.prescribed_puncture_depths_m = {1e-3};
   s.comparison.prony_g = {0.2};
   s.comparison.prony_tau_s = {1.0};
   return s;

@@ -61,7 +61,8 @@ std::vector<json> perturbations(const std::string& pointer, const json& v) {
         {"model", {"neo_hookean", "mooney_rivlin", "veronda_westmann", "ogden"}},
         {"geometry", {"3d", "auto", "axisymmetric"}},
         {"integrator", {"explicit", "quasi_static", "implicit", "sundials"}},
-        {"modulus", {"long_term", "instantaneous"}}};
+        {"modulus", {"long_term", "instantaneous"}},
+        {"kind", {"extruded", "delaunay"}}};
     const auto c = choices.find(key);
     if (c != choices.end()) {
       for (const std::string& s : c->second)

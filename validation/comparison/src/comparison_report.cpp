@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "comparison_heldout.hpp"
 #include "comparison_runs.hpp"
 #include "comparison_tables.hpp"
 #include "puncture/io/provenance.hpp"
@@ -24,8 +25,13 @@ ComparisonOutcome write_model_comparison(const Scene& scene, const DelphiWeights
   const ComparisonMesh mesh = build_comparison_mesh(scene, options, session, out);
 
   ComparisonRunner runner(scene, options, reference, mesh.mesh, session, out, err);
-  for (const std::string& key : options.models)
-    if (key != "fem") runner.run(key, scene, key);
+  for (const std::string& key : options.models) {
+    if (key == "fem") continue;
+    // The real-time model is the scene's (`puncture calibrate` tunes it);
+    // every other model is identified against the FEM first.
+    const bool identify = options.identify_models && key != "realtime";
+    runner.run(key, identify ? runner.identify_model(key) : scene, key);
+  }
   nlohmann::json identification = nlohmann::json::array();
   for (const std::string& method : options.identify) identification.push_back(runner.identify(method));
 
@@ -35,12 +41,27 @@ ComparisonOutcome write_model_comparison(const Scene& scene, const DelphiWeights
   session.write_text("comparison.csv", comparison_csv(scene, rows));
   session.write_text("fem_curve.csv", insertion_curve_csv(reference.fem.curve));
   session.write_text("deflection_profiles.csv", deflection_profiles_csv(reference.data, runs));
-  ComparisonOutcome outcome{rows.metrics, grade_models(rows.metrics, weights), reference.data.has_shaft_forces};
+  ComparisonOutcome outcome;
+  outcome.metrics = rows.metrics;
+  outcome.grade = grade_models(rows.metrics, weights);
+  outcome.has_shaft_forces = reference.data.has_shaft_forces;
   session.write_text("ranking.csv", ranking_csv(outcome.grade));
+
+  // Held out: every model as identified above, on the cases' trajectories and slabs.
+  const std::vector<HeldOutRow> heldout = run_heldout_cases(scene, runner.model_scenes(), options, out, err);
+  if (!heldout.empty()) {
+    session.write_text("heldout.csv", heldout_csv(scene, heldout));
+    outcome.heldout_metrics = aggregate_heldout(heldout, options.models);
+    if (with_fem_row) outcome.heldout_metrics.push_back(rows.metrics.back());  // the reference: no error by definition
+    outcome.heldout_grade = grade_models(outcome.heldout_metrics, weights);
+    session.write_text("ranking_heldout.csv", ranking_csv(outcome.heldout_grade));
+  }
   const double wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - options.wall_start).count();
-  const ComparisonContent content{scene, options, fem, reference, mesh, provenance,
-                                  runs, identification, rows, outcome.grade, weights, wall_time_s};
+  const ComparisonContent content{scene,         options, fem,     reference,      mesh,
+                                  provenance,    runs,    identification, runner.identification_records(),
+                                  rows,          outcome.grade, heldout, outcome,  weights,
+                                  wall_time_s};
   session.write_text("comparison_summary.json", summary_json(content).dump(2) + "\n");
   if (!runner.pvd().empty()) io::write_pvd(session, "comparison.pvd", runner.pvd());
   session.commit();

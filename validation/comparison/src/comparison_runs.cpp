@@ -11,6 +11,8 @@
 #include "comparison_tables.hpp"
 #include "puncture/comparison/model_factory.hpp"
 #include "puncture/needle.hpp"
+#include "puncture/scene_io.hpp"
+#include "puncture/validation/model_identification.hpp"
 #include "puncture/validation/mass_spring_identification.hpp"
 
 namespace puncture::validation::comparison_report_detail {
@@ -84,9 +86,9 @@ ComparisonMesh build_comparison_mesh(const Scene& scene, const ComparisonReportO
                       std::any_of(options.models.begin(), options.models.end(),
                                   [](const std::string& key) { return comparison::is_volumetric_model(key); });
   if (!needed) return m;
-  if (!options.quiet) out << "[compare] CGAL tetrahedral mesh of the slab ...\n" << std::flush;
-  auto mesh = std::make_shared<comparison::TetMesh>(
-      meshing::build_tet_slab_mesh(scene, meshing::tet_slab_mesh_options(scene), &m.report));
+  if (!options.quiet)
+    out << "[compare] tetrahedral mesh of the slab (" << scene.comparison.mesh.kind << ") ...\n" << std::flush;
+  auto mesh = std::make_shared<comparison::TetMesh>(meshing::build_comparison_tet_mesh(scene, &m.report));
   if (!options.quiet)
     out << "[compare] mesh: " << m.report.vertices << " vertices, " << m.report.tetrahedra << " tetrahedra in "
         << shown(m.report.wall_time_s) << " s; " << comparison::describe(m.report.quality) << "\n";
@@ -158,6 +160,7 @@ void ComparisonRunner::run(const std::string& key, const Scene& model_scene, con
          << (run->integrator_report.empty() ? "" : "; " + run->integrator_report) << "\n";
   session_.write_text("curves/" + key + ".csv", curve_csv(model_scene, *run, reference_.data.has_shaft_forces));
   runs_.push_back(std::move(run));
+  if (key == factory_name) model_scenes_.insert_or_assign(key, model_scene);
 }
 
 nlohmann::json ComparisonRunner::identify(const std::string& method) {
@@ -165,17 +168,56 @@ nlohmann::json ComparisonRunner::identify(const std::string& method) {
   id_options.method = method;
   id_options.max_evaluations = options_.identify_evaluations;
   if (!options_.quiet) out_ << "[compare] identifying the mass-spring stiffnesses by " << method << " ...\n" << std::flush;
+  // From the msm row's scene (its identified moduli and critical forces) when it was run.
+  const auto msm = model_scenes_.find("msm");
+  const Scene& base = msm != model_scenes_.end() ? msm->second : scene_;
   const IdentificationResult r = identify_mass_spring_stiffness(
-      scene_, mesh_, reference_.data, id_options, [&](int evaluation, double objective, double best) {
+      base, mesh_, reference_.data, id_options, [&](int evaluation, double objective, double best) {
         if (!options_.quiet)
           out_ << "[identify " << method << "] evaluation " << evaluation << ": objective " << shown(objective, 4)
                << " (best " << shown(best, 4) << ")\n" << std::flush;
       });
   nlohmann::json record = identification_record(method, r, id_options.step_m);
-  Scene identified = scene_;
+  Scene identified = base;
   identified.comparison.mass_spring_stiffness_scale = r.scale_after;
   run(std::string("msm_") + (method == "isres" ? "isres" : "sa"), identified, "msm");
   return record;
+}
+
+Scene ComparisonRunner::identify_model(const std::string& key) {
+  if (!options_.quiet) out_ << "[compare] " << key << ": identifying against the FEM ...\n" << std::flush;
+  const ModelIdentification id = identify_comparison_model(
+      key, scene_, comparison::is_volumetric_model(key) ? mesh_ : nullptr, reference_.data,
+      options_.identify_stiffness, [&](const LayerIdentification& l) {
+        if (!options_.quiet)
+          out_ << "[compare] " << key << ": " << l.layer << " stiffness x " << shown(l.stiffness_scale, 4)
+               << ", breaks at " << shown(l.critical_force_N, 4) << " N\n" << std::flush;
+      });
+  nlohmann::json layers = nlohmann::json::array();
+  for (const LayerIdentification& l : id.layers) {
+    nlohmann::json j = {{"layer", l.layer}, {"identified", l.identified}};
+    if (std::isfinite(l.reference_depth_m)) j["reference_depth_mm"] = l.reference_depth_m / kMm;
+    if (l.identified) {
+      j["stiffness_scale"] = l.stiffness_scale;
+      j["critical_force_N"] = l.critical_force_N;
+      j["window_samples"] = l.window_samples;
+      if (std::isfinite(l.window_rmse_before_N)) j["window_rmse_before_N"] = l.window_rmse_before_N;
+      if (std::isfinite(l.window_rmse_after_N)) j["window_rmse_after_N"] = l.window_rmse_after_N;
+    }
+    if (!l.note.empty()) j["note"] = l.note;
+    layers.push_back(j);
+  }
+  identification_records_[key] = {{"layers", layers},
+                                  {"stiffness_identified", id.stiffness_identified},
+                                  {"model_runs", id.model_runs},
+                                  {"wall_time_s", id.wall_time_s}};
+  Scene identified = with_identified_parameters(scene_, id);
+  identified.name = scene_.name + "_" + key + "_identified";
+  identified.description = "The scene of `puncture compare` with model " + key +
+                           "'s layer stiffness factors and critical contact forces identified against the FEM "
+                           "reference on this scene's trajectory (model_identification.hpp).";
+  session_.write_text("identified/" + key + ".json", scene_to_json_text(identified));
+  return identified;
 }
 
 ComparisonRows comparison_rows(const Scene& scene, const std::vector<std::unique_ptr<ModelRun>>& runs,

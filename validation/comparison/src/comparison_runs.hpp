@@ -5,10 +5,11 @@
 //   reference of the metrics (curve, the skin's u_z(r) profiles; whether the
 //   curve has cutting/friction columns, then totals are compared) and the
 //   depths (m, > 0) and radii (m) at which every model records the skin.
-// build_comparison_mesh: the CGAL tetrahedral mesh of the slab when a
+// build_comparison_mesh: the tetrahedral mesh of the slab (scene.comparison.mesh.kind) when a
 //   volumetric model or an identification needs it (else an empty mesh);
 //   mesh.vtu with write_vtk.
-// ComparisonRunner: builds and runs each model along the scripted insertion
+// ComparisonRunner: identifies a model's stiffness factors and critical forces (identify_model),
+//   builds and runs each model along the scripted insertion
 //   (one haptic step at a time), writes curves/<key>.csv and, with frames,
 //   frames/<key>/... and their .pvd entries (each model shifted along x by
 //   1.25 sample diameters per model); identify() runs one mass-spring
@@ -20,6 +21,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <ostream>
 #include <string>
@@ -31,7 +33,7 @@
 #include "puncture/comparison/tet_mesh.hpp"
 #include "puncture/io/output_session.hpp"
 #include "puncture/io/pvd.hpp"
-#include "puncture/meshing/tet_slab_mesh.hpp"
+#include "puncture/meshing/comparison_tet_slab_mesh.hpp"
 #include "puncture/validation/comparison_report.hpp"
 #include "puncture/validation/fem_comparison.hpp"
 #include "puncture/validation/model_comparison.hpp"
@@ -48,7 +50,7 @@ ComparisonReference read_comparison_reference(const Scene& scene, const std::fil
 
 struct ComparisonMesh {
   std::shared_ptr<const comparison::TetMesh> mesh;  ///< null: no model needs one
-  meshing::TetSlabMeshReport report;
+  meshing::ComparisonTetMeshReport report;
 };
 ComparisonMesh build_comparison_mesh(const Scene& scene, const ComparisonReportOptions& options,
                                      io::OutputSession& session, std::ostream& out);
@@ -62,6 +64,14 @@ class ComparisonRunner {
   void run(const std::string& key, const Scene& model_scene, const std::string& factory_name);
   /// One identification (method: simulated_annealing or isres) and the run of its result.
   nlohmann::json identify(const std::string& method);
+  /// The scene of model `key` with its layers' stiffness factors and
+  /// critical forces identified against the reference
+  /// (model_identification.hpp), also written to identified/<key>.json; the
+  /// record goes to identification_records().
+  Scene identify_model(const std::string& key);
+  const nlohmann::json& identification_records() const { return identification_records_; }
+  /// The scene each run model was built on (key -> scene).
+  const std::map<std::string, Scene>& model_scenes() const { return model_scenes_; }
 
   std::vector<std::unique_ptr<ModelRun>>& runs() { return runs_; }
   const std::vector<io::PvdEntry>& pvd() const { return pvd_; }
@@ -81,6 +91,8 @@ class ComparisonRunner {
   int next_part_ = 0;  ///< .pvd part index of the next model's first dataset
   std::vector<io::PvdEntry> pvd_;
   std::vector<std::unique_ptr<ModelRun>> runs_;
+  nlohmann::json identification_records_ = nlohmann::json::object();
+  std::map<std::string, Scene> model_scenes_;
 };
 
 /// The rows of comparison.csv, ranking.csv and the tables of comparison.md.

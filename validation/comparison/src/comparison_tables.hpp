@@ -22,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "comparison_heldout.hpp"
 #include "comparison_runs.hpp"
 #include "puncture/scene.hpp"
 #include "puncture/validation/comparison_grading.hpp"
@@ -49,8 +50,11 @@ struct ComparisonContent {
   const nlohmann::json& provenance;
   const std::vector<std::unique_ptr<ModelRun>>& runs;
   const nlohmann::json& identification;  ///< array of identification_record
+  const nlohmann::json& model_identification;  ///< per model: its identified stiffness factors and critical forces
   const ComparisonRows& rows;
   const ComparisonGrade& grade;
+  const std::vector<HeldOutRow>& heldout;  ///< empty without held-out cases
+  const ComparisonOutcome& outcome;        ///< heldout_metrics, heldout_grade
   const DelphiWeights& weights;
   double wall_time_s;
 };

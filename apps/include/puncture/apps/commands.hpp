@@ -154,6 +154,9 @@ struct CompareOptions {
   std::vector<std::string> models;    ///< empty: all (realtime, shf, msm, mass_tensor, nonlinear_mass_tensor, viscoelastic_mass_tensor, bem, fem)
   std::vector<std::string> identify;  ///< mass-spring identification methods: simulated_annealing, isres
   int identify_evaluations = 40;      ///< model runs per identification
+  bool scene_parameters = false;      ///< true: no identification (the scene's moduli and breakthrough rules)
+  bool critical_forces_only = false;  ///< identify the critical forces only (no stiffness factors)
+  std::filesystem::path cases;        ///< held-out cases file (validation_cases.hpp); empty: none
   int frames = 20;                    ///< ParaView frames per model over the trajectory (0: none)
   bool write_vtk = true;
   bool quiet = false;

@@ -14,8 +14,11 @@
 // Needle contact and puncture follow the scene rules of the real-time model
 // (simulator.hpp): only the first unpunctured layer is pressed; its contact
 // starts when the tip reaches its top surface (or where the tip is, if it is
-// already deeper); it breaks when its surface deflection, measured from that
-// moment, deforms ring w of the force-mesh lattice (ring_criterion.hpp).
+// already deeper); it breaks by the layer's breakthrough rule of the scene, as
+// the real-time model's does (layer_breakthrough.hpp): a critical contact
+// force, a critical work of the needle on the layer, or the paper's ring rule
+// (its surface deflection, measured from the contact, deforms ring w of the
+// force-mesh lattice, ring_criterion.hpp).
 #pragma once
 
 #include <cstddef>
@@ -73,7 +76,8 @@ class ComparisonModel {
 };
 
 /// Small-strain moduli and density of every scene layer (for the continuum
-/// comparison models): the layer's material E and nu (Pa), density (kg/m^3).
+/// comparison models): the layer's material E (Pa) times its
+/// comparison.stiffness_scale (1 when empty), nu, density (kg/m^3).
 std::vector<LayerElasticity> layer_elasticity(const Scene& scene);
 
 }  // namespace puncture::comparison

@@ -43,7 +43,7 @@
 
 #include "puncture/comparison/comparison_model.hpp"
 #include "puncture/comparison/layered_half_space.hpp"
-#include "puncture/comparison/ring_criterion.hpp"
+#include "puncture/comparison/layer_breakthrough.hpp"
 #include "puncture/sh/layer_surface.hpp"
 
 namespace puncture::comparison {
@@ -68,7 +68,7 @@ class LinearSurfaceModel : public ComparisonModel {
   struct LayerRuntime {
     double top_depth_m = 0.0;
     double stiffness_N_per_m = 0.0;
-    RingBreakthroughCriterion criterion;
+    LayerBreakthroughRule breakthrough;
     std::vector<double> ring_unit_deflection;
     LayerState state = LayerState::Untouched;
     bool contact_started = false;

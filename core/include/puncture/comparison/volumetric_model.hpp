@@ -22,11 +22,14 @@
 //     internal force on them (N, positive resisting insertion);
 //   * during withdrawal a contact node whose reaction turns to tension is
 //     released (no adhesion);
-//   * breakthrough: the ring-w rule (ring_criterion.hpp) on the deflection of
-//     the active layer's top surface at the force-mesh lattice points, measured
-//     from the moment the needle first touched the layer, checked while the
-//     needle advances (as the force mesh, whose deflections only shrink when
-//     the needle is withdrawn). The layer's
+//   * breakthrough: the layer's rule of the scene (layer_breakthrough.hpp):
+//     a critical contact force, a critical work of the needle on the layer, or
+//     the ring-w rule (ring_criterion.hpp) on the deflection of the active
+//     layer's top surface at the force-mesh lattice points, measured from the
+//     moment the needle first touched the layer; checked while the needle
+//     advances (as the force mesh, whose deflections only shrink when the
+//     needle is withdrawn), from the step after the contact started (a
+//     surface put onto the tip is first brought to equilibrium). The layer's
 //     needle-column tetrahedra (TetMesh::needle_column) are then removed (the
 //     cut), its contact nodes released (the surface springs back) and the
 //     next layer becomes active (it may be touched in the same step). When the
@@ -68,7 +71,7 @@
 #include "puncture/comparison/block_sparse.hpp"
 #include "puncture/comparison/comparison_model.hpp"
 #include "puncture/comparison/internal_forces.hpp"
-#include "puncture/comparison/ring_criterion.hpp"
+#include "puncture/comparison/layer_breakthrough.hpp"
 #include "puncture/comparison/sundials_integrator.hpp"
 #include "puncture/comparison/tet_mesh.hpp"
 
@@ -142,7 +145,7 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
     std::vector<int> candidates;  ///< top-surface nodes with rest r <= needle radius
     LayerState state = LayerState::Untouched;
     bool contact_started = false;
-    RingBreakthroughCriterion criterion;
+    LayerBreakthroughRule breakthrough;
     LayerSurfaceProbe ring_probe;
     std::vector<double> baseline_m;  ///< ring-point deflections when the contact started
   };

@@ -39,6 +39,7 @@
 #include "puncture/scene.hpp"
 #include "puncture/validation/comparison_grading.hpp"
 #include "puncture/validation/model_comparison.hpp"
+#include "puncture/validation/validation_cases.hpp"
 
 namespace puncture::validation {
 
@@ -49,6 +50,14 @@ struct ComparisonFemReference {
   bool from_cache = false;    ///< taken from the cache (else computed for this run)
 };
 
+/// A case on which every model, identified once on the scene's trajectory, is
+/// judged without retuning: the case (validation_cases.hpp) and the FEM
+/// reference of the scene with the case's overrides.
+struct ComparisonCase {
+  ValidationCase validation_case;
+  ComparisonFemReference fem;
+};
+
 struct ComparisonReportOptions {
   /// Model keys in table order: comparison::comparison_model_names() and/or
   /// "fem" (the FEM's own row, last). Checked by the caller.
@@ -57,6 +66,17 @@ struct ComparisonReportOptions {
   /// each giving an extra row msm_sa / msm_isres.
   std::vector<std::string> identify;
   int identify_evaluations = 40;  ///< model runs per identification
+  /// Every model but the real-time one (calibrated by `puncture calibrate`)
+  /// gets its layers' stiffness factors (identify_stiffness) and critical
+  /// contact forces identified against the FEM on the scene's trajectory
+  /// (model_identification.hpp); false: the scene's values and rules.
+  bool identify_models = true;
+  bool identify_stiffness = true;
+  /// Held-out cases (empty: none): every model is run on each and measured
+  /// against the case's FEM; heldout.csv, ranking_heldout.csv, and the
+  /// ranking of comparison.md reads the held-out metrics.
+  std::vector<ComparisonCase> cases;
+  std::string cases_file;  ///< recorded in the summary
   int frames = 20;                ///< ParaView frames per model over the trajectory (0: none)
   bool write_vtk = true;          ///< mesh.vtu, frames, comparison.pvd
   bool quiet = false;             ///< no progress lines on `out`
@@ -70,6 +90,9 @@ struct ComparisonReportOptions {
 struct ComparisonOutcome {
   std::vector<ModelMetrics> metrics;  ///< one per row of comparison.csv
   ComparisonGrade grade;              ///< scores and ranks in the same order
+  /// With held-out cases: one row per model over them (aggregate) and their grade.
+  std::vector<ModelMetrics> heldout_metrics;
+  ComparisonGrade heldout_grade;
   bool has_shaft_forces = false;      ///< the total force was compared (else the contact force)
 };
 

@@ -1,0 +1,66 @@
+// layer_breakthrough.hpp: when a comparison model's layer breaks, by the rule
+// the scene gives that layer for the real-time model
+// (Layer::force_law.breakthrough, scene.hpp), so every model punctures by the
+// same kind of criterion:
+//   Rings          the paper's ring-w rule on the surface deflection at the
+//                  force-mesh lattice points (ring_criterion.hpp);
+//   CriticalForce  the model's contact force on the needle (N, positive
+//                  resisting insertion) reaches critical_force_N;
+//   CriticalEnergy the work the needle has done on the layer since its
+//                  contact started, W = integral of F dz over the tip's
+//                  advance (trapezoidal rule over the model's steps, J),
+//                  reaches critical_energy_J (a continuum model's elastic
+//                  energy and damping losses; the force mesh's is its stored
+//                  energy).
+// A depth prescribed for the layer (ComparisonSettings::
+// prescribed_puncture_depths_m) overrides the rule: the layer breaks when the
+// tip reaches it. Checked only while the needle advances (as the force mesh's
+// rule).
+// In: the layer, then per step the tip depth (m) and the contact force (N);
+// the ring deflections (m, into the tissue, from the contact) only for Rings.
+#pragma once
+
+#include <vector>
+
+#include "puncture/comparison/ring_criterion.hpp"
+#include "puncture/scene.hpp"
+
+namespace puncture::comparison {
+
+class LayerBreakthroughRule {
+ public:
+  /// prescribed_depth_m: the depth at which the layer breaks whatever its rule (<= 0: none).
+  explicit LayerBreakthroughRule(const Layer& layer, double prescribed_depth_m = 0.0);
+  /// The rule of layer k of the scene (with its prescribed depth, if any).
+  static LayerBreakthroughRule of(const Scene& scene, std::size_t layer);
+
+  BreakthroughCriterion::Kind kind() const { return kind_; }
+  /// True for the ring rule, which needs the deflections at rings().points_m().
+  bool needs_deflection() const { return kind_ == BreakthroughCriterion::Kind::Rings && !(prescribed_depth_m_ > 0.0); }
+  /// True when the rule reads the contact force (or its work) passed to advance().
+  bool needs_force() const { return !needs_deflection() && !(prescribed_depth_m_ > 0.0); }
+  const RingBreakthroughCriterion& rings() const { return rings_; }
+
+  /// The needle's contact with the layer starts at this tip depth (m).
+  void start(double depth_m);
+  /// One model step (every step while the layer is pressed): the tip depth
+  /// (m) and the contact force (N; 0 when !needs_force()); books the work.
+  void advance(double depth_m, double force_N);
+  /// Work done on the layer since start (J).
+  double work_J() const { return work_J_; }
+  /// Whether the layer breaks with this contact force (N) and, for Rings,
+  /// ring deflections (m).
+  bool broken(double force_N, const std::vector<double>& ring_deflection_m = {}) const;
+
+ private:
+  BreakthroughCriterion::Kind kind_;
+  double critical_force_N_ = 0.0;
+  double critical_energy_J_ = 0.0;
+  double prescribed_depth_m_ = 0.0;
+  RingBreakthroughCriterion rings_;
+  double last_depth_m_ = 0.0;
+  double last_force_N_ = 0.0;
+  double work_J_ = 0.0;
+};
+
+}  // namespace puncture::comparison

@@ -1,0 +1,48 @@
+// layer_breakthrough.cpp: the scene's breakthrough rule for a comparison
+// model's layer; see layer_breakthrough.hpp.
+#include "puncture/comparison/layer_breakthrough.hpp"
+
+#include <stdexcept>
+
+namespace puncture::comparison {
+
+LayerBreakthroughRule::LayerBreakthroughRule(const Layer& layer, double prescribed_depth_m)
+    : kind_(layer.force_law.breakthrough.kind),
+      critical_force_N_(layer.force_law.breakthrough.critical_force_N),
+      critical_energy_J_(layer.force_law.breakthrough.critical_energy_J),
+      prescribed_depth_m_(prescribed_depth_m),
+      rings_(layer.force_mesh) {}
+
+LayerBreakthroughRule LayerBreakthroughRule::of(const Scene& scene, std::size_t layer) {
+  const std::vector<double>& prescribed = scene.comparison.prescribed_puncture_depths_m;
+  return LayerBreakthroughRule(scene.layers.at(layer), layer < prescribed.size() ? prescribed[layer] : 0.0);
+}
+
+void LayerBreakthroughRule::start(double depth_m) {
+  last_depth_m_ = depth_m;
+  last_force_N_ = 0.0;
+  work_J_ = 0.0;
+}
+
+void LayerBreakthroughRule::advance(double depth_m, double force_N) {
+  if (depth_m > last_depth_m_) work_J_ += 0.5 * (force_N + last_force_N_) * (depth_m - last_depth_m_);
+  last_depth_m_ = depth_m;
+  last_force_N_ = force_N;
+}
+
+bool LayerBreakthroughRule::broken(double force_N, const std::vector<double>& ring_deflection_m) const {
+  if (prescribed_depth_m_ > 0.0) return last_depth_m_ >= prescribed_depth_m_;
+  switch (kind_) {
+    case BreakthroughCriterion::Kind::Rings:
+      if (ring_deflection_m.size() != rings_.points_m().size())
+        throw std::invalid_argument("LayerBreakthroughRule: the ring rule needs a deflection at every lattice point");
+      return rings_.broken(ring_deflection_m);
+    case BreakthroughCriterion::Kind::CriticalForce:
+      return force_N >= critical_force_N_;
+    case BreakthroughCriterion::Kind::CriticalEnergy:
+      return work_J_ >= critical_energy_J_;
+  }
+  return false;
+}
+
+}  // namespace puncture::comparison

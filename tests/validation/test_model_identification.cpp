@@ -1,0 +1,118 @@
+// A comparison model's stiffness factors and critical forces identified at a
+// reference: the reference is the BEM itself with known factors (skin x 2,
+// fat x 0.5, muscle x 1.5) and known critical forces. The muscle, pressed on
+// the rigid base alone, has a force proportional to its modulus: its factor
+// is found exactly. The skin and fat are identified while the layers below
+// are still at factor 1, so theirs compensate; the force while each is
+// pressed must then match the reference's (the BEM's force is linear in the
+// indentation, so one factor can match it exactly). The critical forces are
+// the reference's within one step of needle travel, and the identified model
+// punctures where the reference does. A layer the reference does not puncture
+// is not identified.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "puncture/comparison/model_factory.hpp"
+#include "puncture/comparison/surface_models.hpp"
+#include "puncture/scene_io.hpp"
+#include "puncture/validation/model_comparison.hpp"
+#include "puncture/validation/model_identification.hpp"
+
+using namespace puncture;
+
+namespace {
+
+Scene default_scene() { return load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json"); }
+
+/// The default scene's BEM with these factors, breaking each layer when its
+/// force reaches the force of an indentation of indentation_m[k] (a value
+/// above the trajectory's reach: never), and its run as a reference curve.
+struct Reference {
+  Scene scene;
+  std::vector<double> forces;
+  validation::ModelRun run;
+  validation::ReferenceData data;
+};
+Reference reference_of(const std::vector<double>& scale, const std::vector<double>& indentation_m) {
+  Reference r{default_scene(), {}, {}, {}};
+  r.scene.comparison.stiffness_scale = scale;
+  const comparison::BoundaryElementModel scaled(r.scene);
+  for (std::size_t k = 0; k < indentation_m.size(); ++k) {
+    r.forces.push_back(scaled.stiffness_N_per_m(k) * indentation_m[k]);
+    r.scene.layers[k].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+    r.scene.layers[k].force_law.breakthrough.critical_force_N = r.forces.back();
+  }
+  auto bem = comparison::make_comparison_model("bem", r.scene, nullptr);
+  r.run = validation::run_comparison_model(*bem, r.scene);
+  r.data.curve = validation::curve_from_model_run(r.scene, r.run, false);
+  return r;
+}
+
+double first_puncture_depth(const validation::ModelRun& run, std::size_t k) {
+  for (std::size_t i = 0; i < run.steps(); ++i)
+    if (run.states[i][k] == LayerState::Punctured) return run.depth_m[i];
+  return -1.0;
+}
+
+TEST(ModelIdentification, LinearModelRecoversTheFactorsAndForcesOfAReferenceMadeByItself) {
+  const std::vector<double> scale{2.0, 0.5, 1.5};
+  const Reference reference = reference_of(scale, {4e-3, 3e-3, 5e-3});
+  const std::vector<double>& forces = reference.forces;
+  const Scene scene = default_scene();
+  const validation::ModelIdentification id =
+      validation::identify_comparison_model("bem", scene, nullptr, reference.data, true);
+  ASSERT_EQ(id.layers.size(), 3u);
+  EXPECT_GE(id.model_runs, 6);  // two partial runs per layer and the optimiser's
+  const comparison::BoundaryElementModel unit(scene);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const validation::LayerIdentification& l = id.layers[k];
+    ASSERT_TRUE(l.identified) << l.layer << ": " << l.note;
+    EXPECT_NEAR(l.reference_depth_m, first_puncture_depth(reference.run, k), 1e-12) << l.layer;
+    EXPECT_GT(l.window_samples, 10u) << l.layer;
+    EXPECT_TRUE(l.stiffness_note.empty()) << l.stiffness_note;
+    if (k == 2) EXPECT_NEAR(l.stiffness_scale, scale[k], 1e-6 * scale[k]);
+    EXPECT_LT(l.window_rmse_after_N, 0.02 * l.window_rmse_before_N) << l.layer;
+    // The reference breaks on the first step with F >= F_k; the identified
+    // force is the model's on that step: F_k <= F <= F_k + s S 10 um (to the
+    // fit's accuracy).
+    EXPECT_GE(l.critical_force_N, 0.99 * forces[k]) << l.layer;
+    EXPECT_LE(l.critical_force_N, 1.01 * forces[k] + 4.0 * unit.stiffness_N_per_m(k) * 1.1e-5) << l.layer;
+  }
+  const Scene identified = validation::with_identified_parameters(scene, id);
+  auto model = comparison::make_comparison_model("bem", identified, nullptr);
+  const validation::ModelRun run = validation::run_comparison_model(*model, identified);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(identified.layers[k].force_law.breakthrough.kind, BreakthroughCriterion::Kind::CriticalForce);
+    EXPECT_NEAR(first_puncture_depth(run, k), first_puncture_depth(reference.run, k), 1.1e-5) << k;
+  }
+  // The identified scene is a valid scene file.
+  EXPECT_NO_THROW(parse_scene(scene_to_json_text(identified), "identified"));
+}
+
+TEST(ModelIdentification, CriticalForcesOnlyKeepTheModuli) {
+  const Reference reference = reference_of({2.0, 1.0, 1.0}, {4e-3, 3e-3, 5e-3});
+  const validation::ModelIdentification id =
+      validation::identify_comparison_model("shf", default_scene(), nullptr, reference.data, false);
+  EXPECT_EQ(id.model_runs, 3);
+  for (const validation::LayerIdentification& l : id.layers) {
+    EXPECT_TRUE(l.identified) << l.layer;
+    EXPECT_EQ(l.stiffness_scale, 1.0);
+  }
+}
+
+TEST(ModelIdentification, ALayerTheReferenceDoesNotPunctureIsNotIdentified) {
+  const Reference reference = reference_of({1.0, 1.0, 1.0}, {4e-3, 1.0, 1.0});  // only the skin breaks
+  const Scene scene = default_scene();
+  const validation::ModelIdentification id =
+      validation::identify_comparison_model("shf", scene, nullptr, reference.data, true);
+  ASSERT_GE(id.layers.size(), 2u);
+  EXPECT_TRUE(id.layers[0].identified);
+  EXPECT_FALSE(id.layers[1].identified);
+  EXPECT_FALSE(id.layers[1].note.empty());
+  const Scene identified = validation::with_identified_parameters(scene, id);
+  EXPECT_EQ(identified.layers[1].force_law.breakthrough.kind, scene.layers[1].force_law.breakthrough.kind);
+  EXPECT_EQ(identified.comparison.stiffness_scale[1], 1.0);
+}
+
+}  // namespace

@@ -1,0 +1,90 @@
+// model_identification.hpp: the few free parameters of a comparison model
+// identified against the reference (FEM) on the calibration trajectory, on
+// the model that is then compared (its full run, not a surrogate): per layer
+// a factor s_k on its Young's modulus (ComparisonSettings::stiffness_scale)
+// and the critical contact force F_k at which it breaks
+// (layer_breakthrough.hpp: the kind of criterion the calibrated real-time
+// model uses).
+//
+// In:  a comparison model's name (model_factory.hpp; not "realtime", which
+//      `puncture calibrate` tunes), the scene (its insertion is the
+//      calibration trajectory), the comparison mesh (volumetric models; else
+//      null), the reference data, and whether to identify the stiffness.
+// Method. The reference's puncture depths d_k (reference_events,
+// puncture_events.hpp) of the layers it punctures on this trajectory. Every
+// run below is a run of the full model along the trajectory until the tip
+// first reaches d_k, with layer k never breaking and the layers above it
+// broken where the reference breaks them (ComparisonSettings::
+// prescribed_puncture_depths_m), so its window does not move with their
+// parameters.
+//   1. The factors, bottom up (a pressed layer's force depends on the layers
+//      below it, whose factors are then known): run A with s_k = 1; over the
+//      reference's samples with layer k pressed (layer_segments), the model's
+//      contact force c_i and shaft force p_i at the sample's depth (linear in
+//      depth between steps) and the reference force f_i (with shaft forces
+//      when the reference has them, as the comparison compares totals). The
+//      least-squares factor for a contact force proportional to the modulus,
+//      sum c_i (f_i - p_i) / sum c_i^2 (within the bounds), starts
+//      Levenberg-Marquardt on ln s_k in [-ln 1000, ln 1000] with the
+//      residuals (contact force of a run with s_k - (f_i - p_i)) / reference
+//      peak (levenberg_marquardt.hpp, the calibration's optimiser; at most 14
+//      runs, two at a time). The proportional factor is exact only when the
+//      pressed layer's response scales with its own modulus alone (one layer
+//      on a rigid base); a layer on other layers needs the iterations.
+//   2. The critical forces, top down, with the final factors: F_k is the
+//      contact force on the step at d_k, so the model, breaking each layer by
+//      its critical force, breaks it where the reference does.
+//   Without stiffness identification step 1 is skipped (s_k = 1).
+// A layer the reference does not puncture, or at whose puncture depth the
+// model's force is not positive, ends the identification there (identified
+// = false, with the reason); the layers below keep the scene's values.
+// Out: ModelIdentification; with_identified_parameters(scene, id) gives the
+// model's scene (stiffness_scale, each identified layer's rule CriticalForce
+// F_k). The identified values are model properties: held-out cases (other
+// speeds, depths, slabs) run with them unchanged.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/scene.hpp"
+#include "puncture/validation/model_comparison.hpp"
+
+namespace puncture::validation {
+
+struct LayerIdentification {
+  std::string layer;
+  bool identified = false;
+  double stiffness_scale = 1.0;
+  double critical_force_N = 0.0;
+  double reference_depth_m = 0.0;     ///< the reference's puncture depth (m; NaN if none)
+  std::size_t window_samples = 0;     ///< reference samples the scale was fitted on
+  double window_rmse_before_N = 0.0;  ///< force RMSE over them with s_k = 1 (N)
+  double window_rmse_after_N = 0.0;   ///< and with the identified s_k (N)
+  std::string note;                   ///< why not identified (empty when identified)
+  std::string stiffness_note;         ///< why the factor was kept at 1 (empty when fitted)
+};
+
+struct ModelIdentification {
+  std::string model;
+  bool stiffness_identified = false;
+  std::vector<LayerIdentification> layers;
+  int model_runs = 0;
+  double wall_time_s = 0.0;
+};
+
+using IdentificationStepProgress = std::function<void(const LayerIdentification& layer)>;
+
+ModelIdentification identify_comparison_model(const std::string& model, const Scene& scene,
+                                              std::shared_ptr<const comparison::TetMesh> mesh,
+                                              const ReferenceData& reference, bool identify_stiffness,
+                                              const IdentificationStepProgress& progress = {});
+
+/// The model's scene: stiffness_scale (one per layer, 1 where not identified)
+/// and each identified layer's breakthrough rule CriticalForce F_k.
+Scene with_identified_parameters(const Scene& scene, const ModelIdentification& identification);
+
+}  // namespace puncture::validation

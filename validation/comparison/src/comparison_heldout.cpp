@@ -1,0 +1,153 @@
+// comparison_heldout.cpp: every identified model on the held-out cases; see
+// comparison_heldout.hpp.
+#include "comparison_heldout.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include "comparison_runs.hpp"
+#include "comparison_tables.hpp"
+#include "puncture/comparison/model_factory.hpp"
+#include "puncture/meshing/comparison_tet_slab_mesh.hpp"
+#include "puncture/needle.hpp"
+#include "puncture/scene_io.hpp"
+#include "puncture/validation/validation_cases.hpp"
+
+namespace puncture::validation::comparison_report_detail {
+
+namespace {
+
+constexpr double kMm = 1e-3;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::size_t trajectory_steps(const Scene& scene) {
+  const ScriptedTrajectory trajectory(scene.insertion);
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  return static_cast<std::size_t>(std::ceil(trajectory.duration() / dt - 1e-9)) + 1;
+}
+
+/// Every model on one case.
+void run_case(const ComparisonCase& c, const Scene& scene, const std::map<std::string, Scene>& model_scenes,
+              const ComparisonReportOptions& options, std::vector<HeldOutRow>& rows, std::ostream& out,
+              std::ostream& err) {
+  const std::string scene_text = scene_to_json_text(scene);
+  const Scene case_base = case_scene(scene_text, scene.name, c.validation_case).scene;
+  const ComparisonReference reference = read_comparison_reference(case_base, c.fem.dir);
+  std::shared_ptr<const comparison::TetMesh> mesh;
+  for (const auto& [key, model_scene] : model_scenes) {
+    (void)model_scene;
+    if (comparison::is_volumetric_model(key) && !mesh)
+      mesh = std::make_shared<comparison::TetMesh>(meshing::build_comparison_tet_mesh(case_base));
+  }
+  for (const std::string& key : options.models) {
+    const auto it = model_scenes.find(key);
+    if (it == model_scenes.end()) continue;  // "fem"
+    const Scene model_scene =
+        case_scene(scene_to_json_text(it->second), key + " model scene", c.validation_case).scene;
+    if (!options.quiet)
+      out << "[compare] case " << c.validation_case.name << ": " << key << " ...\n" << std::flush;
+    std::unique_ptr<comparison::ComparisonModel> model =
+        comparison::make_comparison_model(key, model_scene, comparison::is_volumetric_model(key) ? mesh : nullptr);
+    ModelRunOptions run_options;
+    run_options.profile_depths_m = reference.profile_depths_m;
+    run_options.profile_radii_m = reference.profile_radii_m;
+    ModelRun run = run_comparison_model(*model, model_scene, run_options);
+    run.model = key;
+    if (run.failed()) err << "warning: " << key << " failed on case " << c.validation_case.name << " " << run.failure << "\n";
+    HeldOutRow row;
+    row.case_name = c.validation_case.name;
+    row.held_out = c.validation_case.held_out;
+    row.metrics = metrics_against_reference(model_scene, run, reference.data, trajectory_steps(model_scene));
+    row.failure = run.failure;
+    rows.push_back(row);
+  }
+}
+
+double mean_of_finite(const std::vector<double>& values) {
+  double sum = 0.0;
+  int n = 0;
+  for (double v : values)
+    if (std::isfinite(v)) sum += v, ++n;
+  return n > 0 ? sum / n : kNaN;
+}
+
+}  // namespace
+
+std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std::string, Scene>& model_scenes,
+                                          const ComparisonReportOptions& options, std::ostream& out,
+                                          std::ostream& err) {
+  std::vector<HeldOutRow> rows;
+  for (std::size_t i = 0; i < options.cases.size(); ++i) {
+    // A case that is not held out is the calibration trajectory: the main table's runs.
+    if (!options.cases[i].validation_case.held_out) continue;
+    if (!options.quiet)
+      out << "[compare] case " << i + 1 << "/" << options.cases.size() << ": " << options.cases[i].validation_case.name
+          << "\n" << std::flush;
+    run_case(options.cases[i], scene, model_scenes, options, rows, out, err);
+  }
+  return rows;
+}
+
+std::string heldout_csv(const Scene& scene, const std::vector<HeldOutRow>& rows) {
+  std::ostringstream csv;
+  csv << "case,held_out,model,force_rmse_relative,peak_force_error_relative,puncture_depth_error_mm,"
+         "puncture_layers_disagreeing";
+  for (const Layer& l : scene.layers) csv << ',' << l.name << "_puncture_mm," << l.name << "_fem_puncture_mm";
+  csv << ",deflection_rmse_relative,step_time_mean_ms,step_time_p99_ms,memory_MB,completed_fraction,failure\n";
+  for (const HeldOutRow& r : rows) {
+    const ModelMetrics& m = r.metrics;
+    csv << r.case_name << ',' << (r.held_out ? "true" : "false") << ',' << m.model << ',' << fmt(m.force_rmse_relative)
+        << ',' << fmt(m.peak_force_error_relative) << ',' << fmt(m.puncture_depth_error_m / kMm) << ','
+        << m.puncture_layers_disagreeing;
+    for (const LayerPunctureComparison& p : m.punctures)
+      csv << ',' << fmt(p.model_depth_m / kMm) << ',' << fmt(p.reference_depth_m / kMm);
+    csv << ',' << fmt(m.deflection_rmse_relative) << ',' << fmt(m.step_time_mean_s * 1e3) << ','
+        << fmt(m.step_time_p99_s * 1e3) << ',' << fmt(m.memory_bytes / 1e6) << ',' << fmt(m.completed_fraction)
+        << ",\"" << r.failure << "\"\n";
+  }
+  return csv.str();
+}
+
+std::vector<ModelMetrics> aggregate_heldout(const std::vector<HeldOutRow>& rows, const std::vector<std::string>& models) {
+  std::vector<ModelMetrics> out;
+  for (const std::string& key : models) {
+    std::vector<double> force, peak, depth, deflection, p99, mean_step, memory, completed;
+    std::vector<LayerPunctureComparison> punctures;
+    int disagreeing = 0;
+    for (const HeldOutRow& r : rows) {
+      if (!r.held_out || r.metrics.model != key) continue;
+      force.push_back(r.metrics.force_rmse_relative);
+      peak.push_back(std::abs(r.metrics.peak_force_error_relative));
+      depth.push_back(r.metrics.puncture_depth_error_m);
+      deflection.push_back(r.metrics.deflection_rmse_relative);
+      p99.push_back(r.metrics.step_time_p99_s);
+      mean_step.push_back(r.metrics.step_time_mean_s);
+      memory.push_back(r.metrics.memory_bytes);
+      completed.push_back(r.metrics.completed_fraction);
+      punctures.insert(punctures.end(), r.metrics.punctures.begin(), r.metrics.punctures.end());
+      disagreeing += r.metrics.puncture_layers_disagreeing;
+    }
+    if (force.empty()) continue;
+    ModelMetrics m;
+    m.model = key;
+    m.punctures = punctures;  // every layer of every case: the ranking's puncture metric is their mean
+    m.puncture_layers_disagreeing = disagreeing;
+    m.force_rmse_relative = mean_of_finite(force);
+    m.peak_force_error_relative = mean_of_finite(peak);
+    m.puncture_depth_error_m = mean_of_finite(depth);
+    m.deflection_rmse_relative = mean_of_finite(deflection);
+    m.step_time_mean_s = mean_of_finite(mean_step);
+    m.step_time_p99_s = *std::max_element(p99.begin(), p99.end(), [](double a, double b) {
+      return std::isfinite(b) && (!std::isfinite(a) || a < b);
+    });
+    m.memory_bytes = *std::max_element(memory.begin(), memory.end());
+    m.completed_fraction = *std::min_element(completed.begin(), completed.end());
+    out.push_back(m);
+  }
+  return out;
+}
+
+}  // namespace puncture::validation::comparison_report_detail

@@ -1,0 +1,233 @@
+// model_identification.cpp: stiffness factors and critical forces of a
+// comparison model against the reference; see model_identification.hpp.
+#include "puncture/validation/model_identification.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "puncture/comparison/model_factory.hpp"
+#include "puncture/needle.hpp"
+#include "puncture/validation/levenberg_marquardt.hpp"
+#include "puncture/validation/puncture_events.hpp"
+
+namespace puncture::validation {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kScaleBound = 1000.0;
+
+/// Time (s) of the first haptic step at which the scripted tip reaches depth_m; < 0 if never.
+double first_step_at_depth(const Scene& scene, double depth_m) {
+  const ScriptedTrajectory trajectory(scene.insertion);
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  for (long i = 0; i * dt <= trajectory.duration() + 1e-12; ++i)
+    if (trajectory.sample(i * dt).depth_m() >= depth_m) return i * dt;
+  return -1.0;
+}
+
+void set_critical_force(Scene& scene, std::size_t layer, double force_N) {
+  BreakthroughCriterion& b = scene.layers[layer].force_law.breakthrough;
+  b.kind = BreakthroughCriterion::Kind::CriticalForce;
+  b.critical_force_N = force_N;
+}
+
+/// The model on `scene` until `until_s` (layer k's rule: never breaks).
+ModelRun run_until(const std::string& model, const Scene& scene, std::shared_ptr<const comparison::TetMesh> mesh,
+                   double until_s) {
+  std::unique_ptr<comparison::ComparisonModel> m =
+      comparison::make_comparison_model(model, scene, comparison::is_volumetric_model(model) ? mesh : nullptr);
+  ModelRunOptions options;
+  options.end_time_s = until_s;
+  return run_comparison_model(*m, scene, options);
+}
+
+/// A run's contact and shaft force at a depth of its insertion (linear in depth between steps); false outside.
+bool forces_at_depth(const ModelRun& run, double depth_m, double& contact_N, double& shaft_N) {
+  for (std::size_t i = 1; i < run.steps(); ++i) {
+    if (!(run.velocity_m_per_s[i] > 0.0) || run.depth_m[i] < depth_m || run.depth_m[i - 1] > depth_m) continue;
+    const double span = run.depth_m[i] - run.depth_m[i - 1];
+    const double t = span > 0.0 ? (depth_m - run.depth_m[i - 1]) / span : 1.0;
+    contact_N = run.contact_force_N[i - 1] + t * (run.contact_force_N[i] - run.contact_force_N[i - 1]);
+    shaft_N = run.post_puncture_force_N[i - 1] + t * (run.post_puncture_force_N[i] - run.post_puncture_force_N[i - 1]);
+    return true;
+  }
+  return false;
+}
+
+/// The reference's samples of a window [from, to) of the insertion: depth
+/// (m) and the force the model's contact force is compared with (N: the
+/// reference's force less the model's shaft force where the reference has
+/// shaft forces; the shaft forces come from the run at s_k = 1, they do not
+/// depend on the pressed layer's modulus).
+struct Window {
+  std::vector<double> depth_m, target_N;
+  double scale_N = 1.0;  ///< residuals are divided by this (the reference's peak force)
+};
+
+Window window_of(const ModelRun& run, const ReferenceData& reference, double from_m, double to_m) {
+  Window w;
+  const InsertionCurve& curve = reference.curve;
+  double peak = 0.0;
+  for (std::size_t i = 0; i < curve.size(); ++i) {
+    if (!(curve.velocity_m_per_s[i] > 0.0)) continue;
+    peak = std::max(peak, std::abs(curve.force_N[i]));
+    if (curve.depth_m[i] < from_m || curve.depth_m[i] >= to_m) continue;
+    double contact = 0.0, shaft = 0.0;
+    if (!forces_at_depth(run, curve.depth_m[i], contact, shaft)) continue;
+    w.depth_m.push_back(curve.depth_m[i]);
+    w.target_N.push_back(curve.force_N[i] - (reference.has_shaft_forces ? shaft : 0.0));
+  }
+  w.scale_N = peak > 0.0 ? peak : 1.0;
+  return w;
+}
+
+/// (model contact force - target) / scale at the window's depths; false if a depth is not reached.
+bool window_residuals(const ModelRun& run, const Window& w, std::vector<double>& r) {
+  r.resize(w.depth_m.size());
+  for (std::size_t i = 0; i < w.depth_m.size(); ++i) {
+    double contact = 0.0, shaft = 0.0;
+    if (!forces_at_depth(run, w.depth_m[i], contact, shaft)) return false;
+    r[i] = (contact - w.target_N[i]) / w.scale_N;
+  }
+  return true;
+}
+
+double rmse_N(const std::vector<double>& r, double scale_N) {
+  double sum = 0.0;
+  for (double x : r) sum += x * x;
+  return r.empty() ? kNaN : scale_N * std::sqrt(sum / r.size());
+}
+
+/// Layer k's factor: the least-squares factor for a force proportional to
+/// the modulus from run A, then Levenberg-Marquardt on ln s_k with the full
+/// model (levenberg_marquardt.hpp). Books the runs and the window's RMSE.
+double identified_scale(const std::string& model, const Scene& trial, std::size_t k,
+                        std::shared_ptr<const comparison::TetMesh> mesh, double until_s, const ModelRun& run_a,
+                        const Window& w, LayerIdentification& layer, int& runs) {
+  std::vector<double> r;
+  window_residuals(run_a, w, r);
+  layer.window_samples = r.size();
+  layer.window_rmse_before_N = rmse_N(r, w.scale_N);
+  double cc = 0.0, cf = 0.0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const double c = r[i] * w.scale_N + w.target_N[i];
+    cc += c * c, cf += c * w.target_N[i];
+  }
+  const double proportional = cc > 0.0 && cf > 0.0 ? std::clamp(cf / cc, 1.0 / kScaleBound, kScaleBound) : 1.0;
+  const ResidualFunction residuals = [&](const std::vector<double>& x, std::vector<double>& out) {
+    Scene s = trial;
+    s.comparison.stiffness_scale[k] = std::exp(x[0]);
+    return window_residuals(run_until(model, s, mesh, until_s), w, out);
+  };
+  LevenbergMarquardtOptions options;
+  options.max_iterations = 6;
+  options.max_evaluations = 14;
+  options.fd_step = options.fd_step_min = 0.02;
+  options.cost_tolerance = 1e-3;
+  options.threads = 2;
+  const double bound = std::log(kScaleBound);
+  try {
+    const LevenbergMarquardtResult fit =
+        levenberg_marquardt(residuals, {std::log(proportional)}, {-bound}, {bound}, options);
+    runs += fit.evaluations;
+    layer.window_rmse_after_N = rmse_N(fit.residuals, w.scale_N);
+    return std::exp(fit.x[0]);
+  } catch (const std::exception& e) {  // the model cannot run at the proportional start
+    layer.stiffness_note = std::string("stiffness kept: ") + e.what();
+    layer.window_rmse_after_N = layer.window_rmse_before_N;
+    return 1.0;
+  }
+}
+
+/// Layer k unbreakable, the layers above it broken where the reference breaks them.
+void prepare_layer_run(Scene& trial, std::size_t k, const std::vector<double>& depths_m) {
+  trial.comparison.prescribed_puncture_depths_m.assign(depths_m.begin(), depths_m.begin() + static_cast<long>(k));
+  set_critical_force(trial, k, std::numeric_limits<double>::infinity());
+}
+
+}  // namespace
+
+ModelIdentification identify_comparison_model(const std::string& model, const Scene& scene,
+                                              std::shared_ptr<const comparison::TetMesh> mesh,
+                                              const ReferenceData& reference, bool identify_stiffness,
+                                              const IdentificationStepProgress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  ModelIdentification result;
+  result.model = model;
+  result.stiffness_identified = identify_stiffness;
+  const std::vector<LayerGeometry> geometry = layer_geometry(scene);
+  const ReferenceEvents events = reference_events(reference.curve, geometry);
+  const std::vector<LayerSegments> segments = layer_segments(events, geometry);
+  // The layers the reference punctures on this trajectory, from the top.
+  std::vector<double> depths_m, until_s;
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    LayerIdentification layer;
+    layer.layer = scene.layers[k].name;
+    const PunctureEventMetrics& p = events.punctures[k];
+    layer.reference_depth_m = p.found ? p.depth_m : kNaN;
+    const double until = p.found ? first_step_at_depth(scene, p.depth_m) : -1.0;
+    result.layers.push_back(layer);
+    if (until < 0.0) {
+      result.layers.back().note = p.found ? "the trajectory does not reach the reference's puncture depth"
+                                          : "the reference does not puncture this layer";
+      break;  // the layers below are not reached either
+    }
+    depths_m.push_back(p.depth_m);
+    until_s.push_back(until);
+  }
+  Scene trial = scene;
+  trial.comparison.stiffness_scale.assign(scene.layers.size(), 1.0);
+  // 1. The factors, bottom up: a layer's force depends on the layers below it
+  //    (and hardly on the punctured ones above), whose factors are then known.
+  for (std::size_t k = depths_m.size(); identify_stiffness && k-- > 0;) {
+    prepare_layer_run(trial, k, depths_m);
+    const ModelRun run = run_until(model, trial, mesh, until_s[k]);
+    ++result.model_runs;
+    const Window window = segments[k].has_pressing && !run.failed()
+                              ? window_of(run, reference, segments[k].pressing_from_m, depths_m[k])
+                              : Window{};
+    if (window.depth_m.size() < 2) continue;
+    LayerIdentification& layer = result.layers[k];
+    layer.stiffness_scale = identified_scale(model, trial, k, mesh, until_s[k], run, window, layer, result.model_runs);
+    trial.comparison.stiffness_scale[k] = layer.stiffness_scale;
+  }
+  // 2. The critical forces, top down, with the final factors: layer k's force
+  //    where the reference breaks it, the layers above broken there too (as
+  //    their own critical forces then do).
+  for (std::size_t k = 0; k < depths_m.size(); ++k) {
+    prepare_layer_run(trial, k, depths_m);
+    const ModelRun run = run_until(model, trial, mesh, until_s[k]);
+    ++result.model_runs;
+    LayerIdentification& layer = result.layers[k];
+    const double force = run.failed() || run.steps() == 0 ? 0.0 : run.contact_force_N.back();
+    if (!(force > 0.0) || !std::isfinite(force)) {
+      layer.note = run.failed() ? "the model run failed: " + run.failure
+                                : "the model's contact force is not positive at the reference's puncture depth";
+      for (std::size_t j = k; j < depths_m.size(); ++j) result.layers[j].stiffness_scale = 1.0;
+      result.layers.resize(k + 1);
+      break;
+    }
+    layer.identified = true;
+    layer.critical_force_N = force;
+    if (progress) progress(layer);
+  }
+  result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+Scene with_identified_parameters(const Scene& scene, const ModelIdentification& identification) {
+  Scene out = scene;
+  out.comparison.stiffness_scale.assign(scene.layers.size(), 1.0);
+  for (std::size_t k = 0; k < identification.layers.size() && k < out.layers.size(); ++k) {
+    const LayerIdentification& l = identification.layers[k];
+    if (!l.identified) continue;
+    out.comparison.stiffness_scale[k] = l.stiffness_scale;
+    set_critical_force(out, k, l.critical_force_N);
+  }
+  return out;
+}
+
+}  // namespace puncture::validation
