@@ -188,10 +188,8 @@ Scene ComparisonRunner::identify_model(const std::string& key) {
   if (!options_.quiet) out_ << "[compare] " << key << ": identifying against the FEM ...\n" << std::flush;
   const ModelIdentification id = identify_comparison_model(
       key, scene_, comparison::is_volumetric_model(key) ? mesh_ : nullptr, reference_.data,
-      options_.identify_stiffness, [&](const LayerIdentification& l) {
-        if (!options_.quiet)
-          out_ << "[compare] " << key << ": " << l.layer << " stiffness x " << shown(l.stiffness_scale, 4)
-               << ", breaks at " << shown(l.critical_force_N, 4) << " N\n" << std::flush;
+      options_.identify_stiffness, [&](const std::string& line) {
+        if (!options_.quiet) out_ << "[compare] " << key << ": " << line << "\n" << std::flush;
       });
   nlohmann::json layers = nlohmann::json::array();
   for (const LayerIdentification& l : id.layers) {

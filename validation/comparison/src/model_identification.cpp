@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
+#include <sstream>
 
 #include "puncture/comparison/model_factory.hpp"
 #include "puncture/needle.hpp"
@@ -106,7 +108,8 @@ double rmse_N(const std::vector<double>& r, double scale_N) {
 /// model (levenberg_marquardt.hpp). Books the runs and the window's RMSE.
 double identified_scale(const std::string& model, const Scene& trial, std::size_t k,
                         std::shared_ptr<const comparison::TetMesh> mesh, double until_s, const ModelRun& run_a,
-                        const Window& w, LayerIdentification& layer, int& runs) {
+                        const Window& w, LayerIdentification& layer, int& runs,
+                        const IdentificationStepProgress& progress) {
   std::vector<double> r;
   window_residuals(run_a, w, r);
   layer.window_samples = r.size();
@@ -117,10 +120,20 @@ double identified_scale(const std::string& model, const Scene& trial, std::size_
     cc += c * c, cf += c * w.target_N[i];
   }
   const double proportional = cc > 0.0 && cf > 0.0 ? std::clamp(cf / cc, 1.0 / kScaleBound, kScaleBound) : 1.0;
+  std::mutex progress_mutex;
+  int evaluations = 0;
   const ResidualFunction residuals = [&](const std::vector<double>& x, std::vector<double>& out) {
     Scene s = trial;
     s.comparison.stiffness_scale[k] = std::exp(x[0]);
-    return window_residuals(run_until(model, s, mesh, until_s), w, out);
+    const bool ok = window_residuals(run_until(model, s, mesh, until_s), w, out);
+    if (progress) {
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      std::ostringstream line;
+      line << layer.layer << ": run " << ++evaluations << " of the optimiser, factor " << std::exp(x[0])
+           << ", force RMSE " << (ok ? rmse_N(out, w.scale_N) : kNaN) << " N";
+      progress(line.str());
+    }
+    return ok;
   };
   LevenbergMarquardtOptions options;
   options.max_iterations = 6;
@@ -191,7 +204,8 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
                               : Window{};
     if (window.depth_m.size() < 2) continue;
     LayerIdentification& layer = result.layers[k];
-    layer.stiffness_scale = identified_scale(model, trial, k, mesh, until_s[k], run, window, layer, result.model_runs);
+    layer.stiffness_scale =
+        identified_scale(model, trial, k, mesh, until_s[k], run, window, layer, result.model_runs, progress);
     trial.comparison.stiffness_scale[k] = layer.stiffness_scale;
   }
   // 2. The critical forces, top down, with the final factors: layer k's force
@@ -212,7 +226,11 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
     }
     layer.identified = true;
     layer.critical_force_N = force;
-    if (progress) progress(layer);
+    if (progress) {
+      std::ostringstream line;
+      line << layer.layer << ": modulus x " << layer.stiffness_scale << ", breaks at " << force << " N";
+      progress(line.str());
+    }
   }
   result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

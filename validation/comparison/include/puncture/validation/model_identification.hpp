@@ -76,7 +76,8 @@ struct ModelIdentification {
   double wall_time_s = 0.0;
 };
 
-using IdentificationStepProgress = std::function<void(const LayerIdentification& layer)>;
+/// One line per model run and per identified layer (called from one thread at a time).
+using IdentificationStepProgress = std::function<void(const std::string& line)>;
 
 ModelIdentification identify_comparison_model(const std::string& model, const Scene& scene,
                                               std::shared_ptr<const comparison::TetMesh> mesh,
