@@ -164,6 +164,7 @@ VolumetricNeedleModel::~VolumetricNeedleModel() = default;
 
 bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, bool withdrawing) {
   bool changed = false;
+  checked_force_N_ = std::numeric_limits<double>::quiet_NaN();
   double snap = 0.0;
   if (withdrawing && active_ < layers_.size()) {
     compute_forces(y_, work_f_);
@@ -203,7 +204,10 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
     }
     const double force = layer.breakthrough.needs_force() ? contact_force_N() : 0.0;
     layer.breakthrough.advance(-z_tip, force);
-    if (!layer.breakthrough.broken(force, deflection)) break;
+    if (!layer.breakthrough.broken(force, deflection)) {
+      if (layer.breakthrough.needs_force()) checked_force_N_ = force;  // the step's contact force, if nothing moves now
+      break;
+    }
     puncture_active_layer();
     changed = true;
   }
@@ -211,7 +215,10 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
   // a puncture lies below the tip) is an impulsive deformation; like the FEM
   // reference, find the equilibrium with the new contact set at once.
   if (changed) static_factor_valid_ = false;
-  if (snap > snap_relax_threshold_m_ && !settings_.quasi_static) relax_to_equilibrium();
+  if (snap > snap_relax_threshold_m_ && !settings_.quasi_static) {
+    relax_to_equilibrium();
+    checked_force_N_ = std::numeric_limits<double>::quiet_NaN();
+  }
   return changed;
 }
 
@@ -418,7 +425,8 @@ double VolumetricNeedleModel::step(const NeedleState& needle) {
     needle_velocity_z_ = velocity_z;
     integrator_->reinit(time_, y_);
   }
-  return contact_force_N();
+  // The breakthrough check may have evaluated it already on this state.
+  return std::isfinite(checked_force_N_) ? checked_force_N_ : contact_force_N();
 }
 
 int VolumetricNeedleModel::contact_node_count() const {

@@ -181,20 +181,7 @@ TEST(ExtrudedTetSlabMesh, LinearTensorMassIndentationConvergesToTheLayeredHalfSp
   // mesh at the needle is refined.
   double previous = 0.0;
   for (double size : {0.3e-3, 0.2e-3}) {
-    Scene s = testing::small_slab_scene();
-    s.layers.resize(1);
-    s.layers[0].thickness_m = 6e-3;
-    s.layers[0].material.youngs_modulus_Pa = 10e3;
-    s.layers[0].material.poisson_ratio = 0.3;
-    s.layers[0].force_mesh.deformed_threshold_m = 1.0;  // no puncture
-    s.sample.diameter_m = 16e-3;
-    s.insertion.start_height_m = 0.0;
-    s.insertion.target_depth_m = 0.03e-3;
-    s.insertion.speed_m_per_s = 0.001;
-    s.comparison.mesh.size_at_axis_m = size;
-    s.comparison.mesh.size_far_m = 2.5e-3;
-    s.comparison.mesh.grading = 0.4;
-    validate_scene(s, "single_layer_scene");
+    const Scene s = testing::single_layer_scene(0.3, size);
     const auto mesh = std::make_shared<comparison::TetMesh>(build_comparison_tet_mesh(s));
     auto model = comparison::make_comparison_model("mass_tensor", s, mesh);
     const ScriptedTrajectory trajectory(s.insertion);

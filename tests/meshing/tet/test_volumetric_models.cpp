@@ -26,26 +26,6 @@ std::shared_ptr<const TetMesh> mesh_of(const Scene& scene) {
   return std::make_shared<TetMesh>(meshing::build_tet_slab_mesh(scene, meshing::tet_slab_mesh_options(scene)));
 }
 
-/// One soft layer, 6 mm thick, 16 mm across; a force mesh that never breaks;
-/// indented 0.03 mm at 1 mm/s (small strain, quasi-static).
-Scene single_layer_scene(double poisson, double size_at_axis_m) {
-  Scene s = testing::small_slab_scene();
-  s.layers.resize(1);
-  s.layers[0].thickness_m = 6e-3;
-  s.layers[0].material.youngs_modulus_Pa = 10e3;
-  s.layers[0].material.poisson_ratio = poisson;
-  s.layers[0].force_mesh.deformed_threshold_m = 1.0;  // no puncture
-  s.sample.diameter_m = 16e-3;
-  s.insertion.start_height_m = 0.0;
-  s.insertion.target_depth_m = 0.03e-3;
-  s.insertion.speed_m_per_s = 0.001;
-  s.comparison.mesh.size_at_axis_m = size_at_axis_m;
-  s.comparison.mesh.size_far_m = 2.5e-3;
-  s.comparison.mesh.grading = 0.4;
-  validate_scene(s, "single_layer_scene");
-  return s;
-}
-
 struct RunRecord {
   std::vector<double> depth_m, force_N;
   std::vector<std::vector<LayerState>> states;
@@ -79,7 +59,7 @@ TEST(VolumetricModels, LinearTensorMassIndentationConvergesToTheLayeredHalfSpace
   // toward 1 as the mesh at the needle is refined.
   double previous = 0.0;
   for (double size : {0.3e-3, 0.15e-3}) {
-    const Scene scene = single_layer_scene(0.3, size);
+    const Scene scene = testing::single_layer_scene(0.3, size);
     const auto mesh = mesh_of(scene);
     auto model = make_comparison_model("mass_tensor", scene, mesh);
     const double until = scene.insertion.target_depth_m / scene.insertion.speed_m_per_s;

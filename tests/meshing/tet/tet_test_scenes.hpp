@@ -56,4 +56,24 @@ inline Scene small_slab_scene() {
   return s;
 }
 
+/// One soft layer (E = 10 kPa), 6 mm thick, 16 mm across; a force mesh that
+/// never breaks; indented 0.03 mm at 1 mm/s (small strain, quasi-static).
+inline Scene single_layer_scene(double poisson, double size_at_axis_m) {
+  Scene s = small_slab_scene();
+  s.layers.resize(1);
+  s.layers[0].thickness_m = 6e-3;
+  s.layers[0].material.youngs_modulus_Pa = 10e3;
+  s.layers[0].material.poisson_ratio = poisson;
+  s.layers[0].force_mesh.deformed_threshold_m = 1.0;  // no puncture
+  s.sample.diameter_m = 16e-3;
+  s.insertion.start_height_m = 0.0;
+  s.insertion.target_depth_m = 0.03e-3;
+  s.insertion.speed_m_per_s = 0.001;
+  s.comparison.mesh.size_at_axis_m = size_at_axis_m;
+  s.comparison.mesh.size_far_m = 2.5e-3;
+  s.comparison.mesh.grading = 0.4;
+  validate_scene(s, "single_layer_scene");
+  return s;
+}
+
 }  // namespace puncture::testing

@@ -12,7 +12,6 @@
 #include "comparison_tables.hpp"
 #include "puncture/comparison/model_factory.hpp"
 #include "puncture/meshing/comparison_tet_slab_mesh.hpp"
-#include "puncture/needle.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/validation_cases.hpp"
 
@@ -23,25 +22,17 @@ namespace {
 constexpr double kMm = 1e-3;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::size_t trajectory_steps(const Scene& scene) {
-  const ScriptedTrajectory trajectory(scene.insertion);
-  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
-  return static_cast<std::size_t>(std::ceil(trajectory.duration() / dt - 1e-9)) + 1;
-}
-
 /// Every model on one case.
 void run_case(const ComparisonCase& c, const Scene& scene, const std::map<std::string, Scene>& model_scenes,
               const ComparisonReportOptions& options, std::vector<HeldOutRow>& rows, std::ostream& out,
               std::ostream& err) {
-  const std::string scene_text = scene_to_json_text(scene);
-  const Scene case_base = case_scene(scene_text, scene.name, c.validation_case).scene;
+  const Scene case_base = case_scene(scene_to_json_text(scene), scene.name, c.validation_case).scene;
   const ComparisonReference reference = read_comparison_reference(case_base, c.fem.dir);
+  // The case's slab and depth have their own mesh.
   std::shared_ptr<const comparison::TetMesh> mesh;
-  for (const auto& [key, model_scene] : model_scenes) {
-    (void)model_scene;
-    if (comparison::is_volumetric_model(key) && !mesh)
-      mesh = std::make_shared<comparison::TetMesh>(meshing::build_comparison_tet_mesh(case_base));
-  }
+  if (std::any_of(model_scenes.begin(), model_scenes.end(),
+                  [](const auto& m) { return comparison::is_volumetric_model(m.first); }))
+    mesh = std::make_shared<comparison::TetMesh>(meshing::build_comparison_tet_mesh(case_base));
   for (const std::string& key : options.models) {
     const auto it = model_scenes.find(key);
     if (it == model_scenes.end()) continue;  // "fem"

@@ -218,11 +218,15 @@ Scene ComparisonRunner::identify_model(const std::string& key) {
   return identified;
 }
 
-ComparisonRows comparison_rows(const Scene& scene, const std::vector<std::unique_ptr<ModelRun>>& runs,
-                               const ComparisonReference& reference, bool with_fem_row) {
+std::size_t trajectory_steps(const Scene& scene) {
   const ScriptedTrajectory trajectory(scene.insertion);
   const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
-  const std::size_t total_steps = static_cast<std::size_t>(std::ceil(trajectory.duration() / dt - 1e-9)) + 1;
+  return static_cast<std::size_t>(std::ceil(trajectory.duration() / dt - 1e-9)) + 1;
+}
+
+ComparisonRows comparison_rows(const Scene& scene, const std::vector<std::unique_ptr<ModelRun>>& runs,
+                               const ComparisonReference& reference, bool with_fem_row) {
+  const std::size_t total_steps = trajectory_steps(scene);
   ComparisonRows rows;
   for (const auto& run : runs) {
     rows.metrics.push_back(metrics_against_reference(scene, *run, reference.data, total_steps));

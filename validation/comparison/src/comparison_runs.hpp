@@ -95,6 +95,10 @@ class ComparisonRunner {
   std::map<std::string, Scene> model_scenes_;
 };
 
+/// Haptic steps of the scene's whole scripted trajectory (the denominator of
+/// ModelMetrics::completed_fraction).
+std::size_t trajectory_steps(const Scene& scene);
+
 /// The rows of comparison.csv, ranking.csv and the tables of comparison.md.
 struct ComparisonRows {
   std::vector<ModelMetrics> metrics;

@@ -215,6 +215,7 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   bool static_factor_valid_ = false;
   long relaxation_factorisations_ = 0;
   double snap_relax_threshold_m_ = 20e-6;
+  double checked_force_N_ = 0.0;  ///< contact force the last breakthrough check computed on the current state (NaN: none)
   long mass_only_setups_ = 0;
   double factorisation_seconds_ = 0.0;
   std::vector<double> decay_rates_;
