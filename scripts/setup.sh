@@ -12,6 +12,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev googletest libbenchmark-dev  # tests, benchmarks
   libdeal.ii-dev                    # reference_fem (brings Trilinos, p4est, MPI)
   libsundials-dev                   # integrators
+  libsuitesparse-dev                # CHOLMOD: the volumetric comparison models' sparse Cholesky
   libcgal-dev                       # meshing
   libvtk9-dev                       # VTK output
   libnlopt-cxx-dev libnlopt-dev libgsl-dev   # calibration

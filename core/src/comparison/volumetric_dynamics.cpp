@@ -136,14 +136,10 @@ int VolumetricNeedleModel::preconditioner_setup(double, const double* yp, bool j
       it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
     }
   }
-  if (!pattern_analysed_) {
-    factor_.analyzePattern(system_);
-    pattern_analysed_ = true;
-  }
-  factor_.factorize(system_);
+  const bool factorised = factor_.factorize(system_);
   factorisation_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++factorisations_;
-  if (factor_.info() != Eigen::Success) {
+  if (!factorised) {
     have_factor_ = false;
     return 1;
   }

@@ -174,7 +174,11 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
         changed = true;
       }
   }
-  while (active_ < layers_.size()) {
+  // No node joins the contact set while the needle is withdrawn: a released
+  // surface that recovers behind the retreating tip would otherwise be put
+  // back onto it, be released again in tension on the next step, and so on
+  // (a contact chatter that restarted the integrator at every haptic step).
+  while (active_ < layers_.size() && !withdrawing) {
     LayerRuntime& layer = layers_[active_];
     bool started_now = false;
     for (int a : layer.candidates) {
@@ -474,8 +478,7 @@ ModelSize VolumetricNeedleModel::model_size() const {
   if (settings_.integrator == IntegratorKind::ImplicitBdf) {
     const std::size_t nnz = static_cast<std::size_t>(tangent_.matrix().nonZeros());
     bytes += 3 * nnz * (sizeof(double) + sizeof(int));  // tangent, full and eliminated system
-    if (pattern_analysed_)
-      bytes += static_cast<std::size_t>(factor_.matrixL().nestedExpression().nonZeros()) * (sizeof(double) + sizeof(int));
+    bytes += factor_.factor_nonzeros() * (sizeof(double) + sizeof(int));
     // SUNDIALS BDF history (up to 6 vectors) and GMRES basis (krylov + 2 vectors).
     bytes += 18 * static_cast<std::size_t>(y_.size()) * sizeof(double);
   } else {
@@ -520,9 +523,9 @@ std::string VolumetricNeedleModel::integrator_report() const {
   out << to_string(integrator_->kind()) << ": " << s.steps << " steps, " << s.rhs_evaluations
       << " rhs evaluations, " << s.linear_iterations << " GMRES iterations, " << s.preconditioner_setups
       << " preconditioner set-ups, " << s.error_test_failures << " error-test and " << s.convergence_failures
-      << " convergence failures; " << factorisations_ << " sparse LDL^T factorisations (" << factorisation_seconds_
-      << " s), " << mass_only_setups_ << " diagonal preconditioners; " << relaxations_
-      << " static relaxations after a contact jump (" << relaxation_factorisations_ << " factorisations); "
+      << " convergence failures; " << factorisations_ << " sparse Cholesky factorisations (" << factorisation_seconds_
+      << " s; " << factor_.fallbacks() << " by the LDL^T fallback), " << mass_only_setups_ << " diagonal preconditioners; " << relaxations_
+      << " static relaxations after a contact jump (" << relaxation_factorisations_ << " LDL^T factorisations); "
       << s.reinitialisations << " restarts (contact, puncture, speed changes), " << failure_restarts_
       << " of them after an integration failure";
   return out.str();

@@ -21,7 +21,9 @@
 //   * contact force = sum over contact nodes of the z component of the
 //     internal force on them (N, positive resisting insertion);
 //   * during withdrawal a contact node whose reaction turns to tension is
-//     released (no adhesion);
+//     released (no adhesion), and no node joins the contact set (a surface
+//     recovering behind the retreating tip would otherwise chatter between
+//     contact and release at every step);
 //   * breakthrough: the layer's rule of the scene (layer_breakthrough.hpp):
 //     a critical contact force, a critical work of the needle on the layer, or
 //     the ring-w rule (ring_criterion.hpp) on the deflection of the active
@@ -48,7 +50,7 @@
 // preconditioned exactly (up to lagging) by eliminating x:
 //   ((1 + gamma alpha) M + gamma beta K0 + gamma^2 K) b = M r_v - gamma K r_x,  a = r_x + gamma b
 // with the law's tangent K at the last setup (prescribed and fixed degrees of
-// freedom eliminated), factorised by a sparse LDL^T (Eigen); laws with an exact
+// freedom eliminated), factorised by a sparse Cholesky (sparse_spd_factor.hpp); laws with an exact
 // tangent also give the Jacobian-vector product from it. The factorisation is
 // reused while gamma stays within a factor 5 of the one it was made with and
 // no Newton iteration has failed to converge since it was made, across new
@@ -72,6 +74,7 @@
 #include "puncture/comparison/comparison_model.hpp"
 #include "puncture/comparison/internal_forces.hpp"
 #include "puncture/comparison/layer_breakthrough.hpp"
+#include "puncture/comparison/sparse_spd_factor.hpp"
 #include "puncture/comparison/sundials_integrator.hpp"
 #include "puncture/comparison/tet_mesh.hpp"
 
@@ -198,8 +201,7 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   NodeBlockMatrix rest_tangent_;       ///< K0 (for the stiffness-proportional damping)
   Eigen::SparseMatrix<double> system_; ///< (1 + gamma alpha) M + gamma^2 K, eliminated
   Eigen::SparseMatrix<double> full_;   ///< the same before elimination
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor_;
-  bool pattern_analysed_ = false;
+  SparseSpdFactor factor_;
   bool have_tangent_ = false;
   bool have_factor_ = false;
   bool mass_only_ = false;          ///< the last setup chose the diagonal preconditioner
@@ -210,6 +212,9 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   Eigen::VectorXd diagonal_;
   long factorisations_ = 0;
   long relaxations_ = 0;
+  /// The static relaxation's tangent K alone (no mass: at most positive
+  /// semi-definite for a mass-spring network) keeps Eigen's LDL^T, whose
+  /// equilibria the quasi-static identification was made with.
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> static_solver_;
   bool static_pattern_analysed_ = false;
   bool static_factor_valid_ = false;

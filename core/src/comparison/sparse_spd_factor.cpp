@@ -1,0 +1,63 @@
+// sparse_spd_factor.cpp: CHOLMOD supernodal Cholesky with Eigen's simplicial
+// LDL^T as the fallback; see sparse_spd_factor.hpp.
+#include "puncture/comparison/sparse_spd_factor.hpp"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/SparseCholesky>
+
+namespace puncture::comparison {
+
+struct SparseSpdFactor::Impl {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> cholesky;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+  bool analysed = false;
+  bool ldlt_analysed = false;
+  bool use_ldlt = false;  ///< the last factorisation is the fallback's
+  long fallbacks = 0;
+
+  Impl() {
+    // Not positive definite is an expected outcome here (the fallback
+    // follows): no messages from CHOLMOD's error handler.
+    cholesky.cholmod().print = 0;
+    cholesky.cholmod().error_handler = nullptr;
+  }
+};
+
+SparseSpdFactor::SparseSpdFactor() : impl_(std::make_unique<Impl>()) {}
+SparseSpdFactor::~SparseSpdFactor() = default;
+
+bool SparseSpdFactor::factorize(const Eigen::SparseMatrix<double>& A) {
+  Impl& s = *impl_;
+  if (!s.analysed) {
+    s.cholesky.analyzePattern(A);
+    s.analysed = true;
+  }
+  s.cholesky.factorize(A);
+  s.use_ldlt = s.cholesky.info() != Eigen::Success;
+  if (!s.use_ldlt) return true;
+  ++s.fallbacks;
+  if (!s.ldlt_analysed) {
+    s.ldlt.analyzePattern(A);
+    s.ldlt_analysed = true;
+  }
+  s.ldlt.factorize(A);
+  return s.ldlt.info() == Eigen::Success;
+}
+
+Eigen::VectorXd SparseSpdFactor::solve(const Eigen::VectorXd& b) const {
+  return impl_->use_ldlt ? Eigen::VectorXd(impl_->ldlt.solve(b)) : Eigen::VectorXd(impl_->cholesky.solve(b));
+}
+
+void SparseSpdFactor::reset() { impl_ = std::make_unique<Impl>(); }
+
+bool SparseSpdFactor::analysed() const { return impl_->analysed; }
+
+std::size_t SparseSpdFactor::factor_nonzeros() const {
+  if (!impl_->analysed) return 0;
+  if (impl_->use_ldlt) return static_cast<std::size_t>(impl_->ldlt.matrixL().nestedExpression().nonZeros());
+  return static_cast<std::size_t>(const_cast<Impl&>(*impl_).cholesky.cholmod().lnz);
+}
+
+long SparseSpdFactor::fallbacks() const { return impl_->fallbacks; }
+
+}  // namespace puncture::comparison
