@@ -20,6 +20,9 @@ cd "$root"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 out=results/comparison/default_scene
 rm -rf "$out.previous"; [ -d "$out" ] && mv "$out" "$out.previous"
+# Interrupted (Ctrl-C, kill): the previous folder back in place.
+restore() { rm -rf "$out"; [ -d "$out.previous" ] && mv "$out.previous" "$out"; }
+trap 'restore; echo "results_comparison.sh: interrupted; $out left as it was" >&2; exit 130' INT TERM HUP
 start=$(date +%s)
 if mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" compare results/tuned_preset/default_tuned.json \
   --cases validation/cases/default_heldout.json --frames 4 -o "$out"; then
@@ -27,7 +30,7 @@ if mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" compare resul
   echo "wrote $out in $(( $(date +%s) - start )) s"
 else
   status=$?
-  rm -rf "$out"; [ -d "$out.previous" ] && mv "$out.previous" "$out"
+  restore
   echo "results_comparison.sh: puncture compare failed (exit $status); $out left as it was" >&2
   exit "$status"
 fi
