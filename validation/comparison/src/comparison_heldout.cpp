@@ -3,10 +3,13 @@
 #include "comparison_heldout.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <sstream>
+#include <thread>
 
 #include "comparison_runs.hpp"
 #include "comparison_tables.hpp"
@@ -21,40 +24,43 @@ namespace {
 
 constexpr double kMm = 1e-3;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr int kHeldOutThreads = 2;
 
-/// Every model on one case.
-void run_case(const ComparisonCase& c, const Scene& scene, const std::map<std::string, Scene>& model_scenes,
-              const ComparisonReportOptions& options, std::vector<HeldOutRow>& rows, std::ostream& out,
-              std::ostream& err) {
-  const Scene case_base = case_scene(scene_to_json_text(scene), scene.name, c.validation_case).scene;
-  const ComparisonReference reference = read_comparison_reference(case_base, c.fem.dir);
-  // The case's slab and depth have their own mesh.
+/// One case as the models see it: its base scene, its FEM reference and, if
+/// a volumetric model is compared, its own tetrahedral mesh (slab and depth).
+struct CaseSetup {
+  Scene base;
+  ComparisonReference reference;
   std::shared_ptr<const comparison::TetMesh> mesh;
+};
+
+CaseSetup setup_case(const ComparisonCase& c, const Scene& scene, const std::map<std::string, Scene>& model_scenes) {
+  CaseSetup setup;
+  setup.base = case_scene(scene_to_json_text(scene), scene.name, c.validation_case).scene;
+  setup.reference = read_comparison_reference(setup.base, c.fem.dir);
   if (std::any_of(model_scenes.begin(), model_scenes.end(),
                   [](const auto& m) { return comparison::is_volumetric_model(m.first); }))
-    mesh = std::make_shared<comparison::TetMesh>(meshing::build_comparison_tet_mesh(case_base));
-  for (const std::string& key : options.models) {
-    const auto it = model_scenes.find(key);
-    if (it == model_scenes.end()) continue;  // "fem"
-    const Scene model_scene =
-        case_scene(scene_to_json_text(it->second), key + " model scene", c.validation_case).scene;
-    if (!options.quiet)
-      out << "[compare] case " << c.validation_case.name << ": " << key << " ...\n" << std::flush;
-    std::unique_ptr<comparison::ComparisonModel> model =
-        comparison::make_comparison_model(key, model_scene, comparison::is_volumetric_model(key) ? mesh : nullptr);
-    ModelRunOptions run_options;
-    run_options.profile_depths_m = reference.profile_depths_m;
-    run_options.profile_radii_m = reference.profile_radii_m;
-    ModelRun run = run_comparison_model(*model, model_scene, run_options);
-    run.model = key;
-    if (run.failed()) err << "warning: " << key << " failed on case " << c.validation_case.name << " " << run.failure << "\n";
-    HeldOutRow row;
-    row.case_name = c.validation_case.name;
-    row.held_out = c.validation_case.held_out;
-    row.metrics = metrics_against_reference(model_scene, run, reference.data, trajectory_steps(model_scene));
-    row.failure = run.failure;
-    rows.push_back(row);
-  }
+    setup.mesh = std::make_shared<comparison::TetMesh>(meshing::build_comparison_tet_mesh(setup.base));
+  return setup;
+}
+
+/// One model on one case: its row.
+HeldOutRow run_model_on_case(const ComparisonCase& c, const CaseSetup& setup, const std::string& key,
+                             const Scene& identified_scene) {
+  const Scene model_scene = case_scene(scene_to_json_text(identified_scene), key + " model scene", c.validation_case).scene;
+  std::unique_ptr<comparison::ComparisonModel> model =
+      comparison::make_comparison_model(key, model_scene, comparison::is_volumetric_model(key) ? setup.mesh : nullptr);
+  ModelRunOptions run_options;
+  run_options.profile_depths_m = setup.reference.profile_depths_m;
+  run_options.profile_radii_m = setup.reference.profile_radii_m;
+  ModelRun run = run_comparison_model(*model, model_scene, run_options);
+  run.model = key;
+  HeldOutRow row;
+  row.case_name = c.validation_case.name;
+  row.held_out = c.validation_case.held_out;
+  row.metrics = metrics_against_reference(model_scene, run, setup.reference.data, trajectory_steps(model_scene));
+  row.failure = run.failure;
+  return row;
 }
 
 double mean_of_finite(const std::vector<double>& values) {
@@ -70,15 +76,46 @@ double mean_of_finite(const std::vector<double>& values) {
 std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std::string, Scene>& model_scenes,
                                           const ComparisonReportOptions& options, std::ostream& out,
                                           std::ostream& err) {
-  std::vector<HeldOutRow> rows;
+  // Every (held-out case, model) pair is one independent run; they share
+  // nothing but the case's mesh and reference (read only), so they run two
+  // at a time (one per core of the reference machine). A case that is not
+  // held out is the calibration trajectory: the main table's runs.
+  std::vector<CaseSetup> setups(options.cases.size());
+  std::vector<std::pair<std::size_t, std::string>> jobs;
   for (std::size_t i = 0; i < options.cases.size(); ++i) {
-    // A case that is not held out is the calibration trajectory: the main table's runs.
     if (!options.cases[i].validation_case.held_out) continue;
-    if (!options.quiet)
-      out << "[compare] case " << i + 1 << "/" << options.cases.size() << ": " << options.cases[i].validation_case.name
-          << "\n" << std::flush;
-    run_case(options.cases[i], scene, model_scenes, options, rows, out, err);
+    setups[i] = setup_case(options.cases[i], scene, model_scenes);
+    for (const std::string& key : options.models)
+      if (model_scenes.count(key)) jobs.emplace_back(i, key);  // not "fem"
   }
+  std::vector<HeldOutRow> rows(jobs.size());
+  std::atomic<std::size_t> next{0};
+  std::mutex report_mutex;
+  const auto worker = [&]() {
+    for (std::size_t j = next++; j < jobs.size(); j = next++) {
+      const ComparisonCase& c = options.cases[jobs[j].first];
+      const std::string& key = jobs[j].second;
+      if (!options.quiet) {
+        const std::lock_guard<std::mutex> lock(report_mutex);
+        out << "[compare] case " << c.validation_case.name << ": " << key << " ...\n" << std::flush;
+      }
+      try {
+        rows[j] = run_model_on_case(c, setups[jobs[j].first], key, model_scenes.at(key));
+      } catch (const std::exception& e) {  // the model could not be built on this case
+        rows[j].case_name = c.validation_case.name;
+        rows[j].held_out = c.validation_case.held_out;
+        rows[j].metrics.model = key;
+        rows[j].failure = e.what();
+      }
+      if (!rows[j].failure.empty()) {
+        const std::lock_guard<std::mutex> lock(report_mutex);
+        err << "warning: " << key << " failed on case " << c.validation_case.name << " " << rows[j].failure << "\n";
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 0; t < std::min<int>(kHeldOutThreads, static_cast<int>(jobs.size())); ++t) threads.emplace_back(worker);
+  for (std::thread& t : threads) t.join();
   return rows;
 }
 

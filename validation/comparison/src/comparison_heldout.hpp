@@ -11,7 +11,9 @@
 //   trajectory, the main table): the case's overrides applied to each model's scene
 //   (case_scene), a tetrahedral mesh of the case's slab when a volumetric
 //   model is compared, every model run along the case's trajectory and
-//   measured against the case's FEM (metrics_against_reference).
+//   measured against the case's FEM (metrics_against_reference). The
+//   (case, model) runs are independent and run two at a time, one per core
+//   (their step times are those of a run beside one other).
 //   Out: one row per case and model (ModelMetrics, the case's name and
 //   whether it is held out).
 // heldout_csv: those rows (heldout.csv).

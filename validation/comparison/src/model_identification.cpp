@@ -86,6 +86,16 @@ Window window_of(const ModelRun& run, const ReferenceData& reference, double fro
   return w;
 }
 
+/// The reference's samples of the insertion in [from, to) (before any model
+/// run: a window with fewer than two is not fitted, and its run is saved).
+std::size_t reference_samples_in(const ReferenceData& reference, double from_m, double to_m) {
+  const InsertionCurve& curve = reference.curve;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < curve.size(); ++i)
+    n += curve.velocity_m_per_s[i] > 0.0 && curve.depth_m[i] >= from_m && curve.depth_m[i] < to_m;
+  return n;
+}
+
 /// (model contact force - target) / scale at the window's depths; false if a depth is not reached.
 bool window_residuals(const ModelRun& run, const Window& w, std::vector<double>& r) {
   r.resize(w.depth_m.size());
@@ -196,6 +206,12 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
   // 1. The factors, bottom up: a layer's force depends on the layers below it
   //    (and hardly on the punctured ones above), whose factors are then known.
   for (std::size_t k = depths_m.size(); identify_stiffness && k-- > 0;) {
+    const std::size_t samples =
+        segments[k].has_pressing ? reference_samples_in(reference, segments[k].pressing_from_m, depths_m[k]) : 0;
+    if (samples < 2) {  // nothing to fit: the factor stays 1, no run
+      result.layers[k].window_samples = samples;
+      continue;
+    }
     prepare_layer_run(trial, k, depths_m);
     const ModelRun run = run_until(model, trial, mesh, until_s[k]);
     ++result.model_runs;
