@@ -8,7 +8,7 @@
 namespace puncture::comparison {
 
 struct SparseSpdFactor::Impl {
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> cholesky;
+  mutable Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> cholesky;  ///< mutable: its cholmod() accessor is not const
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
   bool analysed = false;
   bool ldlt_analysed = false;
@@ -48,14 +48,12 @@ Eigen::VectorXd SparseSpdFactor::solve(const Eigen::VectorXd& b) const {
   return impl_->use_ldlt ? Eigen::VectorXd(impl_->ldlt.solve(b)) : Eigen::VectorXd(impl_->cholesky.solve(b));
 }
 
-void SparseSpdFactor::reset() { impl_ = std::make_unique<Impl>(); }
-
 bool SparseSpdFactor::analysed() const { return impl_->analysed; }
 
 std::size_t SparseSpdFactor::factor_nonzeros() const {
   if (!impl_->analysed) return 0;
   if (impl_->use_ldlt) return static_cast<std::size_t>(impl_->ldlt.matrixL().nestedExpression().nonZeros());
-  return static_cast<std::size_t>(const_cast<Impl&>(*impl_).cholesky.cholmod().lnz);
+  return static_cast<std::size_t>(impl_->cholesky.cholmod().lnz);
 }
 
 long SparseSpdFactor::fallbacks() const { return impl_->fallbacks; }

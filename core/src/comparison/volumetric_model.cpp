@@ -197,10 +197,11 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
       dof_[static_cast<std::size_t>(a)] = Dof::Contact;
       changed = true;
     }
-    // Layers break only while the needle advances, and not on the step their
-    // contact starts: a surface put onto the tip from above is brought to
-    // equilibrium below first (its force before that is the snap's).
-    if (!layer.contact_started || withdrawing || started_now) break;
+    // Layers break only while the needle advances (the loop's condition),
+    // and not on the step their contact starts: a surface put onto the tip
+    // from above is brought to equilibrium below first (its force before
+    // that is the snap's).
+    if (!layer.contact_started || started_now) break;
     std::vector<double> deflection;
     if (layer.breakthrough.needs_deflection()) {
       deflection = layer.ring_probe.deflection_m(y_, mesh_->points_m);

@@ -215,9 +215,8 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
     prepare_layer_run(trial, k, depths_m);
     const ModelRun run = run_until(model, trial, mesh, until_s[k]);
     ++result.model_runs;
-    const Window window = segments[k].has_pressing && !run.failed()
-                              ? window_of(run, reference, segments[k].pressing_from_m, depths_m[k])
-                              : Window{};
+    const Window window =
+        run.failed() ? Window{} : window_of(run, reference, segments[k].pressing_from_m, depths_m[k]);
     if (window.depth_m.size() < 2) continue;
     LayerIdentification& layer = result.layers[k];
     layer.stiffness_scale =

@@ -1,10 +1,10 @@
 // sparse_spd_factor.hpp: the sparse direct solver of the volumetric
-// comparison models (the Newton matrix of their implicit integrator and the
-// tangent of their static relaxation).
+// comparison models' implicit integrator (its Newton matrix; the static
+// relaxation keeps Eigen's LDL^T, see volumetric_model.hpp).
 //
 // In:  a sparse symmetric matrix A (n x n, both triangles stored; only the
 //      lower one is read), factorised again whenever its values change; its
-//      pattern is analysed once (a new pattern: call reset()).
+//      pattern is analysed once (a new pattern needs a new SparseSpdFactor).
 // Out: x = A^-1 b (n).
 //
 // CHOLMOD's supernodal Cholesky A = L L^T (SuiteSparse; fill-reducing
@@ -31,13 +31,11 @@ class SparseSpdFactor {
   SparseSpdFactor(const SparseSpdFactor&) = delete;
   SparseSpdFactor& operator=(const SparseSpdFactor&) = delete;
 
-  /// Factorises A (analysing its pattern on the first call after construction
-  /// or reset()). False if A could not be factorised.
+  /// Factorises A (analysing its pattern on the first call). False if A
+  /// could not be factorised.
   bool factorize(const Eigen::SparseMatrix<double>& A);
   /// x = A^-1 b with the last successful factorisation.
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
-  /// Forget the analysed pattern.
-  void reset();
 
   bool analysed() const;
   /// Non-zeros of the factor L (for memory estimates).
