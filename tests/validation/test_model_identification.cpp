@@ -55,6 +55,29 @@ double first_puncture_depth(const validation::ModelRun& run, std::size_t k) {
   return -1.0;
 }
 
+/// The curve without the loading samples strictly between from_m and to_m
+/// but the last one before to_m (a reference sampled too coarsely there).
+validation::InsertionCurve thinned(const validation::InsertionCurve& c, double from_m, double to_m) {
+  validation::InsertionCurve t = c;
+  std::vector<std::size_t> keep;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const bool inside = c.velocity_m_per_s[i] > 0.0 && c.depth_m[i] > from_m && c.depth_m[i] < to_m;
+    const bool last_inside = inside && i + 1 < c.size() && c.depth_m[i + 1] >= to_m;
+    if (!inside || last_inside) keep.push_back(i);
+  }
+  auto pick = [&](auto& v, const auto& from) {
+    if (from.empty()) return;
+    v.clear();
+    for (std::size_t i : keep) v.push_back(from[i]);
+  };
+  pick(t.time_s, c.time_s), pick(t.depth_m, c.depth_m), pick(t.velocity_m_per_s, c.velocity_m_per_s);
+  pick(t.force_N, c.force_N), pick(t.phase, c.phase);
+  pick(t.tip_force_N, c.tip_force_N), pick(t.cutting_force_N, c.cutting_force_N);
+  pick(t.friction_force_N, c.friction_force_N);
+  for (std::size_t k = 0; k < c.layer_states.size(); ++k) pick(t.layer_states[k], c.layer_states[k]);
+  return t;
+}
+
 TEST(ModelIdentification, LinearModelRecoversTheFactorsAndForcesOfAReferenceMadeByItself) {
   const std::vector<double> scale{2.0, 0.5, 1.5};
   const Reference reference = reference_of(scale, {4e-3, 3e-3, 5e-3});
@@ -113,6 +136,37 @@ TEST(ModelIdentification, ALayerTheReferenceDoesNotPunctureIsNotIdentified) {
   const Scene identified = validation::with_identified_parameters(scene, id);
   EXPECT_EQ(identified.layers[1].force_law.breakthrough.kind, scene.layers[1].force_law.breakthrough.kind);
   EXPECT_EQ(identified.comparison.stiffness_scale[1], 1.0);
+}
+
+TEST(ModelIdentification, ALayerWithFewerThanTwoReferenceSamplesWhilePressedIsNotRunForItsFactor) {
+  // The reference sampled only once while it presses the fat: the fat's
+  // factor stays 1 and no run is spent on it (the start run and the
+  // optimiser's runs of the full reference), its window RMSE is not a number
+  // (not fitted, not "0"), and its critical force is still identified.
+  const Reference full = reference_of({2.0, 0.5, 1.5}, {4e-3, 3e-3, 5e-3});
+  const Scene scene = default_scene();
+  const validation::ModelIdentification all =
+      validation::identify_comparison_model("bem", scene, nullptr, full.data, true);
+  validation::ReferenceData coarse = full.data;
+  coarse.curve = thinned(full.data.curve, first_puncture_depth(full.run, 0), first_puncture_depth(full.run, 1));
+  ASSERT_LT(coarse.curve.size(), full.data.curve.size());
+  const validation::ModelIdentification id =
+      validation::identify_comparison_model("bem", scene, nullptr, coarse, true);
+  ASSERT_EQ(id.layers.size(), 3u);
+  const validation::LayerIdentification& fat = id.layers[1];
+  EXPECT_TRUE(fat.identified) << fat.note;
+  EXPECT_LT(fat.window_samples, 2u);
+  EXPECT_EQ(fat.stiffness_scale, 1.0);
+  EXPECT_FALSE(std::isfinite(fat.window_rmse_before_N));
+  EXPECT_FALSE(std::isfinite(fat.window_rmse_after_N));
+  EXPECT_NEAR(fat.reference_depth_m, first_puncture_depth(full.run, 1), 1e-12);
+  EXPECT_GT(all.layers[1].window_samples, 10u);
+  EXPECT_NE(all.layers[1].stiffness_scale, 1.0);
+  // The fat's start run and its optimiser runs (at least two) are saved.
+  EXPECT_LE(id.model_runs + 2, all.model_runs);
+  // The other layers are fitted as before.
+  EXPECT_NEAR(id.layers[2].stiffness_scale, all.layers[2].stiffness_scale, 1e-9);
+  EXPECT_GT(id.layers[0].window_samples, 10u);
 }
 
 }  // namespace

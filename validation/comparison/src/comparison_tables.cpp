@@ -90,6 +90,14 @@ void markdown_heldout(std::ostringstream& md, const ComparisonContent& c) {
      << ranking_markdown(c.outcome.heldout_grade, c.weights) << "\n";
 }
 
+/// The window RMSE column: "before -> after", or why the factor was not
+/// fitted (fewer than two reference samples while the FEM presses the layer).
+std::string window_rmse_cell(const nlohmann::json& layer) {
+  const auto samples = layer.value("window_samples", std::size_t{0});
+  if (samples < 2) return "not fitted (" + std::to_string(samples) + " FEM samples while pressed)";
+  return shown(layer.value("window_rmse_before_N", kNaN)) + " -> " + shown(layer.value("window_rmse_after_N", kNaN));
+}
+
 /// comparison.md: the identified stiffness factors and critical forces, one row per model and layer.
 void markdown_model_identification(std::ostringstream& md, const nlohmann::json& identification) {
   if (identification.empty()) return;
@@ -106,9 +114,8 @@ void markdown_model_identification(std::ostringstream& md, const nlohmann::json&
       md << "| " << model << " | " << layer["layer"].get<std::string>() << " | "
          << shown(layer.value("reference_depth_mm", kNaN), 4) << " | ";
       if (layer.value("identified", false))
-        md << shown(layer["stiffness_scale"].get<double>(), 4) << " | "
-           << shown(layer.value("window_rmse_before_N", kNaN)) << " -> " << shown(layer.value("window_rmse_after_N", kNaN))
-           << " | " << shown(layer["critical_force_N"].get<double>(), 4);
+        md << shown(layer["stiffness_scale"].get<double>(), 4) << " | " << window_rmse_cell(layer) << " | "
+           << shown(layer["critical_force_N"].get<double>(), 4);
       else
         md << "- | - | not identified: " << layer.value("note", std::string());
       md << " | " << record["model_runs"].get<int>() << " | " << shown(record["wall_time_s"].get<double>()) << " |\n";

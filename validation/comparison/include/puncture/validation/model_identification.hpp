@@ -45,6 +45,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -62,8 +63,10 @@ struct LayerIdentification {
   double critical_force_N = 0.0;
   double reference_depth_m = 0.0;     ///< the reference's puncture depth (m; NaN if none)
   std::size_t window_samples = 0;     ///< reference samples the scale was fitted on
-  double window_rmse_before_N = 0.0;  ///< force RMSE over them with s_k = 1 (N)
-  double window_rmse_after_N = 0.0;   ///< and with the identified s_k (N)
+  /// Force RMSE over them with s_k = 1 and with the identified s_k (N; NaN
+  /// when the factor was not fitted: fewer than two samples).
+  double window_rmse_before_N = std::numeric_limits<double>::quiet_NaN();
+  double window_rmse_after_N = std::numeric_limits<double>::quiet_NaN();
   std::string note;                   ///< why not identified (empty when identified)
   std::string stiffness_note;         ///< why the factor was kept at 1 (empty when fitted)
 };
