@@ -40,6 +40,10 @@ namespace puncture::apps {
 
 namespace {
 
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 std::string shown(double x) { return std::isfinite(x) ? validation::significant_digits(x, 3) : "n/a"; }
 
 std::string joined(const std::vector<std::string>& v, const std::string& separator) {
@@ -90,8 +94,9 @@ std::vector<validation::ComparisonCase> case_references(const std::filesystem::p
   for (std::size_t i = 0; i < cases.cases.size(); ++i) {
     out << "[compare] FEM reference of case " << i + 1 << "/" << cases.cases.size() << ": " << cases.cases[i].name
         << "\n" << std::flush;
+    const auto start = std::chrono::steady_clock::now();
     const validation::FemReference fem = validation::obtain_fem_reference(scenes[i], fem_options, out);
-    references.push_back({cases.cases[i], {fem.dir, fem.hash, fem.from_cache}});
+    references.push_back({cases.cases[i], {fem.dir, fem.hash, fem.from_cache, seconds_since(start)}});
   }
   return references;
 }
@@ -159,6 +164,7 @@ int compare_command(const CompareOptions& options, std::ostream& out, std::ostre
     if (!options.cache_dir.empty()) fem_options.cache_dir = options.cache_dir;
     fem_options.verbose = !options.quiet;
     const validation::FemReference reference = validation::obtain_fem_reference(scene, fem_options, out);
+    const double reference_wall_time_s = seconds_since(report.wall_start);
     if (!options.cases.empty()) {
       report.cases = case_references(scene_path, options.cases, fem_options, out);
       report.cases_file = options.cases.string();
@@ -174,7 +180,7 @@ int compare_command(const CompareOptions& options, std::ostream& out, std::ostre
     report.quiet = options.quiet;
     report.command_line = compare_command_line(options, scene_path, report.output_dir);
     const validation::ComparisonOutcome outcome = validation::write_model_comparison(
-        scene, weights, {reference.dir, reference.hash, reference.from_cache}, report, out, err);
+        scene, weights, {reference.dir, reference.hash, reference.from_cache, reference_wall_time_s}, report, out, err);
     print_summary(outcome, options, report.output_dir, out);
     return 0;
   });

@@ -12,7 +12,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "puncture/apps/commands.hpp"
 #include "puncture/validation/fem_reference.hpp"
@@ -325,6 +328,24 @@ TEST(CompareCommand, ModelsBreakWhereTheFemDoesAndAreJudgedOnHeldOutCases) {
   text << md.rdbuf();
   EXPECT_NE(text.str().find("## Ranking on the held-out cases"), std::string::npos);
   EXPECT_NE(text.str().find("## Every model identified against the FEM"), std::string::npos);
+  EXPECT_NE(text.str().find("## Where the time goes"), std::string::npos);
+  // The time budget: every phase measured (none negative), the models'
+  // identifications and the held-out phase among them, adding up to the total.
+  std::ifstream summary_file(options.output_dir / "comparison_summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  const double total_s = summary["wall_time_s"].get<double>();
+  double sum_s = 0.0;
+  std::set<std::string> phases;
+  for (const nlohmann::json& e : summary["time_budget"]) {
+    const double s = e["wall_time_s"].get<double>();
+    EXPECT_GE(s, 0.0) << e.dump();
+    sum_s += s;
+    phases.insert(e["phase"].get<std::string>());
+  }
+  EXPECT_NEAR(sum_s, total_s, 1e-6 * total_s);
+  for (const char* p : {"FEM reference, calibration trajectory", "FEM references, 2 cases", "mass_tensor: identification",
+                        "mass_tensor: calibration-trajectory run", "held-out phase", "the rest"})
+    EXPECT_EQ(phases.count(p), 1u) << p;
   if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -47,6 +48,7 @@ CaseSetup setup_case(const ComparisonCase& c, const Scene& scene, const std::map
 /// One model on one case: its row.
 HeldOutRow run_model_on_case(const ComparisonCase& c, const CaseSetup& setup, const std::string& key,
                              const Scene& identified_scene) {
+  const auto start = std::chrono::steady_clock::now();
   const Scene model_scene = case_scene(scene_to_json_text(identified_scene), key + " model scene", c.validation_case).scene;
   std::unique_ptr<comparison::ComparisonModel> model =
       comparison::make_comparison_model(key, model_scene, comparison::is_volumetric_model(key) ? setup.mesh : nullptr);
@@ -60,6 +62,7 @@ HeldOutRow run_model_on_case(const ComparisonCase& c, const CaseSetup& setup, co
   row.held_out = c.validation_case.held_out;
   row.metrics = metrics_against_reference(model_scene, run, setup.reference.data, trajectory_steps(model_scene));
   row.failure = run.failure;
+  row.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return row;
 }
 

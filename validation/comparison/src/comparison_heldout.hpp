@@ -40,6 +40,7 @@ struct HeldOutRow {
   bool held_out = true;
   ModelMetrics metrics;
   std::string failure;  ///< the model's run failure (empty when it completed)
+  double wall_time_s = 0.0;  ///< the model's build and run on the case, s
 };
 
 std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std::string, Scene>& model_scenes,

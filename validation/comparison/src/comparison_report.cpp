@@ -4,6 +4,7 @@
 #include "puncture/validation/comparison_report.hpp"
 
 #include <algorithm>
+#include <chrono>
 
 #include "comparison_heldout.hpp"
 #include "comparison_runs.hpp"
@@ -48,7 +49,9 @@ ComparisonOutcome write_model_comparison(const Scene& scene, const DelphiWeights
   session.write_text("ranking.csv", ranking_csv(outcome.grade));
 
   // Held out: every model as identified above, on the cases' trajectories and slabs.
+  const auto heldout_start = std::chrono::steady_clock::now();
   const std::vector<HeldOutRow> heldout = run_heldout_cases(scene, runner.model_scenes(), options, out, err);
+  const double heldout_wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - heldout_start).count();
   if (!heldout.empty()) {
     session.write_text("heldout.csv", heldout_csv(scene, heldout));
     outcome.heldout_metrics = aggregate_heldout(heldout, options.models);
@@ -61,7 +64,7 @@ ComparisonOutcome write_model_comparison(const Scene& scene, const DelphiWeights
   const ComparisonContent content{scene,         options, fem,     reference,      mesh,
                                   provenance,    runs,    identification, runner.identification_records(),
                                   rows,          outcome.grade, heldout, outcome,  weights,
-                                  wall_time_s};
+                                  wall_time_s,   heldout_wall_time_s};
   session.write_text("comparison_summary.json", summary_json(content).dump(2) + "\n");
   if (!runner.pvd().empty()) io::write_pvd(session, "comparison.pvd", runner.pvd());
   session.commit();

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include "puncture/comparison/tet_mesh.hpp"
@@ -142,6 +143,17 @@ void markdown_identification(std::ostringstream& md, const nlohmann::json& ident
   md << "\n";
 }
 
+/// comparison.md: where the wall time went (time_budget).
+void markdown_time_budget(std::ostringstream& md, const ComparisonContent& c) {
+  md << "## Where the time goes\n\nWall time of this command by phase (2 threads in the identifications' optimiser "
+        "and in the held-out phase; everything else on one core).\n\n| phase | wall time s | share | note |\n"
+        "|---|---|---|---|\n";
+  for (const TimeBudgetEntry& e : time_budget(c))
+    md << "| " << e.phase << " | " << shown(e.wall_time_s, 4) << " | " << shown(100.0 * e.wall_time_s / c.wall_time_s, 2)
+       << " % | " << e.note << " |\n";
+  md << "| **total** | **" << shown(c.wall_time_s, 4) << "** | 100 % | |\n\n";
+}
+
 /// comparison.md: the models' descriptions, the plots, the files.
 void markdown_models_and_files(std::ostringstream& md, const ComparisonContent& c,
                                const std::vector<std::string>& plots) {
@@ -254,6 +266,44 @@ nlohmann::json identification_record(const std::string& method, const Identifica
   return j;
 }
 
+std::vector<TimeBudgetEntry> time_budget(const ComparisonContent& c) {
+  std::vector<TimeBudgetEntry> budget;
+  const auto fem_note = [](const ComparisonFemReference& f) { return f.from_cache ? "from the cache" : "solved"; };
+  budget.push_back({"FEM reference, calibration trajectory", c.fem_entry.wall_time_s, fem_note(c.fem_entry)});
+  if (!c.options.cases.empty()) {
+    double seconds = 0.0;
+    int solved = 0;
+    for (const ComparisonCase& k : c.options.cases) seconds += k.fem.wall_time_s, solved += !k.fem.from_cache;
+    budget.push_back({"FEM references, " + std::to_string(c.options.cases.size()) + " cases", seconds,
+                      std::to_string(solved) + " solved, the others from the cache"});
+  }
+  if (c.mesh.mesh) budget.push_back({"tetrahedral mesh", c.mesh.report.wall_time_s, c.mesh.report.kind});
+  for (const auto& run : c.runs) {
+    if (c.model_identification.contains(run->model)) {
+      const nlohmann::json& id = c.model_identification[run->model];
+      budget.push_back({run->model + ": identification", id["wall_time_s"].get<double>(),
+                        std::to_string(id["model_runs"].get<int>()) + " model runs"});
+    }
+    budget.push_back({run->model + ": calibration-trajectory run", run->build_wall_time_s + run->run_wall_time_s,
+                      "build " + shown(run->build_wall_time_s) + " s"});
+  }
+  for (const auto& j : c.identification)
+    budget.push_back({"mass-spring identification, " + j["library"].get<std::string>(), j["wall_time_s"].get<double>(),
+                      std::to_string(j["evaluations"].get<int>()) + " evaluations of the quasi-static surrogate"});
+  if (!c.heldout.empty()) {
+    std::map<std::string, double> per_model;
+    for (const HeldOutRow& r : c.heldout) per_model[r.metrics.model] += r.wall_time_s;
+    std::string note = std::to_string(c.heldout.size()) + " runs, two at a time; run time per model:";
+    for (const auto& [model, seconds] : per_model) note += " " + model + " " + shown(seconds, 4) + " s,";
+    note.pop_back();
+    budget.push_back({"held-out phase", c.heldout_wall_time_s, note});
+  }
+  double accounted = 0.0;
+  for (const TimeBudgetEntry& e : budget) accounted += e.wall_time_s;
+  budget.push_back({"the rest", c.wall_time_s - accounted, "reading the references, metrics, tables and files (the plots come after)"});
+  return budget;
+}
+
 nlohmann::json summary_json(const ComparisonContent& c) {
   const Scene& scene = c.scene;
   nlohmann::json summary;
@@ -292,6 +342,10 @@ nlohmann::json summary_json(const ComparisonContent& c) {
   }
   summary["weights_file"] = c.options.weights_path.string();
   summary["wall_time_s"] = c.wall_time_s;
+  nlohmann::json budget = nlohmann::json::array();
+  for (const TimeBudgetEntry& e : time_budget(c))
+    budget.push_back({{"phase", e.phase}, {"wall_time_s", e.wall_time_s}, {"note", e.note}});
+  summary["time_budget"] = budget;
   return summary;
 }
 
@@ -302,6 +356,7 @@ std::string comparison_markdown(const ComparisonContent& content, const std::vec
   markdown_heldout(md, content);
   markdown_model_identification(md, content.model_identification);
   markdown_identification(md, content.identification);
+  markdown_time_budget(md, content);
   markdown_models_and_files(md, content, plots);
   return md.str();
 }

@@ -56,8 +56,19 @@ struct ComparisonContent {
   const std::vector<HeldOutRow>& heldout;  ///< empty without held-out cases
   const ComparisonOutcome& outcome;        ///< heldout_metrics, heldout_grade
   const DelphiWeights& weights;
-  double wall_time_s;
+  double wall_time_s;          ///< the whole command, s
+  double heldout_wall_time_s;  ///< the held-out phase (its runs two at a time), s
 };
+
+/// Where the command's wall time went: one entry per phase (FEM references,
+/// mesh, each model's identification and calibration-trajectory run, the
+/// held-out phase, the rest), in seconds; they add up to the total.
+struct TimeBudgetEntry {
+  std::string phase;
+  double wall_time_s;
+  std::string note;
+};
+std::vector<TimeBudgetEntry> time_budget(const ComparisonContent& content);
 
 nlohmann::json summary_json(const ComparisonContent& content);
 std::string comparison_markdown(const ComparisonContent& content, const std::vector<std::string>& plots);

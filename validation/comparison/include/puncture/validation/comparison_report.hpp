@@ -48,6 +48,7 @@ struct ComparisonFemReference {
   std::filesystem::path dir;  ///< directory with fem_force_depth.csv, fem_summary.json, ...
   std::string hash;           ///< cache key (shown in the report)
   bool from_cache = false;    ///< taken from the cache (else computed for this run)
+  double wall_time_s = 0.0;   ///< spent obtaining it in this command (reading the cache or solving), s
 };
 
 /// A case on which every model, identified once on the scene's trajectory, is
