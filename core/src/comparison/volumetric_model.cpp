@@ -227,6 +227,27 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
   return changed;
 }
 
+bool VolumetricNeedleModel::factorise_static_tangent(const Eigen::VectorXd& state) {
+  NodeBlockMatrix K(nodes_, tet_node_pairs(*mesh_));
+  law_->add_tangent(state.head(3 * nodes_), 0.0, K);
+  Eigen::SparseMatrix<double> A = K.matrix();
+  for (Eigen::Index j = 0; j < A.outerSize(); ++j) {
+    const bool col_free = dof_[static_cast<std::size_t>(j / 3)] == Dof::Free;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it) {
+      if (col_free && dof_[static_cast<std::size_t>(it.row() / 3)] == Dof::Free) continue;
+      it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
+    }
+  }
+  if (!static_pattern_analysed_) {
+    static_solver_.analyzePattern(A);
+    static_pattern_analysed_ = true;
+  }
+  static_solver_.factorize(A);
+  ++relaxation_factorisations_;
+  static_factor_valid_ = static_solver_.info() == Eigen::Success;
+  return static_factor_valid_;
+}
+
 void VolumetricNeedleModel::relax_to_equilibrium() {
   const int n3 = 3 * nodes_;
   Eigen::VectorXd state = y_;
@@ -236,26 +257,6 @@ void VolumetricNeedleModel::relax_to_equilibrium() {
     for (int d = 0; d < n3; ++d)
       if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) r[d] = 0.0;
     return r.norm();
-  };
-  auto factorise = [&]() {
-    NodeBlockMatrix K(nodes_, tet_node_pairs(*mesh_));
-    law_->add_tangent(state.head(n3), 0.0, K);
-    Eigen::SparseMatrix<double> A = K.matrix();
-    for (Eigen::Index j = 0; j < A.outerSize(); ++j) {
-      const bool col_free = dof_[static_cast<std::size_t>(j / 3)] == Dof::Free;
-      for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it) {
-        if (col_free && dof_[static_cast<std::size_t>(it.row() / 3)] == Dof::Free) continue;
-        it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
-      }
-    }
-    if (!static_pattern_analysed_) {
-      static_solver_.analyzePattern(A);
-      static_pattern_analysed_ = true;
-    }
-    static_solver_.factorize(A);
-    ++relaxation_factorisations_;
-    static_factor_valid_ = static_solver_.info() == Eigen::Success;
-    return static_factor_valid_;
   };
   Eigen::VectorXd r(n3), trial_r(n3);
   double norm = residual(state, r);
@@ -276,7 +277,7 @@ void VolumetricNeedleModel::relax_to_equilibrium() {
   int slow = 0;
   for (int iteration = 0; iteration < 40 && norm > target && slow < 3; ++iteration) {
     if (!static_factor_valid_) {
-      if (!factorise()) return;  // leave the state to the dynamics
+      if (!factorise_static_tangent(state)) return;  // leave the state to the dynamics
       fresh = true;
     }
     const Eigen::VectorXd step = static_solver_.solve(r);  // K dx = f (f = -dW/dx)
@@ -344,39 +345,87 @@ double VolumetricNeedleModel::contact_force_N() {
   return force;
 }
 
+void VolumetricNeedleModel::step_quasi_static(double t, double z_tip, bool withdrawing) {
+  started_ = true;
+  time_ = t;
+  for (int a = 0; a < nodes_; ++a)
+    if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * a + 2] = z_tip;
+  y_.segment(3 * nodes_, 3 * nodes_).setZero();
+  update_contacts(z_tip, 0.0, withdrawing);
+  relax_to_equilibrium();
+  y_.segment(3 * nodes_, 3 * nodes_).setZero();
+}
+
+void VolumetricNeedleModel::start_integration(double t, double z_tip, double velocity_z) {
+  started_ = true;
+  time_ = t;
+  needle_velocity_z_ = velocity_z;
+  IntegratorSettings integration;
+  integration.kind = settings_.integrator;
+  integration.relative_tolerance = settings_.relative_tolerance;
+  integration.max_bdf_order = 2;  // A-stable: the mesh's oscillations stay damped
+  integration.absolute_tolerance.resize(y_.size());
+  integration.absolute_tolerance.head(3 * nodes_).setConstant(settings_.absolute_tolerance_m);
+  integration.absolute_tolerance.segment(3 * nodes_, 3 * nodes_).setConstant(1e3 * settings_.absolute_tolerance_m);
+  if (extra_ > 0) integration.absolute_tolerance.tail(extra_).setConstant(law_->extra_state_abs_tolerance());
+  update_contacts(z_tip, velocity_z, false);
+  integrator_ = std::make_unique<SundialsIntegrator>(static_cast<OdeSystem&>(*this), integration, time_, y_);
+}
+
+void VolumetricNeedleModel::advance_dynamics(double t, double z_tip, double velocity_z) {
+  // The contact nodes follow the needle with its mean velocity over this step.
+  double z_contact = 0.0;
+  bool any_contact = false;
+  for (int a = 0; a < nodes_; ++a)
+    if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) {
+      z_contact = y_[3 * a + 2];
+      any_contact = true;
+      break;
+    }
+  double step_velocity = any_contact ? (z_tip - z_contact) / (t - time_) : velocity_z;
+  // Rounding of the positions must not count as a change of speed.
+  if (std::abs(step_velocity - needle_velocity_z_) <= 1e-9 * std::max(std::abs(step_velocity), 1e-6))
+    step_velocity = needle_velocity_z_;
+  if (any_contact && step_velocity != needle_velocity_z_) {
+    for (int a = 0; a < nodes_; ++a)
+      if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * nodes_ + 3 * a + 2] = step_velocity;
+    integrator_->reinit(time_, y_);
+  }
+  needle_velocity_z_ = step_velocity;
+  try {
+    integrator_->advance(t, y_);
+  } catch (const std::runtime_error&) {
+    // Recovery: the BDF history can lead the error test to fail over and
+    // over (h collapsing to ~1e-7 s) on a smooth stretch of the insertion;
+    // restart from the last accepted haptic state (order 1, new history,
+    // fresh tangent and factorisation) and try once more. A second failure
+    // stops the run with the integrator's message.
+    ++failure_restarts_;
+    have_tangent_ = false;
+    have_factor_ = false;
+    integrator_->reinit(time_, y_);
+    integrator_->advance(t, y_);
+  }
+  time_ = t;
+  for (int a = 0; a < nodes_; ++a)
+    if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * a + 2] = z_tip;
+}
+
 double VolumetricNeedleModel::step(const NeedleState& needle) {
   const double t = needle.time_s;
   const double z_tip = needle.tip_position_m.z();
   const double velocity_z = -needle.axial_velocity_m_per_s * needle.direction.dot(-Eigen::Vector3d::UnitZ());
+  const bool withdrawing = needle.axial_velocity_m_per_s < 0.0;
   if (!needle.tip_position_m.allFinite() || !std::isfinite(t))
     throw std::invalid_argument(name() + ": non-finite needle state");
   if (settings_.quasi_static) {
     // Equilibrium at every step (the identification's fast mode): contact
     // nodes move with the needle, no inertia, no damping.
-    started_ = true;
-    time_ = t;
-    for (int a = 0; a < nodes_; ++a)
-      if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * a + 2] = z_tip;
-    y_.segment(3 * nodes_, 3 * nodes_).setZero();
-    update_contacts(z_tip, 0.0, needle.axial_velocity_m_per_s < 0.0);
-    relax_to_equilibrium();
-    y_.segment(3 * nodes_, 3 * nodes_).setZero();
+    step_quasi_static(t, z_tip, withdrawing);
     return contact_force_N();
   }
   if (!started_) {
-    started_ = true;
-    time_ = t;
-    needle_velocity_z_ = velocity_z;
-    IntegratorSettings integration;
-    integration.kind = settings_.integrator;
-    integration.relative_tolerance = settings_.relative_tolerance;
-    integration.max_bdf_order = 2;  // A-stable: the mesh's oscillations stay damped
-    integration.absolute_tolerance.resize(y_.size());
-    integration.absolute_tolerance.head(3 * nodes_).setConstant(settings_.absolute_tolerance_m);
-    integration.absolute_tolerance.segment(3 * nodes_, 3 * nodes_).setConstant(1e3 * settings_.absolute_tolerance_m);
-    if (extra_ > 0) integration.absolute_tolerance.tail(extra_).setConstant(law_->extra_state_abs_tolerance());
-    update_contacts(z_tip, velocity_z, false);
-    integrator_ = std::make_unique<SundialsIntegrator>(static_cast<OdeSystem&>(*this), integration, time_, y_);
+    start_integration(t, z_tip, velocity_z);
     return contact_force_N();
   }
   const bool touched = std::any_of(layers_.begin(), layers_.end(), [](const LayerRuntime& l) { return l.contact_started; });
@@ -386,44 +435,9 @@ double VolumetricNeedleModel::step(const NeedleState& needle) {
     // integrator restarts from this state at the first contact.
     time_ = t;
   } else if (t > time_) {
-    // The contact nodes follow the needle with its mean velocity over this step.
-    double z_contact = 0.0;
-    bool any_contact = false;
-    for (int a = 0; a < nodes_; ++a)
-      if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) {
-        z_contact = y_[3 * a + 2];
-        any_contact = true;
-        break;
-      }
-    double step_velocity = any_contact ? (z_tip - z_contact) / (t - time_) : velocity_z;
-    // Rounding of the positions must not count as a change of speed.
-    if (std::abs(step_velocity - needle_velocity_z_) <= 1e-9 * std::max(std::abs(step_velocity), 1e-6))
-      step_velocity = needle_velocity_z_;
-    if (any_contact && step_velocity != needle_velocity_z_) {
-      for (int a = 0; a < nodes_; ++a)
-        if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * nodes_ + 3 * a + 2] = step_velocity;
-      integrator_->reinit(time_, y_);
-    }
-    needle_velocity_z_ = step_velocity;
-    try {
-      integrator_->advance(t, y_);
-    } catch (const std::runtime_error&) {
-      // Recovery: the BDF history can lead the error test to fail over and
-      // over (h collapsing to ~1e-7 s) on a smooth stretch of the insertion;
-      // restart from the last accepted haptic state (order 1, new history,
-      // fresh tangent and factorisation) and try once more. A second failure
-      // stops the run with the integrator's message.
-      ++failure_restarts_;
-      have_tangent_ = false;
-      have_factor_ = false;
-      integrator_->reinit(time_, y_);
-      integrator_->advance(t, y_);
-    }
-    time_ = t;
-    for (int a = 0; a < nodes_; ++a)
-      if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) y_[3 * a + 2] = z_tip;
+    advance_dynamics(t, z_tip, velocity_z);
   }
-  if (update_contacts(z_tip, velocity_z, needle.axial_velocity_m_per_s < 0.0)) {
+  if (update_contacts(z_tip, velocity_z, withdrawing)) {
     // The prescribed dofs changed: the factorisation is kept as a lagged
     // preconditioner (see preconditioner_setup); a puncture drops it.
     if (!settings_.lag_preconditioner) have_factor_ = false;

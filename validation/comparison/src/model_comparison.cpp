@@ -213,16 +213,11 @@ double withdrawal_rmse(const InsertionCurve& model, const InsertionCurve& refere
 
 }  // namespace
 
-ModelMetrics metrics_against_reference(const Scene& scene, const ModelRun& run, const ReferenceData& reference,
-                                       std::size_t total_steps) {
-  ModelMetrics m;
-  m.model = run.model;
-  m.completed_fraction = total_steps ? static_cast<double>(run.steps()) / static_cast<double>(total_steps) : 0.0;
-  m.memory_bytes = static_cast<double>(run.size.memory_bytes);
-  m.dofs = run.size.dofs;
-  if (run.steps() < 2) return m;
-  const InsertionCurve curve = curve_from_model_run(scene, run, reference.has_shaft_forces);
+namespace {
 
+/// Force RMSE against the reference (both on the loading phase), the peak
+/// forces and the withdrawal RMSE.
+void add_force_metrics(const InsertionCurve& curve, const ReferenceData& reference, ModelMetrics& m) {
   try {
     const CurveComparison cmp = compare_curves(curve, reference.curve);
     if (cmp.n_compared > 0) {
@@ -245,7 +240,12 @@ ModelMetrics metrics_against_reference(const Scene& scene, const ModelRun& run, 
     m.peak_force_error_relative = (model_peak - reference_peak) / reference_peak;
   }
   m.withdrawal_force_rmse_N = withdrawal_rmse(curve, reference.curve);
+}
 
+/// Each layer's puncture depth in the model and the reference; the mean
+/// error over the layers both puncture.
+void add_puncture_metrics(const Scene& scene, const InsertionCurve& curve, const ReferenceData& reference,
+                          ModelMetrics& m) {
   double depth_error_sum = 0.0;
   int both = 0;
   for (const Layer& layer : scene.layers) {
@@ -264,8 +264,11 @@ ModelMetrics metrics_against_reference(const Scene& scene, const ModelRun& run, 
     m.punctures.push_back(p);
   }
   if (both > 0) m.puncture_depth_error_m = depth_error_sum / both;
+}
 
-  // Skin deflection u_z(r) while the skin is intact in both.
+/// Skin deflection u_z(r) against the reference's while the skin is intact
+/// in both (m.punctures filled).
+void add_deflection_metrics(const ModelRun& run, const ReferenceData& reference, ModelMetrics& m) {
   const double skin_limit = std::min(std::isfinite(m.punctures[0].reference_depth_m) ? m.punctures[0].reference_depth_m : 1e300,
                                      std::isfinite(m.punctures[0].model_depth_m) ? m.punctures[0].model_depth_m : 1e300);
   double sq = 0.0, max_ref = 0.0;
@@ -291,17 +294,36 @@ ModelMetrics metrics_against_reference(const Scene& scene, const ModelRun& run, 
     m.deflection_rmse_m = std::sqrt(sq / static_cast<double>(n));
     if (max_ref > 0.0) m.deflection_rmse_relative = m.deflection_rmse_m / max_ref;
   }
+}
 
+/// Mean, p99 and largest wall time of the steps with the tip in the tissue.
+void add_step_time_metrics(const ModelRun& run, ModelMetrics& m) {
   std::vector<double> in_tissue;
   for (std::size_t i = 0; i < run.steps(); ++i)
     if (run.depth_m[i] > 0.0) in_tissue.push_back(run.step_wall_time_s[i]);
-  if (!in_tissue.empty()) {
-    double sum = 0.0;
-    for (double t : in_tissue) sum += t;
-    m.step_time_mean_s = sum / static_cast<double>(in_tissue.size());
-    m.step_time_p99_s = quantile(in_tissue, 0.99);
-    m.step_time_max_s = *std::max_element(in_tissue.begin(), in_tissue.end());
-  }
+  if (in_tissue.empty()) return;
+  double sum = 0.0;
+  for (double t : in_tissue) sum += t;
+  m.step_time_mean_s = sum / static_cast<double>(in_tissue.size());
+  m.step_time_p99_s = quantile(in_tissue, 0.99);
+  m.step_time_max_s = *std::max_element(in_tissue.begin(), in_tissue.end());
+}
+
+}  // namespace
+
+ModelMetrics metrics_against_reference(const Scene& scene, const ModelRun& run, const ReferenceData& reference,
+                                       std::size_t total_steps) {
+  ModelMetrics m;
+  m.model = run.model;
+  m.completed_fraction = total_steps ? static_cast<double>(run.steps()) / static_cast<double>(total_steps) : 0.0;
+  m.memory_bytes = static_cast<double>(run.size.memory_bytes);
+  m.dofs = run.size.dofs;
+  if (run.steps() < 2) return m;
+  const InsertionCurve curve = curve_from_model_run(scene, run, reference.has_shaft_forces);
+  add_force_metrics(curve, reference, m);
+  add_puncture_metrics(scene, curve, reference, m);
+  add_deflection_metrics(run, reference, m);
+  add_step_time_metrics(run, m);
   return m;
 }
 

@@ -170,7 +170,17 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   /// Static equilibrium of the free nodes with the current contact set
   /// (modified Newton on the law's tangent); free velocities set to zero.
   void relax_to_equilibrium();
+  /// The law's exact tangent at `state` with the prescribed dofs eliminated,
+  /// factorised for relax_to_equilibrium; false if the factorisation failed.
+  bool factorise_static_tangent(const Eigen::VectorXd& state);
   double contact_force_N();
+  // The phases of step(): equilibrium at every step (quasi-static mode); the
+  // first call (integrator set up at the needle's state); one haptic step of
+  // the dynamics (contact nodes moved with the needle, integrator advanced,
+  // restarted once after a failure).
+  void step_quasi_static(double t, double z_tip_m, bool withdrawing);
+  void start_integration(double t, double z_tip_m, double velocity_z_m_per_s);
+  void advance_dynamics(double t, double z_tip_m, double velocity_z_m_per_s);
   Eigen::Matrix3Xd deformed_points() const;
 
   const Scene* scene_;
