@@ -122,27 +122,12 @@ TetSlabMeshOptions tet_slab_mesh_options(const Scene& scene) {
   return o;
 }
 
-comparison::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOptions& options,
-                                        TetSlabMeshReport* report) {
-  require(!scene.layers.empty(), "the scene has no layers");
-  require(options.size_at_axis_m > 0.0, "options.size_at_axis_m must be > 0");
-  require(options.size_far_m >= options.size_at_axis_m, "options.size_far_m must be >= size_at_axis_m");
-  require(options.grading >= 0.0, "options.grading must be >= 0");
-  const double radius_m = 0.5 * scene.sample.diameter_m;
-  require(radius_m > 0.0, "sample.diameter_m must be > 0");
-  require(scene.needle.radius_m > 0.0 && scene.needle.radius_m < radius_m, "needle.radius_m must be in (0, R)");
+namespace {
 
-  const auto start = std::chrono::steady_clock::now();
+/// Mesh_3's refinement of the labelled slab (features on the interface and
+/// rim circles, sizes graded from the axis), sliver exudation optional.
+Complex refine_slab(const SlabGeometry& g, const TetSlabMeshOptions& options) {
   constexpr double kMmPerM = 1e3;
-  SlabGeometry g;
-  g.radius_mm = radius_m * kMmPerM;
-  g.needle_mm = scene.needle.radius_m * kMmPerM;
-  g.interface_z_mm.push_back(0.0);
-  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
-    require(scene.layers[k].thickness_m > 0.0, "layers[" + std::to_string(k) + "].thickness_m must be > 0");
-    g.interface_z_mm.push_back(-(scene.layer_top_depth_m(k) + scene.layers[k].thickness_m) * kMmPerM);
-  }
-
   CGAL::Random random(options.random_seed);
   CGAL::get_default_random() = CGAL::Random(options.random_seed);
   const double margin = 1.0;
@@ -167,17 +152,20 @@ comparison::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOpt
   Complex c3t3 =
       CGAL::make_mesh_3<Complex>(domain, criteria, p::no_perturb(), p::no_exude(), p::no_odt(), p::no_lloyd());
   if (c3t3.number_of_cells_in_complex() == 0) throw std::runtime_error("build_tet_slab_mesh: CGAL returned no cells");
-  const auto refined = std::chrono::steady_clock::now();
-  if (options.exude_slivers) exude_slivers_to_completion(c3t3);
-  const auto exuded = std::chrono::steady_clock::now();
+  return c3t3;
+}
 
-  // The finite cells whose centroid lies in the slab and whose vertices do
-  // not all lie on one boundary surface (the side r = R or one interface
-  // plane), labelled by their centroid. Mesh_3 labels cells by their
-  // circumcentre, and a flat cell spanning the thin skin can have its
-  // circumcentre outside the slab: the complex alone would leave a hole
-  // through the skin. Cells whose vertices all lie on one boundary surface are
-  // flat slivers on that surface (of the convex hull or of the complex).
+/// The tetrahedra of the triangulation that make the slab: the finite cells
+/// whose centroid lies in the slab and whose vertices do not all lie on one
+/// boundary surface (the side r = R or one interface plane), labelled by
+/// their centroid. Mesh_3 labels cells by their circumcentre, and a flat cell
+/// spanning the thin skin can have its circumcentre outside the slab: the
+/// complex alone would leave a hole through the skin. Cells whose vertices
+/// all lie on one boundary surface are flat slivers on that surface (of the
+/// convex hull or of the complex).
+comparison::TetMesh slab_tetrahedra(const Complex& c3t3, const SlabGeometry& g, const TetSlabMeshOptions& options) {
+  constexpr double kMmPerM = 1e3;
+  const SizeField size{g.needle_mm, options.size_at_axis_m * kMmPerM, options.size_far_m * kMmPerM, options.grading};
   comparison::TetMesh mesh;
   const Triangulation& tr = c3t3.triangulation();
   std::map<Triangulation::Vertex_handle, int> index;
@@ -236,6 +224,37 @@ comparison::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOpt
   mesh.points_m.resize(3, static_cast<Eigen::Index>(points.size()));
   for (std::size_t i = 0; i < points.size(); ++i) mesh.points_m.col(static_cast<Eigen::Index>(i)) = points[i];
   comparison::check_tet_mesh(mesh, n_layers);
+  return mesh;
+}
+
+}  // namespace
+
+comparison::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOptions& options,
+                                        TetSlabMeshReport* report) {
+  require(!scene.layers.empty(), "the scene has no layers");
+  require(options.size_at_axis_m > 0.0, "options.size_at_axis_m must be > 0");
+  require(options.size_far_m >= options.size_at_axis_m, "options.size_far_m must be >= size_at_axis_m");
+  require(options.grading >= 0.0, "options.grading must be >= 0");
+  const double radius_m = 0.5 * scene.sample.diameter_m;
+  require(radius_m > 0.0, "sample.diameter_m must be > 0");
+  require(scene.needle.radius_m > 0.0 && scene.needle.radius_m < radius_m, "needle.radius_m must be in (0, R)");
+
+  const auto start = std::chrono::steady_clock::now();
+  constexpr double kMmPerM = 1e3;
+  SlabGeometry g;
+  g.radius_mm = radius_m * kMmPerM;
+  g.needle_mm = scene.needle.radius_m * kMmPerM;
+  g.interface_z_mm.push_back(0.0);
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    require(scene.layers[k].thickness_m > 0.0, "layers[" + std::to_string(k) + "].thickness_m must be > 0");
+    g.interface_z_mm.push_back(-(scene.layer_top_depth_m(k) + scene.layers[k].thickness_m) * kMmPerM);
+  }
+
+  Complex c3t3 = refine_slab(g, options);
+  const auto refined = std::chrono::steady_clock::now();
+  if (options.exude_slivers) exude_slivers_to_completion(c3t3);
+  const auto exuded = std::chrono::steady_clock::now();
+  comparison::TetMesh mesh = slab_tetrahedra(c3t3, g, options);
 
   if (report) {
     report->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
