@@ -2,10 +2,36 @@
 // LDL^T as the fallback; see sparse_spd_factor.hpp.
 #include "puncture/comparison/sparse_spd_factor.hpp"
 
+#include <omp.h>
+
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCholesky>
 
 namespace puncture::comparison {
+
+namespace {
+
+/// CHOLMOD as Debian builds it (SuiteSparse 5.12, CHOLMOD_OMP_NUM_THREADS 4)
+/// runs parts of its supernodal factorisation in OpenMP regions of 4 threads,
+/// whatever the machine has. On the 2-core reference machine that costs more
+/// than it gains (linear tensor-mass run of the tuned slab, 84
+/// factorisations, 2026-12-02: 67 s with them, 48-54 s without in two runs;
+/// the same curve to the last digit), and more again when two models
+/// factorise at once. The regions' thread count is
+/// fixed by a clause, so they are switched off (max active levels 0) on the
+/// calling thread for the factorisation, and the thread's setting restored.
+class SerialOpenMpRegions {
+ public:
+  SerialOpenMpRegions() : levels_(omp_get_max_active_levels()) { omp_set_max_active_levels(0); }
+  ~SerialOpenMpRegions() { omp_set_max_active_levels(levels_); }
+  SerialOpenMpRegions(const SerialOpenMpRegions&) = delete;
+  SerialOpenMpRegions& operator=(const SerialOpenMpRegions&) = delete;
+
+ private:
+  int levels_;
+};
+
+}  // namespace
 
 struct SparseSpdFactor::Impl {
   mutable Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> cholesky;  ///< mutable: its cholmod() accessor is not const
@@ -28,6 +54,7 @@ SparseSpdFactor::~SparseSpdFactor() = default;
 
 bool SparseSpdFactor::factorize(const Eigen::SparseMatrix<double>& A) {
   Impl& s = *impl_;
+  const SerialOpenMpRegions serial;
   if (!s.analysed) {
     s.cholesky.analyzePattern(A);
     s.analysed = true;
@@ -45,6 +72,7 @@ bool SparseSpdFactor::factorize(const Eigen::SparseMatrix<double>& A) {
 }
 
 Eigen::VectorXd SparseSpdFactor::solve(const Eigen::VectorXd& b) const {
+  const SerialOpenMpRegions serial;
   return impl_->use_ldlt ? Eigen::VectorXd(impl_->ldlt.solve(b)) : Eigen::VectorXd(impl_->cholesky.solve(b));
 }
 

@@ -1,7 +1,10 @@
 // SparseSpdFactor (sparse_spd_factor.hpp): solutions against a dense solve of
 // the same system, positive definite (CHOLMOD) and indefinite (the LDL^T
-// fallback), refactorisation with new values on the analysed pattern.
+// fallback), refactorisation with new values on the analysed pattern; the
+// calling thread's OpenMP setting is the same after a factorisation and a
+// solve as before (CHOLMOD's regions are switched off only while it works).
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
@@ -63,6 +66,19 @@ TEST(SparseSpdFactor, IndefiniteSystemsFallBackToLdlt) {
   ASSERT_TRUE(f.factorize(B));
   EXPECT_EQ(f.fallbacks(), 1);
   EXPECT_LT(relative_error_against_dense(f, B), 1e-12);
+}
+
+TEST(SparseSpdFactor, LeavesTheCallingThreadsOpenMpSettingAsItFoundIt) {
+  const int before = omp_get_max_active_levels();
+  omp_set_max_active_levels(before == 2 ? 3 : 2);
+  const int set = omp_get_max_active_levels();
+  SparseSpdFactor f;
+  const Eigen::SparseMatrix<double> A = chain_matrix(400, 0.5);
+  ASSERT_TRUE(f.factorize(A));
+  EXPECT_EQ(omp_get_max_active_levels(), set);
+  EXPECT_LT(relative_error_against_dense(f, A), 1e-12);
+  EXPECT_EQ(omp_get_max_active_levels(), set);
+  omp_set_max_active_levels(before);
 }
 
 }  // namespace

@@ -11,6 +11,9 @@
 // ordering: the best of AMD and METIS nested dissection): on the
 // comparison meshes, whose plan levels couple through the whole disc, a
 // factorisation takes about a third of the time of Eigen's simplicial LDL^T.
+// CHOLMOD's own OpenMP regions (4 threads as Debian builds it) are switched
+// off on the calling thread while it factorises and solves (measured faster
+// on 2 cores; see sparse_spd_factor.cpp).
 // Where A is not positive definite (a tangent under strong compression, a
 // law whose tangent is not exact), Eigen's simplicial LDL^T is used for that
 // factorisation instead; factorize() returns false only if that fails too.
