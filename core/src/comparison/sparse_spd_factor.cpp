@@ -15,9 +15,9 @@ namespace {
 /// runs parts of its supernodal factorisation in OpenMP regions of 4 threads,
 /// whatever the machine has. On the 2-core reference machine that costs more
 /// than it gains (linear tensor-mass run of the tuned slab, 84
-/// factorisations, 2026-12-02: 67 s with them, 48-54 s without in two runs;
-/// the same curve to the last digit), and more again when two models
-/// factorise at once. The regions' thread count is
+/// factorisations, three pairs of runs on 2026-12-02: 67-83 s with them,
+/// 53-62 s without; the same curves; results/comparison/README.md point 7),
+/// and more again when two models factorise at once. The regions' thread count is
 /// fixed by a clause, so they are switched off (max active levels 0) on the
 /// calling thread for the factorisation, and the thread's setting restored.
 class SerialOpenMpRegions {

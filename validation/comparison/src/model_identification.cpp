@@ -69,6 +69,11 @@ struct Window {
   double scale_N = 1.0;  ///< residuals are divided by this (the reference's peak force)
 };
 
+/// Whether sample i of the curve is on the insertion (loading) and in [from, to).
+bool loading_sample_in(const InsertionCurve& curve, std::size_t i, double from_m, double to_m) {
+  return curve.velocity_m_per_s[i] > 0.0 && curve.depth_m[i] >= from_m && curve.depth_m[i] < to_m;
+}
+
 Window window_of(const ModelRun& run, const ReferenceData& reference, double from_m, double to_m) {
   Window w;
   const InsertionCurve& curve = reference.curve;
@@ -76,7 +81,7 @@ Window window_of(const ModelRun& run, const ReferenceData& reference, double fro
   for (std::size_t i = 0; i < curve.size(); ++i) {
     if (!(curve.velocity_m_per_s[i] > 0.0)) continue;
     peak = std::max(peak, std::abs(curve.force_N[i]));
-    if (curve.depth_m[i] < from_m || curve.depth_m[i] >= to_m) continue;
+    if (!loading_sample_in(curve, i, from_m, to_m)) continue;
     double contact = 0.0, shaft = 0.0;
     if (!forces_at_depth(run, curve.depth_m[i], contact, shaft)) continue;
     w.depth_m.push_back(curve.depth_m[i]);
@@ -91,8 +96,7 @@ Window window_of(const ModelRun& run, const ReferenceData& reference, double fro
 std::size_t reference_samples_in(const ReferenceData& reference, double from_m, double to_m) {
   const InsertionCurve& curve = reference.curve;
   std::size_t n = 0;
-  for (std::size_t i = 0; i < curve.size(); ++i)
-    n += curve.velocity_m_per_s[i] > 0.0 && curve.depth_m[i] >= from_m && curve.depth_m[i] < to_m;
+  for (std::size_t i = 0; i < curve.size(); ++i) n += loading_sample_in(curve, i, from_m, to_m);
   return n;
 }
 
