@@ -278,6 +278,7 @@ ForceLaw read_force_law(ObjectReader r, const std::string& file) {
     law.stiffening = read_stiffening(ObjectReader(r.raw("stiffening"), r.child("stiffening"), file));
   law.cutting_force_N = r.number("cutting_force_N", law.cutting_force_N);
   law.cutting_release_m = r.number("cutting_release_mm", law.cutting_release_m / kMm) * kMm;
+  law.rupture_release_m = r.number("rupture_release_mm", law.rupture_release_m / kMm) * kMm;
   if (r.has("friction")) law.friction = read_friction(ObjectReader(r.raw("friction"), r.child("friction"), file));
   r.reject_unknown_keys();
   return law;

@@ -15,6 +15,8 @@ namespace puncture {
 namespace {
 
 using detail::kMm;
+/// Largest rupture release length: a cohesive zone opens over millimetres, not centimetres.
+constexpr double kMaxRuptureRelease_m = 50e-3;
 
 /// Throws SceneError(file, path, "must be <rule> (got value)") unless ok.
 void require(bool ok, const std::string& file, const std::string& path, const std::string& rule, double value) {
@@ -59,6 +61,8 @@ void validate_force_law(const ForceLaw& law, const std::string& file, const std:
           law.cutting_force_N);
   require(law.cutting_release_m > 0 && law.cutting_release_m <= thickness_m + 1e-3, file, p + "/cutting_release_mm",
           "> 0 and at most the layer thickness + 1 mm", law.cutting_release_m / kMm);
+  require(law.rupture_release_m >= 0 && law.rupture_release_m <= kMaxRuptureRelease_m, file, p + "/rupture_release_mm",
+          "in [0, 50]", law.rupture_release_m / kMm);
   const ShaftFrictionLaw& f = law.friction;
   require(f.dynamic_N_per_m >= 0, file, p + "/friction/dynamic_N_per_mm", ">= 0", f.dynamic_N_per_m * kMm);
   require(f.static_N_per_m >= f.dynamic_N_per_m, file, p + "/friction/static_N_per_mm",

@@ -43,6 +43,7 @@ json force_law_json(const ForceLaw& law) {
                        {"strain_scale_mm", st.strain_scale_m / kMm}};
   j["cutting_force_N"] = law.cutting_force_N;
   j["cutting_release_mm"] = law.cutting_release_m / kMm;
+  j["rupture_release_mm"] = law.rupture_release_m / kMm;
   j["friction"] = {{"static_N_per_mm", law.friction.static_N_per_m * kMm},
                    {"dynamic_N_per_mm", law.friction.dynamic_N_per_m * kMm},
                    {"velocity_band_mm_per_s", law.friction.velocity_band_m_per_s / kMm},

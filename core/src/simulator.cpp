@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "puncture/cutting.hpp"
 #include "puncture/shaft_forces.hpp"
 #include "puncture/stiffening.hpp"
 
@@ -50,8 +51,10 @@ PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique
     }
     layer.tip_contact_from_m = std::numeric_limits<double>::infinity();
     if (scene.effects.friction) layer.friction.emplace(in.force_law.friction);
-    if (cutting_on_ && !(in.force_law.cutting_force_N >= 0.0 && in.force_law.cutting_release_m > 0.0))
-      throw std::invalid_argument("layer \"" + in.name + "\": cutting force must be >= 0 and its release distance > 0");
+    if (cutting_on_ && !(in.force_law.cutting_force_N >= 0.0 && in.force_law.cutting_release_m > 0.0 &&
+                         in.force_law.rupture_release_m >= 0.0))
+      throw std::invalid_argument("layer \"" + in.name +
+                                  "\": cutting force must be >= 0, its release distance > 0 and its rupture release >= 0");
     if (scene.effects.stiffening) layer.stiffening = &layer.law.stiffening;
     if (scene.effects.surface_force) {
       double s = 0.0;
@@ -316,6 +319,10 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   if (layer.resumption) layer.resumption->start(layer.mesh->positions(), needle.time_s);
   const double tip_axial = needle.tip_position_m.dot(needle.direction);
   layer.front_m = tip_axial;
+  layer.break_axial_m = tip_axial;
+  layer.release_N = cutting_on_ && layer.law.rupture_release_m > 0.0
+                        ? std::max(0.0, surface_force_N - layer.law.cutting_force_N)
+                        : 0.0;
   ++active_;
   if (active_ < layers_.size() && !interaction_) {
     LayerModel& next = layers_[active_];
@@ -360,6 +367,19 @@ double PunctureSimulator::crack_force(double tip_axial_m) {
   return open_crack_force_N(p.law, p.front_m, tip_axial_m, next);
 }
 
+double PunctureSimulator::rupture_release(double tip_axial_m) {
+  if (!cutting_on_) return 0.0;
+  double total = 0.0;
+  for (std::size_t k = 0; k < active_; ++k) {
+    const LayerModel& p = layers_[k];
+    const double f = rupture_release_force_N(p.release_N, p.law.rupture_release_m, p.law.cutting_release_m,
+                                             p.break_axial_m, deepest_axial_m_, tip_axial_m);
+    result_.layers[k].cutting_force_N = f;
+    total += f;
+  }
+  return total;
+}
+
 double PunctureSimulator::press_needle_layer(const NeedleState& needle, double transmitted_force_N) {
   if (active_ >= layers_.size()) return 0.0;
   if (layers_[active_].mesh) return step_chain(needle, transmitted_force_N);
@@ -379,7 +399,9 @@ bool PunctureSimulator::break_through(const NeedleState& needle, double surface_
     record_puncture(needle, surface_force_N, cutting_force_N);
     surface_force_N = 0.0;
     // A further break in this tick is felt with the crack of the layer that just broke, opened at the tip.
-    cutting_force_N = cutting_on_ ? layers_[active_ - 1].law.cutting_force_N : 0.0;
+    cutting_force_N = cutting_on_ ? layers_[active_ - 1].law.cutting_force_N +
+                                        rupture_release(needle.tip_position_m.dot(needle.direction))
+                                  : 0.0;
     broke = true;
     const bool touched = active_ < n && try_contact(needle);
     if (coupling_) {
@@ -451,21 +473,24 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   result_.velocity_m_per_s = needle.axial_velocity_m_per_s;
   for (LayerTickResult& r : result_.layers) r = LayerTickResult{};
   const double tip_axial_m = needle.tip_position_m.dot(needle.direction);
+  deepest_axial_m_ = std::max(deepest_axial_m_, tip_axial_m);
 
   // 1. Resumption of the layers broken in earlier ticks.
   resume_broken_layers(needle.time_s);
   // 2. Contact of the needle layer; the crack ahead of the tip.
   update_needle_contact(needle);
-  double cut = crack_force(tip_axial_m);
+  double crack = crack_force(tip_axial_m);
+  double cut = crack + rupture_release(tip_axial_m);
   // 3. The chain under the needle (or the needle layer alone).
   double surface_force = press_needle_layer(needle, interaction_ ? cut : 0.0);
   // 4. Breakthrough: the crack through the layer that just broke starts at the tip.
   const bool broke = break_through(needle, surface_force, cut);
   if (broke) {
     surface_force = 0.0;
-    cut = crack_force(tip_axial_m);
+    crack = crack_force(tip_axial_m);
+    cut = crack + rupture_release(tip_axial_m);
   }
-  if (active_ > 0) result_.layers[active_ - 1].cutting_force_N = cut;
+  if (active_ > 0) result_.layers[active_ - 1].cutting_force_N += crack;
   // 5. Shaft friction and damping of the punctured layers.
   const double friction_total = shaft_friction_and_damping(needle);
   result_.tip_force_N = surface_force;

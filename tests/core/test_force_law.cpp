@@ -437,6 +437,86 @@ TEST(ForceLaw, ALayerBrokenBelowTheNextSurfaceIsCutWhileTheNextIsPressed) {
   }
 }
 
+TEST(RuptureRelease, ExponentialFromTheExcessAtTheBreakAndItsEnergy) {
+  const double R = 1.2, l = 0.8e-3, rc = 0.1e-3, b = 9e-3;
+  EXPECT_DOUBLE_EQ(rupture_release_force_N(R, l, rc, b, b, b), R);                 // continuous at the break
+  EXPECT_NEAR(rupture_release_force_N(R, l, rc, b, b + l, b + l), R / std::exp(1.0), 1e-15);
+  EXPECT_EQ(rupture_release_force_N(R, 0.0, rc, b, b + 1e-4, b + 1e-4), 0.0);      // l = 0: released at once
+  EXPECT_EQ(rupture_release_force_N(0.0, l, rc, b, b + 1e-4, b + 1e-4), 0.0);
+  EXPECT_EQ(rupture_release_force_N(-0.5, l, rc, b, b + 1e-4, b + 1e-4), 0.0);
+  // Retraction from the deepest position: linear to 0 over r_c; the travel
+  // counts from the deepest position (a crack does not close again).
+  const double deepest = b + 0.5e-3, f_deep = R * std::exp(-0.5e-3 / l);
+  EXPECT_NEAR(rupture_release_force_N(R, l, rc, b, deepest, deepest - 0.25 * rc), 0.75 * f_deep, 1e-14);
+  EXPECT_EQ(rupture_release_force_N(R, l, rc, b, deepest, deepest - 2.0 * rc), 0.0);
+  // The energy released while the tip goes on, R l (Simpson over 30 l).
+  const double e = simpson([&](double s) { return rupture_release_force_N(R, l, rc, b, b + s, b + s); }, 0.0, 30.0 * l);
+  EXPECT_NEAR(e, R * l, 1e-9 * R * l);
+}
+
+TEST(RuptureRelease, TheLoadAtTheBreakIsLetGoOverTheReleaseLengthWhateverTheLayersBelowDo) {
+  // The 8 mm layer of the test above breaks at 1 N above the lower layer's
+  // surface: the needle feels C + R exp(-s / l), R = F_b - C, while the crack
+  // is cut alone, and R exp(-s / l) alone once the tip presses the layer below
+  // (the crack above is no longer cut, its release goes on); the force at the
+  // break is F_b in the break tick. With l = 0 the force drops to C (the
+  // paper's model); without the cutting effect there is no release.
+  const double C = 0.4, l = 0.7e-3;
+  auto scene_with = [&](double release_m, bool cutting) {
+    Scene scene = single_layer_scene(3e-3);
+    scene.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 4, 1e-3, 100.0, 1.0, 0.05));
+    scene.layers[1].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+    scene.layers[1].force_law.breakthrough.critical_force_N = 1e3;
+    scene.effects.cutting = cutting;
+    scene.layers[0].force_law.breakthrough.critical_force_N = 1.0;
+    scene.layers[0].force_law.cutting_force_N = C;
+    scene.layers[0].force_law.rupture_release_m = release_m;
+    return scene;
+  };
+  for (double release_m : {l, 0.0}) {
+    const Scene scene = scene_with(release_m, true);
+    PunctureSimulator sim(scene, test::plane_surfaces(scene));
+    double t = 0.0, break_depth = -1.0, F_b = 0.0;
+    int cut_alone = 0, pressed_below = 0;
+    drive(sim, t, -0.2e-3, 8e-3, 0.01, [&](const TickResult& r) {
+      if (break_depth >= 0.0 || sim.puncture_events().empty()) return;
+      break_depth = sim.puncture_events()[0].depth_m;
+      F_b = sim.puncture_events()[0].surface_force_N;
+      EXPECT_NEAR(r.total_force_N, release_m > 0.0 ? F_b : C, 1e-12);  // the break tick
+    });
+    ASSERT_EQ(sim.puncture_events().size(), 1u);
+    ASSERT_LT(break_depth, 3e-3);
+    EXPECT_GE(F_b, 1.0);
+    // Again, now checking every tick after the break.
+    PunctureSimulator again(scene, test::plane_surfaces(scene));
+    t = 0.0;
+    drive(again, t, -0.2e-3, 8e-3, 0.01, [&](const TickResult& r) {
+      if (again.puncture_events().empty() || r.depth_m <= break_depth) return;
+      const double s = r.depth_m - break_depth;
+      const double release = release_m > 0.0 ? (F_b - C) * std::exp(-s / l) : 0.0;
+      EXPECT_NEAR(r.total_force_N, r.tip_force_N + r.cutting_force_N, 1e-12);
+      if (r.depth_m <= 3e-3) {
+        EXPECT_NEAR(r.cutting_force_N, C + release, 1e-12);
+        EXPECT_NEAR(r.layers[0].cutting_force_N, C + release, 1e-12);
+        ++cut_alone;
+      } else {
+        EXPECT_NEAR(r.cutting_force_N, release, 1e-12);
+        EXPECT_NEAR(r.tip_force_N, again.force_mesh(1)->static_stiffness_N_per_m() * (r.depth_m - 3e-3), 1e-9);
+        ++pressed_below;
+      }
+    });
+    EXPECT_GT(cut_alone, 10);
+    EXPECT_GT(pressed_below, 100);
+  }
+  // Without the cutting effect: the force drops to 0 at the break.
+  const Scene off = scene_with(l, false);
+  PunctureSimulator sim(off, test::plane_surfaces(off));
+  double t = 0.0;
+  drive(sim, t, -0.2e-3, 2.9e-3, 0.01);
+  ASSERT_EQ(sim.puncture_events().size(), 1u);
+  EXPECT_EQ(sim.tick(needle_at(2.9e-3, 0.01, t + 1e-3)).total_force_N, 0.0);
+}
+
 // ---------------------------------------------------------------------------
 // Breakthrough criteria
 

@@ -14,9 +14,25 @@
 //     F_cut = C max(0, 1 - r / r_c)
 // Re-inserting into an existing crack costs nothing until the tip is back
 // within r_c of the front. Withdrawal: F_cut = 0 once r >= r_c.
+//
+// Rupture release (ForceLaw::rupture_release_m, l > 0). A layer does not let
+// go of its load at once when it breaks: the crack opens through a cohesive
+// process zone whose traction softens with the opening (a bilinear law of
+// strength sigma_c and toughness G_c opens fully at delta_c = 2 G_c / sigma_c,
+// about 1.1 mm for skin; a published skin law opens over 1.6 mm, Mohammadi et
+// al. 2021). The needle feels the part of the layer's surface force at the
+// break F_b that exceeds the cutting force, R = max(0, F_b - C), released
+// as the tip goes on by s past the break depth:
+//     F_rel = R exp(-s / l) max(0, 1 - r / r_c),
+// s the deepest tip position since the break minus the break position (a
+// crack does not close again), r the retraction from that deepest position
+// as above. With l = 0 the force drops to C at the break (the paper's model).
+// The force at the break stays continuous: C + R = F_b. The energy released,
+// R l, is the area between the curve and C.
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 
 namespace puncture {
 
@@ -25,6 +41,18 @@ namespace puncture {
 inline double cutting_force_N(double cutting_force_N, double release_m, double front_m, double tip_m) {
   const double r = std::max(0.0, front_m - tip_m);
   return cutting_force_N * std::max(0.0, 1.0 - r / release_m);
+}
+
+/// F_rel (N) of a layer that broke with release R = release_N (N, >= 0) at
+/// break_m, rupture release length l = length_m (m; <= 0: none), retraction
+/// distance r_c = retraction_m (m > 0), the deepest tip position since the
+/// break deepest_m and the tip at tip_m (m along the needle axis).
+inline double rupture_release_force_N(double release_N, double length_m, double retraction_m, double break_m,
+                                      double deepest_m, double tip_m) {
+  if (!(length_m > 0.0) || !(release_N > 0.0)) return 0.0;
+  const double s = std::max(0.0, deepest_m - break_m);
+  const double r = std::max(0.0, deepest_m - tip_m);
+  return release_N * std::exp(-s / length_m) * std::max(0.0, 1.0 - r / retraction_m);
 }
 
 }  // namespace puncture

@@ -179,6 +179,10 @@ struct ForceLaw {
   StiffeningLaw stiffening;
   double cutting_force_N = 0.0;         ///< force to advance the crack through the layer (~ G_c x cut width)
   double cutting_release_m = 0.1e-3;    ///< retraction over which the cutting force falls to 0
+  /// l (m, >= 0): tip travel past the break over which the surface force the
+  /// layer carried beyond its cutting force is released (exp(-s / l), the
+  /// crack's cohesive process zone; cutting.hpp). 0: at once (the paper).
+  double rupture_release_m = 0.0;
   ShaftFrictionLaw friction;
 };
 

@@ -60,6 +60,9 @@
 //      when the next layer was met at the break (contact at the tip, the
 //      broken layer squeezed between them), while the tip presses it (the
 //      FEM's tip force and cohesive cutting force act together there);
+//      every punctured layer with a rupture release length adds the release
+//      of the load it carried at its break (cutting.hpp), counted as its
+//      cutting force, whatever the layers below do;
 //   6. every punctured layer adds its shaft friction phi h (shaft_friction.hpp,
 //      through shaft_forces.hpp)
 //      and the damping force d h v (Table 1), with h the shaft length inside
@@ -85,6 +88,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -205,6 +209,8 @@ class PunctureSimulator {
     SurfacePoint contact;
     double deflection_m = 0.0;    ///< committed deflection of the contact node relative to the layer below
     double front_m = 0.0;         ///< crack front along the needle axis (punctured layers)
+    double break_axial_m = 0.0;   ///< tip position along the needle axis at the break (punctured layers)
+    double release_N = 0.0;       ///< R of the rupture release (cutting.hpp): surface force at the break beyond C
     mutable Eigen::Matrix3Xd shifted_positions;
   };
 
@@ -223,6 +229,9 @@ class PunctureSimulator {
   void update_needle_contact(const NeedleState& needle);
   /// Cutting force of the deepest punctured layer (shaft_forces.hpp), its crack front advanced.
   double crack_force(double tip_axial_m);
+  /// Rupture release of every punctured layer (cutting.hpp), written to each
+  /// layer's cutting force of this tick; returns their sum (N).
+  double rupture_release(double tip_axial_m);
   /// Chain under the needle stepped; returns the needle layer's surface force.
   double press_needle_layer(const NeedleState& needle, double transmitted_force_N);
   /// Layers breaking under surface_force_N (several in one tick if the next is met already broken);
@@ -252,6 +261,7 @@ class PunctureSimulator {
   bool cutting_on_ = false;
   bool interaction_ = false;
   bool first_tick_ = true;
+  double deepest_axial_m_ = -std::numeric_limits<double>::infinity();  ///< deepest tip position so far (m along the axis)
   double contact_search_height_m_ = 0.0;
   double relayout_tolerance_m_ = 0.0;
   std::array<ChainLink, kMaxChainLinks> links_{};

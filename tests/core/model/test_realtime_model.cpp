@@ -82,8 +82,9 @@ TEST(RealtimeModel, PunctureEventForceIsTheNeedleForceJustBeforeTheBreak) {
   // The physical force law: each layer below the skin is met at the tip and
   // pressed while the crack above is still cut, so the force at its break
   // holds that cutting force (and the shaft forces above), not its surface
-  // force alone. The event's total must be the force the needle felt on the
-  // tick before the break, within one tick of travel.
+  // force alone. The event's total and cutting force must be the needle's on
+  // the tick before the break, within one tick of travel (the rupture release
+  // of the layers above, cutting.hpp, falls a little in that tick).
   const Scene s = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default_force_law.json");
   RealtimeModel m = build_realtime_model(s);
   const ScriptedRunResult run = run_scripted_insertion(m, s);
@@ -95,7 +96,7 @@ TEST(RealtimeModel, PunctureEventForceIsTheNeedleForceJustBeforeTheBreak) {
     ASSERT_GT(i, 0u);
     const TickResult& before = run.ticks[i - 1];
     EXPECT_NEAR(e.total_force_N, before.total_force_N, 0.02 * before.total_force_N + 0.01) << e.layer_name;
-    EXPECT_NEAR(e.cutting_force_N, before.cutting_force_N, 1e-9) << e.layer_name;
+    EXPECT_NEAR(e.cutting_force_N, before.cutting_force_N, 0.02 * before.cutting_force_N + 1e-9) << e.layer_name;
     with_cutting += e.cutting_force_N > 0.0;
   }
   EXPECT_GE(with_cutting, 1) << "no layer broke while the crack above was cut: the test checks nothing new";
