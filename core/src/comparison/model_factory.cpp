@@ -41,6 +41,11 @@ class RealtimeComparisonModel final : public ComparisonModel {
   /// for every model (run_comparison_model, model_comparison.hpp).
   double step(const NeedleState& needle) override { return model_.simulator->tick(needle).tip_force_N; }
   LayerState layer_state(std::size_t k) const override { return model_.simulator->layer_state(k); }
+  double break_force_N(std::size_t k) const override {
+    for (const PunctureEvent& e : model_.simulator->puncture_events())
+      if (e.layer == static_cast<int>(k)) return e.surface_force_N;
+    return std::numeric_limits<double>::quiet_NaN();
+  }
   bool layer_touched(std::size_t k) const override { return model_.simulator->has_contact(k); }
   std::vector<double> surface_deflection_m(std::size_t k, const std::vector<double>& r_m) const override {
     std::vector<double> out(r_m.size(), 0.0);

@@ -213,6 +213,7 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
       if (layer.breakthrough.needs_force()) checked_force_N_ = force;  // the step's contact force, if nothing moves now
       break;
     }
+    layer.break_force_N = layer.breakthrough.needs_force() ? force : contact_force_N();
     puncture_active_layer();
     changed = true;
   }

@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 
+#include "puncture/cutting.hpp"
 #include "puncture/needle.hpp"
 #include "puncture/puncture_force.hpp"
 #include "puncture/shaft_forces.hpp"
@@ -42,14 +44,18 @@ class ShaftForcesOfModel {
  public:
   explicit ShaftForcesOfModel(const Scene& scene)
       : scene_(scene), friction_(scene.layers.size()), front_m_(scene.layers.size(), 0.0),
+        break_m_(scene.layers.size(), 0.0), release_N_(scene.layers.size(), 0.0),
         met_at_break_(scene.layers.size(), 0) {
     if (scene.effects.friction)
       for (std::size_t k = 0; k < scene.layers.size(); ++k) friction_[k].emplace(scene.layers[k].force_law.friction);
   }
 
-  /// Friction, damping and cutting (N) after the model's step to `needle`.
+  /// Friction, damping and cutting (N) after the model's step to `needle`,
+  /// in which the model's contact force was contact_N (a layer breaking in
+  /// this step carried the previous step's contact force: its rupture
+  /// release, cutting.hpp).
   double force_N(const comparison::ComparisonModel& model, const std::vector<LayerState>& states,
-                 const NeedleState& needle) {
+                 const NeedleState& needle, double contact_N) {
     const std::size_t n_layers = states.size();
     double post = 0.0;
     std::size_t punctured = 0;  // layers punctured from the top
@@ -63,8 +69,14 @@ class ShaftForcesOfModel {
       post += f.friction_N + f.damping_N;
     }
     const double tip_axial_m = needle.tip_position_m.dot(needle.direction);
+    deepest_m_ = std::max(deepest_m_, tip_axial_m);
     for (std::size_t k = punctured_before_; k < punctured; ++k) {
       front_m_[k] = tip_axial_m;
+      break_m_[k] = tip_axial_m;
+      const ForceLaw& law = scene_.layers[k].force_law;
+      const double carried = std::isnan(model.break_force_N(k)) ? (k == punctured_before_ ? last_contact_N_ : 0.0)
+                                                                : model.break_force_N(k);
+      release_N_[k] = law.rupture_release_m > 0.0 ? std::max(0.0, carried - law.cutting_force_N) : 0.0;
       if (k + 1 < n_layers && !scene_.effects.layer_interaction && needle.depth_m() > scene_.layer_top_depth_m(k + 1))
         met_at_break_[k + 1] = 1;
     }
@@ -74,7 +86,13 @@ class ShaftForcesOfModel {
                                     : met_at_break_[punctured]                               ? NextLayerContact::MetAtTip
                                                                                              : NextLayerContact::Touched;
       post += open_crack_force_N(scene_.layers[punctured - 1].force_law, front_m_[punctured - 1], tip_axial_m, next);
+      for (std::size_t k = 0; k < punctured; ++k) {
+        const ForceLaw& law = scene_.layers[k].force_law;
+        post += rupture_release_force_N(release_N_[k], law.rupture_release_m, law.cutting_release_m, break_m_[k],
+                                        deepest_m_, tip_axial_m);
+      }
     }
+    last_contact_N_ = contact_N;
     return post;
   }
 
@@ -82,6 +100,9 @@ class ShaftForcesOfModel {
   const Scene& scene_;
   std::vector<std::optional<KarnoppFriction>> friction_;
   std::vector<double> front_m_;
+  std::vector<double> break_m_, release_N_;  ///< rupture release per layer (cutting.hpp)
+  double deepest_m_ = -std::numeric_limits<double>::infinity();
+  double last_contact_N_ = 0.0;
   std::vector<char> met_at_break_;
   std::size_t punctured_before_ = 0;
 };
@@ -122,7 +143,7 @@ ModelRun run_comparison_model(comparison::ComparisonModel& model, const Scene& s
     run.contact_force_N.push_back(force);
     std::vector<LayerState> states(n_layers);
     for (std::size_t k = 0; k < n_layers; ++k) states[k] = model.layer_state(k);
-    const double post = shaft.force_N(model, states, needle);
+    const double post = shaft.force_N(model, states, needle, force);
     run.states.push_back(states);
     run.post_puncture_force_N.push_back(post);
     while (next_profile < profile_depths.size() && needle.axial_velocity_m_per_s > 0.0 &&

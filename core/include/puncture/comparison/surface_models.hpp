@@ -53,6 +53,7 @@ class LinearSurfaceModel : public ComparisonModel {
  public:
   double step(const NeedleState& needle) override;
   LayerState layer_state(std::size_t layer) const override { return layers_[layer].state; }
+  double break_force_N(std::size_t layer) const override { return layers_[layer].break_force_N; }
   std::vector<double> surface_deflection_m(std::size_t layer, const std::vector<double>& r_m) const override;
   /// Force per unit indentation of each layer (N/m).
   double stiffness_N_per_m(std::size_t layer) const { return layers_[layer].stiffness_N_per_m; }
@@ -74,6 +75,7 @@ class LinearSurfaceModel : public ComparisonModel {
     bool contact_started = false;
     double contact_depth_m = 0.0;
     double indentation_m = 0.0;
+    double break_force_N = std::numeric_limits<double>::quiet_NaN();  ///< contact force at the break
   };
   const Scene* scene_;
   std::vector<LayerRuntime> layers_;

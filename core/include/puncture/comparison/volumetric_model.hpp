@@ -128,6 +128,7 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   std::string description() const override { return description_; }
   double step(const NeedleState& needle) override;
   LayerState layer_state(std::size_t layer) const override { return layers_[layer].state; }
+  double break_force_N(std::size_t layer) const override { return layers_[layer].break_force_N; }
   std::vector<double> surface_deflection_m(std::size_t layer, const std::vector<double>& r_m) const override;
   ModelSize model_size() const override;
   bool has_volume() const override { return true; }
@@ -151,6 +152,7 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
     LayerBreakthroughRule breakthrough;
     LayerSurfaceProbe ring_probe;
     std::vector<double> baseline_m;  ///< ring-point deflections when the contact started
+    double break_force_N = std::numeric_limits<double>::quiet_NaN();  ///< contact force at the break
   };
 
   // OdeSystem
