@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -560,4 +561,62 @@ TEST(CalibrationForceLaw, CuttingOfALayerWhoseCutIsTooShortIsIdentifiedByThePunc
   bool said = false;
   for (const std::string& w : r.warnings) said = said || w.find("cutting_force identified in layer fat's stage") != std::string::npos;
   EXPECT_TRUE(said) << "the calibration does not say where the skin's cutting force was identified";
+}
+
+TEST(CalibrationForceLaw, RuptureReleaseIsIdentifiedInItsOwnStageOrInTheNextLayersWhenItsCutIsTooShort) {
+  // The skin lets go of its load beyond its cutting force over l = 0.8 mm
+  // after its break (cutting.hpp); the fat, met at the tip, breaks 0.2 mm
+  // after it. The fat's release is 0 (its surface force at the break is below
+  // its cutting force): not identifiable, not moved.
+  Scene truth = truth_scene(false);
+  truth.layers[0].thickness_m = 0.6e-3;
+  truth.layers[1].force_law.breakthrough.critical_force_N = 0.02;
+  truth.layers[0].force_law.rupture_release_m = 0.8e-3;
+  truth.layers[1].force_law.rupture_release_m = 0.5e-3;
+  const pv::InsertionCurve dense = pv::simulate_insertion_curve(truth);
+  // What the sparse reference below cannot identify (the skin's cutting and
+  // friction, the fat's K: the tests above) starts at the truth; the rest is perturbed.
+  Scene start = truth;
+  start.layers[0].force_law.rupture_release_m = 1.6e-3;
+  start.layers[0].force_law.breakthrough.critical_force_N *= 0.85;
+  start.layers[0].force_mesh.virtual_stiffness_N_per_m *= 1.25;
+  start.layers[1].force_law.cutting_force_N *= 1.5;
+  start.layers[1].force_law.friction.dynamic_N_per_m *= 0.6;
+  start.layers[1].force_law.friction.static_N_per_m = start.layers[1].force_law.friction.dynamic_N_per_m;
+  auto skin_release = [](const pv::CalibrationResult& r) { return r.tuned_scene.layers[0].force_law.rupture_release_m; };
+  auto said_in_fat_stage = [](const pv::CalibrationResult& r) {
+    for (const std::string& w : r.warnings)
+      if (w.find("layer skin: rupture_release identified in layer fat's stage") != std::string::npos) return true;
+    return false;
+  };
+
+  // 20 um per sample: the skin's own cut identifies it, from twice the truth.
+  const pv::CalibrationResult own = pv::calibrate(start, every_nth_sample(dense, 5));
+  EXPECT_NEAR(skin_release(own) / 0.8e-3, 1.0, 0.05) << "the skin's rupture release (start 1.6 mm)";
+  EXPECT_EQ(own.tuned_scene.layers[1].force_law.rupture_release_m, 0.5e-3);
+  EXPECT_FALSE(said_in_fat_stage(own));
+
+  // 0.1 mm per sample (half the FEM's load step): the skin's cut is too short,
+  // the release goes on while the fat is pressed and cut, so the fat's stage
+  // identifies it, and says so: from the start and from the truth it ends at
+  // the same value within two of its standard errors (the identifiability
+  // report's), which are below the value. It is off the truth by the sampling
+  // of the skin's puncture (its force is read up to 0.1 mm before the break,
+  // which the critical force and R absorb), so only loosely near it.
+  const pv::InsertionCurve sparse = every_nth_sample(dense, 50);
+  const auto skin = pv::puncture_event(sparse, "skin"), fat = pv::puncture_event(sparse, "fat");
+  ASSERT_TRUE(skin.found && fat.found);
+  ASSERT_LT(fat.depth_m - skin.depth_m, 0.45e-3);
+  const pv::CalibrationResult from_start = pv::calibrate(start, sparse);
+  Scene at_truth = start;
+  at_truth.layers[0].force_law.rupture_release_m = 0.8e-3;
+  const pv::CalibrationResult from_truth = pv::calibrate(at_truth, sparse);
+  EXPECT_TRUE(said_in_fat_stage(from_start)) << "the calibration does not say where the skin's rupture release was identified";
+  double se_mm = std::numeric_limits<double>::infinity();
+  for (const pv::ParameterIdentifiability& p : from_start.identifiability.parameters)
+    if (p.layer == "skin" && p.name == "rupture_release") se_mm = p.standard_error;
+  ASSERT_LT(se_mm, skin_release(from_start) * 1e3) << "the skin's rupture release is not identified";
+  EXPECT_NEAR(skin_release(from_start) * 1e3, skin_release(from_truth) * 1e3, 2.0 * se_mm);
+  EXPECT_NEAR(skin_release(from_start) / 0.8e-3, 1.0, 0.4);
+  EXPECT_LT(from_start.objective_after, 0.05 * from_start.objective_before);
 }

@@ -127,12 +127,31 @@ bool tunes_cutting_above(const Calibration& c, const CalibrationResult& result, 
          met_at_tip(c, result, k) && c.identifiable[k].punctured;
 }
 
+/// Layer k's stage also tunes the rupture release of the layer above
+/// (cutting.hpp) when its own cut is too short to identify it: the release
+/// goes on while k is pressed and cut (k's stage compares the layers above
+/// down to the end of k's cut), whatever the layers below do.
+bool tunes_release_above(const Calibration& c, std::size_t k) {
+  if (k == 0 || k >= c.scene.layers.size() || !c.options.parameters.cutting || !c.scene.effects.cutting) return false;
+  return c.calibrated(k - 1) && c.calibrated(k) && c.scene.layers[k - 1].force_law.rupture_release_m > 0.0 &&
+         c.identifiable[k - 1].punctured && (c.identifiable[k].pressing() || c.identifiable[k].punctured) &&
+         !unidentified_reason(c.identifiable[k - 1], ParamKind::RuptureRelease).empty();
+}
+
+/// Layer k's parameter `kind` is tuned in layer k + 1's stage (see above).
+bool tuned_in_stage_below(const Calibration& c, const CalibrationResult& result, std::size_t k, ParamKind kind) {
+  if (kind == ParamKind::Cutting) return tunes_cutting_above(c, result, k + 1);
+  if (kind == ParamKind::RuptureRelease) return tunes_release_above(c, k + 1);
+  return false;
+}
+
 /// Why the references cannot identify a parameter; "" when they can (a
-/// cutting force also when the layer below identifies it, tunes_cutting_above),
-/// or when the user asked to tune it anyway (keep_unidentifiable_at_start off).
+/// cutting force or rupture release also when the layer below identifies it,
+/// tuned_in_stage_below), or when the user asked to tune it anyway
+/// (keep_unidentifiable_at_start off).
 std::string withheld_reason(const Calibration& c, const CalibrationResult& result, std::size_t k, ParamKind kind) {
   if (!c.options.keep_unidentifiable_at_start) return {};
-  if (kind == ParamKind::Cutting && tunes_cutting_above(c, result, k + 1)) return {};
+  if (tuned_in_stage_below(c, result, k, kind)) return {};
   return unidentified_reason(c.identifiable[k], kind);
 }
 
@@ -145,12 +164,17 @@ std::pair<std::size_t, std::size_t> withhold_unidentified(const Calibration& c, 
     for (ParamKind kind : layer_kinds(c.scene, k, c.options.parameters)) {
       ++requested;
       const std::string why = unidentified_reason(c.identifiable[k], kind);
-      if (!why.empty() && kind == ParamKind::Cutting && tunes_cutting_above(c, result, k + 1)) {
-        result.warnings.push_back("layer " + c.scene.layers[k].name + ": cutting_force identified in layer " +
-                                  c.scene.layers[k + 1].name + "'s stage (" + why + ", but " +
-                                  c.scene.layers[k + 1].name + " is met at the tip when " + c.scene.layers[k].name +
-                                  " breaks, so this crack is cut while it is pressed: its puncture force and depth "
-                                  "identify this cutting force)");
+      if (!why.empty() && tuned_in_stage_below(c, result, k, kind)) {
+        const std::string& below = c.scene.layers[k + 1].name;
+        result.warnings.push_back(
+            "layer " + c.scene.layers[k].name + ": " + info(kind).name + " identified in layer " + below +
+            "'s stage (" + why + ", but " +
+            (kind == ParamKind::Cutting
+                 ? below + " is met at the tip when " + c.scene.layers[k].name +
+                       " breaks, so this crack is cut while it is pressed: its puncture force and depth identify "
+                       "this cutting force)"
+                 : "the release goes on while " + below + " is pressed and cut, which " + below +
+                       "'s stage compares)"));
         ++tuned;
         continue;
       }
@@ -261,7 +285,9 @@ std::string optimise_stage(StageObjective& stage, const std::vector<double>& x0)
   if (stage.parameters.empty()) return "nothing to tune";
   std::vector<Parameter> shape, level;
   for (const Parameter& p : stage.parameters)
-    (p.kind == ParamKind::Cutting || p.kind == ParamKind::Friction ? level : shape).push_back(p);
+    (p.kind == ParamKind::Cutting || p.kind == ParamKind::Friction || p.kind == ParamKind::RuptureRelease ? level
+                                                                                                          : shape)
+        .push_back(p);
   std::string record;
   if (stage.inputs().options->method != CalibrationMethod::LevenbergMarquardt && !shape.empty() && !level.empty()) {
     for (const std::vector<Parameter>* subset : {&shape, &level}) {
@@ -289,8 +315,9 @@ std::pair<Scene, double> run_ring_candidate(Calibration& c, CalibrationResult& r
   for (ParamKind kind : layer_kinds(candidate, k, c.options.parameters,
                                     c.options.keep_unidentifiable_at_start ? &c.identifiable[k] : nullptr))
     stage.parameters.push_back(c.parameter(k, kind));
-  if (tunes_cutting_above(c, result, k)) {
-    const Parameter above = c.parameter(k - 1, ParamKind::Cutting);
+  for (ParamKind kind : {ParamKind::Cutting, ParamKind::RuptureRelease}) {
+    if (k == 0 || !tuned_in_stage_below(c, result, k - 1, kind)) continue;
+    const Parameter above = c.parameter(k - 1, kind);
     if (std::none_of(stage.parameters.begin(), stage.parameters.end(),
                      [&](const Parameter& p) { return p.layer == above.layer && p.kind == above.kind; }))
       stage.parameters.push_back(above);

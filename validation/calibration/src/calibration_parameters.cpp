@@ -25,6 +25,7 @@ ParamInfo info(ParamKind k) {
     case ParamKind::StiffeningCubic: return {"stiffening_cubic", "N/mm^3", kMm * kMm * kMm, false, 1e6};
     case ParamKind::StiffeningExponential: return {"stiffening_exponential", "N/mm", kMm, false, 10.0};
     case ParamKind::Presliding: return {"friction_presliding", "mm", 1.0 / kMm, false, 1e-3};
+    case ParamKind::RuptureRelease: return {"rupture_release", "mm", 1.0 / kMm, true, 0.0};
   }
   throw std::logic_error("info");
 }
@@ -45,6 +46,7 @@ double& param_ref(Scene& s, std::size_t layer, ParamKind k) {
     case ParamKind::StiffeningCubic: return l.force_law.stiffening.cubic_N_per_m3;
     case ParamKind::StiffeningExponential: return l.force_law.stiffening.exponential_stiffness_N_per_m;
     case ParamKind::Presliding: return l.force_law.friction.presliding_m;
+    case ParamKind::RuptureRelease: return l.force_law.rupture_release_m;
   }
   throw std::logic_error("param_ref");
 }
@@ -71,6 +73,7 @@ void physical_range(const Scene& s, std::size_t layer, ParamKind k, double& lo, 
     case ParamKind::StiffeningCubic: lo = 0.0, hi = 1e12; return;                  // 0 .. 1000 N/mm^3
     case ParamKind::StiffeningExponential: lo = 0.0, hi = 1e6; return;
     case ParamKind::Presliding: lo = 0.0, hi = 0.05; return;                       // 0 .. 50 mm of shaft travel
+    case ParamKind::RuptureRelease: lo = 1e-5, hi = 0.05; return;                  // 10 um .. 50 mm (the scene's limit)
   }
 }
 
@@ -120,7 +123,7 @@ std::string unidentified_reason(const LayerIdentifiability& id, ParamKind kind) 
     case ParamKind::DeformedThreshold:  // a ring deflection: read off the pressing curve
       return !id.punctured ? "the reference has no puncture of this layer"
              : id.pressing() ? "" : fewer + " pressing samples of this layer before its puncture";
-    case ParamKind::Cutting: case ParamKind::Friction: case ParamKind::Presliding:
+    case ParamKind::Cutting: case ParamKind::Friction: case ParamKind::Presliding: case ParamKind::RuptureRelease:
       return id.cut() ? "" : fewer + " samples of the cut through this layer";
     case ParamKind::Damping: return "";
     default: return id.pressing() ? "" : fewer + " pressing samples of this layer";
@@ -152,7 +155,11 @@ std::vector<ParamKind> layer_kinds(const Scene& scene, std::size_t k, const Tune
       kinds.push_back(ParamKind::StiffeningExponential);
     }
   }
-  if (t.cutting && scene.effects.cutting) kinds.push_back(ParamKind::Cutting);
+  if (t.cutting && scene.effects.cutting) {
+    kinds.push_back(ParamKind::Cutting);
+    // The rupture release is tuned when the scene uses it (a start > 0).
+    if (l.force_law.rupture_release_m > 0.0) kinds.push_back(ParamKind::RuptureRelease);
+  }
   if (t.friction && scene.effects.friction) {
     kinds.push_back(ParamKind::Friction);
     // Presliding is tuned when the scene uses it (a start > 0): the

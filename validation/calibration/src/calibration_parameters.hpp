@@ -37,7 +37,8 @@ enum class ParamKind {
   StiffeningQuadratic,
   StiffeningCubic,
   StiffeningExponential,
-  Presliding
+  Presliding,
+  RuptureRelease
 };
 
 struct ParamInfo {
