@@ -6,8 +6,9 @@ then the tuned preset's force meshes without their stiffening (linear springs:
 k_a = z_v = 0), the paper's ring-w breakthrough and no other mechanism; then,
 one at a time, the tuned preset's stiffening (in the mesh: k_a and z_v where
 the surface fit identified them; of the tip spring elsewhere), cutting, shaft
-friction, the critical-force breakthrough, the coupled surfaces (= the tuned
-preset as calibrated) and layer interaction in place of the coupled surfaces. Each row is validated (`puncture validate SCENE --cases
+friction, the critical-force breakthrough, the rupture release (the load at a
+break let go over the release length instead of at once), the coupled surfaces
+(= the tuned preset as calibrated) and layer interaction in place of the coupled surfaces. Each row is validated (`puncture validate SCENE --cases
 CASES_JSON`, FEM from out/.fem_cache) on every case of the cases file; its tick
 cost is the wall time of `puncture run` on the default trajectory (ticks with
 contact: mean and p99).
@@ -26,9 +27,12 @@ import results_io
 
 
 def rows(tuned, paper):
-    def variant(effects, ring_rule):
+    def variant(effects, ring_rule, release=True):
         s = json.loads(json.dumps(tuned), object_pairs_hook=collections.OrderedDict)
         s["effects"] = effects
+        if not release:
+            for l in s["layers"]:
+                l["force_law"]["rupture_release_mm"] = 0.0
         if "stiffening" not in effects:
             for l in s["layers"]:
                 l["force_mesh"].pop("surface_axial_stiffness_N_per_mm", None)
@@ -43,9 +47,10 @@ def rows(tuned, paper):
         ("tuned force meshes, linear springs, ring rule, no other mechanism", variant(base, True)),
         ("+ stiffening (in the mesh where identified from the surface, else of the tip spring)",
          variant(base + ["stiffening"], True)),
-        ("+ cutting", variant(base + ["stiffening", "cutting"], True)),
-        ("+ shaft friction", variant(base + ["stiffening", "cutting", "friction"], True)),
-        ("+ critical-force breakthrough", variant(base + ["stiffening", "cutting", "friction"], False)),
+        ("+ cutting", variant(base + ["stiffening", "cutting"], True, False)),
+        ("+ shaft friction", variant(base + ["stiffening", "cutting", "friction"], True, False)),
+        ("+ critical-force breakthrough", variant(base + ["stiffening", "cutting", "friction"], False, False)),
+        ("+ rupture release", variant(base + ["stiffening", "cutting", "friction"], False)),
         ("+ coupled surfaces (the tuned preset)",
          variant(base + ["stiffening", "cutting", "friction", "coupled_surfaces"], False)),
         ("+ layer interaction (in place of coupled surfaces)",
