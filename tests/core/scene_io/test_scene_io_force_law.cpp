@@ -28,6 +28,7 @@ json with_force_law() {
       {"stiffening", {{"law", "polynomial"}, {"quadratic_N_per_mm2", 0.2}, {"cubic_N_per_mm3", 0.03}}},
       {"cutting_force_N", 1.44},
       {"cutting_release_mm", 0.05},
+      {"rupture_release_mm", 1.2},
       {"friction", {{"static_N_per_mm", 0.015}, {"dynamic_N_per_mm", 0.01}, {"velocity_band_mm_per_s", 0.2},
                     {"presliding_mm", 2.5}}}};
   j["layers"][1]["force_law"] = {{"breakthrough", {{"criterion", "critical_energy"}, {"critical_energy_mJ", 2.5}}},
@@ -58,6 +59,8 @@ TEST(SceneIoForceLaw, KeysAreReadInSiUnits) {
   EXPECT_NEAR(skin.stiffening.cubic_N_per_m3, 0.03e9, 1e-6);     // N/mm^3 -> N/m^3
   EXPECT_DOUBLE_EQ(skin.cutting_force_N, 1.44);
   EXPECT_NEAR(skin.cutting_release_m, 0.05e-3, 1e-18);
+  EXPECT_NEAR(skin.rupture_release_m, 1.2e-3, 1e-18);
+  EXPECT_EQ(s.layers[1].force_law.rupture_release_m, 0.0);  // default: released at once
   EXPECT_NEAR(skin.friction.static_N_per_m, 15.0, 1e-12);  // N/mm -> N/m
   EXPECT_NEAR(skin.friction.dynamic_N_per_m, 10.0, 1e-12);
   EXPECT_NEAR(skin.friction.presliding_m, 2.5e-3, 1e-15);
@@ -90,6 +93,7 @@ TEST(SceneIoForceLaw, RoundTripKeepsEveryForceLawValue) {
     EXPECT_DOUBLE_EQ(x.stiffening.strain_scale_m, y.stiffening.strain_scale_m);
     EXPECT_DOUBLE_EQ(x.cutting_force_N, y.cutting_force_N);
     EXPECT_DOUBLE_EQ(x.cutting_release_m, y.cutting_release_m);
+    EXPECT_DOUBLE_EQ(x.rupture_release_m, y.rupture_release_m);
     EXPECT_DOUBLE_EQ(x.friction.static_N_per_m, y.friction.static_N_per_m);
     EXPECT_DOUBLE_EQ(x.friction.dynamic_N_per_m, y.friction.dynamic_N_per_m);
     EXPECT_DOUBLE_EQ(x.friction.velocity_band_m_per_s, y.friction.velocity_band_m_per_s);
@@ -166,6 +170,10 @@ const BadForceLaw kBad[] = {
      "/layers/0/force_law/stiffening/quadratic_N_per_mm2"},
     {"exponential_without_scale", [](json& j) { j["layers"][1]["force_law"]["stiffening"].erase("strain_scale_mm"); },
      "/layers/1/force_law/stiffening/strain_scale_mm"},
+    {"negative_rupture_release", [](json& j) { j["layers"][0]["force_law"]["rupture_release_mm"] = -0.5; },
+     "/layers/0/force_law/rupture_release_mm"},
+    {"rupture_release_beyond_50_mm", [](json& j) { j["layers"][0]["force_law"]["rupture_release_mm"] = 80.0; },
+     "/layers/0/force_law/rupture_release_mm"},
     {"unknown_law", [](json& j) { j["layers"][0]["force_law"]["stiffening"]["law"] = "ogden"; },
      "/layers/0/force_law/stiffening/law"},
     {"unknown_force_law_key", [](json& j) { j["layers"][0]["force_law"]["cuting_force_N"] = 1.0; },
