@@ -320,9 +320,7 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   const double tip_axial = needle.tip_position_m.dot(needle.direction);
   layer.front_m = tip_axial;
   layer.break_axial_m = tip_axial;
-  layer.release_N = cutting_on_ && layer.law.rupture_release_m > 0.0
-                        ? std::max(0.0, surface_force_N - layer.law.cutting_force_N)
-                        : 0.0;
+  layer.release_N = cutting_on_ ? rupture_release_N(layer.law, surface_force_N) : 0.0;
   ++active_;
   if (active_ < layers_.size() && !interaction_) {
     LayerModel& next = layers_[active_];

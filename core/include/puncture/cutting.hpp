@@ -34,6 +34,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "puncture/scene.hpp"
+
 namespace puncture {
 
 /// F_cut (N) for cutting force C (N), release distance r_c (m > 0), front and
@@ -41,6 +43,12 @@ namespace puncture {
 inline double cutting_force_N(double cutting_force_N, double release_m, double front_m, double tip_m) {
   const double r = std::max(0.0, front_m - tip_m);
   return cutting_force_N * std::max(0.0, 1.0 - r / release_m);
+}
+
+/// R (N): what a layer with force law `law` that broke under the surface
+/// force force_at_break_N (N) releases (0 without a rupture release length).
+inline double rupture_release_N(const ForceLaw& law, double force_at_break_N) {
+  return law.rupture_release_m > 0.0 ? std::max(0.0, force_at_break_N - law.cutting_force_N) : 0.0;
 }
 
 /// F_rel (N) of a layer that broke with release R = release_N (N, >= 0) at

@@ -3,6 +3,7 @@
 #include "puncture/comparison/model_factory.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 

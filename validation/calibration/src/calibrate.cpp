@@ -284,10 +284,11 @@ double stage_turn_depth(const std::vector<TermSelection>& selection, const Calib
 std::string optimise_stage(StageObjective& stage, const std::vector<double>& x0) {
   if (stage.parameters.empty()) return "nothing to tune";
   std::vector<Parameter> shape, level;
-  for (const Parameter& p : stage.parameters)
-    (p.kind == ParamKind::Cutting || p.kind == ParamKind::Friction || p.kind == ParamKind::RuptureRelease ? level
-                                                                                                          : shape)
-        .push_back(p);
+  for (const Parameter& p : stage.parameters) {
+    const bool cut_level = p.kind == ParamKind::Cutting || p.kind == ParamKind::Friction ||
+                           p.kind == ParamKind::RuptureRelease;
+    (cut_level ? level : shape).push_back(p);
+  }
   std::string record;
   if (stage.inputs().options->method != CalibrationMethod::LevenbergMarquardt && !shape.empty() && !level.empty()) {
     for (const std::vector<Parameter>* subset : {&shape, &level}) {

@@ -50,12 +50,9 @@ class ShaftForcesOfModel {
       for (std::size_t k = 0; k < scene.layers.size(); ++k) friction_[k].emplace(scene.layers[k].force_law.friction);
   }
 
-  /// Friction, damping and cutting (N) after the model's step to `needle`,
-  /// in which the model's contact force was contact_N (a layer breaking in
-  /// this step carried the previous step's contact force: its rupture
-  /// release, cutting.hpp).
+  /// Friction, damping and cutting (N) after the model's step to `needle`.
   double force_N(const comparison::ComparisonModel& model, const std::vector<LayerState>& states,
-                 const NeedleState& needle, double contact_N) {
+                 const NeedleState& needle) {
     const std::size_t n_layers = states.size();
     double post = 0.0;
     std::size_t punctured = 0;  // layers punctured from the top
@@ -73,10 +70,7 @@ class ShaftForcesOfModel {
     for (std::size_t k = punctured_before_; k < punctured; ++k) {
       front_m_[k] = tip_axial_m;
       break_m_[k] = tip_axial_m;
-      const ForceLaw& law = scene_.layers[k].force_law;
-      const double carried = std::isnan(model.break_force_N(k)) ? (k == punctured_before_ ? last_contact_N_ : 0.0)
-                                                                : model.break_force_N(k);
-      release_N_[k] = law.rupture_release_m > 0.0 ? std::max(0.0, carried - law.cutting_force_N) : 0.0;
+      release_N_[k] = rupture_release_N(scene_.layers[k].force_law, model.break_force_N(k));
       if (k + 1 < n_layers && !scene_.effects.layer_interaction && needle.depth_m() > scene_.layer_top_depth_m(k + 1))
         met_at_break_[k + 1] = 1;
     }
@@ -92,7 +86,6 @@ class ShaftForcesOfModel {
                                         deepest_m_, tip_axial_m);
       }
     }
-    last_contact_N_ = contact_N;
     return post;
   }
 
@@ -102,7 +95,6 @@ class ShaftForcesOfModel {
   std::vector<double> front_m_;
   std::vector<double> break_m_, release_N_;  ///< rupture release per layer (cutting.hpp)
   double deepest_m_ = -std::numeric_limits<double>::infinity();
-  double last_contact_N_ = 0.0;
   std::vector<char> met_at_break_;
   std::size_t punctured_before_ = 0;
 };
@@ -143,7 +135,7 @@ ModelRun run_comparison_model(comparison::ComparisonModel& model, const Scene& s
     run.contact_force_N.push_back(force);
     std::vector<LayerState> states(n_layers);
     for (std::size_t k = 0; k < n_layers; ++k) states[k] = model.layer_state(k);
-    const double post = shaft.force_N(model, states, needle, force);
+    const double post = shaft.force_N(model, states, needle);
     run.states.push_back(states);
     run.post_puncture_force_N.push_back(post);
     while (next_profile < profile_depths.size() && needle.axial_velocity_m_per_s > 0.0 &&

@@ -21,8 +21,6 @@
 // force-mesh lattice, ring_criterion.hpp).
 #pragma once
 
-#include <limits>
-
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -65,9 +63,8 @@ class ComparisonModel {
   /// step where its deflection is still 0 and its state Untouched.
   virtual bool layer_touched(std::size_t layer) const { return layer_state(layer) != LayerState::Untouched; }
   /// The contact force (N) the layer broke under (its rupture release,
-  /// cutting.hpp); NaN while it is not punctured or when the model cannot
-  /// tell (the harness then takes the contact force of the step before).
-  virtual double break_force_N(std::size_t /*layer*/) const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// cutting.hpp); NaN while it is not punctured.
+  virtual double break_force_N(std::size_t layer) const = 0;
   /// Deflection (m, > 0 into the tissue, i.e. -u_z) of the layer's top surface
   /// at the radii r (m) from the needle axis, mean over the azimuth.
   virtual std::vector<double> surface_deflection_m(std::size_t layer, const std::vector<double>& r_m) const = 0;

@@ -36,6 +36,7 @@
 // narrower than about pi R_s / l.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <vector>
 

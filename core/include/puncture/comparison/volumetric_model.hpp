@@ -63,6 +63,7 @@
 // steps after a restart) the diagonal of the matrix is used instead.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
