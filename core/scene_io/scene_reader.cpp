@@ -236,6 +236,10 @@ BreakthroughCriterion read_breakthrough(ObjectReader r) {
   } else {
     r.fail(r.child("criterion"), "unknown criterion '" + kind + "' (known: rings, critical_force, critical_energy)");
   }
+  if (c.kind != BreakthroughCriterion::Kind::Rings) {  // the threshold's rate law (breakthrough_rate.hpp)
+    c.rate_exponent = r.number("rate_exponent", c.rate_exponent);
+    c.reference_speed_m_per_s = r.number("reference_speed_mm_per_s", c.reference_speed_m_per_s / kMm) * kMm;
+  }
   r.reject_unknown_keys();
   return c;
 }

@@ -51,6 +51,10 @@ void validate_force_law(const ForceLaw& law, const std::string& file, const std:
   if (b.kind == BreakthroughCriterion::Kind::CriticalEnergy)
     require(b.critical_energy_J > 0 && b.critical_energy_J <= 1e3, file, p + "/breakthrough/critical_energy_mJ",
             "in (0, 1e6]", b.critical_energy_J * 1e3);
+  require(b.rate_exponent >= 0 && b.rate_exponent <= 1, file, p + "/breakthrough/rate_exponent", "in [0, 1]",
+          b.rate_exponent);
+  require(b.reference_speed_m_per_s > 0 && b.reference_speed_m_per_s <= 10.0, file,
+          p + "/breakthrough/reference_speed_mm_per_s", "in (0, 10000]", b.reference_speed_m_per_s / kMm);
   const StiffeningLaw& st = law.stiffening;
   require(st.quadratic_N_per_m2 >= 0, file, p + "/stiffening/quadratic_N_per_mm2", ">= 0", st.quadratic_N_per_m2 * kMm * kMm);
   require(st.cubic_N_per_m3 >= 0, file, p + "/stiffening/cubic_N_per_mm3", ">= 0", st.cubic_N_per_m3 * kMm * kMm * kMm);

@@ -32,6 +32,10 @@ json force_law_json(const ForceLaw& law) {
       j["breakthrough"] = {{"criterion", "critical_energy"}, {"critical_energy_mJ", b.critical_energy_J * 1e3}};
       break;
   }
+  if (b.kind != BreakthroughCriterion::Kind::Rings && b.rate_exponent != 0.0) {  // written when used
+    j["breakthrough"]["rate_exponent"] = b.rate_exponent;
+    j["breakthrough"]["reference_speed_mm_per_s"] = b.reference_speed_m_per_s / kMm;
+  }
   const StiffeningLaw& st = law.stiffening;
   if (st.kind == StiffeningLaw::Kind::Polynomial)
     j["stiffening"] = {{"law", "polynomial"},

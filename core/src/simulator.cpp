@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "puncture/breakthrough_rate.hpp"
 #include "puncture/cutting.hpp"
 #include "puncture/shaft_forces.hpp"
 #include "puncture/stiffening.hpp"
@@ -204,6 +205,8 @@ bool PunctureSimulator::try_contact(const NeedleState& needle) {
     layer.contact_at_tip = true;
   }
   layer.contact_set = true;
+  layer.contact_time_s = needle.time_s;
+  layer.contact_axial_m = needle.tip_position_m.dot(needle.direction);
   lay_mesh_on_axis(active_, needle, &hit);
   if (interaction_)
     for (std::size_t j = active_ + 1; j < layers_.size(); ++j) lay_mesh_on_axis(j, needle, nullptr);
@@ -271,19 +274,23 @@ double PunctureSimulator::step_chain(const NeedleState& needle, double transmitt
   return surface_force;
 }
 
-bool PunctureSimulator::breakthrough(std::size_t k, double surface_force_N) {
+bool PunctureSimulator::breakthrough(std::size_t k, double surface_force_N, const NeedleState& needle) {
   const LayerModel& layer = layers_[k];
   if (!layer.mesh) return result_.layers[k].contact_deflection_m > 0.0;
   if (layer.state != LayerState::Pressed) return false;
   const BreakthroughCriterion& c = layer.law.breakthrough;
+  const double rate = breakthrough_rate_factor(
+      c, mean_pressing_speed_m_per_s(layer.contact_axial_m, layer.contact_time_s,
+                                     needle.tip_position_m.dot(needle.direction), needle.time_s,
+                                     c.reference_speed_m_per_s));
   switch (c.kind) {
     case BreakthroughCriterion::Kind::Rings: return layer.mesh->broken();
-    case BreakthroughCriterion::Kind::CriticalForce: return surface_force_N >= c.critical_force_N;
+    case BreakthroughCriterion::Kind::CriticalForce: return surface_force_N >= c.critical_force_N * rate;
     case BreakthroughCriterion::Kind::CriticalEnergy: {
       double e = layer.mesh->virtual_spring_energy_J() + layer.mesh->surface_spring_energy_J();
       if (layer.stiffening) e += stiffening_energy_J(*layer.stiffening, layer.deflection_m);
       result_.layers[k].stored_energy_J = e;
-      return e >= c.critical_energy_J;
+      return e >= c.critical_energy_J * rate;
     }
   }
   return false;
@@ -393,7 +400,7 @@ bool PunctureSimulator::break_through(const NeedleState& needle, double surface_
   const std::size_t n = layers_.size();
   bool broke = false;
   // The next layer becomes the needle layer in the same tick.
-  while (active_ < n && layers_[active_].contact_set && breakthrough(active_, surface_force_N)) {
+  while (active_ < n && layers_[active_].contact_set && breakthrough(active_, surface_force_N, needle)) {
     record_puncture(needle, surface_force_N, cutting_force_N);
     surface_force_N = 0.0;
     // A further break in this tick is felt with the crack of the layer that just broke, opened at the tip.

@@ -11,6 +11,7 @@
 #include <memory>
 #include <vector>
 
+#include "puncture/breakthrough_rate.hpp"
 #include "puncture/cutting.hpp"
 #include "puncture/layer_chain.hpp"
 #include "puncture/shaft_friction.hpp"
@@ -537,6 +538,82 @@ TEST(Breakthrough, CriticalForceBreaksWhereTheForceReachesIt) {
   EXPECT_LT(e.depth_m, z + 1e-5);  // within one tick of travel (10 um)
   EXPECT_GE(e.surface_force_N, 1.5);
   EXPECT_LT(e.surface_force_N, 1.5 + (S + 2 * a2 * z) * 1e-5);
+}
+
+TEST(BreakthroughRate, FactorIsThePowerOfTheMeanPressingSpeedWithinItsClamp) {
+  BreakthroughCriterion c;
+  c.kind = BreakthroughCriterion::Kind::CriticalForce;
+  c.reference_speed_m_per_s = 0.01;
+  EXPECT_EQ(breakthrough_rate_factor(c, 0.04), 1.0);  // n = 0: the paper's threshold at any speed
+  c.rate_exponent = 0.5;
+  EXPECT_NEAR(breakthrough_rate_factor(c, 0.04), 2.0, 1e-15);
+  EXPECT_NEAR(breakthrough_rate_factor(c, 0.0025), 0.5, 1e-15);
+  EXPECT_DOUBLE_EQ(breakthrough_rate_factor(c, 0.01), 1.0);
+  // Clamped to v_ref / 100 .. 100 v_ref: a pause or a retraction does not break the layer at once.
+  EXPECT_NEAR(breakthrough_rate_factor(c, 1e3), 10.0, 1e-12);
+  EXPECT_NEAR(breakthrough_rate_factor(c, 0.0), 0.1, 1e-15);
+  EXPECT_NEAR(breakthrough_rate_factor(c, -0.02), 0.1, 1e-15);
+  // The mean pressing speed: advance since the contact over the time since; v_ref at the contact itself.
+  EXPECT_NEAR(mean_pressing_speed_m_per_s(1e-3, 0.5, 4e-3, 0.8, 0.01), 0.01, 1e-15);
+  EXPECT_EQ(mean_pressing_speed_m_per_s(1e-3, 0.5, 1e-3, 0.5, 0.01), 0.01);
+}
+
+TEST(BreakthroughRate, TheLayerBreaksUnderTheThresholdOfItsPressingSpeed) {
+  // Linear quasi-static layer, F = S z: with F_c (v / v_ref)^n, n = 0.5 and
+  // v_ref = 10 mm/s it breaks at z = F_c s / S, s = 0.5, 1, 2 at 2.5, 10 and
+  // 40 mm/s; with n = 0 at the same depth at every speed.
+  for (double n : {0.5, 0.0})
+    for (double v : {0.0025, 0.01, 0.04}) {
+      Scene scene = single_layer_scene();
+      scene.layers[0].force_law.breakthrough.critical_force_N = 0.5;
+      scene.layers[0].force_law.breakthrough.rate_exponent = n;
+      scene.layers[0].force_law.breakthrough.reference_speed_m_per_s = 0.01;
+      PunctureSimulator sim(scene, test::plane_surfaces(scene));
+      const double S = sim.force_mesh(0)->static_stiffness_N_per_m();
+      const double threshold = 0.5 * std::pow(v / 0.01, n);
+      double t = 0.0;
+      drive(sim, t, -0.2e-3, 1.5 * 2.0 * 0.5 / S, v);
+      ASSERT_EQ(sim.puncture_events().size(), 1u) << n << " " << v;
+      const PunctureEvent& e = sim.puncture_events()[0];
+      EXPECT_GE(e.surface_force_N, threshold) << n << " " << v;
+      EXPECT_LT(e.surface_force_N, threshold + S * v * 1e-3 + 1e-12) << n << " " << v;  // within a tick's travel
+      EXPECT_NEAR(e.depth_m, threshold / S, v * 1e-3 + 1e-12) << n << " " << v;
+    }
+}
+
+TEST(BreakthroughRate, APauseLowersTheThresholdAsTheMeanSpeedFalls) {
+  // Pressed at v_ref to 80 % of F_c in T0 = 0.8 F_c / (S v_ref) from the
+  // contact, then held: the mean speed 0.8 F_c / S / (T0 + t_h) brings the
+  // threshold F_c sqrt(v / v_ref) down to the held force 0.8 F_c after
+  // t_h = T0 (1 / 0.64 - 1) (a viscoelastic layer under a held load tears
+  // later, not never). Without the rate law it holds.
+  for (double n : {0.5, 0.0}) {
+    Scene scene = single_layer_scene();
+    scene.layers[0].force_law.breakthrough.critical_force_N = 0.5;
+    scene.layers[0].force_law.breakthrough.rate_exponent = n;
+    PunctureSimulator sim(scene, test::plane_surfaces(scene));
+    const double S = sim.force_mesh(0)->static_stiffness_N_per_m();
+    const double z_hold = 0.8 * 0.5 / S, v = 0.01;
+    double t = 0.0;
+    drive(sim, t, 0.0, z_hold, v);  // the contact is made in the first tick, at depth v dt
+    ASSERT_TRUE(sim.puncture_events().empty());
+    const double contact_t = 1e-3, T0 = t - contact_t;
+    const double advance = z_hold - v * 1e-3;
+    double broke_at = -1.0;
+    for (int i = 0; i < 20000 && broke_at < 0.0; ++i) {
+      t += 1e-3;
+      sim.tick(needle_at(z_hold, 0.0, t));
+      if (!sim.puncture_events().empty()) broke_at = t - contact_t;
+    }
+    if (n == 0.0) {
+      EXPECT_LT(broke_at, 0.0);
+      continue;
+    }
+    // Held force S z_hold meets 0.5 sqrt(advance / (T v_ref)) at T = advance / (v_ref (S z_hold / 0.5)^2).
+    const double T_break = advance / (0.01 * std::pow(S * z_hold / 0.5, 2));
+    EXPECT_GT(T_break, 1.5 * T0);
+    EXPECT_NEAR(broke_at, T_break, 1.01e-3);
+  }
 }
 
 TEST(Breakthrough, CriticalEnergyBreaksWhereTheStoredEnergyReachesIt) {

@@ -157,8 +157,14 @@ struct BreakthroughCriterion {
   /// CriticalEnergy: the elastic energy stored in the layer's force mesh reaches critical_energy_J.
   enum class Kind { Rings, CriticalForce, CriticalEnergy };
   Kind kind = Kind::Rings;
-  double critical_force_N = 1.0;
-  double critical_energy_J = 1e-3;
+  double critical_force_N = 1.0;   ///< at reference_speed_m_per_s
+  double critical_energy_J = 1e-3; ///< at reference_speed_m_per_s
+  /// n (0 .. 1): the critical force or energy grows with the layer's mean
+  /// pressing speed v as (v / v_ref)^n (a viscoelastic solid's apparent
+  /// fracture toughness rises with the loading rate; breakthrough_rate.hpp).
+  /// 0: rate-independent (the paper). Not used by the ring rule.
+  double rate_exponent = 0.0;
+  double reference_speed_m_per_s = 0.01;  ///< v_ref (> 0): the speed the critical values hold at
 };
 
 /// Karnopp shaft friction per unit length of shaft inside a punctured layer

@@ -207,6 +207,8 @@ class PunctureSimulator {
     /// above when it broke below this layer's rest surface). See try_contact.
     double tip_contact_from_m = 0.0;
     SurfacePoint contact;
+    double contact_time_s = 0.0;   ///< when the needle's contact with this layer began
+    double contact_axial_m = 0.0;  ///< the tip along the needle axis then (the mean pressing speed's start)
     double deflection_m = 0.0;    ///< committed deflection of the contact node relative to the layer below
     double front_m = 0.0;         ///< crack front along the needle axis (punctured layers)
     double break_axial_m = 0.0;   ///< tip position along the needle axis at the break (punctured layers)
@@ -222,7 +224,8 @@ class PunctureSimulator {
   /// Steps the meshes of the chain [active_, chain_end_) (see the header).
   /// Returns the needle layer's surface force (0 without contact).
   double step_chain(const NeedleState& needle, double transmitted_force_N);
-  bool breakthrough(std::size_t k, double surface_force_N);
+  /// Layer k's criterion at its surface force (N), its threshold at the layer's mean pressing speed (breakthrough_rate.hpp).
+  bool breakthrough(std::size_t k, double surface_force_N, const NeedleState& needle);
   void record_puncture(const NeedleState& needle, double surface_force_N, double cutting_force_N);
   /// The tick's phases (tick() calls them in this order; see the header comment).
   void resume_broken_layers(double time_s);

@@ -24,7 +24,8 @@ json default_json() {
 json with_force_law() {
   json j = default_json();
   j["layers"][0]["force_law"] = {
-      {"breakthrough", {{"criterion", "critical_force"}, {"critical_force_N", 1.5}}},
+      {"breakthrough", {{"criterion", "critical_force"}, {"critical_force_N", 1.5}, {"rate_exponent", 0.12},
+                        {"reference_speed_mm_per_s", 5.0}}},
       {"stiffening", {{"law", "polynomial"}, {"quadratic_N_per_mm2", 0.2}, {"cubic_N_per_mm3", 0.03}}},
       {"cutting_force_N", 1.44},
       {"cutting_release_mm", 0.05},
@@ -61,6 +62,10 @@ TEST(SceneIoForceLaw, KeysAreReadInSiUnits) {
   EXPECT_NEAR(skin.cutting_release_m, 0.05e-3, 1e-18);
   EXPECT_NEAR(skin.rupture_release_m, 1.2e-3, 1e-18);
   EXPECT_EQ(s.layers[1].force_law.rupture_release_m, 0.0);  // default: released at once
+  EXPECT_DOUBLE_EQ(skin.breakthrough.rate_exponent, 0.12);
+  EXPECT_NEAR(skin.breakthrough.reference_speed_m_per_s, 5e-3, 1e-18);   // mm/s -> m/s
+  EXPECT_EQ(s.layers[1].force_law.breakthrough.rate_exponent, 0.0);     // default: rate-independent
+  EXPECT_NEAR(s.layers[1].force_law.breakthrough.reference_speed_m_per_s, 10e-3, 1e-18);
   EXPECT_NEAR(skin.friction.static_N_per_m, 15.0, 1e-12);  // N/mm -> N/m
   EXPECT_NEAR(skin.friction.dynamic_N_per_m, 10.0, 1e-12);
   EXPECT_NEAR(skin.friction.presliding_m, 2.5e-3, 1e-15);
@@ -86,6 +91,8 @@ TEST(SceneIoForceLaw, RoundTripKeepsEveryForceLawValue) {
     EXPECT_EQ(x.breakthrough.kind, y.breakthrough.kind);
     EXPECT_DOUBLE_EQ(x.breakthrough.critical_force_N, y.breakthrough.critical_force_N);
     EXPECT_DOUBLE_EQ(x.breakthrough.critical_energy_J, y.breakthrough.critical_energy_J);
+    EXPECT_DOUBLE_EQ(x.breakthrough.rate_exponent, y.breakthrough.rate_exponent);
+    EXPECT_DOUBLE_EQ(x.breakthrough.reference_speed_m_per_s, y.breakthrough.reference_speed_m_per_s);
     EXPECT_EQ(x.stiffening.kind, y.stiffening.kind);
     EXPECT_DOUBLE_EQ(x.stiffening.quadratic_N_per_m2, y.stiffening.quadratic_N_per_m2);
     EXPECT_DOUBLE_EQ(x.stiffening.cubic_N_per_m3, y.stiffening.cubic_N_per_m3);
@@ -174,6 +181,16 @@ const BadForceLaw kBad[] = {
      "/layers/0/force_law/rupture_release_mm"},
     {"rupture_release_beyond_50_mm", [](json& j) { j["layers"][0]["force_law"]["rupture_release_mm"] = 80.0; },
      "/layers/0/force_law/rupture_release_mm"},
+    {"rate_exponent_above_one", [](json& j) { j["layers"][0]["force_law"]["breakthrough"]["rate_exponent"] = 1.5; },
+     "/layers/0/force_law/breakthrough/rate_exponent"},
+    {"negative_rate_exponent", [](json& j) { j["layers"][0]["force_law"]["breakthrough"]["rate_exponent"] = -0.1; },
+     "/layers/0/force_law/breakthrough/rate_exponent"},
+    {"zero_reference_speed",
+     [](json& j) { j["layers"][0]["force_law"]["breakthrough"]["reference_speed_mm_per_s"] = 0.0; },
+     "/layers/0/force_law/breakthrough/reference_speed_mm_per_s"},
+    {"rate_law_with_rings",  // the ring rule has no threshold to scale: an unknown key
+     [](json& j) { j["layers"][0]["force_law"]["breakthrough"] = {{"criterion", "rings"}, {"rate_exponent", 0.1}}; },
+     "/layers/0/force_law/breakthrough/rate_exponent"},
     {"unknown_law", [](json& j) { j["layers"][0]["force_law"]["stiffening"]["law"] = "ogden"; },
      "/layers/0/force_law/stiffening/law"},
     {"unknown_force_law_key", [](json& j) { j["layers"][0]["force_law"]["cuting_force_N"] = 1.0; },

@@ -208,7 +208,8 @@ std::vector<double> rate_dependent_speeds(const Calibration& c) {
 /// Auto: d h v is told apart from the rate-independent shaft friction (and
 /// from everything else a reference's force has in proportion to the shaft
 /// length) only by how the force changes with the speed, so d is tuned when
-/// rate-dependent references span two or more speeds.
+/// rate-dependent references span two or more speeds; so is the rate
+/// exponent n of every breakthrough threshold (run_rate_stage).
 void decide_damping(const Calibration& c, CalibrationResult& result) {
   const std::vector<double> speeds = rate_dependent_speeds(c);
   std::ostringstream listed_text;
@@ -227,7 +228,7 @@ void decide_damping(const Calibration& c, CalibrationResult& result) {
     case DampingPolicy::Auto:
       result.damping_tuned = speeds.size() >= 2;
       if (speeds.size() >= 2)
-        result.damping_note = "d tuned: rate-dependent references at " + listed + " mm/s";
+        result.damping_note = "d (and the breakthrough rate exponents n) tuned: rate-dependent references at " + listed + " mm/s";
       else if (speeds.size() == 1)
         result.damping_note = "d kept fixed: rate-dependent references at one speed only (" + listed +
                               " mm/s); at one speed d h v cannot be told apart from the shaft friction, so d "
@@ -382,11 +383,17 @@ StageObjective whole_objective_stage(Calibration& c, CalibrationResult& result, 
   return stage;
 }
 
-/// d of every calibrated layer on the whole trajectory.
-Scene run_damping_stage(Calibration& c, CalibrationResult& result, const Scene& current) {
+/// The rate stage: d of every calibrated layer, and the rate exponent n of
+/// every breakthrough threshold that has one (breakthrough_rate.hpp), on the
+/// whole trajectory of references at two or more speeds; every other
+/// parameter as the layer stages left it.
+Scene run_rate_stage(Calibration& c, CalibrationResult& result, const Scene& current) {
   std::vector<Parameter> ds;
-  for (std::size_t k : c.layers) ds.push_back(c.parameter(k, ParamKind::Damping));
-  StageObjective stage = whole_objective_stage(c, result, "damping", current, ds);
+  for (std::size_t k : c.layers) {
+    ds.push_back(c.parameter(k, ParamKind::Damping));
+    if (has_breakthrough_rate(c.scene, k)) ds.push_back(c.parameter(k, ParamKind::BreakthroughRate));
+  }
+  StageObjective stage = whole_objective_stage(c, result, "rate (d, n)", current, ds);
   const std::vector<double> x0 = x_values(current, stage.parameters);
   CalibrationStageRecord rec;
   rec.stage = stage.name();
@@ -465,7 +472,9 @@ TunedParameterRecord parameter_record(const Calibration& c, const Scene& tuned, 
 
 void record_parameters(const Calibration& c, CalibrationResult& result) {
   for (std::size_t i = 0; i < c.parameters.size(); ++i) {
-    if (!c.calibrated(c.parameters[i].layer) && c.parameters[i].kind != ParamKind::Damping) continue;
+    if (!c.calibrated(c.parameters[i].layer) && c.parameters[i].kind != ParamKind::Damping &&
+        c.parameters[i].kind != ParamKind::BreakthroughRate)
+      continue;
     const TunedParameterRecord rec = parameter_record(c, result.tuned_scene, i);
     if (rec.start_moved_inside)
       result.warnings.push_back("layer " + rec.layer + ": " + rec.name + " started outside its physical bounds (" +
@@ -512,7 +521,11 @@ void report_identifiability(Calibration& c, CalibrationResult& result) {
       if (!why.empty()) withheld.push_back({k, kind, why});
     }
   if (!result.damping_tuned && c.scene.effects.damping)
-    for (std::size_t k : c.layers) withheld.push_back({k, ParamKind::Damping, result.damping_note});
+    for (std::size_t k : c.layers) {
+      withheld.push_back({k, ParamKind::Damping, result.damping_note});
+      if (has_breakthrough_rate(c.scene, k))
+        withheld.push_back({k, ParamKind::BreakthroughRate, "tuned with d only; " + result.damping_note});
+    }
   result.identifiability = identifiability_report(whole, withheld, c.options);
 }
 
@@ -557,7 +570,7 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
                                         : (scene.effects.layer_interaction && c.layers.size() > 1 ? 2 : 1);
   for (int pass = 0; pass < passes; ++pass)
     for (std::size_t k : c.layers) current = run_layer_stage(c, result, current, k, pass, passes);
-  if (result.damping_tuned) current = run_damping_stage(c, result, current);
+  if (result.damping_tuned) current = run_rate_stage(c, result, current);
   current = run_joint_stage(c, result, current);
 
   result.tuned_scene = current;

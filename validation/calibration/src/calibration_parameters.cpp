@@ -26,6 +26,7 @@ ParamInfo info(ParamKind k) {
     case ParamKind::StiffeningExponential: return {"stiffening_exponential", "N/mm", kMm, false, 10.0};
     case ParamKind::Presliding: return {"friction_presliding", "mm", 1.0 / kMm, false, 1e-3};
     case ParamKind::RuptureRelease: return {"rupture_release", "mm", 1.0 / kMm, true, 0.0};
+    case ParamKind::BreakthroughRate: return {"breakthrough_rate_exponent", "-", 1.0, false, 0.1};
   }
   throw std::logic_error("info");
 }
@@ -47,6 +48,7 @@ double& param_ref(Scene& s, std::size_t layer, ParamKind k) {
     case ParamKind::StiffeningExponential: return l.force_law.stiffening.exponential_stiffness_N_per_m;
     case ParamKind::Presliding: return l.force_law.friction.presliding_m;
     case ParamKind::RuptureRelease: return l.force_law.rupture_release_m;
+    case ParamKind::BreakthroughRate: return l.force_law.breakthrough.rate_exponent;
   }
   throw std::logic_error("param_ref");
 }
@@ -74,6 +76,7 @@ void physical_range(const Scene& s, std::size_t layer, ParamKind k, double& lo, 
     case ParamKind::StiffeningExponential: lo = 0.0, hi = 1e6; return;
     case ParamKind::Presliding: lo = 0.0, hi = 0.05; return;                       // 0 .. 50 mm of shaft travel
     case ParamKind::RuptureRelease: lo = 1e-5, hi = 0.05; return;                  // 10 um .. 50 mm (the scene's limit)
+    case ParamKind::BreakthroughRate: lo = 0.0, hi = 1.0; return;                  // n in [0, 1] (the scene's limit)
   }
 }
 
@@ -125,9 +128,14 @@ std::string unidentified_reason(const LayerIdentifiability& id, ParamKind kind) 
              : id.pressing() ? "" : fewer + " pressing samples of this layer before its puncture";
     case ParamKind::Cutting: case ParamKind::Friction: case ParamKind::Presliding: case ParamKind::RuptureRelease:
       return id.cut() ? "" : fewer + " samples of the cut through this layer";
-    case ParamKind::Damping: return "";
+    case ParamKind::Damping: case ParamKind::BreakthroughRate: return "";  // decided by the references' speeds
     default: return id.pressing() ? "" : fewer + " pressing samples of this layer";
   }
+}
+
+bool has_breakthrough_rate(const Scene& scene, std::size_t k) {
+  const BreakthroughCriterion::Kind kind = scene.layers[k].force_law.breakthrough.kind;
+  return scene.effects.surface_force && kind != BreakthroughCriterion::Kind::Rings;
 }
 
 /// With `id`: only the parameters the references identify.

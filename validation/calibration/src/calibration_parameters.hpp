@@ -38,7 +38,8 @@ enum class ParamKind {
   StiffeningCubic,
   StiffeningExponential,
   Presliding,
-  RuptureRelease
+  RuptureRelease,
+  BreakthroughRate  ///< n of the breakthrough threshold's rate law (breakthrough_rate.hpp); tuned with d
 };
 
 struct ParamInfo {
@@ -73,6 +74,9 @@ void set_param(Scene& s, const Parameter& p, double value);
 Parameter make_parameter(const Scene& start, std::size_t layer, ParamKind kind, double bound_factor, bool& moved);
 /// Why the references do not identify a parameter (reference_checks.hpp); "" when they do.
 std::string unidentified_reason(const LayerIdentifiability& id, ParamKind kind);
+/// True when layer k's breakthrough threshold has a rate law to tune (a
+/// critical force or energy with the surface-force effect).
+bool has_breakthrough_rate(const Scene& scene, std::size_t k);
 /// The stage parameters of layer k the options and the scene's effects call
 /// for; with `id`, only the ones the references identify.
 std::vector<ParamKind> layer_kinds(const Scene& scene, std::size_t k, const TunedParameterSet& t,
