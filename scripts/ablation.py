@@ -7,7 +7,8 @@ k_a = z_v = 0), the paper's ring-w breakthrough and no other mechanism; then,
 one at a time, the tuned preset's stiffening (in the mesh: k_a and z_v where
 the surface fit identified them; of the tip spring elsewhere), cutting, shaft
 friction, the critical-force breakthrough, the rupture release (the load at a
-break let go over the release length instead of at once), the coupled surfaces
+break let go over the release length instead of at once), the breakthrough's
+rate law (its threshold x (v / v_ref)^n, n identified with d at two speeds), the coupled surfaces
 (= the tuned preset as calibrated) and layer interaction in place of the coupled surfaces. Each row is validated (`puncture validate SCENE --cases
 CASES_JSON`, FEM from out/.fem_cache) on every case of the cases file; its tick
 cost is the wall time of `puncture run` on the default trajectory (ticks with
@@ -27,12 +28,16 @@ import results_io
 
 
 def rows(tuned, paper):
-    def variant(effects, ring_rule, release=True):
+    def variant(effects, ring_rule, release=True, rate=True):
         s = json.loads(json.dumps(tuned), object_pairs_hook=collections.OrderedDict)
         s["effects"] = effects
         if not release:
             for l in s["layers"]:
                 l["force_law"]["rupture_release_mm"] = 0.0
+        if not rate:
+            for l in s["layers"]:
+                l["force_law"]["breakthrough"].pop("rate_exponent", None)
+                l["force_law"]["breakthrough"].pop("reference_speed_mm_per_s", None)
         if "stiffening" not in effects:
             for l in s["layers"]:
                 l["force_mesh"].pop("surface_axial_stiffness_N_per_mm", None)
@@ -49,8 +54,9 @@ def rows(tuned, paper):
          variant(base + ["stiffening"], True)),
         ("+ cutting", variant(base + ["stiffening", "cutting"], True, False)),
         ("+ shaft friction", variant(base + ["stiffening", "cutting", "friction"], True, False)),
-        ("+ critical-force breakthrough", variant(base + ["stiffening", "cutting", "friction"], False, False)),
-        ("+ rupture release", variant(base + ["stiffening", "cutting", "friction"], False)),
+        ("+ critical-force breakthrough", variant(base + ["stiffening", "cutting", "friction"], False, False, False)),
+        ("+ rupture release", variant(base + ["stiffening", "cutting", "friction"], False, True, False)),
+        ("+ breakthrough rate law", variant(base + ["stiffening", "cutting", "friction"], False)),
         ("+ coupled surfaces (the tuned preset)",
          variant(base + ["stiffening", "cutting", "friction", "coupled_surfaces"], False)),
         ("+ layer interaction (in place of coupled surfaces)",

@@ -11,8 +11,9 @@
 #                                muscle from the FEM's force and surface profiles together
 #                                (--surface-fit), then everything but d on the FEM
 #                                reference at the scene's 10 mm/s (d cannot be told from the
-#                                friction at one speed); then d alone from the viscoelastic
-#                                FEM references at 1 and 10 mm/s (3 and 20 mm/s stay held
+#                                friction at one speed); then d and the breakthrough rate
+#                                exponents n from the viscoelastic FEM references at 1 and
+#                                10 mm/s (3 and 20 mm/s stay held
 #                                out, scripts/results_heldout.sh): default_tuned.json;
 #                                provenance, identifiability, before/after plot, wall time
 #   results/liver_calibration/   puncture calibrate of the two-layer liver scene against the
@@ -50,7 +51,8 @@ rate=()
 # the FEM's force and surface profiles together, no tip stiffening.
 "$build/apps/puncture" calibrate scenes/default_force_law.json -o results/tuned_preset/single_speed --name default_tuned_single_speed \
   --integrator implicit --force-weight 4 --depth-weight 1 --surface-fit
-# d from two speeds, every other parameter kept at the single-speed values
+# d and the breakthrough rate exponents n (core/include/puncture/breakthrough_rate.hpp)
+# from two speeds, every other parameter kept at the single-speed values
 # (tuning them on both speeds at once let the muscle stop puncturing).
 "${mpi[@]}" "$build/apps/puncture" calibrate results/tuned_preset/single_speed/default_tuned_single_speed.json -o results/tuned_preset \
   --name default_tuned --integrator implicit --force-weight 4 --depth-weight 1 --fem-speeds 1,10 \
