@@ -4,10 +4,13 @@
 
 #include <stdexcept>
 
+#include "puncture/breakthrough_rate.hpp"
+
 namespace puncture::comparison {
 
 LayerBreakthroughRule::LayerBreakthroughRule(const Layer& layer, double prescribed_depth_m)
-    : kind_(layer.force_law.breakthrough.kind),
+    : criterion_(layer.force_law.breakthrough),
+      kind_(layer.force_law.breakthrough.kind),
       critical_force_N_(layer.force_law.breakthrough.critical_force_N),
       critical_energy_J_(layer.force_law.breakthrough.critical_energy_J),
       prescribed_depth_m_(prescribed_depth_m),
@@ -18,16 +21,23 @@ LayerBreakthroughRule LayerBreakthroughRule::of(const Scene& scene, std::size_t 
   return LayerBreakthroughRule(scene.layers.at(layer), layer < prescribed.size() ? prescribed[layer] : 0.0);
 }
 
-void LayerBreakthroughRule::start(double depth_m) {
-  last_depth_m_ = depth_m;
+void LayerBreakthroughRule::start(double depth_m, double time_s) {
+  last_depth_m_ = start_depth_m_ = depth_m;
+  last_time_s_ = start_time_s_ = time_s;
   last_force_N_ = 0.0;
   work_J_ = 0.0;
 }
 
-void LayerBreakthroughRule::advance(double depth_m, double force_N) {
+void LayerBreakthroughRule::advance(double depth_m, double force_N, double time_s) {
   if (depth_m > last_depth_m_) work_J_ += 0.5 * (force_N + last_force_N_) * (depth_m - last_depth_m_);
   last_depth_m_ = depth_m;
   last_force_N_ = force_N;
+  last_time_s_ = time_s;
+}
+
+double LayerBreakthroughRule::rate_factor() const {
+  return breakthrough_rate_factor(criterion_, mean_pressing_speed_m_per_s(start_depth_m_, start_time_s_, last_depth_m_,
+                                                                          last_time_s_, criterion_.reference_speed_m_per_s));
 }
 
 bool LayerBreakthroughRule::broken(double force_N, const std::vector<double>& ring_deflection_m) const {
@@ -38,9 +48,9 @@ bool LayerBreakthroughRule::broken(double force_N, const std::vector<double>& ri
         throw std::invalid_argument("LayerBreakthroughRule: the ring rule needs a deflection at every lattice point");
       return rings_.broken(ring_deflection_m);
     case BreakthroughCriterion::Kind::CriticalForce:
-      return force_N >= critical_force_N_;
+      return force_N >= critical_force_N_ * rate_factor();
     case BreakthroughCriterion::Kind::CriticalEnergy:
-      return work_J_ >= critical_energy_J_;
+      return work_J_ >= critical_energy_J_ * rate_factor();
   }
   return false;
 }

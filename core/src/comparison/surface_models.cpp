@@ -55,11 +55,11 @@ double LinearSurfaceModel::step(const NeedleState& needle) {
       layer.contact_started = true;
       layer.contact_depth_m = contact;
       layer.state = LayerState::Pressed;
-      layer.breakthrough.start(contact);
+      layer.breakthrough.start(contact, needle.time_s);
     }
     layer.indentation_m = std::max(0.0, depth - layer.contact_depth_m);
     const double force = layer.stiffness_N_per_m * layer.indentation_m;
-    layer.breakthrough.advance(depth, force);
+    layer.breakthrough.advance(depth, force, needle.time_s);
     std::vector<double> deflection;
     if (layer.breakthrough.needs_deflection()) {
       deflection.resize(layer.ring_unit_deflection.size());

@@ -189,7 +189,7 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
         layer.baseline_m = layer.ring_probe.deflection_m(y_, mesh_->points_m);
         layer.contact_started = true;
         layer.state = LayerState::Pressed;
-        layer.breakthrough.start(-z_tip);
+        layer.breakthrough.start(-z_tip, time_);
       }
       snap = std::max(snap, y_[3 * a + 2] - z_tip);
       y_[3 * a + 2] = z_tip;
@@ -208,7 +208,7 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
       for (std::size_t i = 0; i < deflection.size(); ++i) deflection[i] -= layer.baseline_m[i];
     }
     const double force = layer.breakthrough.needs_force() ? contact_force_N() : 0.0;
-    layer.breakthrough.advance(-z_tip, force);
+    layer.breakthrough.advance(-z_tip, force, time_);
     if (!layer.breakthrough.broken(force, deflection)) {
       if (layer.breakthrough.needs_force()) checked_force_N_ = force;  // the step's contact force, if nothing moves now
       break;

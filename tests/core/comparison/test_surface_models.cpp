@@ -219,6 +219,28 @@ TEST(BoundaryElementModel, BreaksAtTheLayersCriticalForce) {
   EXPECT_LT(p.force_before_N, critical);
 }
 
+TEST(BoundaryElementModel, TheCriticalForceScalesWithThePressingSpeedAsTheRealTimeModels) {
+  // The rate law of breakthrough_rate.hpp, n = 0.5 about 10 mm/s: at 2.5 and
+  // 10 mm/s the skin breaks at depth F_c s / S, s = sqrt(v / 10 mm/s).
+  Scene scene = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json");
+  const double S = BoundaryElementModel(scene).stiffness_N_per_m(0);
+  const double critical = S * 4e-3;
+  BreakthroughCriterion& b = scene.layers[0].force_law.breakthrough;
+  b.kind = BreakthroughCriterion::Kind::CriticalForce;
+  b.critical_force_N = critical;
+  b.rate_exponent = 0.5;
+  b.reference_speed_m_per_s = 0.01;
+  for (double v : {0.0025, 0.01}) {
+    Scene at_speed = scene;
+    at_speed.insertion.speed_m_per_s = v;
+    BoundaryElementModel bem(at_speed);
+    const FirstPuncture p = first_puncture(bem, at_speed, 0);
+    const double want = critical * std::sqrt(v / 0.01) / S;
+    EXPECT_GE(p.depth_m, want - 1e-12) << v;
+    EXPECT_LE(p.depth_m, want + v * 1e-3 + 1e-9) << v;
+  }
+}
+
 TEST(BoundaryElementModel, BreaksAtTheLayersCriticalWork) {
   // The work of F = S z from contact to z is S z^2 / 2 (the trapezoidal rule
   // is exact for a linear force): the skin breaks at z = sqrt(2 W_c / S).

@@ -12,11 +12,14 @@
 //                  reaches critical_energy_J (a continuum model's elastic
 //                  energy and damping losses; the force mesh's is its stored
 //                  energy).
+// The critical force or energy scales with the layer's mean pressing speed
+// as the real-time model's does (breakthrough_rate.hpp): the tip's advance
+// since the contact started over the time since.
 // A depth prescribed for the layer (ComparisonSettings::
 // prescribed_puncture_depths_m) overrides the rule: the layer breaks when the
 // tip reaches it. Checked only while the needle advances (as the force mesh's
 // rule).
-// In: the layer, then per step the tip depth (m) and the contact force (N);
+// In: the layer, then per step the tip depth (m), the time (s) and the contact force (N);
 // the ring deflections (m, into the tissue, from the contact) only for Rings.
 #pragma once
 
@@ -41,11 +44,11 @@ class LayerBreakthroughRule {
   bool needs_force() const { return !needs_deflection() && !(prescribed_depth_m_ > 0.0); }
   const RingBreakthroughCriterion& rings() const { return rings_; }
 
-  /// The needle's contact with the layer starts at this tip depth (m).
-  void start(double depth_m);
+  /// The needle's contact with the layer starts at this tip depth (m) at time_s (s).
+  void start(double depth_m, double time_s);
   /// One model step (every step while the layer is pressed): the tip depth
-  /// (m) and the contact force (N; 0 when !needs_force()); books the work.
-  void advance(double depth_m, double force_N);
+  /// (m), the time (s) and the contact force (N; 0 when !needs_force()); books the work.
+  void advance(double depth_m, double force_N, double time_s);
   /// Work done on the layer since start (J).
   double work_J() const { return work_J_; }
   /// Whether the layer breaks with this contact force (N) and, for Rings,
@@ -53,6 +56,7 @@ class LayerBreakthroughRule {
   bool broken(double force_N, const std::vector<double>& ring_deflection_m = {}) const;
 
  private:
+  BreakthroughCriterion criterion_;
   BreakthroughCriterion::Kind kind_;
   double critical_force_N_ = 0.0;
   double critical_energy_J_ = 0.0;
@@ -61,6 +65,9 @@ class LayerBreakthroughRule {
   double last_depth_m_ = 0.0;
   double last_force_N_ = 0.0;
   double work_J_ = 0.0;
+  double start_depth_m_ = 0.0, start_time_s_ = 0.0, last_time_s_ = 0.0;
+  /// s(v) of the criterion at the mean pressing speed since start().
+  double rate_factor() const;
 };
 
 }  // namespace puncture::comparison
