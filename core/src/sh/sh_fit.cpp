@@ -92,6 +92,58 @@ SHGrid make_sh_grid(int n_theta, int n_phi) {
   return grid;
 }
 
+namespace {
+
+/// Associated Legendre factors B(i, index(l, m)) = Y_lm(theta_i, phi = 0) (nt x (L + 1)^2).
+Eigen::MatrixXd legendre_factors(const RealSHBasis& basis, const SHGrid& grid) {
+  const int nt = grid.n_theta(), unknowns = basis.count();
+  Eigen::MatrixXd legendre(nt, unknowns);
+  Eigen::VectorXd row(unknowns);
+  for (int i = 0; i < nt; ++i) {
+    basis.evaluate(grid.direction(i, 0), row.data());  // phi_0 = 0
+    legendre.row(i) = row.transpose();
+  }
+  return legendre;
+}
+
+/// Fourier projections per polar node i: a_cos[m](i, :) = (cos_mj * F_i)(m, :) / sum_j cos^2
+/// (likewise a_sin), F_i the np x k block of node i's samples.
+void fourier_projections(const Eigen::MatrixXd& values, const Eigen::MatrixXd& cos_mj, const Eigen::MatrixXd& sin_mj,
+                         int nt, std::vector<Eigen::MatrixXd>& a_cos, std::vector<Eigen::MatrixXd>& a_sin) {
+  const int L = int(cos_mj.rows()) - 1, np = int(cos_mj.cols()), k = int(values.cols());
+  a_cos.assign(L + 1, Eigen::MatrixXd(nt, k));
+  a_sin.assign(L + 1, Eigen::MatrixXd(nt, k));
+  for (int i = 0; i < nt; ++i) {
+    const Eigen::MatrixXd block = values.middleRows(i * np, np);
+    const Eigen::MatrixXd pc = cos_mj * block, ps = sin_mj * block;
+    for (int m = 0; m <= L; ++m) {
+      const double w = (m == 0) ? np : 0.5 * np;  // sum_j trig^2
+      a_cos[m].row(i) = pc.row(m) / w;
+      a_sin[m].row(i) = ps.row(m) / w;
+    }
+  }
+}
+
+/// The fit minus the samples at every grid sample (size x k).
+Eigen::MatrixXd grid_residual(const Eigen::MatrixXd& values, const Eigen::MatrixXd& cos_mj,
+                              const Eigen::MatrixXd& sin_mj, const std::vector<Eigen::MatrixXd>& fit_cos,
+                              const std::vector<Eigen::MatrixXd>& fit_sin, int nt) {
+  const int L = int(cos_mj.rows()) - 1, np = int(cos_mj.cols()), k = int(values.cols());
+  Eigen::MatrixXd residual(values.rows(), k);
+  Eigen::MatrixXd gc(L + 1, k), gs(L + 1, k);
+  for (int i = 0; i < nt; ++i) {
+    for (int m = 0; m <= L; ++m) {
+      gc.row(m) = fit_cos[m].row(i);
+      gs.row(m) = fit_sin[m].row(i);
+    }
+    residual.middleRows(i * np, np) =
+        cos_mj.transpose() * gc + sin_mj.transpose() * gs - values.middleRows(i * np, np);
+  }
+  return residual;
+}
+
+}  // namespace
+
 SHFitReport fit_sh_on_grid(const RealSHBasis& basis, const SHGrid& grid,
                            const Eigen::MatrixXd& values, Eigen::MatrixXd& coefficients) {
   const int L = basis.degree(), nt = grid.n_theta(), np = grid.n_phi();
@@ -107,15 +159,7 @@ SHFitReport fit_sh_on_grid(const RealSHBasis& basis, const SHGrid& grid,
                                 std::to_string(L + 1) + ")");
   }
 
-  // Associated Legendre factors B_m(i, l) = Y_lm(theta_i, phi = 0), m >= 0.
-  Eigen::MatrixXd legendre(nt, unknowns);
-  {
-    Eigen::VectorXd row(unknowns);
-    for (int i = 0; i < nt; ++i) {
-      basis.evaluate(grid.direction(i, 0), row.data());  // phi_0 = 0
-      legendre.row(i) = row.transpose();
-    }
-  }
+  const Eigen::MatrixXd legendre = legendre_factors(basis, grid);
   // Discrete Fourier factors: trig(m, j).
   Eigen::MatrixXd cos_mj(L + 1, np), sin_mj(L + 1, np);
   for (int m = 0; m <= L; ++m)
@@ -123,17 +167,8 @@ SHFitReport fit_sh_on_grid(const RealSHBasis& basis, const SHGrid& grid,
       cos_mj(m, j) = std::cos(m * grid.phi(j));
       sin_mj(m, j) = std::sin(m * grid.phi(j));
     }
-  // Fourier projections per polar node: proj_cos[i] = cos_mj * F_i  ((L+1) x k).
-  std::vector<Eigen::MatrixXd> a_cos(L + 1, Eigen::MatrixXd(nt, k)), a_sin(L + 1, Eigen::MatrixXd(nt, k));
-  for (int i = 0; i < nt; ++i) {
-    const Eigen::MatrixXd block = values.middleRows(i * np, np);
-    const Eigen::MatrixXd pc = cos_mj * block, ps = sin_mj * block;
-    for (int m = 0; m <= L; ++m) {
-      const double w = (m == 0) ? np : 0.5 * np;  // sum_j trig^2
-      a_cos[m].row(i) = pc.row(m) / w;
-      a_sin[m].row(i) = ps.row(m) / w;
-    }
-  }
+  std::vector<Eigen::MatrixXd> a_cos, a_sin;
+  fourier_projections(values, cos_mj, sin_mj, nt, a_cos, a_sin);
 
   coefficients.setZero(unknowns, k);
   double sigma_max = 0.0, sigma_min = std::numeric_limits<double>::infinity();
@@ -158,17 +193,7 @@ SHFitReport fit_sh_on_grid(const RealSHBasis& basis, const SHGrid& grid,
     }
   }
 
-  // Residuals over every grid sample.
-  Eigen::MatrixXd residual(grid.size(), k);
-  Eigen::MatrixXd gc(L + 1, k), gs(L + 1, k);
-  for (int i = 0; i < nt; ++i) {
-    for (int m = 0; m <= L; ++m) {
-      gc.row(m) = fit_cos[m].row(i);
-      gs.row(m) = fit_sin[m].row(i);
-    }
-    residual.middleRows(i * np, np) =
-        cos_mj.transpose() * gc + sin_mj.transpose() * gs - values.middleRows(i * np, np);
-  }
+  const Eigen::MatrixXd residual = grid_residual(values, cos_mj, sin_mj, fit_cos, fit_sin, nt);
   SHFitReport report;
   report.samples = grid.size();
   report.unknowns = unknowns;

@@ -155,6 +155,62 @@ IdentificationEvaluation evaluate_mass_spring(const Scene& scene, std::shared_pt
   return e;
 }
 
+namespace {
+
+/// The seed's simulated annealing (GSL gsl_siman) over the log scale factors, from state.log_start.
+void run_simulated_annealing(SearchState& state, const IdentificationOptions& options, double start_objective,
+                             double bound) {
+  const std::size_t n = state.log_start.size();
+  gsl_rng_env_setup();
+  state.rng = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(state.rng, options.seed);
+  LogPoint x0{};
+  x0.n = static_cast<int>(n);
+  for (std::size_t k = 0; k < n; ++k) x0.x[k] = state.log_start[k];
+  // Temperatures relative to the starting objective; the cooling schedule
+  // spends the evaluation budget: T from T0 down to T0 / 100 in
+  // ceil(budget / iters) steps.
+  const int iters_per_temperature = 4;
+  const int temperatures = std::max(2, options.max_evaluations / iters_per_temperature);
+  gsl_siman_params_t params{};
+  params.n_tries = 1;
+  params.iters_fixed_T = iters_per_temperature;
+  params.step_size = 0.25 * bound;
+  params.k = 1.0;
+  params.t_initial = 0.3 * std::max(start_objective, 1e-3);
+  params.mu_t = std::pow(100.0, 1.0 / (temperatures - 1));
+  params.t_min = params.t_initial / 100.0 * 0.999;
+  g_state = &state;
+  gsl_siman_solve(state.rng, &x0, siman_energy, siman_step, siman_distance, nullptr, nullptr, nullptr, nullptr,
+                  sizeof(LogPoint), params);
+  g_state = nullptr;
+  gsl_rng_free(state.rng);
+}
+
+/// NLopt's ISRES evolution strategy over the log scale factors within +- bound of state.log_start.
+void run_evolution_strategy(SearchState& state, const IdentificationOptions& options, double bound) {
+  const std::size_t n = state.log_start.size();
+  nlopt::opt opt(nlopt::GN_ISRES, static_cast<unsigned>(n));
+  std::vector<double> lo(n), hi(n), x(state.log_start);
+  for (std::size_t k = 0; k < n; ++k) lo[k] = state.log_start[k] - bound, hi[k] = state.log_start[k] + bound;
+  opt.set_lower_bounds(lo);
+  opt.set_upper_bounds(hi);
+  opt.set_maxeval(options.max_evaluations);
+  opt.set_population(static_cast<unsigned>(options.population));
+  nlopt::srand(options.seed);
+  opt.set_min_objective(
+      [](unsigned, const double* xv, double*, void* data) { return evaluate_log(*static_cast<SearchState*>(data), xv); },
+      &state);
+  double value = 0.0;
+  try {
+    opt.optimize(x, value);
+  } catch (const nlopt::roundoff_limited&) {
+  } catch (const nlopt::forced_stop&) {
+  }
+}
+
+}  // namespace
+
 IdentificationResult identify_mass_spring_stiffness(const Scene& scene, std::shared_ptr<const comparison::TetMesh> mesh,
                                                     const ReferenceData& reference, const IdentificationOptions& options,
                                                     const IdentificationProgress& progress) {
@@ -185,50 +241,10 @@ IdentificationResult identify_mass_spring_stiffness(const Scene& scene, std::sha
   state.best = result.before.objective;
   const double bound = std::log(options.bound_factor);
 
-  if (options.method == "simulated_annealing") {
-    gsl_rng_env_setup();
-    state.rng = gsl_rng_alloc(gsl_rng_mt19937);
-    gsl_rng_set(state.rng, options.seed);
-    LogPoint x0{};
-    x0.n = static_cast<int>(n);
-    for (std::size_t k = 0; k < n; ++k) x0.x[k] = state.log_start[k];
-    // Temperatures relative to the starting objective; the cooling schedule
-    // spends the evaluation budget: T from T0 down to T0 / 100 in
-    // ceil(budget / iters) steps.
-    const int iters_per_temperature = 4;
-    const int temperatures = std::max(2, options.max_evaluations / iters_per_temperature);
-    gsl_siman_params_t params{};
-    params.n_tries = 1;
-    params.iters_fixed_T = iters_per_temperature;
-    params.step_size = 0.25 * bound;
-    params.k = 1.0;
-    params.t_initial = 0.3 * std::max(result.before.objective, 1e-3);
-    params.mu_t = std::pow(100.0, 1.0 / (temperatures - 1));
-    params.t_min = params.t_initial / 100.0 * 0.999;
-    g_state = &state;
-    gsl_siman_solve(state.rng, &x0, siman_energy, siman_step, siman_distance, nullptr, nullptr, nullptr, nullptr,
-                    sizeof(LogPoint), params);
-    g_state = nullptr;
-    gsl_rng_free(state.rng);
-  } else {
-    nlopt::opt opt(nlopt::GN_ISRES, static_cast<unsigned>(n));
-    std::vector<double> lo(n), hi(n), x(state.log_start);
-    for (std::size_t k = 0; k < n; ++k) lo[k] = state.log_start[k] - bound, hi[k] = state.log_start[k] + bound;
-    opt.set_lower_bounds(lo);
-    opt.set_upper_bounds(hi);
-    opt.set_maxeval(options.max_evaluations);
-    opt.set_population(static_cast<unsigned>(options.population));
-    nlopt::srand(options.seed);
-    opt.set_min_objective(
-        [](unsigned, const double* xv, double*, void* data) { return evaluate_log(*static_cast<SearchState*>(data), xv); },
-        &state);
-    double value = 0.0;
-    try {
-      opt.optimize(x, value);
-    } catch (const nlopt::roundoff_limited&) {
-    } catch (const nlopt::forced_stop&) {
-    }
-  }
+  if (options.method == "simulated_annealing")
+    run_simulated_annealing(state, options, result.before.objective, bound);
+  else
+    run_evolution_strategy(state, options, bound);
 
   // The best point seen (both searches may end elsewhere).
   IdentificationEvaluation best = result.before;

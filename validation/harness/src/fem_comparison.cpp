@@ -264,17 +264,11 @@ std::string num(const nlohmann::json& j, const char* key, double scale = 1.0, in
 }
 }  // namespace
 
-std::string validation_summary_markdown(const Scene& scene, const io::Provenance& provenance,
-                                        const FemReferenceInfo& reference, const FemResultFiles& fem,
-                                        const CurveComparison& cmp, const nlohmann::json& layers,
-                                        const std::vector<std::string>& plots, bool has_vtk,
-                                        const std::string& acceptance_section) {
-  std::ostringstream md;
-  md << "# Validation: " << scene.name << "\n\n";
-  md << "Real-time SHF + MSM model against the deal.II FEM reference on the identical insertion ("
-     << num(scene.insertion.speed_m_per_s / kMm) << " mm/s to " << num(scene.insertion.target_depth_m / kMm)
-     << " mm), aligned on depth (withdrawal on depth, dwell on the time since it began). The table below is the "
-        "insertion per layer; the acceptance section compares the whole trajectory.\n\n";
+namespace {
+
+/// The summary's provenance section.
+void provenance_section(std::ostringstream& md, const Scene& scene, const io::Provenance& provenance,
+                        const FemReferenceInfo& reference, const FemResultFiles& fem) {
   md << "## Provenance\n\n";
   md << "- command: `" << provenance.command << "`\n";
   md << "- program " << provenance.program_version << ", git revision " << provenance.git_revision << "\n";
@@ -288,6 +282,10 @@ std::string validation_summary_markdown(const Scene& scene, const io::Provenance
   md << "- real-time model: SH degree " << scene.realtime.sh_degree << ", integrator " << scene.realtime.integrator
      << ", haptic rate " << num(scene.realtime.haptic_rate_Hz) << " Hz\n\n";
 
+}
+
+/// The summary's force table per layer.
+void force_section(std::ostringstream& md, const CurveComparison& cmp, const nlohmann::json& layers) {
   md << "## Force against depth\n\n";
   md << "Force RMSE over the compared insertion (" << num(cmp.compared_from_depth_m / kMm) << " to "
      << num(cmp.compared_to_depth_m / kMm) << " mm, " << cmp.n_compared << " FEM samples): **"
@@ -317,20 +315,10 @@ std::string validation_summary_markdown(const Scene& scene, const io::Provenance
         "of the layer's top surface at the same distance from the needle. The recovery compares the FEM's "
         "spring-back (same depth, after the material along the needle path was removed) with the real-time "
         "ring deflections one resumption time (the layer's resumption_time_s, rounded up to haptic steps) after its breakthrough.\n\n";
-  if (!acceptance_section.empty()) {
-    md << "## Acceptance per layer (whole trajectory)\n\n"
-          "A layer is accepted when its force RMSE over pressing and cut is at most 10 % of the FEM peak, "
-          "its puncture depth within the layer's force-mesh spacing L of the FEM's, its puncture force within "
-          "10 % of the FEM's (the FEM's punctures from its state columns), and its surface's deflection RMSE at "
-          "most 15 % of the FEM's largest deflection before its breakthrough and 25 % after it (the comparison "
-          "above).\n\n"
-       << acceptance_section << "\n";
-  }
+}
 
-  if (!plots.empty()) {
-    md << "## Plots\n\n";
-    for (const std::string& p : plots) md << "![" << p << "](" << p << ")\n\n";
-  }
+/// The summary's list of files.
+void files_section(std::ostringstream& md, const Scene& scene, bool has_vtk) {
   md << "## Files\n\n";
   md << "| file | content |\n|---|---|\n";
   md << "| [force_depth_aligned.csv](force_depth_aligned.csv) | FEM insertion samples with the real-time force at "
@@ -347,6 +335,38 @@ std::string validation_summary_markdown(const Scene& scene, const io::Provenance
           "at x = 0; the real-time layer surfaces and force meshes (`realtime/*.vtp`) stand beside it, shifted by "
           "one sample diameter (" << num(scene.sample.diameter_m / kMm) << " mm) in +x, with point fields "
           "`deflection_mm` and `deflection_error_mm` (real-time minus FEM at the same r and depth) |\n";
+}
+
+}  // namespace
+
+std::string validation_summary_markdown(const Scene& scene, const io::Provenance& provenance,
+                                        const FemReferenceInfo& reference, const FemResultFiles& fem,
+                                        const CurveComparison& cmp, const nlohmann::json& layers,
+                                        const std::vector<std::string>& plots, bool has_vtk,
+                                        const std::string& acceptance_section) {
+  std::ostringstream md;
+  md << "# Validation: " << scene.name << "\n\n";
+  md << "Real-time SHF + MSM model against the deal.II FEM reference on the identical insertion ("
+     << num(scene.insertion.speed_m_per_s / kMm) << " mm/s to " << num(scene.insertion.target_depth_m / kMm)
+     << " mm), aligned on depth (withdrawal on depth, dwell on the time since it began). The table below is the "
+        "insertion per layer; the acceptance section compares the whole trajectory.\n\n";
+  provenance_section(md, scene, provenance, reference, fem);
+  force_section(md, cmp, layers);
+  if (!acceptance_section.empty()) {
+    md << "## Acceptance per layer (whole trajectory)\n\n"
+          "A layer is accepted when its force RMSE over pressing and cut is at most 10 % of the FEM peak, "
+          "its puncture depth within the layer's force-mesh spacing L of the FEM's, its puncture force within "
+          "10 % of the FEM's (the FEM's punctures from its state columns), and its surface's deflection RMSE at "
+          "most 15 % of the FEM's largest deflection before its breakthrough and 25 % after it (the comparison "
+          "above).\n\n"
+       << acceptance_section << "\n";
+  }
+
+  if (!plots.empty()) {
+    md << "## Plots\n\n";
+    for (const std::string& p : plots) md << "![" << p << "](" << p << ")\n\n";
+  }
+  files_section(md, scene, has_vtk);
   return md.str();
 }
 
