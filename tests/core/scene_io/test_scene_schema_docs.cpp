@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <cmath>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -13,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "puncture/scene_io.hpp"
+#include "puncture/scene_schema.hpp"
 
 namespace puncture {
 namespace {
@@ -55,12 +57,13 @@ Scene scene_with_every_block() {
   return s;
 }
 
-/// Every key of the written schema, with the criteria and laws that write other keys.
-std::set<std::string> written_keys() {
-  std::set<std::string> keys;
+/// The scene with every block written out, and again with each other
+/// breakthrough criterion, stiffening law, FEM puncture criterion and tip
+/// (which write other keys).
+std::vector<json> written_variants() {
+  std::vector<json> out;
   Scene s = scene_with_every_block();
-  collect_keys(json::parse(scene_to_json_text(s)), keys);
-  // The other breakthrough criteria, stiffening law and FEM puncture criteria.
+  out.push_back(json::parse(scene_to_json_text(s)));
   ForceLaw& law = s.layers[0].force_law;
   law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalEnergy;
   law.breakthrough.critical_energy_J = 1e-3;
@@ -68,10 +71,65 @@ std::set<std::string> written_keys() {
   s.layers[0].puncture.kind = PunctureCriterion::Kind::CriticalForce;
   s.layers[1].puncture.kind = PunctureCriterion::Kind::CriticalStretch;
   s.needle.tip = "blunt";
-  collect_keys(json::parse(scene_to_json_text(s)), keys);
+  out.push_back(json::parse(scene_to_json_text(s)));
   law.breakthrough.kind = BreakthroughCriterion::Kind::Rings;
-  collect_keys(json::parse(scene_to_json_text(s)), keys);
+  out.push_back(json::parse(scene_to_json_text(s)));
+  return out;
+}
+
+/// Every key of the written schema, with the criteria and laws that write other keys.
+std::set<std::string> written_keys() {
+  std::set<std::string> keys;
+  for (const json& j : written_variants()) collect_keys(j, keys);
   return keys;
+}
+
+/// Leaf paths of j with array indices as "*" (an array of scalars is one leaf).
+void collect_paths(const json& j, const std::string& path, std::set<std::string>& out) {
+  if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it) collect_paths(it.value(), path + "/" + it.key(), out);
+  } else if (j.is_array() && !j.empty() && (j.front().is_object() || j.front().is_array())) {
+    for (const json& e : j) collect_paths(e, path + "/*", out);
+  } else {
+    out.insert(path);
+  }
+}
+
+/// The first concrete JSON pointer in j that matches the schema path
+/// ("*": any array index), or "" when j holds none.
+std::string first_match(const json& j, const std::string& path, std::size_t from = 1, const std::string& done = "") {
+  if (from > path.size()) return done;
+  const std::size_t end = std::min(path.find('/', from), path.size());
+  const std::string token = path.substr(from, end - from);
+  if (token == "*") {
+    if (!j.is_array()) return {};
+    for (std::size_t i = 0; i < j.size(); ++i) {
+      const std::string m = first_match(j[i], path, end + 1, done + "/" + std::to_string(i));
+      if (!m.empty()) return m;
+    }
+    return {};
+  }
+  if (!j.is_object() || !j.contains(token)) return {};
+  return first_match(j.at(token), path, end + 1, done + "/" + token);
+}
+
+/// The first written variant that holds the field, and where (pointer).
+const json* variant_with(const std::vector<json>& variants, const std::string& path, std::string& pointer) {
+  for (const json& j : variants) {
+    pointer = first_match(j, path);
+    if (!pointer.empty()) return &j;
+  }
+  return nullptr;
+}
+
+/// The reader's error for text j, or "" when it accepts it.
+std::string reader_error(const json& j) {
+  try {
+    parse_scene(j.dump(), "schema_check.json");
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return {};
 }
 
 /// The "Schema" section of scenes/README.md (up to the next heading).
@@ -108,6 +166,114 @@ TEST(SceneSchemaDocs, EveryEffectIsInTheSchemaTableAndTheFuzzDictionary) {
     EXPECT_NE(docs.find("`" + effect + "`"), std::string::npos) << "effect '" << effect << "' not in the schema table";
     EXPECT_NE(dict.find("\"\\\"" + effect + "\\\"\""), std::string::npos)
         << "effect '" << effect << "' not in tests/fuzz/scene.dict";
+  }
+}
+
+TEST(SceneSchema, TheWriterWritesExactlyTheSchemasWrittenFields) {
+  std::set<std::string> written;
+  for (const json& j : written_variants()) collect_paths(j, "", written);
+  std::set<std::string> declared;
+  for (const SceneField& f : scene_schema()) {
+    EXPECT_TRUE(declared.insert(f.path).second) << "the schema declares " << f.path << " twice";
+    if (f.written) EXPECT_TRUE(written.count(f.path)) << "the schema's field " << f.path << " is never written";
+    else EXPECT_FALSE(written.count(f.path)) << f.path << " is written but declared read-only";
+  }
+  for (const std::string& p : written)
+    EXPECT_TRUE(declared.count(p)) << "the writer writes " << p << ", which the schema (scene_schema.cpp) does not declare";
+}
+
+TEST(SceneSchema, TheReaderRejectsAValueBeyondEachRangeNamingItsPath) {
+  // Each bound of the table, crossed by the smallest step that leaves it
+  // (the bound itself when it is open), in the first written variant that
+  // holds the field: the reader refuses and names the field's JSON path.
+  const std::vector<json> variants = written_variants();
+  int checked = 0;
+  for (const SceneField& f : scene_schema()) {
+    if (!f.range.bounded() || !f.written) continue;
+    const bool list = f.type == SceneFieldType::NumberList;
+    std::string field;
+    const json* base = variant_with(variants, f.path, field);
+    ASSERT_NE(base, nullptr) << "no written variant holds " << f.path;
+    const std::string pointer = field + (list ? "/0" : "");
+    const bool integer = f.type == SceneFieldType::Integer;
+    std::vector<double> beyond;
+    if (std::isfinite(f.range.lower))
+      beyond.push_back(f.range.lower_open ? f.range.lower
+                                          : f.range.lower - (integer ? 1.0 : 0.5 * std::abs(f.range.lower) + 0.5));
+    if (std::isfinite(f.range.upper))
+      beyond.push_back(f.range.upper_open ? f.range.upper
+                                          : f.range.upper + (integer ? 1.0 : 0.5 * std::abs(f.range.upper) + 0.5));
+    for (double v : beyond) {
+      json j = *base;
+      if (integer) j[json::json_pointer(pointer)] = static_cast<long long>(v);
+      else j[json::json_pointer(pointer)] = v;
+      const std::string error = reader_error(j);
+      EXPECT_NE(error.find(field), std::string::npos)
+          << f.path << " = " << v << " outside the schema's range: " << (error.empty() ? "accepted" : error);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 80);
+}
+
+TEST(SceneSchema, TheReaderAcceptsEachBoundOfAClosedRangeAndJustInsideAnOpenOne) {
+  // The other side of the test above: a range declared wider than the
+  // reader's fails here (a value inside it is refused naming the field).
+  const std::vector<json> variants = written_variants();
+  for (const SceneField& f : scene_schema()) {
+    if (!f.range.bounded() || !f.written) continue;
+    const bool list = f.type == SceneFieldType::NumberList, integer = f.type == SceneFieldType::Integer;
+    std::string field;
+    const json* base = variant_with(variants, f.path, field);
+    ASSERT_NE(base, nullptr) << "no written variant holds " << f.path;
+    const std::string pointer = field + (list ? "/0" : "");
+    // The insertion's speeds are also bounded below by the scripted
+    // insertion's duration limit (scene_limits.hpp: travel / speed), a bound
+    // that depends on other fields: just inside theirs is 1 mm/s.
+    const bool speed = f.path.rfind("/insertion/", 0) == 0 && f.key().find("speed_mm_per_s") != std::string::npos;
+    auto inside = [&](double bound, bool open, double direction) {
+      if (speed && direction > 0.0) return bound + 1.0;
+      if (!open) return bound;
+      return bound + direction * (integer ? 1.0 : 1e-6 * std::max(1.0, std::abs(bound)));
+    };
+    std::vector<double> values;
+    if (std::isfinite(f.range.lower)) values.push_back(inside(f.range.lower, f.range.lower_open, +1.0));
+    if (std::isfinite(f.range.upper)) values.push_back(inside(f.range.upper, f.range.upper_open, -1.0));
+    for (double v : values) {
+      json j = *base;
+      if (integer) j[json::json_pointer(pointer)] = static_cast<long long>(v);
+      else j[json::json_pointer(pointer)] = v;
+      const std::string error = reader_error(j);
+      EXPECT_EQ(error.find(field), std::string::npos) << f.path << " = " << v << " inside the schema's range: " << error;
+    }
+  }
+}
+
+TEST(SceneSchema, TheReaderNamesEveryMissingRequiredField) {
+  const std::vector<json> variants = written_variants();
+  int checked = 0;
+  for (const SceneField& f : scene_schema()) {
+    if (!f.required || !f.written) continue;
+    std::string pointer;
+    const json* base = variant_with(variants, f.path, pointer);
+    ASSERT_NE(base, nullptr) << "no written variant holds " << f.path;
+    json j = *base;
+    const json::json_pointer ptr(pointer);
+    j[ptr.parent_pointer()].erase(f.key());
+    const std::string error = reader_error(j);
+    EXPECT_NE(error.find(pointer), std::string::npos) << f.path << " removed: " << (error.empty() ? "accepted" : error);
+    ++checked;
+  }
+  EXPECT_GT(checked, 20);
+}
+
+TEST(SceneSchema, EveryKeyIsInTheSchemaTableAndTheFuzzDictionary) {
+  const std::string docs = schema_section();
+  const std::string dict = read_text(std::string(PUNCTURE_SOURCE_DIR) + "/tests/fuzz/scene.dict");
+  for (const SceneField& f : scene_schema()) {
+    EXPECT_TRUE(names(docs, f.key())) << "scenes/README.md's schema table does not name '" << f.key() << "' (" << f.path << ")";
+    EXPECT_NE(dict.find("\"\\\"" + f.key() + "\\\"\""), std::string::npos)
+        << "tests/fuzz/scene.dict has no entry for '" << f.key() << "'";
   }
 }
 

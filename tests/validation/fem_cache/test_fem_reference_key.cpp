@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include "puncture/scene_io.hpp"
+#include "puncture/scene_schema.hpp"
 #include "puncture/validation/fem_reference.hpp"
 #include "puncture/validation/fem_reference_key.hpp"
 
@@ -145,6 +146,21 @@ TEST(FemReferenceKey, ChangesWithEveryLeafOfTheDefaultSceneExceptTheRealtimeOnly
     EXPECT_FALSE(is_realtime_only(p)) << p;
   EXPECT_GT(fem_leaves, 40u);
   EXPECT_GT(realtime_leaves, 40u);
+}
+
+TEST(FemReferenceKey, TheRealtimeOnlyListAgreesWithTheSceneSchema) {
+  // A field the schema says the FEM reads is in the key, every other field
+  // is left out of it (scene_schema.hpp's `fem` column). The key is made of
+  // the written scene, so the read-only spellings do not enter it.
+  for (const SceneField& f : scene_schema()) {
+    if (!f.written) continue;
+    std::string pointer = f.path;
+    for (std::size_t at = pointer.find("/*"); at != std::string::npos; at = pointer.find("/*", at + 2))
+      pointer.replace(at, 2, "/0");
+    EXPECT_EQ(is_realtime_only(pointer), !f.fem)
+        << f.path << (f.fem ? ": the schema says the FEM reads it, the key leaves it out"
+                            : ": the schema says the FEM does not read it, the key holds it");
+  }
 }
 
 TEST(FemReferenceKey, SolverOptionsEnterTheKeyAndOverridesEqualToTheSceneDoNot) {

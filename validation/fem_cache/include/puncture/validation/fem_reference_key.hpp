@@ -7,7 +7,8 @@
 // options (refinement / degree overrides applied to the scene's fem block, the
 // 3D hex mesh options), the program version, a digest of the FEM and mesh
 // sources and the key format. So a field that is added to the scene enters the
-// key unless someone declares it real-time-only in realtime_only_fields(); a
+// key unless someone declares it real-time-only in realtime_only_fields()
+// (which a test checks against the `fem` column of scene_schema.hpp); a
 // test (tests/validation/test_fem_reference_key.cpp) perturbs every leaf of
 // the default scene and runs the FEM with every real-time-only field changed
 // to show that those fields leave the FEM's result as it was.
