@@ -18,7 +18,7 @@ out=results/validation_heldout
 rm -rf "$out.previous"; [ -d "$out" ] && mv "$out" "$out.previous"
 if mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json \
   --cases validation/cases/default_heldout.json -o "$out" --no-vtk -q \
-  --model-note "every parameter but d calibrated on the calibration trajectory (10 mm/s) only, results/tuned_preset/single_speed; d and the breakthrough rate exponents n then from the viscoelastic FEM at 1 and 10 mm/s with the rest kept; 3 and 20 mm/s, the 25 mm hold and the other slab never seen"; then
+  --model-note "every parameter but d and n calibrated on the calibration trajectory (10 mm/s) only, results/tuned_preset/single_speed; d and the breakthrough rate exponents n then from the viscoelastic FEM at 1 and 10 mm/s with the rest kept; 3 and 20 mm/s, the 25 mm hold and the other slab never seen"; then
   rm -rf "$out.previous"
   echo "wrote $out"
 else
