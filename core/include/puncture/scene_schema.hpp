@@ -9,7 +9,7 @@
 // older spellings are read only).
 //
 // The table is what the other places that name scene fields are checked
-// against (tests/core/scene_io/test_scene_schema.cpp and
+// against (tests/core/scene_io/test_scene_schema_docs.cpp and
 // tests/validation/fem_cache/test_fem_reference_key.cpp): the reader rejects a
 // value beyond each range naming the field's JSON path and a missing required
 // field likewise; the writer writes exactly the written fields; scenes/README's
@@ -24,7 +24,7 @@
 
 namespace puncture {
 
-enum class SceneFieldType { Number, Integer, String, Boolean, NumberList, StringList };
+enum class SceneFieldType { Number, Integer, String, NumberList, StringList };
 
 /// A closed or open interval; an infinite bound is no bound.
 struct SceneFieldRange {
