@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Regenerates results/validation_speeds/: the tuned preset validated at 1, 3, 10 and
+# 20 mm/s (validation/cases/default_speeds.json; its d and breakthrough rate exponents
+# were identified at 1 and 10 mm/s, 3 and 20 mm/s are held out), and speed_law.md /
+# speed_law.png: each layer's puncture depth and force against speed, beside the FEM's.
+# The FEM references come from out/.fem_cache (scripts/results_validation.sh and
+# results_heldout.sh make them; a missing one is computed, a few minutes each).
+#   bash scripts/results_speeds.sh
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${PUNCTURE_BUILD_DIR:-$root/build}"
+cd "$root"
+[ -x "$build/apps/puncture" ] || bash scripts/build.sh
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+out=results/validation_speeds
+rm -rf "$out.previous"; [ -d "$out" ] && mv "$out" "$out.previous"
+restore() { rm -rf "$out"; [ -d "$out.previous" ] && mv "$out.previous" "$out"; }
+trap 'restore; exit 130' INT TERM HUP
+if ! mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json \
+  --cases validation/cases/default_speeds.json -o "$out" --no-vtk -q \
+  --model-note "d and the breakthrough rate exponents n identified at 1 and 10 mm/s, every other parameter at 10 mm/s only; 3 and 20 mm/s never seen"; then
+  status=$?; restore; echo "results_speeds.sh: puncture validate failed (exit $status); $out left as it was" >&2; exit "$status"
+fi
+"$(command -v /usr/bin/python3 || command -v python3)" scripts/speed_law.py results/tuned_preset/default_tuned.json "$out"
+trap - INT TERM HUP
+rm -rf "$out.previous"
+echo "wrote $out"
