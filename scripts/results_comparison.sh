@@ -19,10 +19,7 @@ cd "$root"
 [ -x "$build/apps/puncture" ] || bash scripts/build.sh
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 out=results/comparison/default_scene
-rm -rf "$out.previous"; [ -d "$out" ] && mv "$out" "$out.previous"
-# Interrupted (Ctrl-C, kill): the previous folder back in place.
-restore() { rm -rf "$out"; [ -d "$out.previous" ] && mv "$out.previous" "$out"; }
-trap 'restore; echo "results_comparison.sh: interrupted; $out left as it was" >&2; exit 130' INT TERM HUP
+source scripts/results_folder.sh
 start=$(date +%s)
 # Three volumetric models are left out here by default, for their cost on this
 # slab's extruded mesh (4560 vertices; measured 2026-12-02 on 2 cores): msm,
@@ -35,13 +32,6 @@ start=$(date +%s)
 # MODELS=all puts them back (or name the models, comma separated).
 models="${MODELS:-realtime,shf,mass_tensor,bem,fem}"
 model_option=(--models "$models"); [ "$models" = all ] && model_option=()
-if mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" compare results/tuned_preset/default_tuned.json \
-  "${model_option[@]}" --cases validation/cases/default_heldout.json --frames 4 -o "$out"; then
-  rm -rf "$out.previous"
-  echo "wrote $out in $(( $(date +%s) - start )) s"
-else
-  status=$?
-  restore
-  echo "results_comparison.sh: puncture compare failed (exit $status); $out left as it was" >&2
-  exit "$status"
-fi
+replace_results_folder "$out" mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" compare results/tuned_preset/default_tuned.json \
+  "${model_option[@]}" --cases validation/cases/default_heldout.json --frames 4 -o "$out"
+echo "wrote $out in $(( $(date +%s) - start )) s"

@@ -14,16 +14,8 @@ cd "$root"
 [ -x "$build/apps/puncture" ] || bash scripts/build.sh
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 out=results/validation_heldout
-# The folder is the command's output alone: reports of cases no longer in the file go.
-rm -rf "$out.previous"; [ -d "$out" ] && mv "$out" "$out.previous"
-if mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json \
+source scripts/results_folder.sh
+replace_results_folder "$out" mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json \
   --cases validation/cases/default_heldout.json -o "$out" --no-vtk -q \
-  --model-note "every parameter but d and n calibrated on the calibration trajectory (10 mm/s) only, results/tuned_preset/single_speed; d and the breakthrough rate exponents n then from the viscoelastic FEM at 1 and 10 mm/s with the rest kept; 3 and 20 mm/s, the 25 mm hold and the other slab never seen"; then
-  rm -rf "$out.previous"
-  echo "wrote $out"
-else
-  status=$?
-  rm -rf "$out"; [ -d "$out.previous" ] && mv "$out.previous" "$out"
-  echo "results_heldout.sh: puncture validate --cases failed (exit $status); $out left as it was" >&2
-  exit "$status"
-fi
+  --model-note "every parameter but d and n calibrated on the calibration trajectory (10 mm/s) only, results/tuned_preset/single_speed; d and the breakthrough rate exponents n then from the viscoelastic FEM at 1 and 10 mm/s with the rest kept; 3 and 20 mm/s, the 25 mm hold and the other slab never seen"
+echo "wrote $out"

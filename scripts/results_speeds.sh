@@ -13,15 +13,12 @@ cd "$root"
 [ -x "$build/apps/puncture" ] || bash scripts/build.sh
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 out=results/validation_speeds
-rm -rf "$out.previous"; [ -d "$out" ] && mv "$out" "$out.previous"
-restore() { rm -rf "$out"; [ -d "$out.previous" ] && mv "$out.previous" "$out"; }
-trap 'restore; exit 130' INT TERM HUP
-if ! mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json \
-  --cases validation/cases/default_speeds.json -o "$out" --no-vtk -q \
-  --model-note "d and the breakthrough rate exponents n identified at 1 and 10 mm/s, every other parameter at 10 mm/s only; 3 and 20 mm/s never seen"; then
-  status=$?; restore; echo "results_speeds.sh: puncture validate failed (exit $status); $out left as it was" >&2; exit "$status"
-fi
-"$(command -v /usr/bin/python3 || command -v python3)" scripts/speed_law.py results/tuned_preset/default_tuned.json "$out"
-trap - INT TERM HUP
-rm -rf "$out.previous"
+write_speeds() {
+  mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json \
+    --cases validation/cases/default_speeds.json -o "$out" --no-vtk -q \
+    --model-note "d and the breakthrough rate exponents n identified at 1 and 10 mm/s, every other parameter at 10 mm/s only; 3 and 20 mm/s never seen"
+  "$(command -v /usr/bin/python3 || command -v python3)" scripts/speed_law.py results/tuned_preset/default_tuned.json "$out"
+}
+source scripts/results_folder.sh
+replace_results_folder "$out" write_speeds
 echo "wrote $out"

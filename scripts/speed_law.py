@@ -26,9 +26,12 @@ def punctures(metrics_path):
     """{layer: (model depth mm, model force N, FEM depth mm, FEM force N)} of one case."""
     out = {}
     for a in json.load(open(metrics_path))["acceptance"]:
-        match = NOTE.search(a["puncture_force_error_relative"].get("note", ""))
+        note = a["puncture_force_error_relative"].get("note", "")
+        match = NOTE.search(note)
         if match:
             out[a["layer"]] = tuple(float(x) for x in match.groups())
+        elif a["puncture_force_error_relative"].get("available", False):
+            sys.exit(f"speed_law.py: {metrics_path}: layer {a['layer']}: cannot read the punctures from '{note}'")
     return out
 
 

@@ -10,9 +10,6 @@ namespace puncture::comparison {
 
 LayerBreakthroughRule::LayerBreakthroughRule(const Layer& layer, double prescribed_depth_m)
     : criterion_(layer.force_law.breakthrough),
-      kind_(layer.force_law.breakthrough.kind),
-      critical_force_N_(layer.force_law.breakthrough.critical_force_N),
-      critical_energy_J_(layer.force_law.breakthrough.critical_energy_J),
       prescribed_depth_m_(prescribed_depth_m),
       rings_(layer.force_mesh) {}
 
@@ -42,15 +39,15 @@ double LayerBreakthroughRule::rate_factor() const {
 
 bool LayerBreakthroughRule::broken(double force_N, const std::vector<double>& ring_deflection_m) const {
   if (prescribed_depth_m_ > 0.0) return last_depth_m_ >= prescribed_depth_m_;
-  switch (kind_) {
+  switch (criterion_.kind) {
     case BreakthroughCriterion::Kind::Rings:
       if (ring_deflection_m.size() != rings_.points_m().size())
         throw std::invalid_argument("LayerBreakthroughRule: the ring rule needs a deflection at every lattice point");
       return rings_.broken(ring_deflection_m);
     case BreakthroughCriterion::Kind::CriticalForce:
-      return force_N >= critical_force_N_ * rate_factor();
+      return force_N >= criterion_.critical_force_N * rate_factor();
     case BreakthroughCriterion::Kind::CriticalEnergy:
-      return work_J_ >= critical_energy_J_ * rate_factor();
+      return work_J_ >= criterion_.critical_energy_J * rate_factor();
   }
   return false;
 }

@@ -37,9 +37,9 @@ class LayerBreakthroughRule {
   /// The rule of layer k of the scene (with its prescribed depth, if any).
   static LayerBreakthroughRule of(const Scene& scene, std::size_t layer);
 
-  BreakthroughCriterion::Kind kind() const { return kind_; }
+  BreakthroughCriterion::Kind kind() const { return criterion_.kind; }
   /// True for the ring rule, which needs the deflections at rings().points_m().
-  bool needs_deflection() const { return kind_ == BreakthroughCriterion::Kind::Rings && !(prescribed_depth_m_ > 0.0); }
+  bool needs_deflection() const { return criterion_.kind == BreakthroughCriterion::Kind::Rings && !(prescribed_depth_m_ > 0.0); }
   /// True when the rule reads the contact force (or its work) passed to advance().
   bool needs_force() const { return !needs_deflection() && !(prescribed_depth_m_ > 0.0); }
   const RingBreakthroughCriterion& rings() const { return rings_; }
@@ -56,10 +56,7 @@ class LayerBreakthroughRule {
   bool broken(double force_N, const std::vector<double>& ring_deflection_m = {}) const;
 
  private:
-  BreakthroughCriterion criterion_;
-  BreakthroughCriterion::Kind kind_;
-  double critical_force_N_ = 0.0;
-  double critical_energy_J_ = 0.0;
+  BreakthroughCriterion criterion_;  ///< the layer's rule: kind, critical values, rate law
   double prescribed_depth_m_ = 0.0;
   RingBreakthroughCriterion rings_;
   double last_depth_m_ = 0.0;
