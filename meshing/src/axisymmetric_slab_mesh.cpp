@@ -61,22 +61,7 @@ std::size_t index_of(const std::vector<double>& lines, double x) {
   return best;
 }
 
-}  // namespace
-
-double crack_radius_for_tip(const Needle& needle) {
-  if (needle.tip == "bevel") return 2.0 * needle.radius_m / kPi;
-  if (needle.tip == "hollow") return needle.inner_radius_m;
-  return needle.radius_m;
-}
-
-double crack_path_depth(const Scene& scene) {
-  const double a = scene.needle.radius_m;
-  const double H = scene.total_thickness_m();
-  const double h_tip = a / std::max(2, scene.fem.mesh.elements_per_needle_radius);
-  return std::min(scene.insertion.target_depth_m + std::max(2e-3, 4.0 * a), H - h_tip);
-}
-
-AxisymmetricSlabMesh build_axisymmetric_slab_mesh(const Scene& scene, int refinement) {
+void check_inputs(const Scene& scene, int refinement) {
   if (scene.layers.empty()) fail("layers", "must not be empty");
   for (std::size_t i = 0; i < scene.layers.size(); ++i)
     if (!(scene.layers[i].thickness_m > 0.0))
@@ -90,18 +75,11 @@ AxisymmetricSlabMesh build_axisymmetric_slab_mesh(const Scene& scene, int refine
   if (!(ms.radial_growth >= 1.0)) fail("fem.mesh.radial_growth", "must be >= 1");
   if (!(ms.path_element_size_mm > 0.0)) fail("fem.mesh.path_element_size_mm", "must be > 0");
   if (refinement < 0 || refinement > 4) fail("refinement", "must lie in [0, 4]");
+}
 
-  AxisymmetricSlabMesh mesh;
-  const double r_c = crack_radius_for_tip(scene.needle);
-  if (!(r_c > 0.0 && r_c <= a)) fail("needle.inner_radius_m", "must lie in (0, needle radius]");
-  const double h_tip = a / ms.elements_per_needle_radius;
-  const double D_p = crack_path_depth(scene);
-  if (!(D_p > 0.0)) fail("insertion.target_depth_m", "leaves no room for the needle path");
-  mesh.crack_radius_m = r_c;
-  mesh.path_depth_m = D_p;
-  mesh.tip_element_size_m = h_tip / (1 << refinement);
-
-  // Radial lines: core, needle wall, then graded to the sample radius.
+/// Radial lines: the core [0, r_c] and the needle wall [r_c, a] in elements of
+/// about h_tip, then graded by `growth` to the sample radius R_s.
+std::vector<double> radial_lines(double r_c, double a, double R_s, double h_tip, double growth) {
   std::vector<double> R{0.0};
   const int n_core = std::max(2, static_cast<int>(std::lround(r_c / h_tip)));
   append_lines(R, std::vector<double>(n_core, r_c / n_core), +1.0);
@@ -109,9 +87,13 @@ AxisymmetricSlabMesh build_axisymmetric_slab_mesh(const Scene& scene, int refine
     const int n_wall = std::max(2, static_cast<int>(std::lround((a - r_c) / h_tip)));
     append_lines(R, std::vector<double>(n_wall, (a - r_c) / n_wall), +1.0);
   }
-  append_lines(R, graded_divisions(R_s - a, h_tip, ms.radial_growth), +1.0);
+  append_lines(R, graded_divisions(R_s - a, h_tip, growth), +1.0);
+  return R;
+}
 
-  // Axial lines, layer by layer (Z decreasing from 0).
+/// Axial lines, layer by layer (Z decreasing from 0; see the header's layout).
+std::vector<double> axial_lines(const Scene& scene, double D_p, double h_tip) {
+  const FemMeshSettings& ms = scene.fem.mesh;
   std::vector<double> Z{0.0};
   const double path_size = ms.path_element_size_mm * 1e-3;
   double below_path_size = h_tip;
@@ -138,13 +120,13 @@ AxisymmetricSlabMesh build_axisymmetric_slab_mesh(const Scene& scene, int refine
     append_lines(Z, sizes, -1.0);
     Z.back() = -bottom;  // exact interface
   }
+  return Z;
+}
 
-  R = refine_lines(R, refinement);
-  Z = refine_lines(Z, refinement);
-  mesh.radial_lines_m = R;
-  mesh.axial_lines_m = Z;
-
-  // Per layer statistics on the needle path.
+/// Per layer: the elements through its thickness and the largest one on the path.
+void record_path_statistics(const Scene& scene, AxisymmetricSlabMesh& mesh) {
+  const std::vector<double>& Z = mesh.axial_lines_m;
+  const double D_p = mesh.path_depth_m;
   for (std::size_t i = 0; i < scene.layers.size(); ++i) {
     const double top = -scene.layer_top_depth_m(i), bottom = top - scene.layers[i].thickness_m;
     int n = 0;
@@ -157,33 +139,50 @@ AxisymmetricSlabMesh build_axisymmetric_slab_mesh(const Scene& scene, int refine
     mesh.elements_through_layer.push_back(n);
     mesh.largest_path_element_m.push_back(largest);
   }
+}
 
-  // Vertices: grid (k, j), plus the outer copies of the crack vertices (blunt).
-  const std::size_t nR = R.size(), nZ = Z.size();
-  const std::size_t k_c = index_of(R, r_c);
-  const std::size_t j_p = index_of(Z, -D_p);
-  const bool open_channel = scene.needle.tip == "bevel" || scene.needle.tip == "hollow";
-  mesh.open_channel = open_channel;
-  auto grid = [nR](std::size_t k, std::size_t j) { return static_cast<unsigned>(j * nR + k); };
-  std::vector<Eigen::Vector2d> vertices;
-  vertices.reserve(nR * nZ + j_p);
-  for (std::size_t j = 0; j < nZ; ++j)
-    for (std::size_t k = 0; k < nR; ++k) vertices.emplace_back(R[k], Z[j]);
-  std::vector<unsigned> outer_copy(nZ, 0);
-  std::vector<std::pair<unsigned, unsigned>> pairs;
+/// The vertices of the tensor-product grid: (k, j) at (R[k], Z[j]), plus for a
+/// blunt punch an outer-side copy of each crack-line vertex above the path depth.
+struct GridVertices {
+  std::size_t nR = 0;   ///< radial lines
+  std::size_t k_c = 0;  ///< radial line of the crack
+  std::size_t j_p = 0;  ///< axial line of the path depth
+  bool open_channel = false;
+  std::vector<Eigen::Vector2d> points;
+  std::vector<unsigned> outer_copy;                     ///< per axial line above j_p (blunt)
+  std::vector<std::pair<unsigned, unsigned>> pairs;     ///< (core side, outer side) of the crack
+  unsigned grid(std::size_t k, std::size_t j) const { return static_cast<unsigned>(j * nR + k); }
+  /// The vertex a cell on the outer (R >= r_c) or core side uses at (k, j).
+  unsigned vertex(std::size_t k, std::size_t j, bool outer_side) const {
+    return (!open_channel && outer_side && k == k_c && j < j_p) ? outer_copy[j] : grid(k, j);
+  }
+};
+
+GridVertices grid_vertices(const std::vector<double>& R, const std::vector<double>& Z, std::size_t k_c,
+                           std::size_t j_p, bool open_channel) {
+  GridVertices g;
+  g.nR = R.size();
+  g.k_c = k_c;
+  g.j_p = j_p;
+  g.open_channel = open_channel;
+  g.points.reserve(R.size() * Z.size() + j_p);
+  for (std::size_t j = 0; j < Z.size(); ++j)
+    for (std::size_t k = 0; k < R.size(); ++k) g.points.emplace_back(R[k], Z[j]);
+  g.outer_copy.assign(Z.size(), 0);
   if (!open_channel)
     for (std::size_t j = 0; j < j_p; ++j) {
-      outer_copy[j] = static_cast<unsigned>(vertices.size());
-      vertices.emplace_back(R[k_c], Z[j]);
-      pairs.emplace_back(grid(k_c, j), outer_copy[j]);
+      g.outer_copy[j] = static_cast<unsigned>(g.points.size());
+      g.points.emplace_back(R[k_c], Z[j]);
+      g.pairs.emplace_back(g.grid(k_c, j), g.outer_copy[j]);
     }
-  auto vertex = [&](std::size_t k, std::size_t j, bool outer_side) {
-    return (!open_channel && outer_side && k == k_c && j < j_p) ? outer_copy[j] : grid(k, j);
-  };
+  return g;
+}
 
-  // Cells, with the layer of their centre; none inside the open channel.
+/// Cells row by row, with the layer of their centre; none inside the open channel.
+std::vector<std::array<unsigned, 4>> grid_cells(const Scene& scene, const std::vector<double>& Z,
+                                                const GridVertices& g, std::vector<int>& material_id) {
   std::vector<std::array<unsigned, 4>> cells;
-  for (std::size_t j = 0; j + 1 < nZ; ++j) {
+  for (std::size_t j = 0; j + 1 < Z.size(); ++j) {
     const double zc = 0.5 * (Z[j] + Z[j + 1]);
     int layer = static_cast<int>(scene.layers.size()) - 1;
     for (std::size_t i = 0; i < scene.layers.size(); ++i)
@@ -191,29 +190,76 @@ AxisymmetricSlabMesh build_axisymmetric_slab_mesh(const Scene& scene, int refine
         layer = static_cast<int>(i);
         break;
       }
-    for (std::size_t k = 0; k + 1 < nR; ++k) {
-      const bool outer_side = k >= k_c;
-      if (open_channel && !outer_side && j < j_p) continue;
-      cells.push_back({vertex(k, j + 1, outer_side), vertex(k + 1, j + 1, outer_side), vertex(k, j, outer_side),
-                       vertex(k + 1, j, outer_side)});
-      mesh.material_id.push_back(layer);
+    for (std::size_t k = 0; k + 1 < g.nR; ++k) {
+      const bool outer_side = k >= g.k_c;
+      if (g.open_channel && !outer_side && j < g.j_p) continue;
+      cells.push_back({g.vertex(k, j + 1, outer_side), g.vertex(k + 1, j + 1, outer_side),
+                       g.vertex(k, j, outer_side), g.vertex(k + 1, j, outer_side)});
+      material_id.push_back(layer);
     }
   }
+  return cells;
+}
 
-  // Keep only the vertices cells use (the channel's interior has none).
-  std::vector<long> new_index(vertices.size(), -1);
+/// Keeps only the vertices the cells use (the channel's interior has none),
+/// numbered in the order the cells first use them; the crack pairs and faces follow.
+void keep_used_vertices(const GridVertices& g, std::vector<std::array<unsigned, 4>> cells,
+                        AxisymmetricSlabMesh& mesh) {
+  std::vector<long> new_index(g.points.size(), -1);
   for (auto& c : cells)
     for (unsigned& v : c) {
       if (new_index[v] < 0) {
         new_index[v] = static_cast<long>(mesh.vertices.size());
-        mesh.vertices.push_back(vertices[v]);
+        mesh.vertices.push_back(g.points[v]);
       }
       v = static_cast<unsigned>(new_index[v]);
     }
   mesh.cells = std::move(cells);
-  for (const auto& [c, o] : pairs) mesh.crack_vertex_pairs.emplace_back(new_index[c], new_index[o]);
-  if (open_channel)
-    for (std::size_t j = 0; j < j_p; ++j) mesh.crack_face_vertices.push_back(static_cast<unsigned>(new_index[grid(k_c, j)]));
+  for (const auto& [c, o] : g.pairs) mesh.crack_vertex_pairs.emplace_back(new_index[c], new_index[o]);
+  if (g.open_channel)
+    for (std::size_t j = 0; j < g.j_p; ++j)
+      mesh.crack_face_vertices.push_back(static_cast<unsigned>(new_index[g.grid(g.k_c, j)]));
+}
+
+}  // namespace
+
+double crack_radius_for_tip(const Needle& needle) {
+  if (needle.tip == "bevel") return 2.0 * needle.radius_m / kPi;
+  if (needle.tip == "hollow") return needle.inner_radius_m;
+  return needle.radius_m;
+}
+
+double crack_path_depth(const Scene& scene) {
+  const double a = scene.needle.radius_m;
+  const double H = scene.total_thickness_m();
+  const double h_tip = a / std::max(2, scene.fem.mesh.elements_per_needle_radius);
+  return std::min(scene.insertion.target_depth_m + std::max(2e-3, 4.0 * a), H - h_tip);
+}
+
+AxisymmetricSlabMesh build_axisymmetric_slab_mesh(const Scene& scene, int refinement) {
+  check_inputs(scene, refinement);
+  const double a = scene.needle.radius_m;
+  const FemMeshSettings& ms = scene.fem.mesh;
+  AxisymmetricSlabMesh mesh;
+  const double r_c = crack_radius_for_tip(scene.needle);
+  if (!(r_c > 0.0 && r_c <= a)) fail("needle.inner_radius_m", "must lie in (0, needle radius]");
+  const double h_tip = a / ms.elements_per_needle_radius;
+  const double D_p = crack_path_depth(scene);
+  if (!(D_p > 0.0)) fail("insertion.target_depth_m", "leaves no room for the needle path");
+  mesh.crack_radius_m = r_c;
+  mesh.path_depth_m = D_p;
+  mesh.tip_element_size_m = h_tip / (1 << refinement);
+  mesh.open_channel = scene.needle.tip == "bevel" || scene.needle.tip == "hollow";
+
+  const double R_s = 0.5 * scene.sample.diameter_m;
+  mesh.radial_lines_m = refine_lines(radial_lines(r_c, a, R_s, h_tip, ms.radial_growth), refinement);
+  mesh.axial_lines_m = refine_lines(axial_lines(scene, D_p, h_tip), refinement);
+  record_path_statistics(scene, mesh);
+
+  const std::vector<double>& R = mesh.radial_lines_m;
+  const std::vector<double>& Z = mesh.axial_lines_m;
+  const GridVertices grid = grid_vertices(R, Z, index_of(R, r_c), index_of(Z, -D_p), mesh.open_channel);
+  keep_used_vertices(grid, grid_cells(scene, Z, grid, mesh.material_id), mesh);
   return mesh;
 }
 

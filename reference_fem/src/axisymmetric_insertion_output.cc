@@ -78,7 +78,7 @@ void AxisymmetricInsertionRun::write_frame(double time) {
 
 // Writes the outputs (wall time first, so the summary reports it).
 void AxisymmetricInsertionRun::write_outputs() {
-  summary_.wall_time_s = insertion::seconds_since(wall_start_);
+  summary_.wall_time_s = wall_timer_.wall_time();
   if (!options_.write_files) return;
   insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
   write_pvd();

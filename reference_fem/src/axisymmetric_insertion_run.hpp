@@ -4,8 +4,8 @@
 #pragma once
 
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/timer.h>
 #include <algorithm>
-#include <chrono>
 #include <cstdlib>
 #include <cmath>
 #include <filesystem>
@@ -104,7 +104,7 @@ class AxisymmetricInsertionRun {
   const Scene& scene_;
   const FemRunOptions& options_;
   FemRunSummary& summary_;
-  const std::chrono::steady_clock::time_point wall_start_ = std::chrono::steady_clock::now();
+  const dealii::Timer wall_timer_;  ///< runs from the run's construction
   const int degree_;
   const int refinement_;
   const bool cutting_;  // a bevel or hollow tip (else a flat punch)

@@ -18,7 +18,6 @@
 #include <deal.II/numerics/vector_tools.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdlib>
 #include <cmath>
 #include <iomanip>
@@ -243,6 +242,7 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
 }
 
 bool AxisymmetricSolver::assemble(const Vector<double>& u, bool with_matrix) {
+  TimerOutput::Scope section(timer_, "assemble");
   if (!compute_cell_contributions(u, with_matrix)) return false;
   add_cell_contributions(with_matrix);
   if (!add_cohesive_forces(u, with_matrix)) return false;

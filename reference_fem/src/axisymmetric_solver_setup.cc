@@ -16,7 +16,6 @@
 #include <deal.II/numerics/vector_tools.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdlib>
 #include <cmath>
 #include <iomanip>

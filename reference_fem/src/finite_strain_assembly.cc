@@ -23,7 +23,6 @@
 #include <Teuchos_ParameterList.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -140,151 +139,203 @@ void void_lame(const LayerMaterial& m, double fraction, double& lambda, double& 
   mu = E / (2.0 * (1.0 + nu));
 }
 
+/// What the assembly of one cell works in: its values, its element matrix and
+/// vector, and the scratch of the three-field condensation (sized once).
+struct CellScratch {
+  CellScratch(const FiniteElement<3>& fe, unsigned degree)
+      : fev(fe, QGauss<3>(degree + 1), update_values | update_gradients | update_JxW_values),
+        fefv(fe, QGauss<2>(degree + 1), update_values | update_JxW_values),
+        dpc(fe.n_dofs_per_cell()),
+        nq(fev.n_quadrature_points),
+        np(n_pressure_modes(degree)),
+        Ke(dpc, dpc),
+        Re(dpc),
+        minus_Re(dpc),
+        dofs(dpc),
+        grad_u(nq),
+        grad_N(dpc),
+        dE(dpc),
+        CC_dE(dpc),
+        B(np, dpc),
+        G(np, np),
+        tmp(np, np),
+        GB(np, dpc) {}
+  FEValues<3> fev;
+  FEFaceValues<3> fefv;
+  const FEValuesExtractors::Vector displacement{0};
+  unsigned dpc, nq, np;
+  FullMatrix<double> Ke;  ///< element tangent (lower triangle filled, then mirrored)
+  Vector<double> Re, minus_Re;  ///< element residual f_int - f_ext and its negative
+  std::vector<types::global_dof_index> dofs;
+  std::vector<Tensor<2, 3>> grad_u, grad_N;
+  std::vector<SymTensor2> dE, CC_dE;
+  FullMatrix<double> B, G, tmp, GB;  ///< three-field condensation
+  CellState st;
+};
+
+/// Removed cell: small-strain linear void material of `fraction` x E.
+void add_void_cell(const LayerMaterial& material, double fraction, bool with_matrix, CellScratch& s) {
+  double lambda = 0.0, mu = 0.0;
+  void_lame(material, fraction, lambda, mu);
+  const SymTensor2 I = unit_symmetric_tensor<3>();
+  for (unsigned q = 0; q < s.nq; ++q) {
+    const SymTensor2 eps = symmetrize(s.grad_u[q]);
+    const SymTensor2 sigma = lambda * trace(eps) * I + 2.0 * mu * eps;
+    const double dV = s.fev.JxW(q);
+    for (unsigned i = 0; i < s.dpc; ++i) {
+      s.dE[i] = s.fev[s.displacement].symmetric_gradient(i, q);
+      s.Re(i) += scalar_product(sigma, s.dE[i]) * dV;
+    }
+    if (with_matrix)
+      for (unsigned i = 0; i < s.dpc; ++i) {
+        const SymTensor2 sig_i = lambda * trace(s.dE[i]) * I + 2.0 * mu * s.dE[i];
+        for (unsigned j = 0; j <= i; ++j) s.Ke(i, j) += scalar_product(sig_i, s.dE[j]) * dV;
+      }
+  }
+}
+
+/// Three-field condensation of the volumetric tangent: K += B^T (M^-1 K_JJ M^-1) B.
+void add_condensed_volumetric_tangent(CellScratch& s) {
+  s.st.M_inv.mmult(s.tmp, s.st.K_JJ);
+  s.tmp.mmult(s.G, s.st.M_inv);
+  s.G.mmult(s.GB, s.B);
+  for (unsigned i = 0; i < s.dpc; ++i)
+    for (unsigned j = 0; j <= i; ++j) {
+      double sum = 0.0;
+      for (unsigned a = 0; a < s.np; ++a) sum += s.B(a, i) * s.GB(a, j);
+      s.Ke(i, j) += sum;
+    }
+}
+
+/// Hyperelastic cell: residual int S : dE dV and (with_matrix) the material
+/// and geometric tangent, condensed for the three-field formulation. Returns
+/// false if a quadrature point is inverted or non-finite.
+bool add_solid_cell(const LayerMaterial& material, VolumetricFormulation formulation, unsigned degree,
+                    bool with_matrix, CellScratch& s) {
+  if (!evaluate_cell(material, formulation, degree, s.fev, s.grad_u, s.st)) return false;
+  const bool three_field = formulation == VolumetricFormulation::three_field;
+  if (three_field) s.B = 0.0;
+  for (unsigned q = 0; q < s.nq; ++q) {
+    const double dV = s.fev.JxW(q);
+    const Tensor<2, 3> S_full(s.st.S[q]);
+    const Tensor<2, 3> F_inv_T = transpose(invert(s.st.F[q]));
+    for (unsigned i = 0; i < s.dpc; ++i) {
+      s.grad_N[i] = s.fev[s.displacement].gradient(i, q);
+      s.dE[i] = strain_variation(s.st.F[q], s.grad_N[i]);
+      s.Re(i) += scalar_product(s.st.S[q], s.dE[i]) * dV;
+    }
+    if (!with_matrix) continue;
+    for (unsigned i = 0; i < s.dpc; ++i) {
+      s.CC_dE[i] = s.st.CC[q] * s.dE[i];
+      const Tensor<2, 3> gNi_S = s.grad_N[i] * S_full;
+      for (unsigned j = 0; j <= i; ++j)
+        s.Ke(i, j) += (scalar_product(s.CC_dE[i], s.dE[j]) + scalar_product(gNi_S, s.grad_N[j])) * dV;
+    }
+    if (three_field)
+      for (unsigned i = 0; i < s.dpc; ++i) {
+        const double dJ_i = s.st.J[q] * scalar_product(s.grad_N[i], F_inv_T);
+        for (unsigned a = 0; a < s.np; ++a) s.B(a, i) += s.st.Np[q][a] * dJ_i * dV;
+      }
+  }
+  if (with_matrix && three_field) add_condensed_volumetric_tangent(s);
+  return true;
+}
+
+/// Dead-load tractions (per reference area) on the cell's boundary faces
+/// enter the residual as -f_ext.
+void add_face_tractions(const FiniteStrainSolver::CellIterator& cell,
+                        const std::map<types::boundary_id, Tensor<1, 3>>& tractions, const FiniteElement<3>& fe,
+                        CellScratch& s) {
+  if (tractions.empty()) return;
+  for (unsigned f = 0; f < cell->n_faces(); ++f) {
+    if (!cell->face(f)->at_boundary()) continue;
+    const auto it = tractions.find(cell->face(f)->boundary_id());
+    if (it == tractions.end()) continue;
+    s.fefv.reinit(cell, f);
+    for (unsigned q = 0; q < s.fefv.n_quadrature_points; ++q)
+      for (unsigned i = 0; i < s.dpc; ++i) {
+        const unsigned comp = fe.system_to_component_index(i).first;
+        s.Re(i) -= it->second[comp] * s.fefv.shape_value(i, q) * s.fefv.JxW(q);
+      }
+  }
+}
+
+/// Mirrors the cell tangent's lower triangle and adds the cell into the
+/// global residual and, with constraints, into the Newton system (tangent,
+/// rhs = -R with the increment constraints applied).
+void scatter_cell(const FiniteStrainSolver::CellIterator& cell, const AffineConstraints<double>* constraints,
+                  CellScratch& s, TrilinosWrappers::SparseMatrix& tangent, TrilinosWrappers::MPI::Vector& rhs,
+                  TrilinosWrappers::MPI::Vector& residual) {
+  for (unsigned i = 0; i < s.dpc; ++i)
+    for (unsigned j = i + 1; j < s.dpc; ++j) s.Ke(i, j) = s.Ke(j, i);
+  cell->get_dof_indices(s.dofs);
+  residual.add(s.dofs, s.Re);
+  if (constraints == nullptr) return;
+  for (unsigned i = 0; i < s.dpc; ++i) s.minus_Re(i) = -s.Re(i);
+  constraints->distribute_local_to_global(s.Ke, s.minus_Re, s.dofs, tangent, rhs);
+}
+
 }  // namespace
 
 FiniteStrainSolver::AssemblyResult FiniteStrainSolver::assemble(
     const TrilinosWrappers::MPI::Vector& u, bool with_matrix,
     const AffineConstraints<double>* constraints) {
-  const unsigned degree = settings_.degree;
-  const QGauss<3> quadrature(degree + 1);
-  const QGauss<2> face_quadrature(degree + 1);
-  FEValues<3> fev(fe_, quadrature, update_values | update_gradients | update_JxW_values);
-  FEFaceValues<3> fefv(fe_, face_quadrature, update_values | update_JxW_values);
-  const FEValuesExtractors::Vector displacement(0);
-  const unsigned dpc = fe_.n_dofs_per_cell();
-  const unsigned nq = quadrature.size();
-  const unsigned np = n_pressure_modes(degree);
-
-  FullMatrix<double> Ke(dpc, dpc);
-  Vector<double> Re(dpc), minus_Re(dpc);
-  std::vector<types::global_dof_index> dofs(dpc);
-  std::vector<Tensor<2, 3>> grad_u(nq);
-  std::vector<Tensor<2, 3>> grad_N(dpc);
-  std::vector<SymTensor2> dE(dpc), CC_dE(dpc);
-  FullMatrix<double> B(np, dpc), G(np, np), tmp(np, np), GB(np, dpc);
-  CellState st;
-
+  TimerOutput::Scope section(timer_, "assemble");
+  CellScratch s(fe_, settings_.degree);
   if (with_matrix) tangent_ = 0.0;
   rhs_ = 0.0;
   residual_ = 0.0;
   bool valid = true;
-
   for (const auto& cell : dof_handler_.active_cell_iterators()) {
     if (!cell->is_locally_owned() || !valid) continue;
-    fev.reinit(cell);
-    fev[displacement].get_function_gradients(u, grad_u);
-    Ke = 0.0;
-    Re = 0.0;
+    s.fev.reinit(cell);
+    s.fev[s.displacement].get_function_gradients(u, s.grad_u);
+    s.Ke = 0.0;
+    s.Re = 0.0;
     const LayerMaterial& material = materials_[cell->material_id()];
-
     if (removed_[cell->active_cell_index()]) {
-      double lambda = 0.0, mu = 0.0;
-      void_lame(material, settings_.void_stiffness_fraction, lambda, mu);
-      const SymTensor2 I = unit_symmetric_tensor<3>();
-      for (unsigned q = 0; q < nq; ++q) {
-        const SymTensor2 eps = symmetrize(grad_u[q]);
-        const SymTensor2 sigma = lambda * trace(eps) * I + 2.0 * mu * eps;
-        const double dV = fev.JxW(q);
-        for (unsigned i = 0; i < dpc; ++i) {
-          dE[i] = fev[displacement].symmetric_gradient(i, q);
-          Re(i) += scalar_product(sigma, dE[i]) * dV;
-        }
-        if (with_matrix)
-          for (unsigned i = 0; i < dpc; ++i) {
-            const SymTensor2 sig_i = lambda * trace(dE[i]) * I + 2.0 * mu * dE[i];
-            for (unsigned j = 0; j <= i; ++j) Ke(i, j) += scalar_product(sig_i, dE[j]) * dV;
-          }
-      }
-    } else {
-      if (!evaluate_cell(material, settings_.formulation, degree, fev, grad_u, st)) {
-        valid = false;
-        continue;
-      }
-      if (settings_.formulation == VolumetricFormulation::three_field) B = 0.0;
-      for (unsigned q = 0; q < nq; ++q) {
-        const double dV = fev.JxW(q);
-        const Tensor<2, 3> S_full(st.S[q]);
-        const Tensor<2, 3> F_inv_T = transpose(invert(st.F[q]));
-        for (unsigned i = 0; i < dpc; ++i) {
-          grad_N[i] = fev[displacement].gradient(i, q);
-          dE[i] = strain_variation(st.F[q], grad_N[i]);
-          Re(i) += scalar_product(st.S[q], dE[i]) * dV;
-        }
-        if (!with_matrix) continue;
-        for (unsigned i = 0; i < dpc; ++i) {
-          CC_dE[i] = st.CC[q] * dE[i];
-          const Tensor<2, 3> gNi_S = grad_N[i] * S_full;
-          for (unsigned j = 0; j <= i; ++j)
-            Ke(i, j) += (scalar_product(CC_dE[i], dE[j]) + scalar_product(gNi_S, grad_N[j])) * dV;
-        }
-        if (settings_.formulation == VolumetricFormulation::three_field)
-          for (unsigned i = 0; i < dpc; ++i) {
-            const double dJ_i = st.J[q] * scalar_product(grad_N[i], F_inv_T);
-            for (unsigned a = 0; a < np; ++a) B(a, i) += st.Np[q][a] * dJ_i * dV;
-          }
-      }
-      if (with_matrix && settings_.formulation == VolumetricFormulation::three_field) {
-        // K += B^T (M^-1 K_JJ M^-1) B
-        st.M_inv.mmult(tmp, st.K_JJ);
-        tmp.mmult(G, st.M_inv);
-        G.mmult(GB, B);
-        for (unsigned i = 0; i < dpc; ++i)
-          for (unsigned j = 0; j <= i; ++j) {
-            double s = 0.0;
-            for (unsigned a = 0; a < np; ++a) s += B(a, i) * GB(a, j);
-            Ke(i, j) += s;
-          }
-      }
+      add_void_cell(material, settings_.void_stiffness_fraction, with_matrix, s);
+    } else if (!add_solid_cell(material, settings_.formulation, settings_.degree, with_matrix, s)) {
+      valid = false;
+      continue;
     }
-    // Dead-load tractions (per reference area) enter the residual as -f_ext.
-    if (!tractions_.empty())
-      for (unsigned f = 0; f < cell->n_faces(); ++f) {
-        if (!cell->face(f)->at_boundary()) continue;
-        const auto it = tractions_.find(cell->face(f)->boundary_id());
-        if (it == tractions_.end()) continue;
-        fefv.reinit(cell, f);
-        for (unsigned q = 0; q < fefv.n_quadrature_points; ++q)
-          for (unsigned i = 0; i < dpc; ++i) {
-            const unsigned comp = fe_.system_to_component_index(i).first;
-            Re(i) -= it->second[comp] * fefv.shape_value(i, q) * fefv.JxW(q);
-          }
-      }
-    for (unsigned i = 0; i < dpc; ++i)
-      for (unsigned j = i + 1; j < dpc; ++j) Ke(i, j) = Ke(j, i);
-    cell->get_dof_indices(dofs);
-    residual_.add(dofs, Re);
-    if (with_matrix && constraints != nullptr) {
-      for (unsigned i = 0; i < dpc; ++i) minus_Re(i) = -Re(i);
-      constraints->distribute_local_to_global(Ke, minus_Re, dofs, tangent_, rhs_);
-    }
+    add_face_tractions(cell, tractions_, fe_, s);
+    scatter_cell(cell, with_matrix ? constraints : nullptr, s, tangent_, rhs_, residual_);
   }
-  // Anchor springs: f = k (u - anchor) on free, locally owned dofs.
+  add_anchor_springs(u, with_matrix ? constraints : nullptr);
+  if (with_matrix) tangent_.compress(VectorOperation::add);
+  rhs_.compress(VectorOperation::add);
+  residual_.compress(VectorOperation::add);
+  add_released_load(constraints);
+  const bool all_valid = Utilities::MPI::min(valid ? 1 : 0, mpi_communicator()) == 1;
+  return {all_valid && std::isfinite(residual_.l2_norm())};
+}
+
+void FiniteStrainSolver::add_anchor_springs(const TrilinosWrappers::MPI::Vector& u,
+                                            const AffineConstraints<double>* constraints) {
+  // f = k (u - anchor) on free, locally owned dofs.
   for (const auto& [dof, spring] : anchors_) {
     const double k = anchor_scale_ * spring.stiffness_N_per_m;
     if (targets_.count(dof) || k == 0.0) continue;
     const double f = k * (u[dof] - spring.anchor_m);
     residual_[dof] += f;
-    if (with_matrix && constraints != nullptr) {
+    if (constraints != nullptr) {
       rhs_[dof] -= f;
       tangent_.add(dof, dof, k);
     }
   }
-  if (with_matrix) tangent_.compress(VectorOperation::add);
-  rhs_.compress(VectorOperation::add);
-  residual_.compress(VectorOperation::add);
-  // Frozen removal load (internal force of removed cells, a dead load).
-  if (released_fraction_ > 0.0) {
-    residual_.add(released_fraction_, released_force_);
-    if (constraints != nullptr) {
-      TrilinosWrappers::MPI::Vector free_part(released_force_);
-      for (const auto& [dof, target] : targets_)
-        if (locally_owned_.is_element(dof)) free_part[dof] = 0.0;
-      free_part.compress(VectorOperation::insert);
-      rhs_.add(-released_fraction_, free_part);
-    }
-  }
-  const bool all_valid = Utilities::MPI::min(valid ? 1 : 0, mpi_communicator()) == 1;
-  return {all_valid && std::isfinite(residual_.l2_norm())};
+}
+
+void FiniteStrainSolver::add_released_load(const AffineConstraints<double>* constraints) {
+  // The frozen removal load (internal force of removed cells) is a dead load.
+  if (released_fraction_ <= 0.0) return;
+  residual_.add(released_fraction_, released_force_);
+  if (constraints == nullptr) return;
+  TrilinosWrappers::MPI::Vector free_part(released_force_);
+  for (const auto& [dof, target] : targets_)
+    if (locally_owned_.is_element(dof)) free_part[dof] = 0.0;
+  free_part.compress(VectorOperation::insert);
+  rhs_.add(-released_fraction_, free_part);
 }
 
 CellFields FiniteStrainSolver::cell_fields() const {

@@ -2,6 +2,8 @@
 #include <puncture/fem/finite_strain_solver.hpp>
 #include <puncture/fem/kinematics.hpp>
 
+#include "solver_timing.hpp"
+
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/dofs/dof_tools.h>
@@ -22,7 +24,6 @@
 #include <Teuchos_ParameterList.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -259,6 +260,7 @@ void FiniteStrainSolver::build_preconditioner() {
 
 unsigned int FiniteStrainSolver::solve_linear(TrilinosWrappers::MPI::Vector& du, double absolute_tolerance,
                                               bool rebuild_preconditioner) {
+  TimerOutput::Scope section(timer_, "linear solve");
   du = 0.0;
   const double rhs_norm = rhs_.l2_norm();
   if (rhs_norm == 0.0) return 0;
@@ -303,136 +305,181 @@ unsigned int FiniteStrainSolver::solve_linear(TrilinosWrappers::MPI::Vector& du,
   return 1;
 }
 
-NewtonReport FiniteStrainSolver::solve_step(double predictor_scale) {
+/// What the phases of one solve_step share.
+struct FiniteStrainSolver::Step {
   NewtonReport report;
-  const MPI_Comm comm = mpi_communicator();
-  const bool root = Utilities::MPI::this_mpi_process(comm) == 0;
-  const TrilinosWrappers::MPI::Vector u_start(solution_);
+  TrilinosWrappers::MPI::Vector u_start;        ///< the last converged solution (restored on failure)
+  TrilinosWrappers::MPI::Vector du, trial;      ///< Newton direction; the line search's state (owned)
+  TrilinosWrappers::MPI::Vector trial_ghosted;  ///< the line search's state (ghosted)
+  AffineConstraints<double> constraints;        ///< the increment's constraints at solution_
+  AffineConstraints<double> trial_constraints;  ///< and at the line search's full step
+  double gap_tolerance_m = 0.0;  ///< prescribed displacement gap counted as closed
+  double max_free = 0.0;         ///< largest free residual of the step so far (N)
+  int stalled = 0;               ///< consecutive iterations with a short line-search step
+  bool assembled_here = false;   ///< tangent, rhs and residual are those of solution_
+};
+
+/// One Newton iterate (the state solution_).
+struct FiniteStrainSolver::Iterate {
+  int it = 0;
+  double free = 0.0;   ///< free residual (N)
+  double gap = 0.0;    ///< largest prescribed displacement not yet reached (m)
+  double scale = 0.0;  ///< force scale of the convergence test (N)
+  bool converged = false;
+  unsigned linear_iterations = 0;
+  double assemble_s = 0.0, solve_s = 0.0;
+  std::ostringstream line;  ///< the iterate's line of the Newton log
+};
+
+NewtonReport FiniteStrainSolver::solve_step(double predictor_scale) {
   if (!(predictor_scale >= 0.0) || !std::isfinite(predictor_scale))
     throw std::invalid_argument("FiniteStrainSolver::solve_step: predictor_scale must be finite and >= 0");
-  bool predicted = false;
+  Step step;
+  start_step(step, predictor_scale);
+  for (int it = 0;; ++it) {
+    Iterate x;
+    x.it = it;
+    if (const Failure why = evaluate_iterate(step, x)) return fail_step(step, *why);
+    if (x.converged) return accept_step(step, x);
+    if (it >= settings_.max_newton_iterations) {
+      step.report.table.push_back(x.line.str());
+      step.report.iterations = it;
+      return fail_step(step, "no convergence in " + std::to_string(it) + " Newton iterations");
+    }
+    if (const Failure why = newton_direction(step, x)) return fail_step(step, *why);
+    double alpha = 0.0;
+    if (const Failure why = line_search(step, x, alpha)) return fail_step(step, *why);
+    step.stalled = alpha <= 0.125 ? step.stalled + 1 : 0;
+    x.line << "  lin_its " << x.linear_iterations << "  alpha " << std::defaultfloat << alpha << "  t_assemble "
+           << std::setprecision(3) << x.assemble_s << " s  t_solve " << x.solve_s << " s";
+    step.report.table.push_back(x.line.str());
+    print_verbose(step.report.table.back());
+    solution_ = step.trial;
+    solution_ghosted_ = solution_;
+    if (settings_.max_stalled_iterations > 0 && step.stalled >= settings_.max_stalled_iterations) {
+      step.report.iterations = it + 1;
+      return fail_step(step, "stalled: " + std::to_string(step.stalled) +
+                                 " iterations in a row with a line-search step <= 1/8");
+    }
+  }
+}
+
+void FiniteStrainSolver::start_step(Step& step, double predictor_scale) {
+  const MPI_Comm comm = mpi_communicator();
+  step.u_start = solution_;
   if (predictor_scale > 0.0 && last_increment_.linfty_norm() > 0.0) {
     // Extrapolated start; kept only if no element inverts.
     solution_.add(predictor_scale, last_increment_);
     solution_ghosted_ = solution_;
-    predicted = assemble(solution_ghosted_, false, nullptr).valid;
-    if (!predicted) {
-      solution_ = u_start;
+    if (assemble(solution_ghosted_, false, nullptr).valid) {
+      step.report.table.push_back("     predictor: u + " + std::to_string(predictor_scale) + " x last increment");
+    } else {
+      solution_ = step.u_start;
       solution_ghosted_ = solution_;
     }
   }
-  if (predicted) report.table.push_back("     predictor: u + " + std::to_string(predictor_scale) + " x last increment");
-  TrilinosWrappers::MPI::Vector du(locally_owned_, comm), trial(locally_owned_, comm);
-  TrilinosWrappers::MPI::Vector trial_ghosted(locally_owned_, locally_relevant_, comm);
-  double max_free = 0.0;
+  step.du.reinit(locally_owned_, comm);
+  step.trial.reinit(locally_owned_, comm);
+  step.trial_ghosted.reinit(locally_owned_, locally_relevant_, comm);
   double target_scale = 1e-12;
   for (const auto& [dof, t] : targets_) target_scale = std::max(target_scale, std::abs(t));
-  target_scale = Utilities::MPI::max(target_scale, comm);
-  const double gap_tolerance = 1e-12 * target_scale;
+  step.gap_tolerance_m = 1e-12 * Utilities::MPI::max(target_scale, comm);
+}
 
-  auto fail = [&](const std::string& why) {
-    solution_ = u_start;
-    solution_ghosted_ = solution_;
-    assemble(solution_ghosted_, false, nullptr);
-    report.converged = false;
-    report.failure = why;
-    if (settings_.verbose && root) std::cout << "      newton failed: " << why << std::endl;
-    return report;
-  };
+FiniteStrainSolver::Failure FiniteStrainSolver::evaluate_iterate(Step& step, Iterate& x) {
+  increment_constraints(solution_ghosted_, step.constraints);
+  const double assemble_before_s = section_wall_seconds(timer_, "assemble");
+  // The full step of the last line search already assembled the tangent here.
+  const bool assembled_valid = step.assembled_here || assemble(solution_ghosted_, true, &step.constraints).valid;
+  step.assembled_here = false;
+  x.assemble_s = section_wall_seconds(timer_, "assemble") - assemble_before_s;
+  if (!assembled_valid) return "inverted or non-finite state at the start of an iteration";
+  x.free = free_residual_norm();
+  x.gap = max_constraint_gap();
+  step.max_free = std::max(step.max_free, x.free);
+  x.scale = std::max({reaction_norm(), external_load_norm(), step.max_free});
+  step.report.residual_N = x.free;
+  step.report.force_scale_N = x.scale;
+  if (!std::isfinite(x.free)) return "non-finite residual";
+  x.converged = x.gap <= step.gap_tolerance_m && (x.free <= settings_.newton_tolerance * x.scale ||
+                                                  x.free <= settings_.absolute_residual_floor_N);
+  x.line << std::setw(4) << x.it << "  |R_free| " << std::scientific << std::setprecision(3) << x.free
+         << " N  |R_free|/scale " << (x.scale > 0 ? x.free / x.scale : 0.0) << "  gap " << x.gap << " m";
+  return std::nullopt;
+}
 
-  int stalled = 0;  // consecutive iterations with a short line-search step
-  bool assembled_here = false;  // tangent, rhs and residual are those of the current state
-  AffineConstraints<double> constraints, trial_constraints;
-  for (int it = 0;; ++it) {
-    increment_constraints(solution_ghosted_, constraints);
-    const auto t_assemble = std::chrono::steady_clock::now();
-    // The full step of the last line search already assembled the tangent here.
-    const bool assembled_valid = assembled_here || assemble(solution_ghosted_, true, &constraints).valid;
-    assembled_here = false;
-    const double assemble_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t_assemble).count();
-    if (!assembled_valid)
-      return fail("inverted or non-finite state at the start of an iteration");
-    const double free = free_residual_norm();
-    const double gap = max_constraint_gap();
-    max_free = std::max(max_free, free);
-    const double scale = std::max({reaction_norm(), external_load_norm(), max_free});
-    report.residual_N = free;
-    report.force_scale_N = scale;
-    if (!std::isfinite(free)) return fail("non-finite residual");
-    const bool converged =
-        gap <= gap_tolerance &&
-        (free <= settings_.newton_tolerance * scale || free <= settings_.absolute_residual_floor_N);
-    std::ostringstream line;
-    line << std::setw(4) << it << "  |R_free| " << std::scientific << std::setprecision(3) << free
-         << " N  |R_free|/scale " << (scale > 0 ? free / scale : 0.0) << "  gap " << gap << " m";
-    if (converged) {
-      report.table.push_back(line.str() + "  converged");
-      if (settings_.verbose && root) std::cout << "      " << report.table.back() << std::endl;
-      report.converged = true;
-      report.iterations = it;
-      last_increment_ = solution_;
-      last_increment_ -= u_start;
-      return report;
-    }
-    if (it >= settings_.max_newton_iterations) {
-      report.table.push_back(line.str());
-      report.iterations = it;
-      return fail("no convergence in " + std::to_string(it) + " Newton iterations");
-    }
-    const auto t_solve = std::chrono::steady_clock::now();
-    const double newton_target =
-        std::max(settings_.newton_tolerance * scale, settings_.absolute_residual_floor_N);
-    const unsigned lin_its =
-        solve_linear(du, 0.1 * newton_target, it == 0 || settings_.rebuild_preconditioner_every_iteration);
-    const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_solve).count();
-    report.linear_iterations += lin_its;
-    constraints.distribute(du);
-    if (!std::isfinite(du.l2_norm())) return fail("non-finite Newton update");
+FiniteStrainSolver::Failure FiniteStrainSolver::newton_direction(Step& step, Iterate& x) {
+  // K du = -R by CG + AMG (or a direct solver) to a tenth of the Newton target;
+  // the AMG is rebuilt at the step's first iteration.
+  const double newton_target =
+      std::max(settings_.newton_tolerance * x.scale, settings_.absolute_residual_floor_N);
+  const double solve_before_s = section_wall_seconds(timer_, "linear solve");
+  x.linear_iterations =
+      solve_linear(step.du, 0.1 * newton_target, x.it == 0 || settings_.rebuild_preconditioner_every_iteration);
+  x.solve_s = section_wall_seconds(timer_, "linear solve") - solve_before_s;
+  step.report.linear_iterations += x.linear_iterations;
+  step.constraints.distribute(step.du);
+  if (!std::isfinite(step.du.l2_norm())) return "non-finite Newton update";
+  return std::nullopt;
+}
 
-    // Backtracking line search.
-    double alpha = 1.0, best_alpha = -1.0, best_free = std::numeric_limits<double>::infinity();
-    bool accepted = false;
-    for (int h = 0; h <= settings_.max_line_search_halvings; ++h, alpha *= 0.5) {
-      trial = solution_;
-      trial.add(alpha, du);
-      trial_ghosted = trial;
-      // The full step is evaluated with the tangent: when it is accepted (the
-      // common case) the next iteration needs no assembly of its own.
-      const bool full_step = h == 0;
-      if (full_step) increment_constraints(trial_ghosted, trial_constraints);
-      if (!assemble(trial_ghosted, full_step, full_step ? &trial_constraints : nullptr).valid) continue;
-      const double trial_free = free_residual_norm();
-      if (!std::isfinite(trial_free)) continue;
-      if (gap > gap_tolerance || trial_free < (1.0 - 1e-4 * alpha) * free ||
-          trial_free <= settings_.absolute_residual_floor_N) {
-        accepted = true;
-        assembled_here = full_step;
-        break;
-      }
-      if (trial_free < best_free) {
-        best_free = trial_free;
-        best_alpha = alpha;
-      }
+FiniteStrainSolver::Failure FiniteStrainSolver::line_search(Step& step, const Iterate& x, double& alpha) {
+  // Backtracking: the first of alpha = 1, 1/2, 1/4, ... whose free residual
+  // falls enough (any admissible one while a prescribed gap is open), else the
+  // least bad admissible one.
+  double best_alpha = -1.0, best_free = std::numeric_limits<double>::infinity();
+  alpha = 1.0;
+  for (int h = 0; h <= settings_.max_line_search_halvings; ++h, alpha *= 0.5) {
+    step.trial = solution_;
+    step.trial.add(alpha, step.du);
+    step.trial_ghosted = step.trial;
+    // The full step is evaluated with the tangent: when it is accepted (the
+    // common case) the next iteration needs no assembly of its own.
+    const bool full_step = h == 0;
+    if (full_step) increment_constraints(step.trial_ghosted, step.trial_constraints);
+    if (!assemble(step.trial_ghosted, full_step, full_step ? &step.trial_constraints : nullptr).valid) continue;
+    const double trial_free = free_residual_norm();
+    if (!std::isfinite(trial_free)) continue;
+    if (x.gap > step.gap_tolerance_m || trial_free < (1.0 - 1e-4 * alpha) * x.free ||
+        trial_free <= settings_.absolute_residual_floor_N) {
+      step.assembled_here = full_step;
+      return std::nullopt;
     }
-    if (!accepted) {
-      if (best_alpha < 0.0) return fail("line search: every trial state has inverted elements");
-      alpha = best_alpha;  // no decrease found: take the least bad admissible step
-      trial = solution_;
-      trial.add(alpha, du);
-    }
-    stalled = alpha <= 0.125 ? stalled + 1 : 0;
-    line << "  lin_its " << lin_its << "  alpha " << std::defaultfloat << alpha << "  t_assemble "
-         << std::setprecision(3) << assemble_s << " s  t_solve " << solve_s << " s";
-    report.table.push_back(line.str());
-    if (settings_.verbose && root) std::cout << "      " << report.table.back() << std::endl;
-    solution_ = trial;
-    solution_ghosted_ = solution_;
-    if (settings_.max_stalled_iterations > 0 && stalled >= settings_.max_stalled_iterations) {
-      report.iterations = it + 1;
-      return fail("stalled: " + std::to_string(stalled) + " iterations in a row with a line-search step <= 1/8");
+    if (trial_free < best_free) {
+      best_free = trial_free;
+      best_alpha = alpha;
     }
   }
+  if (best_alpha < 0.0) return "line search: every trial state has inverted elements";
+  alpha = best_alpha;
+  step.trial = solution_;
+  step.trial.add(alpha, step.du);
+  return std::nullopt;
+}
+
+NewtonReport FiniteStrainSolver::accept_step(Step& step, const Iterate& x) {
+  step.report.table.push_back(x.line.str() + "  converged");
+  print_verbose(step.report.table.back());
+  step.report.converged = true;
+  step.report.iterations = x.it;
+  last_increment_ = solution_;
+  last_increment_ -= step.u_start;
+  return step.report;
+}
+
+NewtonReport FiniteStrainSolver::fail_step(Step& step, const std::string& why) {
+  solution_ = step.u_start;
+  solution_ghosted_ = solution_;
+  assemble(solution_ghosted_, false, nullptr);
+  step.report.converged = false;
+  step.report.failure = why;
+  print_verbose("newton failed: " + why);
+  return step.report;
+}
+
+void FiniteStrainSolver::print_verbose(const std::string& line) const {
+  if (settings_.verbose && Utilities::MPI::this_mpi_process(mpi_communicator()) == 0)
+    std::cout << "      " << line << std::endl;
 }
 
 double FiniteStrainSolver::sum_of_residual(const std::vector<types::global_dof_index>& dofs) const {

@@ -9,7 +9,6 @@
 // forces in N; times in s.
 #pragma once
 
-#include <chrono>
 #include <cstddef>
 #include <filesystem>
 #include <iomanip>
@@ -37,11 +36,6 @@ inline std::string format_double(double v, int precision = 9) {
   std::ostringstream s;
   s << std::setprecision(precision) << v;
   return s.str();
-}
-
-/// Seconds of wall time since `start`.
-inline double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 /// u_z(r) of a surface: pairs (r, u_z), both in m.

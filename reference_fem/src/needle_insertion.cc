@@ -13,7 +13,6 @@
 #include <deal.II/numerics/vector_tools.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -258,7 +257,7 @@ FemRunSummary SlabInsertionRun::run() {
     throw std::runtime_error(e.what());
   }
   write_outputs("completed", "");
-  summary_.wall_time_s = insertion::seconds_since(wall_start_);
+  summary_.wall_time_s = wall_timer_.wall_time();
   log("fem: done in " + format_double(summary_.wall_time_s, 4) + " s, " + std::to_string(summary_.load_steps) +
       " load steps, " + std::to_string(summary_.newton_iterations) + " Newton iterations, peak force " +
       format_double(summary_.peak_force_N, 5) + " N");
@@ -444,9 +443,9 @@ bool SlabInsertionRun::solve_at(double depth, NewtonReport& report, double predi
     const bool joined = join_reached_nodes(z_tip);
     if (!joined && !solution_is_stale_ && !any_contact()) return true;  // nothing to do
     apply_targets(z_tip);
-    const auto t0 = std::chrono::steady_clock::now();
+    const Timer solve_timer;
     report = solver_.solve_step(pass == 0 && !joined ? predictor_scale : 0.0);
-    summary_.solve_time_s += insertion::seconds_since(t0);
+    summary_.solve_time_s += solve_timer.wall_time();
     summary_.newton_iterations += report.iterations;
     summary_.linear_iterations += report.linear_iterations;
     records_.newton_log << "depth " << format_double(depth * 1e3, 6) << " mm, contact nodes " << contact_.size()

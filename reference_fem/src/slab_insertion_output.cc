@@ -107,7 +107,7 @@ void SlabInsertionRun::write_outputs(const std::string& status, const std::strin
   if (!root_) return;
   insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
   insertion::list_text_outputs(summary_.files_written);
-  summary_.wall_time_s = insertion::seconds_since(wall_start_);
+  summary_.wall_time_s = wall_timer_.wall_time();
   io::write_file_atomically(out_dir_ / "fem_summary.json", summary_json(status, error).dump(2) + "\n");
 }
 

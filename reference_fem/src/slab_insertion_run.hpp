@@ -6,12 +6,12 @@
 #include <puncture/fem/needle_insertion.hpp>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/timer.h>
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/manifold_lib.h>
 #include <deal.II/grid/tria.h>
 #include <deal.II/numerics/vector_tools.h>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -116,7 +116,7 @@ class SlabInsertionRun {
   }
 
   // What the scene asks for.
-  const std::chrono::steady_clock::time_point wall_start_ = std::chrono::steady_clock::now();
+  const dealii::Timer wall_timer_;  ///< runs from the run's construction
   const Scene& scene_;
   const FemRunOptions& options_;
   const MPI_Comm comm_;

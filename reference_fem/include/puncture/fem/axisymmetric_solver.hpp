@@ -43,6 +43,7 @@
 #pragma once
 
 #include <deal.II/base/point.h>
+#include <deal.II/base/timer.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/grid/tria.h>
@@ -52,6 +53,7 @@
 #include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/vector.h>
 
+#include <iostream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -376,6 +378,9 @@ class AxisymmetricSolver {
   double dt_s_ = 0.0;
   NeedleForce force_, force_trial_;
   bool debug_contacts_ = false;
+  /// Wall time by section ("assemble", "linear solve"); the Newton log's
+  /// per-iteration times are differences of its totals. Never printed by itself.
+  dealii::TimerOutput timer_{std::cout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times};
 };
 
 }  // namespace puncture::fem

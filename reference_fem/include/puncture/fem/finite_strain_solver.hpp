@@ -54,6 +54,7 @@
 #pragma once
 
 #include <deal.II/base/point.h>
+#include <deal.II/base/timer.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
@@ -63,8 +64,10 @@
 #include <deal.II/lac/trilinos_vector.h>
 
 #include <functional>
+#include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -213,8 +216,34 @@ class FiniteStrainSolver {
   struct AssemblyResult {
     bool valid = true;  ///< false: an inverted or non-finite quadrature point somewhere
   };
+  // --- solve_step(), one Newton step in phases --------------------------------
+  struct Step;     ///< what the phases of one step share (defined in the .cc)
+  struct Iterate;  ///< one Newton iterate: residual, force scale, test, log line (in the .cc)
+  using Failure = std::optional<std::string>;  ///< why the step fails (nullopt: it goes on)
+  /// Saves the start of the step and applies the predictor if it is admissible.
+  void start_step(Step& step, double predictor_scale);
+  /// Assembles at solution_ (unless the line search did): free residual, force scale, convergence test.
+  Failure evaluate_iterate(Step& step, Iterate& x);
+  /// Newton direction: K du = -R with the increment constraints (solve_linear).
+  Failure newton_direction(Step& step, Iterate& x);
+  /// Backtracking line search along du from solution_: the step length alpha and step.trial.
+  Failure line_search(Step& step, const Iterate& x, double& alpha);
+  /// A converged step: its log line and the last increment.
+  NewtonReport accept_step(Step& step, const Iterate& x);
+  /// A failed step: the state at its start restored, the reason reported.
+  NewtonReport fail_step(Step& step, const std::string& why);
+  /// A line of the Newton log on rank 0 when settings_.verbose.
+  void print_verbose(const std::string& line) const;
+
+  // --- assemble(): residual_, rhs_ and (with_matrix) tangent_ at u -------------
   AssemblyResult assemble(const dealii::TrilinosWrappers::MPI::Vector& u_ghosted, bool with_matrix,
                           const dealii::AffineConstraints<double>* constraints);
+  /// Anchor springs f = k (u - anchor) on free, locally owned dofs (into the
+  /// Newton system too when constraints are given).
+  void add_anchor_springs(const dealii::TrilinosWrappers::MPI::Vector& u,
+                          const dealii::AffineConstraints<double>* constraints);
+  /// The frozen removal load at released_fraction_ (a dead load).
+  void add_released_load(const dealii::AffineConstraints<double>* constraints);
   /// Constraints of the Newton update at state u (ghosted): du = target - u
   /// on the prescribed dofs.
   void increment_constraints(const dealii::TrilinosWrappers::MPI::Vector& u,
@@ -257,6 +286,9 @@ class FiniteStrainSolver {
   dealii::TrilinosWrappers::MPI::Vector residual_;       ///< R = f_int - f_ext, unconstrained
   dealii::TrilinosWrappers::MPI::Vector solution_;       ///< owned
   dealii::TrilinosWrappers::MPI::Vector solution_ghosted_;
+  /// Wall time by section ("assemble", "linear solve"); the Newton log's
+  /// per-iteration times are differences of its totals. Never printed by itself.
+  dealii::TimerOutput timer_{std::cout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times};
 };
 
 }  // namespace puncture::fem
