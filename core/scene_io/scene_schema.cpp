@@ -20,7 +20,8 @@ SceneFieldRange within(double lo, double hi, bool lo_open = false, bool hi_open 
 using T = SceneFieldType;
 constexpr bool kRequired = true, kOptional = false, kFem = true, kRealtime = false, kWritten = true, kReadOnly = false;
 
-std::vector<SceneField> table() {
+/// The scene, its sample and its needle.
+std::vector<SceneField> scene_and_needle_fields() {
   const double max_mm = scene_limits::kMaxLengthMm;
   return {
       {"/schema_version", T::Integer, "", kRequired, within(1, 1), kFem, kWritten},
@@ -31,7 +32,13 @@ std::vector<SceneField> table() {
       {"/needle/tip", T::String, "", kOptional, any(), kFem, kWritten},
       {"/needle/inner_radius_mm", T::Number, "mm", kOptional, any(), kFem, kWritten},
       {"/needle/tip_angle_deg", T::Number, "deg", kOptional, within(5, 60), kFem, kWritten},
+  };
+}
 
+/// Each layer: thickness, density, force mesh.
+std::vector<SceneField> layer_fields() {
+  const double max_mm = scene_limits::kMaxLengthMm;
+  return {
       {"/layers/*/name", T::String, "", kRequired, any(), kFem, kWritten},
       {"/layers/*/thickness_mm", T::Number, "mm", kRequired, within(0, max_mm, true), kFem, kWritten},
       {"/layers/*/density_kg_per_m3", T::Number, "kg/m^3", kOptional, above(0), kRealtime, kWritten},
@@ -47,7 +54,12 @@ std::vector<SceneField> table() {
       {"/layers/*/damping_d_N_s_per_m2", T::Number, "N s/m^2", kRequired, at_least(0), kRealtime, kWritten},
       {"/layers/*/resumption_time_s", T::Number, "s", kOptional, above(0), kRealtime, kWritten},
       {"/layers/*/resumption_rate", T::Number, "", kOptional, within(0, 1, true), kRealtime, kReadOnly},
+  };
+}
 
+/// Each layer's force law (breakthrough, cutting, friction, stiffening).
+std::vector<SceneField> force_law_fields() {
+  return {
       {"/layers/*/force_law/breakthrough/criterion", T::String, "", kRequired, any(), kRealtime, kWritten},
       {"/layers/*/force_law/breakthrough/critical_force_N", T::Number, "N", kRequired, within(0, 1e3, true), kRealtime,
        kWritten},
@@ -72,7 +84,12 @@ std::vector<SceneField> table() {
       {"/layers/*/force_law/friction/velocity_band_mm_per_s", T::Number, "mm/s", kOptional, above(0), kRealtime,
        kWritten},
       {"/layers/*/force_law/friction/presliding_mm", T::Number, "mm", kOptional, at_least(0), kRealtime, kWritten},
+  };
+}
 
+/// Each layer's continuum material (the FEM's and the comparison models').
+std::vector<SceneField> material_fields() {
+  return {
       {"/layers/*/material/model", T::String, "", kOptional, any(), kFem, kWritten},
       {"/layers/*/material/youngs_modulus_kPa", T::Number, "kPa", kRequired, above(0), kFem, kWritten},
       {"/layers/*/material/poisson_ratio", T::Number, "", kRequired, within(-1, 0.5, true, true), kFem, kWritten},
@@ -96,7 +113,13 @@ std::vector<SceneField> table() {
       {"/layers/*/shaft_friction/coefficient", T::Number, "", kRequired, within(0, 5), kFem, kWritten},
       {"/layers/*/shaft_friction/static_coefficient", T::Number, "", kOptional, within(-kInf, 5), kFem, kWritten},
       {"/layers/*/shaft_friction/source", T::String, "", kOptional, any(), kRealtime, kWritten},
+  };
+}
 
+/// The insertion and the real-time loop.
+std::vector<SceneField> insertion_and_realtime_fields() {
+  const double max_mm = scene_limits::kMaxLengthMm;
+  return {
       {"/insertion/start_height_mm", T::Number, "mm", kOptional, within(0, max_mm), kFem, kWritten},
       {"/insertion/speed_mm_per_s", T::Number, "mm/s", kRequired, within(0, 1e4, true), kFem, kWritten},
       {"/insertion/target_depth_mm", T::Number, "mm", kRequired, above(0), kFem, kWritten},
@@ -109,7 +132,12 @@ std::vector<SceneField> table() {
        kRealtime, kWritten},
       {"/realtime/integrator", T::String, "", kOptional, any(), kRealtime, kWritten},
       {"/realtime/frame_rate_Hz", T::Number, "Hz", kOptional, above(0), kRealtime, kWritten},
+  };
+}
 
+/// The FEM reference.
+std::vector<SceneField> fem_fields() {
+  return {
       {"/fem/geometry", T::String, "", kOptional, any(), kFem, kWritten},
       {"/fem/refinement", T::Integer, "", kOptional, within(0, 4), kFem, kWritten},
       {"/fem/element_degree", T::Integer, "", kOptional, within(1, 2), kFem, kWritten},
@@ -122,7 +150,12 @@ std::vector<SceneField> table() {
       {"/fem/mesh/min_elements_per_layer", T::Integer, "", kOptional, within(1, 200), kFem, kWritten},
       {"/fem/mesh/radial_growth", T::Number, "", kOptional, within(1, 2), kFem, kWritten},
       {"/fem/mesh/path_element_size_mm", T::Number, "mm", kOptional, within(0, 10, true), kFem, kWritten},
+  };
+}
 
+/// The comparison models.
+std::vector<SceneField> comparison_fields() {
+  return {
       {"/comparison/mesh/kind", T::String, "", kOptional, any(), kRealtime, kWritten},
       {"/comparison/mesh/size_at_axis_mm", T::Number, "mm", kOptional, above(0), kRealtime, kWritten},
       {"/comparison/mesh/size_far_mm", T::Number, "mm", kOptional, any(), kRealtime, kWritten},
@@ -137,13 +170,27 @@ std::vector<SceneField> table() {
       {"/comparison/stiffness_scale", T::NumberList, "", kOptional, above(0), kRealtime, kWritten},
       {"/comparison/prescribed_puncture_depths_mm", T::NumberList, "mm", kOptional, above(0), kRealtime, kWritten},
       {"/comparison/mass_spring_stiffness_scale", T::NumberList, "", kOptional, above(0), kRealtime, kWritten},
+  };
+}
 
+/// Effects and haptics.
+std::vector<SceneField> effects_and_haptics_fields() {
+  return {
       {"/effects", T::StringList, "", kOptional, any(), kRealtime, kWritten},
       {"/haptics/max_force_N", T::Number, "N", kOptional, above(0), kRealtime, kWritten},
       {"/haptics/max_force_rate_N_per_s", T::Number, "N/s", kOptional, above(0), kRealtime, kWritten},
       {"/haptics/device_damping_N_s_per_m", T::Number, "N s/m", kOptional, at_least(0), kRealtime, kWritten},
       {"/haptics/device_max_stiffness_N_per_mm", T::Number, "N/mm", kOptional, above(0), kRealtime, kWritten},
   };
+}
+
+std::vector<SceneField> table() {
+  std::vector<SceneField> all;
+  for (const auto& part : {scene_and_needle_fields(), layer_fields(), force_law_fields(), material_fields(),
+                           insertion_and_realtime_fields(), fem_fields(), comparison_fields(),
+                           effects_and_haptics_fields()})
+    all.insert(all.end(), part.begin(), part.end());
+  return all;
 }
 
 }  // namespace

@@ -30,16 +30,12 @@
 #include <stdexcept>
 
 #include "axisymmetric_cell.hpp"
+#include "backtracking_line_search.hpp"
 #include "solver_timing.hpp"
 
 namespace puncture::fem {
 using namespace dealii;
-using axisymmetric_cell::CellState;
-using axisymmetric_cell::DisplacementGradients;
-using axisymmetric_cell::ViscousCell;
-using axisymmetric_cell::evaluate_cell;
-using axisymmetric_cell::kTwoPi;
-using axisymmetric_cell::n_pressure_modes;
+using namespace axisymmetric_cell;
 
 /// What the phases of one solve_step share.
 struct AxisymmetricSolver::Step {
@@ -243,28 +239,21 @@ AxisymmetricSolver::Failure AxisymmetricSolver::newton_direction(Step& step, Ite
 }
 
 AxisymmetricSolver::Failure AxisymmetricSolver::line_search(Step& step, const Iterate& x, double& alpha) {
-  // Backtracking: the first of alpha = 1, 1/2, 1/4, ... whose free residual
-  // falls enough (any admissible one while the punch gap closes), else the
-  // best admissible one.
-  double best_alpha = -1.0, best_free = std::numeric_limits<double>::infinity();
-  alpha = 1.0;
-  for (int h = 0; h <= settings_.max_line_search_halvings; ++h, alpha *= 0.5) {
-    step.trial = solution_;
-    step.trial.add(alpha, step.du);
-    if (!assemble(step.trial, false)) continue;
-    AffineConstraints<double> tc;
-    make_constraints(step.trial, tc);
-    const double trial_free = free_residual_norm(tc);
-    if (!std::isfinite(trial_free)) continue;
-    if (x.gap > 0.0 || trial_free < (1.0 - 1e-4 * alpha) * x.free || trial_free <= settings_.absolute_residual_floor_N)
-      return std::nullopt;
-    if (trial_free < best_free) {
-      best_free = trial_free;
-      best_alpha = alpha;
-    }
-  }
-  if (best_alpha < 0.0) return "line search: every trial state is inverted or non-finite";
-  alpha = best_alpha;
+  // Any admissible step while the punch gap closes.
+  const LineSearchResult search = backtracking_line_search(
+      x.free, x.gap > 0.0, settings_.absolute_residual_floor_N, settings_.max_line_search_halvings,
+      [&](double a, int) -> std::optional<double> {
+        step.trial = solution_;
+        step.trial.add(a, step.du);
+        if (!assemble(step.trial, false)) return std::nullopt;
+        AffineConstraints<double> tc;
+        make_constraints(step.trial, tc);
+        return free_residual_norm(tc);
+      });
+  alpha = search.alpha;
+  if (search.accepted) return std::nullopt;
+  if (alpha < 0.0) return "line search: every trial state is inverted or non-finite";
+  // No decrease found: the least bad admissible step.
   step.trial = solution_;
   step.trial.add(alpha, step.du);
   return std::nullopt;

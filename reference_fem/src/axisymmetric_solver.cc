@@ -34,12 +34,7 @@
 
 namespace puncture::fem {
 using namespace dealii;
-using axisymmetric_cell::CellState;
-using axisymmetric_cell::DisplacementGradients;
-using axisymmetric_cell::ViscousCell;
-using axisymmetric_cell::evaluate_cell;
-using axisymmetric_cell::kTwoPi;
-using axisymmetric_cell::n_pressure_modes;
+using namespace axisymmetric_cell;
 
 namespace {
 

@@ -2,6 +2,7 @@
 #include <puncture/fem/finite_strain_solver.hpp>
 #include <puncture/fem/kinematics.hpp>
 
+#include "backtracking_line_search.hpp"
 #include "solver_timing.hpp"
 
 #include <deal.II/base/mpi.h>
@@ -424,34 +425,28 @@ FiniteStrainSolver::Failure FiniteStrainSolver::newton_direction(Step& step, Ite
 }
 
 FiniteStrainSolver::Failure FiniteStrainSolver::line_search(Step& step, const Iterate& x, double& alpha) {
-  // Backtracking: the first of alpha = 1, 1/2, 1/4, ... whose free residual
-  // falls enough (any admissible one while a prescribed gap is open), else the
-  // least bad admissible one.
-  double best_alpha = -1.0, best_free = std::numeric_limits<double>::infinity();
-  alpha = 1.0;
-  for (int h = 0; h <= settings_.max_line_search_halvings; ++h, alpha *= 0.5) {
-    step.trial = solution_;
-    step.trial.add(alpha, step.du);
-    step.trial_ghosted = step.trial;
-    // The full step is evaluated with the tangent: when it is accepted (the
-    // common case) the next iteration needs no assembly of its own.
-    const bool full_step = h == 0;
-    if (full_step) increment_constraints(step.trial_ghosted, step.trial_constraints);
-    if (!assemble(step.trial_ghosted, full_step, full_step ? &step.trial_constraints : nullptr).valid) continue;
-    const double trial_free = free_residual_norm();
-    if (!std::isfinite(trial_free)) continue;
-    if (x.gap > step.gap_tolerance_m || trial_free < (1.0 - 1e-4 * alpha) * x.free ||
-        trial_free <= settings_.absolute_residual_floor_N) {
-      step.assembled_here = full_step;
-      return std::nullopt;
-    }
-    if (trial_free < best_free) {
-      best_free = trial_free;
-      best_alpha = alpha;
-    }
+  // Any admissible step while a prescribed displacement is still being reached.
+  const LineSearchResult search = backtracking_line_search(
+      x.free, x.gap > step.gap_tolerance_m, settings_.absolute_residual_floor_N, settings_.max_line_search_halvings,
+      [&](double a, int halvings) -> std::optional<double> {
+        step.trial = solution_;
+        step.trial.add(a, step.du);
+        step.trial_ghosted = step.trial;
+        // The full step is evaluated with the tangent: when it is accepted (the
+        // common case) the next iteration needs no assembly of its own.
+        const bool full_step = halvings == 0;
+        if (full_step) increment_constraints(step.trial_ghosted, step.trial_constraints);
+        if (!assemble(step.trial_ghosted, full_step, full_step ? &step.trial_constraints : nullptr).valid)
+          return std::nullopt;
+        return free_residual_norm();
+      });
+  alpha = search.alpha;
+  if (search.accepted) {
+    step.assembled_here = search.halvings == 0;
+    return std::nullopt;
   }
-  if (best_alpha < 0.0) return "line search: every trial state has inverted elements";
-  alpha = best_alpha;
+  if (alpha < 0.0) return "line search: every trial state has inverted elements";
+  // No decrease found: the least bad admissible step.
   step.trial = solution_;
   step.trial.add(alpha, step.du);
   return std::nullopt;
