@@ -134,6 +134,16 @@ void SurfaceCoupling::freeze_break(std::size_t k, const Eigen::Ref<const Eigen::
   has_break_[k] = true;
 }
 
+void SurfaceCoupling::set_break_force(std::size_t k, double force_N) {
+  if (k < n_ && has_break_[k]) break_force_N_[k] = force_N;
+}
+
+bool SurfaceCoupling::baseline_taken_over(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own_k) const {
+  if (k >= n_ || !lattice_[k] || !has_baseline_[k] || !(baseline_[k](0) > 0.0)) return true;
+  own_profile(k, own_k, scratch_);
+  return scratch_(0) >= baseline_[k](0);
+}
+
 void SurfaceCoupling::freeze_baseline(std::size_t k) {
   if (k == 0 || k >= n_ || !lattice_[k] || !lattice_[k - 1] || !has_break_[k - 1]) return;
   baseline_[k].noalias() = *weights_[k - 1][k] * break_profile_[k - 1];

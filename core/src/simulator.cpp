@@ -112,14 +112,20 @@ void PunctureSimulator::update_drawn_surfaces() const {
   if (drawn_tick_ == ticks_) return;
   for (std::size_t k = 0; k < layers_.size(); ++k)
     if (layers_[k].mesh) own_deflection(k, own_deflection_[k]);  // sized at construction
-  // The layer the tip is in after its break carries the needle's load while no layer below is pressed.
+  // The last broken layer carries the needle's load while no layer below bears
+  // it by itself: none is pressed, or the one met at the tip (the broken layer
+  // squeezed between them) has not yet taken its baseline over.
   SurfaceCoupling::LoadAfterBreak load;
-  const bool loaded = active_ > 0 && (active_ == layers_.size() || !layers_[active_].contact_set);
+  const bool next_bears_load =
+      active_ < layers_.size() && layers_[active_].contact_set &&
+      (!layers_[active_].contact_at_tip || !layers_[active_].mesh ||
+       coupling_->baseline_taken_over(active_, own_deflection_[active_]));
+  const bool loaded = active_ > 0 && !next_bears_load;
   if (loaded) {
     load.layer = active_ - 1;
     load.tip_depth_m = result_.depth_m;
-    load.tip_force_N = result_.tip_force_N + result_.layers[active_ - 1].cutting_force_N;
-    load.shaft_force_N = result_.layers[active_ - 1].friction_force_N + result_.layers[active_ - 1].damping_force_N;
+    load.tip_force_N = result_.tip_force_N + result_.cutting_force_N;
+    load.shaft_force_N = result_.friction_force_N;
   }
   coupling_->drawn(own_deflection_, active_, drawn_deflection_, loaded ? &load : nullptr);
   drawn_tick_ = ticks_;
@@ -448,9 +454,12 @@ double PunctureSimulator::shaft_friction_and_damping(const NeedleState& needle) 
 
 void PunctureSimulator::add_shaft_forces_to_events(double time_s) {
   for (PunctureEvent& e : events_)
-    if (e.time_s == time_s)
+    if (e.time_s == time_s) {
       for (int k = 0; k < e.layer; ++k)
         e.total_force_N += result_.layers[k].damping_force_N + result_.layers[k].friction_force_N;
+      // The needle's whole force at the break scales the broken surface's load (coupled_surfaces.hpp).
+      if (coupling_) coupling_->set_break_force(static_cast<std::size_t>(e.layer), e.total_force_N);
+    }
 }
 
 void PunctureSimulator::refine_pending_layouts() {

@@ -329,3 +329,45 @@ TEST(CoupledSurfaces, ReadingTheSurfacesAllocatesNothing) {
 }
 
 }  // namespace
+
+TEST(CoupledSurfaces, ABrokenLayerSqueezedOntoTheLayerMetAtTheTipIsHeldByTheNeedlesLoad) {
+  // The thin layer breaks below the thick one's rest surface: it is squeezed
+  // between the tip and the layer met there. While the needle still cuts
+  // through it (its load stays), it is drawn held down by that load, not
+  // resting on the layer below: deeper than without the cutting load, and no
+  // deeper than (F / F_b) times its centre deflection at the break (the load
+  // rule with T(c) <= 1 at the centre of a peaked profile), until that layer's
+  // own mesh takes its baseline over.
+  Scene cut = thin_over_thick(true), plain = thin_over_thick(true);
+  cut.effects.cutting = true;
+  cut.layers[0].force_law.cutting_force_N = 0.8;
+  PunctureSimulator with_cut(cut, test::plane_surfaces(cut)), without_cut(plain, test::plane_surfaces(plain));
+  const std::vector<NeedleState> states = descent(600);
+  double centre_at_break = 0.0, break_force = 0.0, break_t = -1.0;
+  int held_ticks = 0, compared_ticks = 0;
+  for (const NeedleState& n : states) {
+    const double before_cut = centre_deflection(with_cut, 0);
+    const TickResult& r = with_cut.tick(n);
+    without_cut.tick(n);
+    if (with_cut.puncture_events().empty()) continue;
+    if (break_t < 0.0) {
+      break_t = n.time_s;
+      centre_at_break = before_cut;
+      break_force = with_cut.puncture_events()[0].total_force_N;
+      ASSERT_GT(break_force, 0.8);
+      continue;
+    }
+    if (n.time_s < break_t + 0.025 || n.time_s > break_t + 0.1) continue;  // own meshes recovered
+    ++compared_ticks;
+    const double held = centre_deflection(with_cut, 0), rests = centre_deflection(without_cut, 0);
+    // (the breaking tick pressed 0.01 mm further than the tick before it)
+    EXPECT_LE(held, r.total_force_N / break_force * (centre_at_break + 0.02e-3)) << "t = " << n.time_s;
+    EXPECT_GE(held, centre_deflection(with_cut, 1) - 1e-15);  // never through the layer below
+    if (held > rests + 1e-6) ++held_ticks;
+    // Once the pressed layer's mesh has taken its baseline over it bears the
+    // load: the broken layer rests on it again, as without the cutting load.
+    if (n.time_s > break_t + 0.09) EXPECT_NEAR(held, rests, 1e-12) << "t = " << n.time_s;
+  }
+  ASSERT_GT(compared_ticks, 50);
+  EXPECT_GE(held_ticks, 20);  // held from the recovery (25 ms) for at least 20 ms
+}

@@ -24,15 +24,22 @@
 //   a broken layer k < a: D_k = max(O_k, D_{k+1}): it rests on the layer
 //                         below and returns to it, not through it to its rest
 //                         shape (bottom-up);
-//   the layer k the tip is in after its break, while no layer below is
-//                         pressed (the last layer once all are broken):
+//   the last broken layer k = a - 1 while no layer below bears the needle's
+//                         load by itself: no layer below is pressed (the last
+//                         layer once all are broken), or layer a was met at the
+//                         tip (layer k squeezed between it and the tip) and its
+//                         mesh has not yet taken its baseline over (s < 1):
 //                         D_k = max(O_k, (F_tip / F_b) T(c) P_b +
 //                         (F_shaft / F_b) T(c / 2) P_b), P_b its drawn profile
-//                         at the break under the surface force F_b, c how far
-//                         the tip went on past the break, F_tip the force at
-//                         the tip (the cutting force; the next layer's surface
-//                         force), F_shaft the layer's shaft friction and d h v
-//                         (acting along the shaft: at c / 2). By reciprocity
+//                         at the break, F_b the needle's whole force at the
+//                         break, c how far the tip went on past the break,
+//                         F_tip the force at the tip (the needle layer's surface
+//                         force and every cutting force), F_shaft every layer's
+//                         shaft friction and d h v (acting along the shaft: at
+//                         c / 2). The FEM's broken surfaces keep their shape at
+//                         the break scaled by the needle's force (its skin and
+//                         fat a load step after their breaks, at 1-20 mm/s), so
+//                         the ratio is of whole forces. By reciprocity
 //                         the surface deflection of a load buried at depth c
 //                         is T(c) of the deflection of the same load on the
 //                         surface, so the needle's load keeps the broken
@@ -70,12 +77,12 @@ class SurfaceCoupling {
     double spacing_m = 0.0;
     double top_depth_m = 0.0;
   };
-  /// The needle's load on the layer the tip is in after its break.
+  /// The needle's load on the last broken layer (see the file comment).
   struct LoadAfterBreak {
     std::size_t layer = 0;
     double tip_depth_m = 0.0;   ///< below the first surface
-    double tip_force_N = 0.0;   ///< at the tip: cutting, the next layer's surface force
-    double shaft_force_N = 0.0; ///< the layer's shaft friction and d h v
+    double tip_force_N = 0.0;   ///< at the tip: the needle layer's surface force and every cutting force
+    double shaft_force_N = 0.0; ///< every layer's shaft friction and d h v
   };
   /// slab_depth_m: how deep the tip can go below the first surface (sets
   /// the deepest transmission level). Throws std::invalid_argument for a
@@ -92,11 +99,17 @@ class SurfaceCoupling {
   /// slab's depth, once per process), the identity blended in below 0.25 mm,
   /// the deepest level beyond. No allocation.
   void transmitted(const Eigen::VectorXd& profile, double depth_m, Eigen::VectorXd& out) const;
-  /// Layer k broke with own node deflections own_at_break under the surface
+  /// Layer k broke with own node deflections own_at_break under the needle
   /// force force_N (N), the tip at tip_depth_m below the first surface: keeps
   /// its drawn profile P_b (no allocation).
   void freeze_break(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own_at_break, double force_N,
                     double tip_depth_m);
+  /// The needle's whole force F_b at layer k's break, once the tick that broke
+  /// it knows its shaft forces (after freeze_break).
+  void set_break_force(std::size_t k, double force_N);
+  /// True unless layer k has a baseline its own deflection own_k (its node
+  /// deflections) has not yet taken over (s < 1 in the file comment).
+  bool baseline_taken_over(std::size_t k, const Eigen::Ref<const Eigen::VectorXd>& own_k) const;
   /// Layer k (> 0) met at the tip when layer k - 1 broke (after
   /// freeze_break(k - 1, ...)): sets B_k = T(k - 1 -> k) P_b (no allocation).
   void freeze_baseline(std::size_t k);
