@@ -214,7 +214,16 @@ LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size
   if (after != fem.after_breakthrough.end() && broke < run.ticks.size()) {
     const auto delay_ticks =
         static_cast<std::size_t>(std::ceil(layer.resumption_time_s * scene.realtime.haptic_rate_Hz - 1e-9));
-    const std::size_t tick = std::min(run.ticks.size() - 1, broke + delay_ticks);
+    std::size_t tick = std::min(run.ticks.size() - 1, broke + delay_ticks);
+    // The FEM's profile after the break is taken before the next layer breaks
+    // (at the break's load step or the next): so is this one, if the next
+    // layer breaks within the resumption time (fast insertions).
+    if (k + 1 < scene.layers.size())
+      for (std::size_t i = broke + 1; i <= tick; ++i)
+        if (run.ticks[i].layers[k + 1].state == LayerState::Punctured) {
+          tick = i - 1;
+          break;
+        }
     c.recovery_delay_s = run.ticks[tick].time_s - run.ticks[broke].time_s;
     c.recovery_realtime_depth_m = run.ticks[tick].depth_m;
     c.realtime_recovered_rings_m = recorder.rings(tick, k);
@@ -314,7 +323,9 @@ void force_section(std::ostringstream& md, const CurveComparison& cmp, const nlo
         "the layer is intact in both models: ring deflections Delta Z_j at r = (j - 1) L against the FEM's -u_z "
         "of the layer's top surface at the same distance from the needle. The recovery compares the FEM's "
         "spring-back (same depth, after the material along the needle path was removed) with the real-time "
-        "ring deflections one resumption time (the layer's resumption_time_s, rounded up to haptic steps) after its breakthrough.\n\n";
+        "ring deflections one resumption time (the layer's resumption_time_s, rounded up to haptic steps) after its breakthrough, "
+        "or at the last tick before the next layer breaks if that comes first (the FEM's profile after a break is taken "
+        "before the next layer breaks).\n\n";
 }
 
 /// The summary's list of files.

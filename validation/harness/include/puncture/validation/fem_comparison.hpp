@@ -104,7 +104,9 @@ struct LayerDeflectionComparison {
 /// Delta Z_j at that tick against the FEM profile of the layer at that depth
 /// (linear between the two recorded load steps that bracket it). After: the FEM spring-back profile against the real-time rings
 /// ceil(resumption time x haptic rate) ticks after the real-time breakthrough
-/// (the layer's resumption_time_s, when Eq. 8's recovery factor has reached 0).
+/// (the layer's resumption_time_s, when Eq. 8's recovery factor has reached 0),
+/// or the last tick before layer k + 1 breaks if that comes first (the FEM's
+/// profile after the break is taken before the next layer breaks).
 LayerDeflectionComparison compare_layer_deflection(const Scene& scene, std::size_t k, const ScriptedRunResult& run,
                                                    const RingRecorder& recorder, const FemResultFiles& fem);
 
