@@ -19,7 +19,8 @@ surface and compares, at six distances from the axis:
      the FEM follows);
   3. the muscle after its break against the load rule (reciprocity: the
      break shape scaled by the needle's load and transmitted through the depth
-     the tip went on), with the FEM's own forces.
+     the tip went on), with the FEM's own forces;
+  4. the fat after its break, squeezed onto the muscle, against the same rule.
 Writes OUT_DIR/README.md (tables, with the command, git revision, machine and
 date). Needs numpy (Debian python3-numpy, scripts/setup.sh).
 """
@@ -136,40 +137,56 @@ def main():
     lines += ["", f"## 2. After the {names[0]} and the {names[1]} broke: the broken surfaces over the pressed "
               f"{names[2]}\n", header, rule]
     source_and_targets((11.4, 13.4, 18.4, 28.4), 2, (1, 0), "up through")
-    # 3. The last layer after its break, held by the needle's load (reciprocity).
+    # 3. and 4. Broken layers held by the needle's load (reciprocity).
     rows = [l for l in open(os.path.join(fem_dir, "fem_force_depth.csv")) if not l.startswith("#")]
     head = rows[0].strip().split(",")
     curve = [dict(zip(head, r.strip().split(","))) for r in rows[1:]]
     curve = [r for r in curve if r["phase"] == "insertion"]
-    state = f"{names[2]}_state"
-    broke = next((r for r in curve if r.get(state) == "punctured"), None)
-    if broke is not None:
-        zb = round(float(broke["depth_mm"]), 1)
-        force = {round(float(r["depth_mm"]), 1): r for r in curve}
-        lines += ["", f"## 3. The {names[2]} after its break ({zb:.1f} mm): held by the needle's load\n",
-                  f"Rule (core/coupled_surfaces.hpp): the shape at the break times (force at the tip / force at the "
-                  f"break) transmitted through c, plus (shaft force / force at the break) through c / 2, c = depth - "
-                  f"{zb:.1f} mm; the FEM's own forces (fem_force_depth.csv: tip + cutting at the tip, friction along "
-                  "the shaft). Relative RMSE over the six radii, of the FEM's largest.\n",
-                  "| depth (mm) | surface | " + " | ".join(f"r = {r} mm" for r in RADII_MM) + " | RMSE / largest |",
+    force = {round(float(r["depth_mm"]), 1): r for r in curve}
+
+    def break_depth(k):
+        broke = next((r for r in curve if r.get(f"{names[k]}_state") == "punctured"), None)
+        return None if broke is None else round(float(broke["depth_mm"]), 1)
+
+    def load_rule_rows(k, zb, depths):
+        """Layer k's top past its break at zb beside the load rule with the FEM's own forces."""
+        rb, ub = surface_profile(by_depth[zb], tops[k])
+        fb = float(force[zb]["force_N"])
+        for d in depths:
+            if d not in by_depth or d not in force:
+                continue
+            r = force[d]
+            tip = float(r["tip_force_N"]) + float(r["cutting_force_N"])
+            shaft = float(r["friction_force_N"])
+            c = d - zb
+            rule_values = np.array([tip / fb * transmitted(rb, ub, x, c) + shaft / fb * transmitted(rb, ub, x, c / 2)
+                                    for x in RADII_MM])
+            rt, ut = surface_profile(by_depth[d], tops[k])
+            fem = np.interp(RADII_MM, rt, ut)
+            rel = np.sqrt(np.mean((rule_values - fem) ** 2)) / np.max(np.abs(fem))
+            lines.append(f"| {d:.1f} | {names[k]} top (FEM) | {row(fem)} | |")
+            lines.append(f"| {d:.1f} | {names[k]} top: the load rule | {row(rule_values)} | {rel:.2f} |")
+
+    rule_text = ("Rule (core/coupled_surfaces.hpp): the shape at the break times (force at the tip / force at the "
+                 "break) transmitted through c, plus (shaft force / force at the break) through c / 2, c = depth - "
+                 "{zb:.1f} mm; the FEM's own forces (fem_force_depth.csv: the needle's whole force at the break; tip + "
+                 "cutting at the tip, friction along the shaft). Relative RMSE over the six radii, of the FEM's "
+                 "largest.\n")
+    table_head = ["| depth (mm) | surface | " + " | ".join(f"r = {r} mm" for r in RADII_MM) + " | RMSE / largest |",
                   "|---|---|" + "---|" * (len(RADII_MM) + 1)]
-        if zb in by_depth:
-            rb, ub = surface_profile(by_depth[zb], tops[2])
-            fb = float(force[zb]["force_N"])
-            for d in (16.4, 18.4, 20.4, 24.4, 28.4):
-                if d not in by_depth or d not in force:
-                    continue
-                r = force[d]
-                tip = float(r["tip_force_N"]) + float(r["cutting_force_N"])
-                shaft = float(r["friction_force_N"])
-                c = d - zb
-                rule_values = np.array([tip / fb * transmitted(rb, ub, x, c) + shaft / fb * transmitted(rb, ub, x, c / 2)
-                                        for x in RADII_MM])
-                rt, ut = surface_profile(by_depth[d], tops[2])
-                fem = np.interp(RADII_MM, rt, ut)
-                rel = np.sqrt(np.mean((rule_values - fem) ** 2)) / np.max(np.abs(fem))
-                lines.append(f"| {d:.1f} | {names[2]} top (FEM) | {row(fem)} | |")
-                lines.append(f"| {d:.1f} | {names[2]} top: the load rule | {row(rule_values)} | {rel:.2f} |")
+    zb = break_depth(2)
+    if zb is not None and zb in by_depth:
+        lines += ["", f"## 3. The {names[2]} after its break ({zb:.1f} mm): held by the needle's load\n",
+                  rule_text.format(zb=zb)] + table_head
+        load_rule_rows(2, zb, (16.4, 18.4, 20.4, 24.4, 28.4))
+    zf = break_depth(1)
+    if zf is not None and zf in by_depth:
+        lines += ["", f"## 4. The {names[1]} after its break ({zf:.1f} mm), squeezed between the tip and the "
+                  f"{names[2]}: held by the needle's load\n",
+                  f"The tip broke the {names[1]} below the {names[2]}'s rest surface; until the {names[2]} is pressed "
+                  f"by the tip itself the broken {names[1]} carries the needle's load (in the real-time model: until the "
+                  f"{names[2]}'s mesh has taken over the deformation it was met with). " + rule_text.format(zb=zf)] + table_head
+        load_rule_rows(1, zf, tuple(d for d in sorted(by_depth) if zf < d <= zf + 1.5))
     lines += ["",
               "Reading: below a pressed surface the half-space transmission follows the FEM through the thin skin "
               "(the fat's top) at every depth; through the thick fat onto the stiffer muscle it is right near the "
@@ -179,7 +196,8 @@ def main():
               "to 0.5 mm shallower at 2-4 mm (the fat bridges), the skin deeper right at the axis (the shaft drags "
               "the hole's rim); the upward transmission is 2-4 times too small near the axis, so coupled_surfaces "
               "draws a broken surface on the layer below it, not through a kernel. The last layer after its break "
-              "follows the load rule of section 3 as the tip goes deeper."]
+              "follows the load rule of section 3 as the tip goes deeper, and so does a broken layer squeezed onto "
+              "the layer below it until that layer bears the tip (section 4)."]
     os.makedirs(out_dir, exist_ok=True)
     results_io.write_text(os.path.join(out_dir, "README.md"), "\n".join(lines) + "\n")
     print("wrote", os.path.join(out_dir, "README.md"))
