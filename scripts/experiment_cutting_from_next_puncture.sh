@@ -9,11 +9,7 @@
 # they are computed: about 2 min each on 2 cores).
 #   bash scripts/experiment_cutting_from_next_puncture.sh      (RANKS=2)
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${PUNCTURE_BUILD_DIR:-$root/build}"
-cd "$root"
-[ -x "$build/apps/puncture" ] || bash scripts/build.sh
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+source "$(dirname "${BASH_SOURCE[0]}")/results_env.sh"
 mpi=(mpirun --oversubscribe -np "${RANKS:-2}")
 out=results/experiments/cutting_from_next_puncture
 work="$(mktemp -d)"

@@ -13,11 +13,7 @@
 # about 2 min each on 2 cores).
 #   bash scripts/results_comparison.sh          (RANKS=2; MODELS=all: every model)
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${PUNCTURE_BUILD_DIR:-$root/build}"
-cd "$root"
-[ -x "$build/apps/puncture" ] || bash scripts/build.sh
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+source "$(dirname "${BASH_SOURCE[0]}")/results_env.sh"
 out=results/comparison/default_scene
 source scripts/results_folder.sh
 start=$(date +%s)

@@ -8,11 +8,7 @@
 # out/.fem_cache), about 2 min each on 2 cores when not cached.
 #   bash scripts/results_heldout.sh          (RANKS=2)
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${PUNCTURE_BUILD_DIR:-$root/build}"
-cd "$root"
-[ -x "$build/apps/puncture" ] || bash scripts/build.sh
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+source "$(dirname "${BASH_SOURCE[0]}")/results_env.sh"
 out=results/validation_heldout
 source scripts/results_folder.sh
 replace_results_folder "$out" mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json \

@@ -7,11 +7,7 @@
 # results_heldout.sh make them; a missing one is computed, a few minutes each).
 #   bash scripts/results_speeds.sh
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${PUNCTURE_BUILD_DIR:-$root/build}"
-cd "$root"
-[ -x "$build/apps/puncture" ] || bash scripts/build.sh
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+source "$(dirname "${BASH_SOURCE[0]}")/results_env.sh"
 out=results/validation_speeds
 write_speeds() {
   mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json \

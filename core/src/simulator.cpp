@@ -118,8 +118,7 @@ void PunctureSimulator::update_drawn_surfaces() const {
   SurfaceCoupling::LoadAfterBreak load;
   const bool next_bears_load =
       active_ < layers_.size() && layers_[active_].contact_set &&
-      (!layers_[active_].contact_at_tip || !layers_[active_].mesh ||
-       coupling_->baseline_taken_over(active_, own_deflection_[active_]));
+      (!layers_[active_].contact_at_tip || coupling_->baseline_taken_over(active_, own_deflection_[active_]));
   const bool loaded = active_ > 0 && !next_bears_load;
   if (loaded) {
     load.layer = active_ - 1;

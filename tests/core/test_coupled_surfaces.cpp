@@ -13,6 +13,7 @@
 #include "puncture/simulator.hpp"
 #include "puncture/surface_transmission.hpp"
 #include "table2_scene.hpp"
+#include "thin_over_thick_scene.hpp"
 
 using namespace puncture;
 
@@ -222,37 +223,8 @@ TEST(SurfaceCoupling, TheNeedlesLoadHoldsTheBrokenSurfaceAndFadesWithDepthByReci
 // ---------------------------------------------------------------------------
 // The simulator with coupled surfaces
 
-/// A thin upper layer broken 1.5 mm deep, below the rest surface of the thick
-/// one under it (met at the tip), on planes; quasi-static meshes.
-Scene thin_over_thick(bool coupled) {
-  Scene s;
-  s.name = "thin_over_thick";
-  s.layers.push_back(test::table2_layer("a", 1e-3, 200.0, 0.0, 8, 1e-3, 100.0, 1.0, 0.05));
-  s.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 6, 1e-3, 100.0, 1.0, 0.05));
-  for (Layer& l : s.layers) {
-    l.force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
-    l.force_law.breakthrough.critical_force_N = 1e3;
-    l.resumption_time_s = 0.02;
-  }
-  s.layers[0].force_law.breakthrough.critical_force_N = 1.0;
-  s.realtime.integrator = "quasi_static";
-  s.effects.damping = false;
-  s.effects.coupled_surfaces = coupled;
-  return s;
-}
-
-/// The needle going down at 10 mm/s from 0.5 mm above the first surface, one state per 1 ms tick.
-std::vector<NeedleState> descent(int ticks) {
-  std::vector<NeedleState> states;
-  for (int i = 0; i < ticks; ++i) {
-    NeedleState n;
-    n.time_s = i * 1e-3;
-    n.tip_position_m = Eigen::Vector3d(0.0, 0.0, 0.5e-3 - 0.01 * n.time_s);
-    n.axial_velocity_m_per_s = 0.01;
-    states.push_back(n);
-  }
-  return states;
-}
+using test::descent;
+using test::thin_over_thick;
 
 double centre_deflection(const PunctureSimulator& sim, std::size_t k) {
   return sim.node_rest_positions(k)(2, 0) - sim.node_positions(k)(2, 0);

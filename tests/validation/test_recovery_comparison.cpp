@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "../core/table2_scene.hpp"
+#include "../core/thin_over_thick_scene.hpp"
 #include "puncture/needle.hpp"
 #include "puncture/simulator.hpp"
 #include "puncture/validation/fem_comparison.hpp"
@@ -15,24 +16,6 @@ using namespace puncture;
 using namespace puncture::validation;
 
 namespace {
-
-/// A thin layer "a" (breaks at 1 N) over a thick layer "b" that breaks at
-/// b_critical_N, pressed from the tip on once "a" broke; 20 ms resumption.
-Scene two_layers(double b_critical_N) {
-  Scene s;
-  s.name = "recovery";
-  s.layers.push_back(test::table2_layer("a", 1e-3, 200.0, 0.0, 8, 1e-3, 100.0, 1.0, 0.05));
-  s.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 6, 1e-3, 100.0, 1.0, 0.05));
-  for (Layer& l : s.layers) {
-    l.force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
-    l.resumption_time_s = 0.02;
-  }
-  s.layers[0].force_law.breakthrough.critical_force_N = 1.0;
-  s.layers[1].force_law.breakthrough.critical_force_N = b_critical_N;
-  s.realtime.integrator = "quasi_static";
-  s.effects.damping = false;
-  return s;
-}
 
 struct Recorded {
   ScriptedRunResult run;
@@ -43,11 +26,7 @@ struct Recorded {
 Recorded descend(const Scene& scene, int ticks) {
   PunctureSimulator sim(scene, test::plane_surfaces(scene));
   Recorded r{{}, RingRecorder(scene)};
-  for (int i = 0; i < ticks; ++i) {
-    NeedleState n;
-    n.time_s = i * 1e-3;
-    n.tip_position_m = Eigen::Vector3d(0.0, 0.0, 0.5e-3 - 0.01 * n.time_s);
-    n.axial_velocity_m_per_s = 0.01;
+  for (const NeedleState& n : test::descent(ticks)) {
     r.run.ticks.push_back(sim.tick(n));
     r.recorder.record(sim);
   }
@@ -75,7 +54,7 @@ std::size_t first_punctured(const ScriptedRunResult& run, std::size_t k) {
 }  // namespace
 
 TEST(RecoveryComparison, TakenWhenTheResumptionIsDoneIfTheNextLayerHolds) {
-  const Scene scene = two_layers(1e3);
+  const Scene scene = test::thin_over_thick(false, 1e3);
   const Recorded r = descend(scene, 400);
   const std::size_t broke = first_punctured(r.run, 0);
   ASSERT_LT(broke, r.run.ticks.size());
@@ -87,7 +66,7 @@ TEST(RecoveryComparison, TakenWhenTheResumptionIsDoneIfTheNextLayerHolds) {
 }
 
 TEST(RecoveryComparison, TakenBeforeTheNextLayerBreaksIfThatComesFirst) {
-  const Scene scene = two_layers(0.05);  // "b" breaks a few ticks after "a"
+  const Scene scene = test::thin_over_thick(false, 0.05);  // "b" breaks a few ticks after "a"
   const Recorded r = descend(scene, 400);
   const std::size_t broke = first_punctured(r.run, 0), next = first_punctured(r.run, 1);
   ASSERT_LT(broke, next);
