@@ -301,7 +301,8 @@ bool PunctureSimulator::breakthrough(std::size_t k, double surface_force_N, cons
   return false;
 }
 
-void PunctureSimulator::record_puncture(const NeedleState& needle, double surface_force_N, double cutting_force_N) {
+void PunctureSimulator::record_puncture(const NeedleState& needle, double surface_force_N, double cutting_force_N,
+                                        double crack_above_N) {
   LayerModel& layer = layers_[active_];
   LayerTickResult& out = result_.layers[active_];
   layer.state = LayerState::Punctured;
@@ -332,7 +333,9 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   const double tip_axial = needle.tip_position_m.dot(needle.direction);
   layer.front_m = tip_axial;
   layer.break_axial_m = tip_axial;
-  layer.release_N = cutting_on_ ? rupture_release_N(layer.law, surface_force_N) : 0.0;
+  // The load the tip carried, its surface force and the crack above still cut
+  // (a layer met at the tip), passes to this layer's crack.
+  layer.release_N = cutting_on_ ? rupture_release_N(layer.law, surface_force_N + crack_above_N) : 0.0;
   ++active_;
   if (active_ < layers_.size() && !interaction_) {
     LayerModel& next = layers_[active_];
@@ -401,17 +404,17 @@ double PunctureSimulator::press_needle_layer(const NeedleState& needle, double t
   return 0.0;
 }
 
-bool PunctureSimulator::break_through(const NeedleState& needle, double surface_force_N, double cutting_force_N) {
+bool PunctureSimulator::break_through(const NeedleState& needle, double surface_force_N, double cutting_force_N,
+                                      double crack_force_N) {
   const std::size_t n = layers_.size();
   bool broke = false;
   // The next layer becomes the needle layer in the same tick.
   while (active_ < n && layers_[active_].contact_set && breakthrough(active_, surface_force_N, needle)) {
-    record_puncture(needle, surface_force_N, cutting_force_N);
+    record_puncture(needle, surface_force_N, cutting_force_N, crack_force_N);
     surface_force_N = 0.0;
     // A further break in this tick is felt with the crack of the layer that just broke, opened at the tip.
-    cutting_force_N = cutting_on_ ? layers_[active_ - 1].law.cutting_force_N +
-                                        rupture_release(needle.tip_position_m.dot(needle.direction))
-                                  : 0.0;
+    crack_force_N = cutting_on_ ? layers_[active_ - 1].law.cutting_force_N : 0.0;
+    cutting_force_N = cutting_on_ ? crack_force_N + rupture_release(needle.tip_position_m.dot(needle.direction)) : 0.0;
     broke = true;
     const bool touched = active_ < n && try_contact(needle);
     if (coupling_) {
@@ -497,7 +500,7 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   // 3. The chain under the needle (or the needle layer alone).
   double surface_force = press_needle_layer(needle, interaction_ ? cut : 0.0);
   // 4. Breakthrough: the crack through the layer that just broke starts at the tip.
-  const bool broke = break_through(needle, surface_force, cut);
+  const bool broke = break_through(needle, surface_force, cut, crack);
   if (broke) {
     surface_force = 0.0;
     crack = crack_force(tip_axial_m);

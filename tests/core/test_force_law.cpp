@@ -518,6 +518,57 @@ TEST(RuptureRelease, TheLoadAtTheBreakIsLetGoOverTheReleaseLengthWhateverTheLaye
   EXPECT_EQ(sim.tick(needle_at(2.9e-3, 0.01, t + 1e-3)).total_force_N, 0.0);
 }
 
+TEST(RuptureRelease, ALayerMetAtTheTipTakesOverTheLoadOfTheCrackAboveAtItsBreak) {
+  // The 1 mm layer a of the cutting test above breaks below b's rest surface,
+  // so b is pressed from the tip while a's crack (C_a) is still cut. When b
+  // breaks, a's crack stops, and the whole load at the tip, b's surface force
+  // + C_a, passes to b's crack: R_b = F_s,b + C_a - C_b, released over l_b.
+  // The force is continuous at b's break (F_s,b + C_a in the break tick), not
+  // a drop to C_b (only b's surface force beyond C_b would be released, here
+  // less than C_a). With l_b = 0 it drops to C_b (the paper's model).
+  const double C_a = 0.8, C_b = 0.3, l_b = 0.6e-3;
+  for (double release_m : {l_b, 0.0}) {
+    Scene scene = single_layer_scene(1e-3);
+    scene.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 4, 1e-3, 100.0, 1.0, 0.05));
+    scene.effects.cutting = true;
+    scene.layers[0].force_law.breakthrough.critical_force_N = 1.0;
+    scene.layers[0].force_law.cutting_force_N = C_a;
+    scene.layers[1].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+    scene.layers[1].force_law.breakthrough.critical_force_N = 0.5;
+    scene.layers[1].force_law.cutting_force_N = C_b;
+    scene.layers[1].force_law.rupture_release_m = release_m;
+    PunctureSimulator sim(scene, test::plane_surfaces(scene));
+    double t = 0.0, break_b = -1.0, F_s = 0.0, before = 0.0;
+    int after = 0;
+    drive(sim, t, -0.2e-3, 8e-3, 0.01, [&](const TickResult& r) {
+      const auto& events = sim.puncture_events();
+      if (events.size() < 2) {
+        before = r.total_force_N;
+        return;
+      }
+      if (break_b < 0.0) {
+        break_b = events[1].depth_m;
+        F_s = events[1].surface_force_N;
+        ASSERT_GE(F_s, 0.5);
+        EXPECT_NEAR(before, F_s + C_a, 0.05);  // b pressed and a cut in the tick before
+        EXPECT_NEAR(r.total_force_N, release_m > 0.0 ? F_s + C_a : C_b, 1e-12);  // the break tick
+        EXPECT_NEAR(events[1].cutting_force_N, C_a, 1e-12);
+        return;
+      }
+      const double s = r.depth_m - break_b;
+      const double release = release_m > 0.0 ? (F_s + C_a - C_b) * std::exp(-s / l_b) : 0.0;
+      EXPECT_EQ(r.tip_force_N, 0.0);
+      EXPECT_EQ(r.layers[0].cutting_force_N, 0.0);  // a's crack is no longer cut, a has no release
+      EXPECT_NEAR(r.layers[1].cutting_force_N, C_b + release, 1e-12);
+      EXPECT_NEAR(r.total_force_N, C_b + release, 1e-12);
+      ++after;
+    });
+    ASSERT_EQ(sim.puncture_events().size(), 2u);
+    EXPECT_GT(sim.puncture_events()[1].depth_m, 1e-3);  // b broke below a: met at the tip
+    EXPECT_GT(after, 100);
+  }
+}
+
 // ---------------------------------------------------------------------------
 // Breakthrough criteria
 

@@ -20,9 +20,14 @@
 // process zone whose traction softens with the opening (a bilinear law of
 // strength sigma_c and toughness G_c opens fully at delta_c = 2 G_c / sigma_c,
 // about 1.1 mm for skin; a published skin law opens over 1.6 mm, Mohammadi et
-// al. 2021). The needle feels the part of the layer's surface force at the
-// break F_b that exceeds the cutting force, R = max(0, F_b - C), released
-// as the tip goes on by s past the break depth:
+// al. 2021). The needle feels the part of the load at its tip at the break
+// F_b that exceeds the cutting force, R = max(0, F_b - C), released as the
+// tip goes on by s past the break depth. F_b is the layer's surface force
+// plus, when the layer was met at the tip with the layer above broken and
+// squeezed between them, the crack force of that layer still cut at the
+// break: its crack stops with the break, and the load it carried passes to
+// this layer's crack (the FEM's fat, pressed through the cut skin, keeps
+// cutting after its own break under the force the skin's crack carried):
 //     F_rel = R exp(-s / l) max(0, 1 - r / r_c),
 // s the deepest tip position since the break minus the break position (a
 // crack does not close again), r the retraction from that deepest position
@@ -45,8 +50,9 @@ inline double cutting_force_N(double cutting_force_N, double release_m, double f
   return cutting_force_N * std::max(0.0, 1.0 - r / release_m);
 }
 
-/// R (N): what a layer with force law `law` that broke under the surface
-/// force force_at_break_N (N) releases (0 without a rupture release length).
+/// R (N): what a layer with force law `law` that broke under the load
+/// force_at_break_N (N) at the tip (its surface force + the crack above still
+/// cut) releases (0 without a rupture release length).
 inline double rupture_release_N(const ForceLaw& law, double force_at_break_N) {
   return law.rupture_release_m > 0.0 ? std::max(0.0, force_at_break_N - law.cutting_force_N) : 0.0;
 }

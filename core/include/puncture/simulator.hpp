@@ -61,8 +61,9 @@
 //      broken layer squeezed between them), while the tip presses it (the
 //      FEM's tip force and cohesive cutting force act together there);
 //      every punctured layer with a rupture release length adds the release
-//      of the load it carried at its break (cutting.hpp), counted as its
-//      cutting force, whatever the layers below do;
+//      of the load the tip carried at its break beyond its cutting force (its
+//      surface force and the crack above still cut, cutting.hpp), counted as
+//      its cutting force, whatever the layers below do;
 //   6. every punctured layer adds its shaft friction phi h (shaft_friction.hpp,
 //      through shaft_forces.hpp)
 //      and the damping force d h v (Table 1), with h the shaft length inside
@@ -212,7 +213,7 @@ class PunctureSimulator {
     double deflection_m = 0.0;    ///< committed deflection of the contact node relative to the layer below
     double front_m = 0.0;         ///< crack front along the needle axis (punctured layers)
     double break_axial_m = 0.0;   ///< tip position along the needle axis at the break (punctured layers)
-    double release_N = 0.0;       ///< R of the rupture release (cutting.hpp): surface force at the break beyond C
+    double release_N = 0.0;       ///< R of the rupture release (cutting.hpp): load at the tip at the break beyond C
     mutable Eigen::Matrix3Xd shifted_positions;
   };
 
@@ -226,7 +227,10 @@ class PunctureSimulator {
   double step_chain(const NeedleState& needle, double transmitted_force_N);
   /// Layer k's criterion at its surface force (N), its threshold at the layer's mean pressing speed (breakthrough_rate.hpp).
   bool breakthrough(std::size_t k, double surface_force_N, const NeedleState& needle);
-  void record_puncture(const NeedleState& needle, double surface_force_N, double cutting_force_N);
+  /// crack_above_N: the crack force of the layer above still cut at the break (N; 0 unless this layer was met
+  /// at the tip), which passes with the surface force to this layer's rupture release.
+  void record_puncture(const NeedleState& needle, double surface_force_N, double cutting_force_N,
+                       double crack_above_N);
   /// The tick's phases (tick() calls them in this order; see the header comment).
   void resume_broken_layers(double time_s);
   void update_needle_contact(const NeedleState& needle);
@@ -239,8 +243,10 @@ class PunctureSimulator {
   double press_needle_layer(const NeedleState& needle, double transmitted_force_N);
   /// Layers breaking under surface_force_N (several in one tick if the next is met already broken);
   /// true if any broke.
-  /// cutting_force_N: the crack force the needle feels at the first break (crack_force()).
-  bool break_through(const NeedleState& needle, double surface_force_N, double cutting_force_N);
+  /// cutting_force_N: what the needle's cracks add at the first break (crack + rupture releases);
+  /// crack_force_N: the open crack's part of it (crack_force()).
+  bool break_through(const NeedleState& needle, double surface_force_N, double cutting_force_N,
+                     double crack_force_N);
   /// Friction and damping of every punctured layer; returns their sum (N).
   double shaft_friction_and_damping(const NeedleState& needle);
   /// Puncture events of this tick: their total force includes the layers above's shaft forces.
