@@ -68,9 +68,17 @@ class ShaftForcesOfModel {
     const double tip_axial_m = needle.tip_position_m.dot(needle.direction);
     deepest_m_ = std::max(deepest_m_, tip_axial_m);
     for (std::size_t k = punctured_before_; k < punctured; ++k) {
+      // The crack above still cut at the break (k met at the tip; the one
+      // just opened at the tip in a chain of breaks) passes its load to k's.
+      double crack_above_N = 0.0;
+      if (k > 0 && scene_.effects.cutting)
+        crack_above_N = k > punctured_before_
+                            ? scene_.layers[k - 1].force_law.cutting_force_N
+                            : open_crack_force_N(scene_.layers[k - 1].force_law, front_m_[k - 1], tip_axial_m,
+                                                 met_at_break_[k] ? NextLayerContact::MetAtTip : NextLayerContact::Touched);
       front_m_[k] = tip_axial_m;
       break_m_[k] = tip_axial_m;
-      release_N_[k] = rupture_release_N(scene_.layers[k].force_law, model.break_force_N(k));
+      release_N_[k] = rupture_release_N(scene_.layers[k].force_law, model.break_force_N(k) + crack_above_N);
       if (k + 1 < n_layers && !scene_.effects.layer_interaction && needle.depth_m() > scene_.layer_top_depth_m(k + 1))
         met_at_break_[k + 1] = 1;
     }
