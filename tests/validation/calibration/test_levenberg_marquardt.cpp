@@ -70,6 +70,51 @@ TEST(LevenbergMarquardt, StopsAtTheBoundWhenTheMinimumLiesOutside) {
   EXPECT_NEAR(res.cost, 1.0, 1e-9);
 }
 
+TEST(LevenbergMarquardt, WithoutACoarserDifferenceStepTheFirstStallEndsTheFit) {
+  // r = (x - 3)^2 + 0.01 from x = 0 on one thread: the cost falls by orders
+  // of magnitude, then, near its floor 1e-4, by under 5 % a step. Two such
+  // steps in a row are a stall. With fd_step == fd_step_min there is no
+  // coarser step to start a new cycle from, so the fit ends at the first
+  // stall (each further iteration would cost a Jacobian and a trial, i.e.
+  // simulation runs, for a few 1e-5 of the cost). The runs are read back
+  // from the order of the evaluations (start, then per iteration a Jacobian
+  // column after every accepted step and a trial).
+  std::vector<double> costs;
+  const pv::ResidualFunction r = [&](const std::vector<double>& x, std::vector<double>& out) {
+    out = {(x[0] - 3.0) * (x[0] - 3.0) + 0.01};
+    costs.push_back(out[0] * out[0]);
+    return true;
+  };
+  pv::LevenbergMarquardtOptions o;
+  o.max_iterations = 100;
+  o.fd_step = o.fd_step_min = 0.02;
+  o.cost_tolerance = 0.05;
+  o.threads = 1;
+  const pv::LevenbergMarquardtResult res = pv::levenberg_marquardt(r, {0.0}, {-1e3}, {1e3}, o);
+  EXPECT_LT(res.cost, 1.5e-4);  // near the minimum, cost 1e-4 at x = 3
+  EXPECT_EQ(res.status, "cost_tolerance");
+  ASSERT_GE(costs.size(), 3u);
+  double current = costs[0];
+  bool jacobian_next = true;
+  int stalls = 0;
+  std::size_t first_stall_end = 0;
+  for (std::size_t i = 1; i < costs.size(); ++i) {
+    if (jacobian_next) {
+      jacobian_next = false;
+      continue;
+    }
+    if (costs[i] < current) {  // an accepted trial
+      stalls = (current - costs[i]) / current < o.cost_tolerance ? stalls + 1 : 0;
+      current = costs[i];
+      jacobian_next = true;
+      if (stalls == 2 && first_stall_end == 0) first_stall_end = i;
+    }
+  }
+  ASSERT_GT(first_stall_end, 0u) << "the fit never stalled";
+  EXPECT_EQ(costs.size(), first_stall_end + 1) << "the fit went on after its first stall";
+  EXPECT_DOUBLE_EQ(res.cost, current);
+}
+
 TEST(LevenbergMarquardt, NeverAcceptsAPointThatCannotBeEvaluated) {
   // r fails for x > 1.5 (e.g. a simulation that throws); the unconstrained minimum is at 3.
   std::atomic<int> failures{0};

@@ -188,8 +188,9 @@ LevenbergMarquardtResult levenberg_marquardt(const ResidualFunction& r, const st
   double cycle_start_cost = res.cost;
   auto refine = [&](const char* why) {
     if (fd_step / 10.0 < 0.999 * o.fd_step_min) {
-      // At the finest step: another cycle from the coarse step while the last one paid.
-      if (!(res.cost < (1.0 - 10.0 * o.cost_tolerance) * cycle_start_cost)) {
+      // At the finest step: another cycle from the coarse step while the last one paid
+      // (none without a coarser step: it would go on at the step that just stalled).
+      if (!(o.fd_step > o.fd_step_min) || !(res.cost < (1.0 - 10.0 * o.cost_tolerance) * cycle_start_cost)) {
         res.status = why;
         return false;
       }

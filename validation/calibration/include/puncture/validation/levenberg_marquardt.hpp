@@ -28,8 +28,9 @@
 // a piecewise smooth objective across a kink misleads at a coarse step) and
 // the iteration goes on from the same point, while the step stays at or
 // above fd_step_min; at the finest step, a new cycle starts from fd_step if
-// the last cycle lowered the cost by more than 10 cost_tolerance; else it
-// stops, as it does when the iteration or evaluation budget is used up.
+// fd_step is coarser and the last cycle lowered the cost by more than
+// 10 cost_tolerance; else it stops (with fd_step == fd_step_min at the first
+// stall), as it does when the iteration or evaluation budget is used up.
 #pragma once
 
 #include <functional>
