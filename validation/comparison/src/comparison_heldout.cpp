@@ -25,6 +25,15 @@ namespace {
 
 constexpr double kMm = 1e-3;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr int kHeldOutThreads = 2;
+
+/// One case as the models see it: its base scene, its FEM reference and, if
+/// a volumetric model is compared, its own tetrahedral mesh (slab and depth).
+struct CaseSetup {
+  Scene base;
+  ComparisonReference reference;
+  std::shared_ptr<const comparison::TetMesh> mesh;
+};
 
 CaseSetup setup_case(const ComparisonCase& c, const Scene& scene, const std::map<std::string, Scene>& model_scenes) {
   CaseSetup setup;
@@ -67,57 +76,50 @@ double mean_of_finite(const std::vector<double>& values) {
 
 }  // namespace
 
-HeldOutRuns::HeldOutRuns(const Scene& scene, const std::map<std::string, Scene>& model_scenes,
-                         const ComparisonReportOptions& options, std::ostream& out, std::ostream& err)
-    : options_(options), model_scenes_(model_scenes), out_(out), err_(err), setups_(options.cases.size()) {
+std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std::string, Scene>& model_scenes,
+                                          const ComparisonReportOptions& options, std::ostream& out,
+                                          std::ostream& err) {
   // Every (held-out case, model) pair is one independent run; they share
-  // nothing but the case's mesh and reference (read only). A case that is not
+  // nothing but the case's mesh and reference (read only), so they run two
+  // at a time (one per core of the reference machine). A case that is not
   // held out is the calibration trajectory: the main table's runs.
+  std::vector<CaseSetup> setups(options.cases.size());
+  std::vector<std::pair<std::size_t, std::string>> jobs;
   for (std::size_t i = 0; i < options.cases.size(); ++i) {
     if (!options.cases[i].validation_case.held_out) continue;
-    setups_[i] = setup_case(options.cases[i], scene, model_scenes);
+    setups[i] = setup_case(options.cases[i], scene, model_scenes);
     for (const std::string& key : options.models)
-      if (model_scenes.count(key)) jobs_.emplace_back(i, key);  // not "fem"
+      if (model_scenes.count(key)) jobs.emplace_back(i, key);  // not "fem"
   }
-  rows_.resize(jobs_.size());
-}
-
-HeldOutRuns::~HeldOutRuns() {
-  if (background_.joinable()) background_.join();
-}
-
-void HeldOutRuns::start_background() {
-  if (!jobs_.empty() && !background_.joinable()) background_ = std::thread([this] { work(); });
-}
-
-std::vector<HeldOutRow> HeldOutRuns::finish() {
-  work();
-  if (background_.joinable()) background_.join();
-  return rows_;
-}
-
-void HeldOutRuns::work() {
-  for (std::size_t j = next_++; j < jobs_.size(); j = next_++) {
-    const ComparisonCase& c = options_.cases[jobs_[j].first];
-    const std::string& key = jobs_[j].second;
-    if (!options_.quiet) {
-      const std::lock_guard<std::mutex> lock(report_mutex_);
-      out_ << "[compare] case " << c.validation_case.name << ": " << key << " ...\n" << std::flush;
+  std::vector<HeldOutRow> rows(jobs.size());
+  std::atomic<std::size_t> next{0};
+  std::mutex report_mutex;
+  const auto worker = [&]() {
+    for (std::size_t j = next++; j < jobs.size(); j = next++) {
+      const ComparisonCase& c = options.cases[jobs[j].first];
+      const std::string& key = jobs[j].second;
+      if (!options.quiet) {
+        const std::lock_guard<std::mutex> lock(report_mutex);
+        out << "[compare] case " << c.validation_case.name << ": " << key << " ...\n" << std::flush;
+      }
+      try {
+        rows[j] = run_model_on_case(c, setups[jobs[j].first], key, model_scenes.at(key));
+      } catch (const std::exception& e) {  // the model could not be built on this case
+        rows[j].case_name = c.validation_case.name;
+        rows[j].held_out = c.validation_case.held_out;
+        rows[j].metrics.model = key;
+        rows[j].failure = e.what();
+      }
+      if (!rows[j].failure.empty()) {
+        const std::lock_guard<std::mutex> lock(report_mutex);
+        err << "warning: " << key << " failed on case " << c.validation_case.name << " " << rows[j].failure << "\n";
+      }
     }
-    HeldOutRow& row = rows_[j];
-    try {
-      row = run_model_on_case(c, setups_[jobs_[j].first], key, model_scenes_.at(key));
-    } catch (const std::exception& e) {  // the model could not be built on this case
-      row.case_name = c.validation_case.name;
-      row.held_out = c.validation_case.held_out;
-      row.metrics.model = key;
-      row.failure = e.what();
-    }
-    if (!row.failure.empty()) {
-      const std::lock_guard<std::mutex> lock(report_mutex_);
-      err_ << "warning: " << key << " failed on case " << c.validation_case.name << " " << row.failure << "\n";
-    }
-  }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 0; t < std::min<int>(kHeldOutThreads, static_cast<int>(jobs.size())); ++t) threads.emplace_back(worker);
+  for (std::thread& t : threads) t.join();
+  return rows;
 }
 
 std::string heldout_csv(const Scene& scene, const std::vector<HeldOutRow>& rows) {

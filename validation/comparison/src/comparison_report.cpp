@@ -1,13 +1,10 @@
 // write_model_comparison: the report of `puncture compare` (see
 // comparison_report.hpp), top-down: the FEM reference's files, the mesh,
-// every model identified, its runs (the calibration trajectory's beside the
-// held-out cases'), the mass-spring identifications, the metrics and
-// grading, the files.
+// every model, the identifications, the metrics and grading, the files.
 #include "puncture/validation/comparison_report.hpp"
 
 #include <algorithm>
 #include <chrono>
-#include <map>
 
 #include "comparison_heldout.hpp"
 #include "comparison_runs.hpp"
@@ -29,22 +26,13 @@ ComparisonOutcome write_model_comparison(const Scene& scene, const DelphiWeights
   const ComparisonMesh mesh = build_comparison_mesh(scene, options, session, out);
 
   ComparisonRunner runner(scene, options, reference, mesh.mesh, session, out, err);
-  // The real-time model is the scene's (`puncture calibrate` tunes it);
-  // every other model is identified against the FEM first (two threads).
-  std::map<std::string, Scene> model_scenes;
-  for (const std::string& key : options.models)
-    if (key != "fem") model_scenes[key] = options.identify_models && key != "realtime" ? runner.identify_model(key) : scene;
-  // Held out: every model as identified, on the cases' trajectories and
-  // slabs. Those runs begin on one core while the calibration trajectory's
-  // runs (one core) take the other, then go on two at a time.
-  HeldOutRuns heldout_runs(scene, model_scenes, options, out, err);
-  heldout_runs.start_background();
-  for (const std::string& key : options.models)
-    if (key != "fem") runner.run(key, model_scenes.at(key), key);
-  const auto heldout_alone_start = std::chrono::steady_clock::now();
-  const std::vector<HeldOutRow> heldout = heldout_runs.finish();
-  const double heldout_wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - heldout_alone_start).count();
+  for (const std::string& key : options.models) {
+    if (key == "fem") continue;
+    // The real-time model is the scene's (`puncture calibrate` tunes it);
+    // every other model is identified against the FEM first.
+    const bool identify = options.identify_models && key != "realtime";
+    runner.run(key, identify ? runner.identify_model(key) : scene, key);
+  }
   nlohmann::json identification = nlohmann::json::array();
   for (const std::string& method : options.identify) identification.push_back(runner.identify(method));
 
@@ -60,6 +48,10 @@ ComparisonOutcome write_model_comparison(const Scene& scene, const DelphiWeights
   outcome.has_shaft_forces = reference.data.has_shaft_forces;
   session.write_text("ranking.csv", ranking_csv(outcome.grade));
 
+  // Held out: every model as identified above, on the cases' trajectories and slabs.
+  const auto heldout_start = std::chrono::steady_clock::now();
+  const std::vector<HeldOutRow> heldout = run_heldout_cases(scene, runner.model_scenes(), options, out, err);
+  const double heldout_wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - heldout_start).count();
   if (!heldout.empty()) {
     session.write_text("heldout.csv", heldout_csv(scene, heldout));
     outcome.heldout_metrics = aggregate_heldout(heldout, options.models);

@@ -145,10 +145,8 @@ void markdown_identification(std::ostringstream& md, const nlohmann::json& ident
 
 /// comparison.md: where the wall time went (time_budget).
 void markdown_time_budget(std::ostringstream& md, const ComparisonContent& c) {
-  md << "## Where the time goes\n\nWall time of this command by phase (2 threads in the identifications' optimiser; "
-        "the held-out runs begin on one core beside the calibration-trajectory runs on the other, so those runs' "
-        "step times, as the held-out ones', are of a run beside one other; everything else on one core).\n\n"
-        "| phase | wall time s | share | note |\n"
+  md << "## Where the time goes\n\nWall time of this command by phase (2 threads in the identifications' optimiser "
+        "and in the held-out phase; everything else on one core).\n\n| phase | wall time s | share | note |\n"
         "|---|---|---|---|\n";
   for (const TimeBudgetEntry& e : time_budget(c))
     md << "| " << e.phase << " | " << shown(e.wall_time_s, 4) << " | " << shown(100.0 * e.wall_time_s / c.wall_time_s, 2)
@@ -295,16 +293,14 @@ std::vector<TimeBudgetEntry> time_budget(const ComparisonContent& c) {
   if (!c.heldout.empty()) {
     std::map<std::string, double> per_model;
     for (const HeldOutRow& r : c.heldout) per_model[r.metrics.model] += r.wall_time_s;
-    std::string note = std::to_string(c.heldout.size()) +
-                       " runs, two at a time, begun beside the calibration-trajectory runs (their time there is "
-                       "in those rows); run time per model:";
+    std::string note = std::to_string(c.heldout.size()) + " runs, two at a time; run time per model:";
     for (const auto& [model, seconds] : per_model) note += " " + model + " " + shown(seconds, 4) + " s,";
     note.pop_back();
-    budget.push_back({"held-out phase, after the calibration-trajectory runs", c.heldout_wall_time_s, note});
+    budget.push_back({"held-out phase", c.heldout_wall_time_s, note});
   }
   double accounted = 0.0;
   for (const TimeBudgetEntry& e : budget) accounted += e.wall_time_s;
-  budget.push_back({"the rest", c.wall_time_s - accounted, "reading the references, the held-out cases' meshes, metrics, tables and files (the plots come after)"});
+  budget.push_back({"the rest", c.wall_time_s - accounted, "reading the references, metrics, tables and files (the plots come after)"});
   return budget;
 }
 

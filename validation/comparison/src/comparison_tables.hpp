@@ -57,7 +57,7 @@ struct ComparisonContent {
   const ComparisonOutcome& outcome;        ///< heldout_metrics, heldout_grade
   const DelphiWeights& weights;
   double wall_time_s;          ///< the whole command, s
-  double heldout_wall_time_s;  ///< the held-out phase after the calibration trajectory's runs (begun beside them), s
+  double heldout_wall_time_s;  ///< the held-out phase (its runs two at a time), s
 };
 
 /// Where the command's wall time went: one entry per phase (FEM references,
