@@ -69,6 +69,20 @@ Scene single_layer_scene(double thickness_m = 5e-3) {
   return s;
 }
 
+/// Layer "a" of single_layer_scene (upper_m thick, breaks at 1 N, cutting
+/// force C_a) over a 20 mm layer "b" that breaks at b_critical_N, with the
+/// cutting effect.
+Scene cut_layer_over_b(double upper_m, double C_a, double b_critical_N = 1e3) {
+  Scene scene = single_layer_scene(upper_m);
+  scene.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 4, 1e-3, 100.0, 1.0, 0.05));
+  scene.layers[1].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+  scene.layers[1].force_law.breakthrough.critical_force_N = b_critical_N;
+  scene.effects.cutting = true;
+  scene.layers[0].force_law.breakthrough.critical_force_N = 1.0;
+  scene.layers[0].force_law.cutting_force_N = C_a;
+  return scene;
+}
+
 /// Drives the simulator at constant speed from `from` to `to` (m), dt = 1 ms;
 /// calls check(result) after each tick. Returns the time reached.
 double drive(PunctureSimulator& sim, double& t, double from, double to, double speed,
@@ -394,13 +408,7 @@ TEST(ForceLaw, ALayerBrokenBelowTheNextSurfaceIsCutWhileTheNextIsPressed) {
   // same two layers with the upper one 8 mm thick: it breaks above the lower
   // surface, is cut alone until the tip touches it, and no longer after.
   for (double upper_m : {1e-3, 8e-3}) {
-    Scene scene = single_layer_scene(upper_m);
-    scene.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 4, 1e-3, 100.0, 1.0, 0.05));
-    scene.layers[1].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
-    scene.layers[1].force_law.breakthrough.critical_force_N = 1e3;
-    scene.effects.cutting = true;
-    scene.layers[0].force_law.breakthrough.critical_force_N = 1.0;
-    scene.layers[0].force_law.cutting_force_N = 0.8;
+    const Scene scene = cut_layer_over_b(upper_m, 0.8);
     PunctureSimulator sim(scene, test::plane_surfaces(scene));
     double t = 0.0;
     double break_depth = -1.0;
@@ -464,13 +472,8 @@ TEST(RuptureRelease, TheLoadAtTheBreakIsLetGoOverTheReleaseLengthWhateverTheLaye
   // paper's model); without the cutting effect there is no release.
   const double C = 0.4, l = 0.7e-3;
   auto scene_with = [&](double release_m, bool cutting) {
-    Scene scene = single_layer_scene(3e-3);
-    scene.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 4, 1e-3, 100.0, 1.0, 0.05));
-    scene.layers[1].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
-    scene.layers[1].force_law.breakthrough.critical_force_N = 1e3;
+    Scene scene = cut_layer_over_b(3e-3, C);
     scene.effects.cutting = cutting;
-    scene.layers[0].force_law.breakthrough.critical_force_N = 1.0;
-    scene.layers[0].force_law.cutting_force_N = C;
     scene.layers[0].force_law.rupture_release_m = release_m;
     return scene;
   };
@@ -528,13 +531,7 @@ TEST(RuptureRelease, ALayerMetAtTheTipTakesOverTheLoadOfTheCrackAboveAtItsBreak)
   // less than C_a). With l_b = 0 it drops to C_b (the paper's model).
   const double C_a = 0.8, C_b = 0.3, l_b = 0.6e-3;
   for (double release_m : {l_b, 0.0}) {
-    Scene scene = single_layer_scene(1e-3);
-    scene.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 4, 1e-3, 100.0, 1.0, 0.05));
-    scene.effects.cutting = true;
-    scene.layers[0].force_law.breakthrough.critical_force_N = 1.0;
-    scene.layers[0].force_law.cutting_force_N = C_a;
-    scene.layers[1].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
-    scene.layers[1].force_law.breakthrough.critical_force_N = 0.5;
+    Scene scene = cut_layer_over_b(1e-3, C_a, 0.5);
     scene.layers[1].force_law.cutting_force_N = C_b;
     scene.layers[1].force_law.rupture_release_m = release_m;
     PunctureSimulator sim(scene, test::plane_surfaces(scene));
