@@ -121,34 +121,18 @@ void AxisymmetricInsertionRun::write_pvd() const {
 // fem_summary.json: the model, the peak, the energies, the counts, the
 // timings, the punctures and the files.
 nlohmann::json AxisymmetricInsertionRun::summary_json() const {
-  nlohmann::json j;
-  j["status"] = "ok";
-  j["scene"] = scene_.name;
-  j["geometry"] = "axisymmetric";
-  j["n_dofs"] = summary_.n_dofs;
-  j["assembly_threads"] = summary_.assembly_threads;
-  j["n_cells"] = summary_.n_cells;
-  j["n_ranks_used"] = 1;
-  j["element_degree"] = degree_;
-  j["refinement"] = refinement_;
-  j["tip_element_size_mm"] = mesh_.tip_element_size_m * 1e3;
-  j["crack_radius_mm"] = mesh_.crack_radius_m * 1e3;
-  j["elements_through_layer"] = mesh_.elements_through_layer;
-  j["load_step_mm"] = scene_.fem.load_step_m * 1e3;
-  j["peak_force_N"] = summary_.peak_force_N;
-  j["peak_force_depth_mm"] = summary_.peak_force_depth_m * 1e3;
-  j["cohesive_dissipation_J"] = summary_.cohesive_dissipation_J;
-  j["stabilization_dissipation_J"] = summary_.stabilization_dissipation_J;
-  j["needle_work_insertion_J"] = summary_.needle_work_J;
-  j["load_steps"] = summary_.load_steps;
-  j["step_cuts"] = summary_.step_cuts;
-  j["steps_accepted_at_stall"] = summary_.steps_accepted_at_stall;
-  j["newton_iterations"] = summary_.newton_iterations;
-  j["wall_time_s"] = summary_.wall_time_s;
-  j["solve_time_s"] = summary_.solve_time_s;
-  j["warnings"] = summary_.warnings;
-  j["punctures"] = insertion::punctures_json(summary_.punctures, /*with_stretch=*/false);
-  j["files"] = summary_.files_written;
+  nlohmann::json j = insertion::common_summary_json("ok", scene_.name, summary_, degree_, refinement_,
+                                                    scene_.fem.load_step_m, /*with_stretch=*/false);
+  j.update({{"geometry", "axisymmetric"},
+            {"assembly_threads", summary_.assembly_threads},
+            {"n_ranks_used", 1},
+            {"tip_element_size_mm", mesh_.tip_element_size_m * 1e3},
+            {"crack_radius_mm", mesh_.crack_radius_m * 1e3},
+            {"elements_through_layer", mesh_.elements_through_layer},
+            {"cohesive_dissipation_J", summary_.cohesive_dissipation_J},
+            {"stabilization_dissipation_J", summary_.stabilization_dissipation_J},
+            {"needle_work_insertion_J", summary_.needle_work_J},
+            {"steps_accepted_at_stall", summary_.steps_accepted_at_stall}});
   return j;
 }
 

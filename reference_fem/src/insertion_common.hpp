@@ -128,4 +128,33 @@ inline nlohmann::json punctures_json(const std::vector<PunctureEvent>& events, b
   return out;
 }
 
+/// The fields of fem_summary.json both drivers write: the run's status, its
+/// scene, the discretisation (dofs, cells, element degree, refinement, load
+/// step in mm), the peak force, the step and Newton counts, the timings, the
+/// warnings, the punctures (with the tip's stretch when `with_stretch`) and
+/// the files. Each driver adds its own fields to the object this returns.
+inline nlohmann::json common_summary_json(const std::string& status, const std::string& scene_name,
+                                          const FemRunSummary& summary, int element_degree, int refinement,
+                                          double load_step_m, bool with_stretch) {
+  nlohmann::json j;
+  j["status"] = status;
+  j["scene"] = scene_name;
+  j["n_dofs"] = summary.n_dofs;
+  j["n_cells"] = summary.n_cells;
+  j["element_degree"] = element_degree;
+  j["refinement"] = refinement;
+  j["load_step_mm"] = load_step_m * 1e3;
+  j["peak_force_N"] = summary.peak_force_N;
+  j["peak_force_depth_mm"] = summary.peak_force_depth_m * 1e3;
+  j["load_steps"] = summary.load_steps;
+  j["step_cuts"] = summary.step_cuts;
+  j["newton_iterations"] = summary.newton_iterations;
+  j["wall_time_s"] = summary.wall_time_s;
+  j["solve_time_s"] = summary.solve_time_s;
+  j["warnings"] = summary.warnings;
+  j["punctures"] = punctures_json(summary.punctures, with_stretch);
+  j["files"] = summary.files_written;
+  return j;
+}
+
 }  // namespace puncture::fem::insertion

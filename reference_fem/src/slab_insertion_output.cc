@@ -128,33 +128,17 @@ std::string SlabInsertionRun::force_depth_csv() const {
 // fem_summary.json: the model, the peak, the counts, the timings, the
 // punctures and the files.
 nlohmann::json SlabInsertionRun::summary_json(const std::string& status, const std::string& error) const {
-  nlohmann::json j;
-  j["status"] = status;
+  nlohmann::json j = insertion::common_summary_json(status, scene_.name, summary_, disc_.degree, disc_.refinement,
+                                                    load_step_, /*with_stretch=*/true);
   if (!error.empty()) j["error"] = error;
-  j["scene"] = scene_.name;
-  j["n_dofs"] = summary_.n_dofs;
-  j["n_cells"] = summary_.n_cells;
-  j["n_ranks"] = summary_.n_ranks;
-  j["element_degree"] = disc_.degree;
-  j["refinement"] = disc_.refinement;
-  j["formulation"] = options_.formulation;
-  j["load_step_mm"] = load_step_ * 1e3;
-  j["final_depth_mm"] = final_depth_ * 1e3;
-  j["note"] = "quasi-static; the FEM stops at the target depth (no dwell, no withdrawal)";
-  j["warnings"] = summary_.warnings;
-  j["peak_force_N"] = summary_.peak_force_N;
-  j["peak_force_depth_mm"] = summary_.peak_force_depth_m * 1e3;
-  j["load_steps"] = summary_.load_steps;
-  j["step_cuts"] = summary_.step_cuts;
-  j["puncture_bisections"] = summary_.bisections;
-  j["spring_back_stages"] = summary_.spring_back_stages;
-  j["puncture_depth_resolution_mm"] = resolution_ * 1e3;
-  j["newton_iterations"] = summary_.newton_iterations;
-  j["linear_iterations"] = summary_.linear_iterations;
-  j["wall_time_s"] = summary_.wall_time_s;
-  j["solve_time_s"] = summary_.solve_time_s;
-  j["punctures"] = insertion::punctures_json(summary_.punctures, /*with_stretch=*/true);
-  j["files"] = summary_.files_written;
+  j.update({{"n_ranks", summary_.n_ranks},
+            {"formulation", options_.formulation},
+            {"final_depth_mm", final_depth_ * 1e3},
+            {"note", "quasi-static; the FEM stops at the target depth (no dwell, no withdrawal)"},
+            {"puncture_bisections", summary_.bisections},
+            {"spring_back_stages", summary_.spring_back_stages},
+            {"puncture_depth_resolution_mm", resolution_ * 1e3},
+            {"linear_iterations", summary_.linear_iterations}});
   return j;
 }
 

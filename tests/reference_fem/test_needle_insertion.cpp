@@ -113,6 +113,19 @@ TEST(NeedleInsertion, PuncturesSkinThenFatWithSpringBackAndWritesFiles) {
   const auto j = nlohmann::json::parse(js);
   EXPECT_EQ(j["status"], "completed");
   EXPECT_EQ(j["punctures"].size(), r.punctures.size());
+  // The fields both drivers write (common_summary_json) and this driver's own.
+  EXPECT_EQ(j["n_dofs"].get<std::size_t>(), r.n_dofs);
+  EXPECT_EQ(j["n_cells"].get<std::size_t>(), r.n_cells);
+  EXPECT_EQ(j["load_steps"].get<int>(), r.load_steps);
+  EXPECT_EQ(j["newton_iterations"].get<int>(), r.newton_iterations);
+  EXPECT_DOUBLE_EQ(j["peak_force_N"].get<double>(), r.peak_force_N);
+  EXPECT_DOUBLE_EQ(j["peak_force_depth_mm"].get<double>(), r.peak_force_depth_m * 1e3);
+  EXPECT_DOUBLE_EQ(j["punctures"][0]["depth_mm"].get<double>(), r.punctures[0].depth_m * 1e3);
+  EXPECT_TRUE(j["punctures"][0].contains("max_stretch"));
+  EXPECT_EQ(j["n_ranks"].get<int>(), r.n_ranks);
+  EXPECT_EQ(j["puncture_bisections"].get<int>(), r.bisections);
+  EXPECT_TRUE(j.contains("files") && j.contains("warnings") && j.contains("element_degree") &&
+              j.contains("refinement") && j.contains("load_step_mm") && j.contains("wall_time_s"));
   EXPECT_TRUE(std::filesystem::exists(dir / "fem_fields.pvd"));
   EXPECT_TRUE(std::filesystem::exists(dir / "fem_surface_profile.csv"));
   std::ifstream rec(dir / "fem_recovery_profile.csv");
