@@ -27,7 +27,16 @@ def machine():
                 break
     except OSError:
         pass
-    return f"{platform.system()} {platform.release()}, {os.cpu_count()} cores ({cpu})"
+    # The BLAS Debian's alternatives select (as machine_summary() in
+    # core/io/src/provenance.cpp): the last digits of the FEM and of the
+    # tensor-mass models depend on it.
+    blas = ""
+    for lib in ("/usr/lib/x86_64-linux-gnu/libblas.so.3", "/usr/lib/aarch64-linux-gnu/libblas.so.3"):
+        if os.path.exists(lib):
+            folder = os.path.basename(os.path.dirname(os.path.realpath(lib)))
+            blas = ", reference BLAS" if folder == "blas" else f", {folder}"
+            break
+    return f"{platform.system()} {platform.release()}, {os.cpu_count()} cores ({cpu}){blas}"
 
 
 def utc_now():

@@ -2,8 +2,12 @@
 
 #include "puncture/io/host.hpp"
 
+#include <link.h>
+
 #include <ctime>
+#include <filesystem>
 #include <fstream>
+#include <system_error>
 #include <thread>
 
 namespace puncture::io {
@@ -30,6 +34,13 @@ std::string cpu_model() {
   return "unknown CPU";
 }
 
+int find_blas(dl_phdr_info* info, std::size_t, void* data) {
+  const std::string name = info->dlpi_name ? info->dlpi_name : "";
+  if (name.find("/libblas.so") == std::string::npos) return 0;
+  *static_cast<std::string*>(data) = name;
+  return 1;
+}
+
 std::string one_line(std::string s) {
   for (char& c : s)
     if (c == '\n' || c == '\r') c = ' ';
@@ -37,9 +48,21 @@ std::string one_line(std::string s) {
 }
 }  // namespace
 
+std::string blas_library() {
+  std::string loaded;
+  dl_iterate_phdr(find_blas, &loaded);
+  if (loaded.empty()) return "";
+  std::error_code ec;
+  const std::filesystem::path real = std::filesystem::canonical(loaded, ec);
+  if (ec) return loaded;
+  const std::string dir = real.parent_path().filename().string();  // Debian's alternatives: blas, openblas-serial, ...
+  return dir == "blas" ? "reference BLAS" : dir;
+}
+
 std::string machine_summary() {
-  return host_name() + " (" + cpu_model() + ", " + std::to_string(std::thread::hardware_concurrency()) +
-         " cores)";
+  const std::string blas = blas_library();
+  return host_name() + " (" + cpu_model() + ", " + std::to_string(std::thread::hardware_concurrency()) + " cores" +
+         (blas.empty() ? "" : ", " + blas) + ")";
 }
 
 Provenance make_provenance(const std::string& command_line) {

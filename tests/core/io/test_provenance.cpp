@@ -79,5 +79,12 @@ TEST(Provenance, FieldDataIsInsertedIntoVtkXmlText) {
   EXPECT_THROW(add_vtk_xml_field_data("<html/>", {}), std::invalid_argument);
 }
 
+TEST(Provenance, WithoutABlasLoadedTheMachineSummaryEndsWithTheCores) {
+  // This test program links no BLAS (the comparison suite checks the other case).
+  EXPECT_EQ(blas_library(), "");
+  const std::string m = machine_summary();
+  EXPECT_EQ(m.substr(m.size() - 7), " cores)") << m;
+}
+
 }  // namespace
 }  // namespace puncture::io

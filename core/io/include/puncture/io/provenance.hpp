@@ -6,7 +6,8 @@
 // built from (generated at build time by core/io/cmake/write_build_info.cmake;
 // "<hash>-dirty" when tracked files differed from that commit, "unknown"
 // outside a git checkout), the UTC date (ISO 8601, "2026-11-21T23:59:00Z")
-// and the machine ("host (CPU model, N cores)").
+// and the machine ("host (CPU model, N cores, BLAS)": the BLAS when one is
+// loaded, blas_library()).
 //
 // How each kind of file carries it:
 //   CSV    "# key: value" comment lines before the header (csv_table.hpp,
@@ -29,7 +30,12 @@ const char* program_version();
 const char* git_revision();
 
 std::string utc_timestamp();    ///< now, e.g. "2026-11-21T23:59:00Z"
-std::string machine_summary();  ///< e.g. "host (Intel Xeon ..., 2 cores)"
+/// The BLAS this process has loaded (the folder Debian's alternatives keep
+/// it in, e.g. "openblas-serial"; "reference BLAS" for Debian's libblas), or
+/// "" when none is loaded: CHOLMOD's and UMFPACK's factorisations, and so the
+/// FEM's and the tensor-mass models' last digits and speed, depend on it.
+std::string blas_library();
+std::string machine_summary();  ///< e.g. "host (Intel Xeon ..., 2 cores, openblas-serial)"
 
 struct Provenance {
   std::string command;
