@@ -54,6 +54,10 @@ double& param_ref(Scene& s, std::size_t layer, ParamKind k) {
 }
 double param_value(const Scene& s, std::size_t layer, ParamKind k) { return param_ref(const_cast<Scene&>(s), layer, k); }
 
+/// The release length's floor (m) and its number of haptic ticks (physical_range).
+constexpr double kMinRuptureRelease_m = 1e-4;
+constexpr double kRuptureReleaseTicks = 5.0;
+
 /// Physical range of a parameter (SI); see calibration.hpp.
 void physical_range(const Scene& s, std::size_t layer, ParamKind k, double& lo, double& hi) {
   const Layer& l = s.layers[layer];
@@ -75,7 +79,20 @@ void physical_range(const Scene& s, std::size_t layer, ParamKind k, double& lo, 
     case ParamKind::StiffeningCubic: lo = 0.0, hi = 1e12; return;                  // 0 .. 1000 N/mm^3
     case ParamKind::StiffeningExponential: lo = 0.0, hi = 1e6; return;
     case ParamKind::Presliding: lo = 0.0, hi = 0.05; return;                       // 0 .. 50 mm of shaft travel
-    case ParamKind::RuptureRelease: lo = 1e-5, hi = 0.05; return;                  // 10 um .. 50 mm (the scene's limit)
+    case ParamKind::RuptureRelease: {
+      // The release exp(-s / l) is applied once per haptic tick: a length
+      // shorter than a few ticks' travel is a one-tick drop whose size is set
+      // by the tick, not by the tissue (at 1 kHz and 10 mm/s a tick is 10 um:
+      // l = 10 um keeps 37 % of R on the tick after the break, 82 % at the
+      // calibration's 2 um steps). Lower bound: 5 ticks at the scene's
+      // insertion speed and haptic rate, and never below 0.1 mm (5 ticks at
+      // 20 mm/s, the fastest held-out speed; the FEM's shortest decay after a
+      // break is 0.21 mm, at 1 mm/s). Upper: 50 mm (the scene's limit).
+      const double tick_m = s.realtime.haptic_rate_Hz > 0.0 ? s.insertion.speed_m_per_s / s.realtime.haptic_rate_Hz : 0.0;
+      lo = std::max(kMinRuptureRelease_m, kRuptureReleaseTicks * tick_m);
+      hi = 0.05;
+      return;
+    }
     case ParamKind::BreakthroughRate: lo = 0.0, hi = 1.0; return;                  // n in [0, 1] (the scene's limit)
   }
 }

@@ -22,7 +22,9 @@
 //   inside an absolute physical range (e.g. a ring threshold between 1 um,
 //   below which a ring counts as deformed by numerical noise, and the layer
 //   thickness; a critical force between 0.1 mN and 50 N, the span of
-//   measured puncture forces; a cutting force between 0 and 20 N), and the
+//   measured puncture forces; a cutting force between 0 and 20 N; a rupture
+//   release length of at least five haptic ticks' travel and 0.1 mm, so that
+//   its decay is resolved by the ticks it is applied on), and the
 //   scale parameters (K, k_s, L, d, threshold, critical force and energy)
 //   also within [p0 / bound_factor, p0 x bound_factor] of their start. A
 //   start outside the physical range is moved inside it (and reported).

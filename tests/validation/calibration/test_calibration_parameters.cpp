@@ -1,0 +1,54 @@
+// The parameter table's bounds (calibration_parameters.hpp): the rupture
+// release length is never shorter than the haptic ticks resolve.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "calibration_parameters.hpp"
+#include "puncture/scene_io.hpp"
+
+namespace pc = puncture::validation::calibration_detail;
+using puncture::Scene;
+
+namespace {
+
+Scene default_scene() {
+  return puncture::load_scene(std::filesystem::path(PUNCTURE_SOURCE_DIR) / "scenes" / "default_force_law.json");
+}
+
+/// exp(-tick / l): the share of the release R the force keeps on the tick after a break.
+double kept_after_one_tick(const Scene& s, double l_m) {
+  return std::exp(-s.insertion.speed_m_per_s / s.realtime.haptic_rate_Hz / l_m);
+}
+
+}  // namespace
+
+TEST(CalibrationParameters, TheRuptureReleaseSpansAtLeastFiveHapticTicksAndATenthOfAMillimetre) {
+  Scene s = default_scene();
+  ASSERT_DOUBLE_EQ(s.realtime.haptic_rate_Hz, 1000.0);
+  ASSERT_DOUBLE_EQ(s.insertion.speed_m_per_s, 0.01);
+  double lo = 0.0, hi = 0.0;
+  pc::physical_range(s, 0, pc::ParamKind::RuptureRelease, lo, hi);
+  EXPECT_DOUBLE_EQ(lo, 1e-4);  // 5 ticks at 10 mm/s are 50 um: the floor holds
+  EXPECT_DOUBLE_EQ(hi, 0.05);
+  // At the floor the tick after the break keeps over 90 % of R at 10 mm/s and
+  // over 80 % at 20 mm/s, where 10 um kept 37 % (a drop set by the tick).
+  EXPECT_GT(kept_after_one_tick(s, lo), 0.9);
+  EXPECT_LT(kept_after_one_tick(s, 1e-5), 0.37);
+
+  // A fast scene: 100 mm/s at 1 kHz is 0.1 mm per tick, so 5 ticks are 0.5 mm.
+  s.insertion.speed_m_per_s = 0.1;
+  pc::physical_range(s, 0, pc::ParamKind::RuptureRelease, lo, hi);
+  EXPECT_NEAR(lo, 5e-4, 1e-15);
+  EXPECT_GT(kept_after_one_tick(s, lo), 0.8);
+
+  // A start below the floor (the earlier bound, 10 um) is moved onto it, and said so.
+  s = default_scene();
+  s.layers[0].force_law.rupture_release_m = 1e-5;
+  bool moved = false;
+  const pc::Parameter p = pc::make_parameter(s, 0, pc::ParamKind::RuptureRelease, 1000.0, moved);
+  EXPECT_TRUE(moved);
+  EXPECT_DOUBLE_EQ(p.value_lo, 1e-4);
+  EXPECT_DOUBLE_EQ(p.lower, std::log(1e-4));
+}
