@@ -575,8 +575,8 @@ TEST(CalibrationForceLaw, AtTheReleaseLengthsFloorTheForceAfterABreakHardlyDepen
   s.layers[0].thickness_m = 0.6e-3;
   s.layers[1].force_law.breakthrough.critical_force_N = 0.02;
   double floor_m = 0.0, hi = 0.0;
-  puncture::validation::calibration_detail::physical_range(
-      s, 0, puncture::validation::calibration_detail::ParamKind::RuptureRelease, floor_m, hi);
+  namespace pcd = puncture::validation::calibration_detail;
+  pcd::physical_range(s, 0, pcd::ParamKind::RuptureRelease, floor_m, hi);
   ASSERT_DOUBLE_EQ(floor_m, 1e-4);
   auto fat_puncture_force = [&](double l_m, double rate_Hz) {
     Scene t = s;
