@@ -4,6 +4,9 @@
 
 #include <omp.h>
 
+#include <cmath>
+#include <stdexcept>
+
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCholesky>
 
@@ -85,5 +88,65 @@ std::size_t SparseSpdFactor::factor_nonzeros() const {
 }
 
 long SparseSpdFactor::fallbacks() const { return impl_->fallbacks; }
+
+GammaFactorPool::GammaFactorPool(double reuse_factor, int capacity)
+    : log_reuse_(std::log(reuse_factor)), capacity_(static_cast<std::size_t>(capacity)) {
+  if (!(reuse_factor > 1.0) || capacity < 1)
+    throw std::invalid_argument("GammaFactorPool: reuse factor must exceed 1 and capacity be at least 1");
+}
+
+const SparseSpdFactor* GammaFactorPool::find(double gamma) {
+  Slot* best = nullptr;
+  double best_distance = log_reuse_;
+  for (const auto& slot : slots_) {
+    if (!slot->valid) continue;
+    const double distance = std::abs(std::log(gamma / slot->gamma));
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = slot.get();
+    }
+  }
+  if (!best) return nullptr;
+  best->last_use = ++uses_;
+  return &best->factor;
+}
+
+const SparseSpdFactor* GammaFactorPool::factorize(double gamma, const Eigen::SparseMatrix<double>& A) {
+  Slot* target = nullptr;
+  for (const auto& slot : slots_)
+    if (!slot->valid) {
+      target = slot.get();
+      break;
+    }
+  if (!target && slots_.size() < capacity_) {
+    slots_.push_back(std::make_unique<Slot>());
+    target = slots_.back().get();
+  }
+  if (!target) {
+    target = slots_.front().get();
+    for (const auto& slot : slots_)
+      if (slot->last_use < target->last_use) target = slot.get();
+  }
+  target->valid = target->factor.factorize(A);
+  target->gamma = gamma;
+  target->last_use = ++uses_;
+  return target->valid ? &target->factor : nullptr;
+}
+
+void GammaFactorPool::clear() {
+  for (const auto& slot : slots_) slot->valid = false;
+}
+
+std::size_t GammaFactorPool::factor_nonzeros() const {
+  std::size_t n = 0;
+  for (const auto& slot : slots_) n += slot->factor.factor_nonzeros();
+  return n;
+}
+
+long GammaFactorPool::fallbacks() const {
+  long n = 0;
+  for (const auto& slot : slots_) n += slot->factor.fallbacks();
+  return n;
+}
 
 }  // namespace puncture::comparison

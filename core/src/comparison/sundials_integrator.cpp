@@ -175,17 +175,17 @@ void SundialsIntegrator::advance(double t_out, Eigen::VectorXd& y) {
   if (!y.allFinite()) throw std::runtime_error("time integration returned a non-finite state at t = " + std::to_string(t_out));
 }
 
-void SundialsIntegrator::reinit(double t, const Eigen::VectorXd& y) {
+void SundialsIntegrator::reinit(double t, const Eigen::VectorXd& y, FirstStep first_step) {
   if (y.size() != impl_->n) throw std::invalid_argument("SundialsIntegrator::reinit: wrong size");
   std::copy(y.data(), y.data() + impl_->n, N_VGetArrayPointer(impl_->y));
   before_restarts_ = stats();  // the counters restart with the integrator
   realtype last_step = 0.0;
   if (settings_.kind == IntegratorKind::ImplicitBdf) {
-    CVodeGetLastStep(impl_->memory, &last_step);
+    if (first_step == FirstStep::FromLastStep) CVodeGetLastStep(impl_->memory, &last_step);
     check(CVodeReInit(impl_->memory, t, impl_->y), "CVodeReInit");
     check(CVodeSetInitStep(impl_->memory, last_step > 0.0 ? 0.25 * last_step : 0.0), "CVodeSetInitStep");
   } else {
-    ERKStepGetLastStep(impl_->memory, &last_step);
+    if (first_step == FirstStep::FromLastStep) ERKStepGetLastStep(impl_->memory, &last_step);
     check(ERKStepReInit(impl_->memory, rhs_callback, t, impl_->y), "ERKStepReInit");
     check(ERKStepSetInitStep(impl_->memory, last_step > 0.0 ? 0.25 * last_step : 0.0), "ERKStepSetInitStep");
   }

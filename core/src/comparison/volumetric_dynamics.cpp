@@ -11,14 +11,6 @@
 
 namespace puncture::comparison {
 
-namespace {
-
-/// The preconditioner's factorisation is reused while SUNDIALS' gamma stays
-/// within this factor of the gamma it was computed with.
-constexpr double kReuseFactor = 5.0;
-
-}  // namespace
-
 void VolumetricNeedleModel::compute_masses() {
   std::vector<double> node_mass(static_cast<std::size_t>(nodes_), 0.0);
   for (std::size_t t = 0; t < mesh_->tets.size(); ++t) {
@@ -34,6 +26,11 @@ void VolumetricNeedleModel::compute_masses() {
     mass_.segment<3>(3 * a).setConstant(node_mass[static_cast<std::size_t>(a)]);
     if (!(node_mass[static_cast<std::size_t>(a)] > 0.0)) dof_[static_cast<std::size_t>(a)] = Dof::Fixed;  // orphan
   }
+}
+
+void VolumetricNeedleModel::drop_factors() {
+  factors_.clear();
+  factor_in_use_ = nullptr;
 }
 
 void VolumetricNeedleModel::compute_rest_tangent() {
@@ -101,7 +98,7 @@ int VolumetricNeedleModel::preconditioner_setup(double, const double* yp, bool j
     // to converge with it. Factorisations dominate the cost of a step.
     if (!settings_.lag_preconditioner || !integrator_ ||
         integrator_->stats().convergence_failures != factor_convergence_failures_)
-      have_factor_ = false;
+      drop_factors();
     updated = true;
   }
   const double alpha = settings_.mass_damping_per_s, beta = settings_.stiffness_damping_s;
@@ -119,15 +116,18 @@ int VolumetricNeedleModel::preconditioner_setup(double, const double* yp, bool j
     ++mass_only_setups_;
     return 0;
   }
-  // Reuse the factorisation while gamma stays within a factor kReuseFactor of
-  // the one it was made with: the preconditioned spectrum stays within
-  // [1/f^2, f^2] and GMRES absorbs the difference.
-  if (have_factor_ && gamma < kReuseFactor * factor_gamma_ && gamma > factor_gamma_ / kReuseFactor) return 0;
+  // A kept factorisation made with a gamma within kFactorReuse of this one
+  // (the preconditioned spectrum stays within [1/f^2, f^2] and GMRES absorbs
+  // the difference); the pool keeps several, as gamma ramps up after every
+  // restart through the values of the last ramp.
+  if (const SparseSpdFactor* kept = factors_.find(gamma)) {
+    factor_in_use_ = kept;
+    return 0;
+  }
   const auto start = std::chrono::steady_clock::now();
-  full_ = tangent_.matrix() * (gamma * gamma);
-  if (beta > 0.0) full_ += rest_tangent_.matrix() * (gamma * beta);  // same pattern
-  for (int d = 0; d < 3 * nodes_; ++d) full_.coeffRef(d, d) += (1.0 + gamma * alpha) * mass_[d];
-  system_ = full_;
+  system_ = tangent_.matrix() * (gamma * gamma);
+  if (beta > 0.0) system_ += rest_tangent_.matrix() * (gamma * beta);  // same pattern
+  for (int d = 0; d < 3 * nodes_; ++d) system_.coeffRef(d, d) += (1.0 + gamma * alpha) * mass_[d];
   for (Eigen::Index j = 0; j < system_.outerSize(); ++j) {
     const bool col_free = dof_[static_cast<std::size_t>(j / 3)] == Dof::Free;
     for (Eigen::SparseMatrix<double>::InnerIterator it(system_, j); it; ++it) {
@@ -136,15 +136,10 @@ int VolumetricNeedleModel::preconditioner_setup(double, const double* yp, bool j
       it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
     }
   }
-  const bool factorised = factor_.factorize(system_);
+  factor_in_use_ = factors_.factorize(gamma, system_);
   factorisation_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++factorisations_;
-  if (!factorised) {
-    have_factor_ = false;
-    return 1;
-  }
-  have_factor_ = true;
-  factor_gamma_ = gamma;
+  if (!factor_in_use_) return 1;
   factor_convergence_failures_ = integrator_ ? integrator_->stats().convergence_failures : 0;
   return 0;
 }
@@ -173,11 +168,16 @@ int VolumetricNeedleModel::preconditioner_solve(double, const double* yp, const 
     work_b_.setZero(n3);
     for (int d = 0; d < n3; ++d)
       if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) work_b_[d] = rv[d];
-    work_a_ = mass_.cwiseProduct(rv) - gamma * (K * rx) - full_ * work_b_;
+    // The prescribed dofs' values enter the free rows through the Newton
+    // matrix of this gamma (the factorisation may have been made with another).
+    work_a_ = mass_.cwiseProduct(rv) - gamma * (K * rx) - (gamma * gamma) * (K * work_b_) -
+              (1.0 + gamma * settings_.mass_damping_per_s) * mass_.cwiseProduct(work_b_);
+    if (settings_.stiffness_damping_s > 0.0)
+      work_a_.noalias() -= (gamma * settings_.stiffness_damping_s) * (rest_tangent_.matrix() * work_b_);
     if (extra_ > 0) work_a_ += gamma * q_force;
     for (int d = 0; d < n3; ++d)
       if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) work_a_[d] = rv[d];
-    b = factor_.solve(work_a_);
+    b = factor_in_use_->solve(work_a_);
   }
   if (!b.allFinite()) return 1;
   for (int d = 0; d < n3; ++d)

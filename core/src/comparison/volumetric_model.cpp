@@ -3,6 +3,7 @@
 #include "puncture/comparison/volumetric_model.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -239,12 +240,16 @@ bool VolumetricNeedleModel::factorise_static_tangent(const Eigen::VectorXd& stat
       it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
     }
   }
+  ++relaxation_factorisations_;
+  if (!settings_.quasi_static) {
+    static_factor_valid_ = relax_factor_.factorize(A);
+    return static_factor_valid_;
+  }
   if (!static_pattern_analysed_) {
     static_solver_.analyzePattern(A);
     static_pattern_analysed_ = true;
   }
   static_solver_.factorize(A);
-  ++relaxation_factorisations_;
   static_factor_valid_ = static_solver_.info() == Eigen::Success;
   return static_factor_valid_;
 }
@@ -281,7 +286,8 @@ void VolumetricNeedleModel::relax_to_equilibrium() {
       if (!factorise_static_tangent(state)) return;  // leave the state to the dynamics
       fresh = true;
     }
-    const Eigen::VectorXd step = static_solver_.solve(r);  // K dx = f (f = -dW/dx)
+    const Eigen::VectorXd step =  // K dx = f (f = -dW/dx)
+        settings_.quasi_static ? Eigen::VectorXd(static_solver_.solve(r)) : relax_factor_.solve(r);
     double scale = 1.0, trial_norm = std::numeric_limits<double>::infinity();
     Eigen::VectorXd trial = state;
     if (step.allFinite()) {
@@ -328,7 +334,7 @@ void VolumetricNeedleModel::puncture_active_layer() {
   layers_[active_].state = LayerState::Punctured;
   ++active_;
   have_tangent_ = false;
-  have_factor_ = false;
+  drop_factors();
   static_factor_valid_ = false;
   ++events_;
 }
@@ -403,7 +409,7 @@ void VolumetricNeedleModel::advance_dynamics(double t, double z_tip, double velo
     // stops the run with the integrator's message.
     ++failure_restarts_;
     have_tangent_ = false;
-    have_factor_ = false;
+    drop_factors();
     integrator_->reinit(time_, y_);
     integrator_->advance(t, y_);
   }
@@ -438,12 +444,17 @@ double VolumetricNeedleModel::step(const NeedleState& needle) {
   } else if (t > time_) {
     advance_dynamics(t, z_tip, velocity_z);
   }
+  const long punctures_before = events_;
   if (update_contacts(z_tip, velocity_z, withdrawing)) {
     // The prescribed dofs changed: the factorisation is kept as a lagged
-    // preconditioner (see preconditioner_setup); a puncture drops it.
-    if (!settings_.lag_preconditioner) have_factor_ = false;
+    // preconditioner (see preconditioner_setup); a puncture drops it, and
+    // the restart after it starts from the integrator's own step estimate
+    // (the freed nodes' fast transient).
+    if (!settings_.lag_preconditioner) drop_factors();
     needle_velocity_z_ = velocity_z;
-    integrator_->reinit(time_, y_);
+    integrator_->reinit(time_, y_,
+                        events_ != punctures_before ? SundialsIntegrator::FirstStep::Estimate
+                                                    : SundialsIntegrator::FirstStep::FromLastStep);
   }
   // The breakthrough check may have evaluated it already on this state.
   return std::isfinite(checked_force_N_) ? checked_force_N_ : contact_force_N();
@@ -493,8 +504,8 @@ ModelSize VolumetricNeedleModel::model_size() const {
   bytes += 2 * static_cast<std::size_t>(y_.size()) * sizeof(double);  // integrator state copies
   if (settings_.integrator == IntegratorKind::ImplicitBdf) {
     const std::size_t nnz = static_cast<std::size_t>(tangent_.matrix().nonZeros());
-    bytes += 3 * nnz * (sizeof(double) + sizeof(int));  // tangent, full and eliminated system
-    bytes += factor_.factor_nonzeros() * (sizeof(double) + sizeof(int));
+    bytes += 2 * nnz * (sizeof(double) + sizeof(int));  // tangent and eliminated system
+    bytes += (factors_.factor_nonzeros() + relax_factor_.factor_nonzeros()) * (sizeof(double) + sizeof(int));
     // SUNDIALS BDF history (up to 6 vectors) and GMRES basis (krylov + 2 vectors).
     bytes += 18 * static_cast<std::size_t>(y_.size()) * sizeof(double);
   } else {
@@ -540,8 +551,8 @@ std::string VolumetricNeedleModel::integrator_report() const {
       << " rhs evaluations, " << s.linear_iterations << " GMRES iterations, " << s.preconditioner_setups
       << " preconditioner set-ups, " << s.error_test_failures << " error-test and " << s.convergence_failures
       << " convergence failures; " << factorisations_ << " sparse Cholesky factorisations (" << factorisation_seconds_
-      << " s; " << factor_.fallbacks() << " by the LDL^T fallback), " << mass_only_setups_ << " diagonal preconditioners; " << relaxations_
-      << " static relaxations after a contact jump (" << relaxation_factorisations_ << " LDL^T factorisations); "
+      << " s; " << factors_.fallbacks() << " by the LDL^T fallback), " << mass_only_setups_ << " diagonal preconditioners; " << relaxations_
+      << " static relaxations after a contact jump (" << relaxation_factorisations_ << " sparse Cholesky factorisations); "
       << s.reinitialisations << " restarts (contact, puncture, speed changes), " << failure_restarts_
       << " of them after an integration failure";
   return out.str();

@@ -3,6 +3,9 @@
 // fallback), refactorisation with new values on the analysed pattern; the
 // calling thread's OpenMP setting is the same after a factorisation and a
 // solve as before (CHOLMOD's regions are switched off only while it works).
+// GammaFactorPool: which kept factorisation a gamma gets (the nearest within
+// the reuse factor), the least recently used one replaced when full, clear()
+// and a failed factorisation leave none behind.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -79,6 +82,58 @@ TEST(SparseSpdFactor, LeavesTheCallingThreadsOpenMpSettingAsItFoundIt) {
   EXPECT_LT(relative_error_against_dense(f, A), 1e-12);
   EXPECT_EQ(omp_get_max_active_levels(), set);
   omp_set_max_active_levels(before);
+}
+
+/// The Newton-matrix family of a chain: I + gamma^2 K (K the chain Laplacian).
+Eigen::SparseMatrix<double> newton_matrix(double gamma) {
+  Eigen::SparseMatrix<double> A = chain_matrix(30, 0.0) * (gamma * gamma);
+  for (int i = 0; i < A.rows(); ++i) A.coeffRef(i, i) += 1.0;
+  return A;
+}
+
+TEST(GammaFactorPool, GivesTheNearestKeptFactorisationWithinTheReuseFactor) {
+  GammaFactorPool pool(5.0, 2);
+  EXPECT_EQ(pool.find(1.0), nullptr);
+  const SparseSpdFactor* one = pool.factorize(1.0, newton_matrix(1.0));
+  ASSERT_NE(one, nullptr);
+  EXPECT_LT(relative_error_against_dense(*one, newton_matrix(1.0)), 1e-12);
+  EXPECT_EQ(pool.find(4.9), one);
+  EXPECT_EQ(pool.find(0.21), one);
+  EXPECT_EQ(pool.find(5.1), nullptr);
+  EXPECT_EQ(pool.find(0.19), nullptr);
+  const SparseSpdFactor* four = pool.factorize(4.0, newton_matrix(4.0));
+  ASSERT_NE(four, nullptr);
+  EXPECT_NE(four, one);
+  EXPECT_LT(relative_error_against_dense(*four, newton_matrix(4.0)), 1e-12);
+  EXPECT_EQ(pool.find(2.5), four);  // ratio 1.6 to 4, 2.5 to 1
+  EXPECT_EQ(pool.find(1.5), one);
+  // Full (capacity 2): the least recently used (4, last found before 1.5) is replaced.
+  const SparseSpdFactor* hundred = pool.factorize(100.0, newton_matrix(100.0));
+  ASSERT_NE(hundred, nullptr);
+  EXPECT_EQ(hundred, four);  // its slot
+  EXPECT_EQ(pool.find(1.0), one);
+  EXPECT_EQ(pool.find(4.0), one);  // 4 is gone: 1 is within the factor
+  EXPECT_EQ(pool.find(90.0), hundred);
+  EXPECT_LT(relative_error_against_dense(*pool.find(100.0), newton_matrix(100.0)), 1e-12);
+}
+
+TEST(GammaFactorPool, ClearAndFailedFactorisationsLeaveNoneBehind) {
+  GammaFactorPool pool(5.0, 3);
+  ASSERT_NE(pool.factorize(1.0, newton_matrix(1.0)), nullptr);
+  const std::size_t memory = pool.factor_nonzeros();
+  EXPECT_GT(memory, 0u);
+  pool.clear();
+  EXPECT_EQ(pool.find(1.0), nullptr);
+  EXPECT_EQ(pool.factor_nonzeros(), memory);  // the slot keeps its memory for the next one
+  // A singular matrix (a zero row and column): neither Cholesky nor LDL^T.
+  Eigen::SparseMatrix<double> singular = newton_matrix(2.0);
+  for (Eigen::Index j = 0; j < singular.outerSize(); ++j)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(singular, j); it; ++it)
+      if (it.row() == 0 || it.col() == 0) it.valueRef() = 0.0;
+  EXPECT_EQ(pool.factorize(2.0, singular), nullptr);
+  EXPECT_EQ(pool.find(2.0), nullptr);
+  EXPECT_THROW(GammaFactorPool(1.0, 2), std::invalid_argument);
+  EXPECT_THROW(GammaFactorPool(5.0, 0), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // sparse_spd_factor.hpp: the sparse direct solver of the volumetric
-// comparison models' implicit integrator (its Newton matrix; the static
-// relaxation keeps Eigen's LDL^T, see volumetric_model.hpp).
+// comparison models' implicit integrator (its Newton matrix, and the static
+// relaxation after a contact jump; the quasi-static mode keeps Eigen's LDL^T,
+// see volumetric_model.hpp), and the pool of its factorisations by gamma.
 //
 // In:  a sparse symmetric matrix A (n x n, both triangles stored; only the
 //      lower one is read), factorised again whenever its values change; its
@@ -21,6 +22,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -49,6 +51,48 @@ class SparseSpdFactor {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+/// Factorisations of a one-parameter family of matrices A(gamma), kept for
+/// several gamma: the implicit integrator's Newton matrix
+/// (1 + gamma alpha) M + (gamma^2 + gamma beta) K, whose gamma (the BDF step
+/// times its coefficient) ramps up over several decades after every restart
+/// (a contact change, a puncture) and falls again after failed steps, passing
+/// the same values again and again. A factorisation made with a gamma within
+/// `reuse_factor` of the one asked for is used as the preconditioner (the
+/// preconditioned spectrum stays within [1/f^2, f^2]; GMRES absorbs the
+/// rest).
+///
+/// In:  gamma > 0 (s) and, to factorise, A(gamma) (as SparseSpdFactor).
+/// Out: a factorisation, or nullptr. At most `capacity` are kept (the least
+///      recently used is replaced); clear() drops them all (a new tangent or
+///      mesh) and keeps each slot's pattern analysis and memory.
+class GammaFactorPool {
+ public:
+  GammaFactorPool(double reuse_factor, int capacity);
+  /// The kept factorisation whose gamma is nearest this one (in ratio),
+  /// if within the reuse factor; nullptr otherwise.
+  const SparseSpdFactor* find(double gamma);
+  /// Factorises A(gamma) into a free slot or the least recently used one;
+  /// nullptr if A could not be factorised (that slot is then free).
+  const SparseSpdFactor* factorize(double gamma, const Eigen::SparseMatrix<double>& A);
+  void clear();
+  /// Non-zeros of every slot's factor (the pool's memory, kept after clear()).
+  std::size_t factor_nonzeros() const;
+  /// Factorisations that needed the LDL^T fallback, over every slot.
+  long fallbacks() const;
+
+ private:
+  struct Slot {
+    SparseSpdFactor factor;
+    double gamma = 0.0;
+    bool valid = false;
+    long last_use = 0;
+  };
+  double log_reuse_;
+  std::size_t capacity_;
+  long uses_ = 0;
+  std::vector<std::unique_ptr<Slot>> slots_;
 };
 
 }  // namespace puncture::comparison

@@ -96,11 +96,20 @@ class SundialsIntegrator {
 
   /// Integrates to t_out (> current time) and returns y(t_out).
   void advance(double t_out, Eigen::VectorXd& y);
-  /// Restart from (t, y) (after a state change: contact, puncture). The first
-  /// step tried is a quarter of the last one taken (the integrator's own
-  /// estimate when nothing was taken yet), so a restart does not climb up
-  /// from a microsecond again.
-  void reinit(double t, const Eigen::VectorXd& y);
+  /// How a restart chooses its first step.
+  enum class FirstStep {
+    /// A quarter of the last step taken (the integrator's own estimate when
+    /// nothing was taken yet), so a restart after a small change of the
+    /// forcing (a contact change) does not climb up from a microsecond again.
+    FromLastStep,
+    /// The integrator's own estimate from the new state's derivatives: after
+    /// a jump of the state far from equilibrium (a puncture frees the nodes
+    /// that carried the needle), where a long first step fails its error
+    /// test over and over.
+    Estimate,
+  };
+  /// Restart from (t, y) (after a state change: contact, puncture).
+  void reinit(double t, const Eigen::VectorXd& y, FirstStep first_step = FirstStep::FromLastStep);
   /// The integrator does not step past t_stop (a kink of the forcing).
   void set_stop_time(double t_stop);
 

@@ -167,6 +167,8 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
 
   void compute_masses();
   void compute_rest_tangent();
+  /// Drops every kept factorisation of the Newton matrix (a new tangent or mesh).
+  void drop_factors();
   void compute_forces(const Eigen::VectorXd& y, Eigen::VectorXd& f) const;
   bool update_contacts(double z_tip_m, double velocity_z_m_per_s, bool withdrawing);
   void puncture_active_layer();
@@ -212,22 +214,27 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   // Preconditioner data (implicit).
   NodeBlockMatrix tangent_;            ///< K at the last setup
   NodeBlockMatrix rest_tangent_;       ///< K0 (for the stiffness-proportional damping)
-  Eigen::SparseMatrix<double> system_; ///< (1 + gamma alpha) M + gamma^2 K, eliminated
-  Eigen::SparseMatrix<double> full_;   ///< the same before elimination
-  SparseSpdFactor factor_;
+  Eigen::SparseMatrix<double> system_; ///< (1 + gamma alpha) M + (gamma^2 + gamma beta) K, eliminated
+  /// A factorisation is used for gammas within this factor of its own.
+  static constexpr double kFactorReuse = 10.0;
+  /// Factorisations kept (about 55 MB each on the default slab's mesh).
+  static constexpr int kFactorsKept = 8;
+  GammaFactorPool factors_{kFactorReuse, kFactorsKept};
+  const SparseSpdFactor* factor_in_use_ = nullptr;  ///< the preconditioner's (one of factors_)
   bool have_tangent_ = false;
-  bool have_factor_ = false;
   bool mass_only_ = false;          ///< the last setup chose the diagonal preconditioner
-  double factor_gamma_ = 0.0;
-  long factor_convergence_failures_ = 0;
-  long failure_restarts_ = 0;  ///< restarts after the integrator failed (step())  ///< integrator's convergence failures when the factor was made
+  long factor_convergence_failures_ = 0;  ///< integrator's convergence failures when the last factor was made
+  long failure_restarts_ = 0;  ///< restarts after the integrator failed (step())
   double omega_squared_bound_ = 0.0;
   Eigen::VectorXd diagonal_;
   long factorisations_ = 0;
   long relaxations_ = 0;
   /// The static relaxation's tangent K alone (no mass: at most positive
-  /// semi-definite for a mass-spring network) keeps Eigen's LDL^T, whose
-  /// equilibria the quasi-static identification was made with.
+  /// semi-definite for a mass-spring network): after a contact jump of the
+  /// dynamics CHOLMOD's Cholesky (Eigen's LDL^T where K is not positive
+  /// definite); in the quasi-static mode Eigen's LDL^T, whose equilibria the
+  /// quasi-static identification was made with.
+  SparseSpdFactor relax_factor_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> static_solver_;
   bool static_pattern_analysed_ = false;
   bool static_factor_valid_ = false;
