@@ -11,12 +11,14 @@
 // The key is derived from everything the FEM reads: fem_reference_key.hpp.
 #include "puncture/validation/fem_reference.hpp"
 
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -25,6 +27,8 @@
 
 #ifdef PUNCTURE_HAVE_FEM
 #include <deal.II/base/mpi.h>
+#include <sched.h>
+#include <unistd.h>
 
 #include "puncture/fem/needle_insertion.hpp"
 #endif
@@ -93,6 +97,47 @@ std::unique_ptr<dealii::Utilities::MPI::MPI_InitFinalize>& mpi_session() {
   static std::unique_ptr<dealii::Utilities::MPI::MPI_InitFinalize> session;
   return session;
 }
+
+/// mpirun binds every rank to one core (OpenMPI's default for two ranks or
+/// fewer). Rank 0 does all of a command's work after the FEM references, with
+/// two threads where it can (the optimisers, the held-out runs), while the
+/// other ranks wait asleep: let it use every online core. Best effort: where
+/// the system refuses, the binding stays. (The FEM solver widens its own
+/// affinity the same way when it solves; a run whose references all come from
+/// the cache would otherwise stay on one core.)
+void widen_cpu_affinity() {
+#ifdef __linux__
+  const long n = ::sysconf(_SC_NPROCESSORS_ONLN);
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (long c = 0; c < n && c < CPU_SETSIZE; ++c) CPU_SET(static_cast<int>(c), &set);
+  (void)::sched_setaffinity(0, sizeof set, &set);
+#endif
+}
+
+/// The ranks other than 0 have only helped with the FEM references; they
+/// wait here, asleep (a test every 20 ms), until rank 0 has done the rest of
+/// the command and releases them. Left to MPI_Finalize, OpenMPI's wait polls
+/// and keeps a core busy for the whole of rank 0's run (on 2 cores that is
+/// the core rank 0's second thread would use).
+void release_or_wait_for_root() {
+  int size = 1, rank = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (size < 2) return;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  constexpr int kDoneTag = 7301;
+  if (rank == 0) {
+    for (int other = 1; other < size; ++other) MPI_Send(nullptr, 0, MPI_BYTE, other, kDoneTag, MPI_COMM_WORLD);
+    return;
+  }
+  MPI_Request request;
+  MPI_Irecv(nullptr, 0, MPI_BYTE, 0, kDoneTag, MPI_COMM_WORLD, &request);
+  for (int done = 0;;) {
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
 }  // namespace
 #endif
 
@@ -110,6 +155,9 @@ void ensure_mpi() {
   static char* argv_storage[] = {program, nullptr};
   static char** argv = argv_storage;
   mpi_session() = std::make_unique<dealii::Utilities::MPI::MPI_InitFinalize>(argc, argv, 1);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank == 0) widen_cpu_affinity();
 #endif
 }
 
@@ -132,6 +180,7 @@ bool is_mpi_root() {
 
 void finalize_mpi() {
 #ifdef PUNCTURE_HAVE_FEM
+  if (mpi_session()) release_or_wait_for_root();
   mpi_session().reset();
 #endif
 }

@@ -66,7 +66,9 @@ bool is_mpi_root();
 
 /// Finalises what ensure_mpi() initialised (nothing if it was not called).
 /// Call it before main() returns: finalising from a static destructor at exit
-/// races with the destruction of other libraries' statics.
+/// races with the destruction of other libraries' statics. Under mpirun every
+/// rank calls it: the ranks other than 0 wait in it asleep until rank 0 gets
+/// there (they helped with the FEM only), rank 0 releases them.
 void finalize_mpi();
 
 }  // namespace puncture::validation
