@@ -177,6 +177,7 @@ int VolumetricNeedleModel::preconditioner_solve(double, const double* yp, const 
     if (extra_ > 0) work_a_ += gamma * q_force;
     for (int d = 0; d < n3; ++d)
       if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) work_a_[d] = rv[d];
+    if (!factor_in_use_) return 1;  // no setup since the factorisations were dropped: CVODE sets up again
     b = factor_in_use_->solve(work_a_);
   }
   if (!b.allFinite()) return 1;

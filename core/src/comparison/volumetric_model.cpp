@@ -3,7 +3,6 @@
 #include "puncture/comparison/volumetric_model.hpp"
 
 #include <algorithm>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <limits>

@@ -118,8 +118,8 @@ void widen_cpu_affinity() {
 /// The ranks other than 0 have only helped with the FEM references; they
 /// wait here, asleep (a test every 20 ms), until rank 0 has done the rest of
 /// the command and releases them. Left to MPI_Finalize, OpenMPI's wait polls
-/// and keeps a core busy for the whole of rank 0's run (on 2 cores that is
-/// the core rank 0's second thread would use).
+/// (measured: about a fifth of a core for the whole of rank 0's run, on the
+/// core rank 0's second thread would use).
 void release_or_wait_for_root() {
   int size = 1, rank = 0;
   MPI_Comm_size(MPI_COMM_WORLD, &size);
