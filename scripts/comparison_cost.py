@@ -111,7 +111,9 @@ def main():
     # Factorisations of the volumetric runs (integrator_report.txt, one line per
     # volumetric run, in the benchmark's order).
     reports = [l for l in open(report_path)] if os.path.exists(report_path) else []
-    pattern = re.compile(r"^(\w+): .*?(\d+) sparse LDL\^T factorisations \(([0-9.eE+-]+) s\)")
+    # "N sparse Cholesky factorisations (T s; ...)" (CHOLMOD, since 2026-12-02), "N sparse LDL^T
+    # factorisations (T s)" in the reports of earlier runs.
+    pattern = re.compile(r"^(\w+): .*?(\d+) sparse (?:LDL\^T|Cholesky) factorisations \(([0-9.eE+-]+) s[;)]")
     factorisations = [pattern.match(l) for l in reports]
     factorisations = [(m.group(1), int(m.group(2)), float(m.group(3))) for m in factorisations if m]
     volumetric = [x for x in rows if x["model"] in ("msm", "mass_tensor", "nonlinear_mass_tensor", "viscoelastic_mass_tensor")]
@@ -172,7 +174,7 @@ def main():
         f = lambda s: "n/a (DoFs do not change)" if s is None else f"{s:.2f}"
         md.append(f"| {m} | {KNOB.get(m, 'FEM mesh (elements per needle radius)')} | {f(s_med)} | {f(s_mean)} | "
                   f"{'n/a' if m == 'fem' else f(s_cpu)} |")
-    md += ["", "Volumetric models, one sparse LDL^T factorisation of the Newton matrix (wall time, from "
+    md += ["", "Volumetric models, one sparse factorisation of the Newton matrix (CHOLMOD's Cholesky, Eigen's LDL^T where it is not positive definite; wall time, from "
            "`integrator_report.txt`, every factorisation of the run; the matrix is 3 x nodes square for every law): slope of log(s per factorisation) against log(3 x nodes): " +
            ", ".join(f"{m} {fit_slope([3 * x['nodes'] for x in rows if x['model'] == m and 's_per_factorisation' in x], [x['s_per_factorisation'] for x in rows if x['model'] == m and 's_per_factorisation' in x]) or float('nan'):.2f}"
                      for m in ("msm", "mass_tensor", "nonlinear_mass_tensor", "viscoelastic_mass_tensor")
