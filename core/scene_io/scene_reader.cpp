@@ -281,6 +281,13 @@ ForceLaw read_force_law(ObjectReader r, const std::string& file) {
   if (r.has("stiffening"))
     law.stiffening = read_stiffening(ObjectReader(r.raw("stiffening"), r.child("stiffening"), file));
   law.cutting_force_N = r.number("cutting_force_N", law.cutting_force_N);
+  if (r.has("cutting_rate")) {
+    ObjectReader c(r.raw("cutting_rate"), r.child("cutting_rate"), file);
+    law.cutting_rate.viscous_fraction = c.number("viscous_fraction", law.cutting_rate.viscous_fraction);
+    law.cutting_rate.reference_speed_m_per_s =
+        c.number("reference_speed_mm_per_s", law.cutting_rate.reference_speed_m_per_s / kMm) * kMm;
+    c.reject_unknown_keys();
+  }
   law.cutting_release_m = r.number("cutting_release_mm", law.cutting_release_m / kMm) * kMm;
   law.rupture_release_m = r.number("rupture_release_mm", law.rupture_release_m / kMm) * kMm;
   if (r.has("friction")) law.friction = read_friction(ObjectReader(r.raw("friction"), r.child("friction"), file));

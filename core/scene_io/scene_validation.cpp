@@ -63,6 +63,10 @@ void validate_force_law(const ForceLaw& law, const std::string& file, const std:
   require(st.strain_scale_m > 0, file, p + "/stiffening/strain_scale_mm", "> 0", st.strain_scale_m / kMm);
   require(law.cutting_force_N >= 0 && law.cutting_force_N <= 1e3, file, p + "/cutting_force_N", "in [0, 1000]",
           law.cutting_force_N);
+  require(law.cutting_rate.viscous_fraction >= 0 && law.cutting_rate.viscous_fraction <= 1, file,
+          p + "/cutting_rate/viscous_fraction", "in [0, 1]", law.cutting_rate.viscous_fraction);
+  require(law.cutting_rate.reference_speed_m_per_s > 0 && law.cutting_rate.reference_speed_m_per_s <= 10.0, file,
+          p + "/cutting_rate/reference_speed_mm_per_s", "in (0, 10000]", law.cutting_rate.reference_speed_m_per_s / kMm);
   require(law.cutting_release_m > 0 && law.cutting_release_m <= thickness_m + 1e-3, file, p + "/cutting_release_mm",
           "> 0 and at most the layer thickness + 1 mm", law.cutting_release_m / kMm);
   require(law.rupture_release_m >= 0 && law.rupture_release_m <= kMaxRuptureRelease_m, file, p + "/rupture_release_mm",

@@ -46,6 +46,9 @@ json force_law_json(const ForceLaw& law) {
                        {"stiffness_N_per_mm", st.exponential_stiffness_N_per_m * kMm},
                        {"strain_scale_mm", st.strain_scale_m / kMm}};
   j["cutting_force_N"] = law.cutting_force_N;
+  if (law.cutting_rate.viscous_fraction != 0.0)  // written when used
+    j["cutting_rate"] = {{"viscous_fraction", law.cutting_rate.viscous_fraction},
+                         {"reference_speed_mm_per_s", law.cutting_rate.reference_speed_m_per_s / kMm}};
   j["cutting_release_mm"] = law.cutting_release_m / kMm;
   j["rupture_release_mm"] = law.rupture_release_m / kMm;
   j["friction"] = {{"static_N_per_mm", law.friction.static_N_per_m * kMm},

@@ -19,11 +19,13 @@ LayerShaftForce punctured_layer_shaft_force(double top_depth_m, double thickness
   return out;
 }
 
-double open_crack_force_N(const ForceLaw& law, double& front_m, double tip_axial_m, NextLayerContact next) {
-  if (next == NextLayerContact::Touched) return 0.0;
-  const double f = cutting_force_N(law.cutting_force_N, law.cutting_release_m, front_m, tip_axial_m);
+CuttingForceParts open_crack_force_N(const ForceLaw& law, double& front_m, double tip_axial_m,
+                                     double axial_speed_m_per_s, NextLayerContact next) {
+  if (next == NextLayerContact::Touched) return {};
+  const double release = cutting_force_N(1.0, law.cutting_release_m, front_m, tip_axial_m);
   front_m = std::max(front_m, tip_axial_m);
-  return f;
+  const CuttingForceParts c = rate_cutting_force(law, axial_speed_m_per_s);
+  return {c.fracture_N * release, c.viscous_N * release};
 }
 
 }  // namespace puncture

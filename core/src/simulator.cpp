@@ -335,7 +335,8 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   layer.break_axial_m = tip_axial;
   // The load the tip carried, its surface force and the crack above still cut
   // (a layer met at the tip), passes to this layer's crack.
-  layer.release_N = cutting_on_ ? rupture_release_N(layer.law, surface_force_N + crack_above_N) : 0.0;
+  layer.release_N =
+      cutting_on_ ? rupture_release_N(layer.law, surface_force_N + crack_above_N, needle.axial_velocity_m_per_s) : 0.0;
   ++active_;
   if (active_ < layers_.size() && !interaction_) {
     LayerModel& next = layers_[active_];
@@ -367,17 +368,20 @@ void PunctureSimulator::update_needle_contact(const NeedleState& needle) {
   first_tick_ = false;
 }
 
-double PunctureSimulator::crack_force(double tip_axial_m) {
+double PunctureSimulator::crack_force(double tip_axial_m, double axial_speed_m_per_s) {
   // The punctured layer the tip is in is cut until the next layer is touched,
   // or, when that layer was met at the break (contact at the tip, the broken
   // layer squeezed between them), while the tip presses it.
+  crack_viscous_N_ = 0.0;
   if (!cutting_on_ || active_ == 0) return 0.0;
   const std::size_t n = layers_.size();
   const NextLayerContact next = active_ == n || !layers_[active_].contact_set ? NextLayerContact::None
                                 : layers_[active_].contact_at_tip          ? NextLayerContact::MetAtTip
                                                                            : NextLayerContact::Touched;
   LayerModel& p = layers_[active_ - 1];
-  return open_crack_force_N(p.law, p.front_m, tip_axial_m, next);
+  const CuttingForceParts c = open_crack_force_N(p.law, p.front_m, tip_axial_m, axial_speed_m_per_s, next);
+  crack_viscous_N_ = c.viscous_N;
+  return c.total_N();
 }
 
 double PunctureSimulator::rupture_release(double tip_axial_m) {
@@ -413,7 +417,8 @@ bool PunctureSimulator::break_through(const NeedleState& needle, double surface_
     record_puncture(needle, surface_force_N, cutting_force_N, crack_force_N);
     surface_force_N = 0.0;
     // A further break in this tick is felt with the crack of the layer that just broke, opened at the tip.
-    crack_force_N = cutting_on_ ? layers_[active_ - 1].law.cutting_force_N : 0.0;
+    crack_force_N =
+        cutting_on_ ? rate_cutting_force(layers_[active_ - 1].law, needle.axial_velocity_m_per_s).total_N() : 0.0;
     cutting_force_N = cutting_on_ ? crack_force_N + rupture_release(needle.tip_position_m.dot(needle.direction)) : 0.0;
     broke = true;
     const bool touched = active_ < n && try_contact(needle);
@@ -495,7 +500,7 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   resume_broken_layers(needle.time_s);
   // 2. Contact of the needle layer; the crack ahead of the tip.
   update_needle_contact(needle);
-  double crack = crack_force(tip_axial_m);
+  double crack = crack_force(tip_axial_m, needle.axial_velocity_m_per_s);
   double cut = crack + rupture_release(tip_axial_m);
   // 3. The chain under the needle (or the needle layer alone).
   double surface_force = press_needle_layer(needle, interaction_ ? cut : 0.0);
@@ -503,14 +508,15 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   const bool broke = break_through(needle, surface_force, cut, crack);
   if (broke) {
     surface_force = 0.0;
-    crack = crack_force(tip_axial_m);
+    crack = crack_force(tip_axial_m, needle.axial_velocity_m_per_s);
     cut = crack + rupture_release(tip_axial_m);
   }
   if (active_ > 0) result_.layers[active_ - 1].cutting_force_N += crack;
   // 5. Shaft friction and damping of the punctured layers.
   const double friction_total = shaft_friction_and_damping(needle);
-  result_.tip_force_N = surface_force;
-  result_.cutting_force_N = cut;
+  // The crack's viscous part (cutting.hpp) is the tissue the bevel wedges apart: tip force.
+  result_.tip_force_N = surface_force + crack_viscous_N_;
+  result_.cutting_force_N = cut - crack_viscous_N_;
   result_.friction_force_N = friction_total;
   result_.total_force_N = surface_force + cut + friction_total;
   if (broke) add_shaft_forces_to_events(needle.time_s);

@@ -398,6 +398,43 @@ TEST(ForceLaw, CuttingPlusFrictionAfterThePunctureReversingOnWithdrawal) {
   });
 }
 
+TEST(ForceLaw, ARateDependentCutIsSplitIntoTipAndCuttingForceAndFollowsTheSpeed) {
+  // The 5 mm layer of the test above cut with C = 0.8 N, b = 0.25 at
+  // v_ref = 10 mm/s (cutting.hpp): at 20 mm/s the tick reports the fracture part
+  // 0.6 N as cutting and the viscous part 0.2 x 2 = 0.4 N as tip force; at
+  // 5 mm/s 0.6 + 0.1 N; standing on the crack front (a dwell) 0.6 N only.
+  Scene scene = single_layer_scene();
+  scene.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 4, 1e-3, 100.0, 1.0, 0.05));
+  scene.layers[1].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+  scene.layers[1].force_law.breakthrough.critical_force_N = 1e3;
+  scene.effects.cutting = true;
+  Layer& a = scene.layers[0];
+  a.force_law.breakthrough.critical_force_N = 1.0;
+  a.force_law.cutting_force_N = 0.8;
+  a.force_law.cutting_rate.viscous_fraction = 0.25;
+  a.force_law.cutting_rate.reference_speed_m_per_s = 0.01;
+  PunctureSimulator sim(scene, test::plane_surfaces(scene));
+  double t = 0.0;
+  drive(sim, t, -0.2e-3, 4.5e-3, 0.01);
+  ASSERT_EQ(sim.puncture_events().size(), 1u);
+  drive(sim, t, 4.5e-3, 4.6e-3, 0.02, [&](const TickResult& r) {
+    EXPECT_NEAR(r.cutting_force_N, 0.6, 1e-12);
+    EXPECT_NEAR(r.tip_force_N, 0.4, 1e-12);
+    EXPECT_NEAR(r.total_force_N, 1.0, 1e-12);
+    EXPECT_NEAR(r.layers[0].cutting_force_N, 1.0, 1e-12);  // the layer's crack force, both parts
+  });
+  drive(sim, t, 4.6e-3, 4.7e-3, 0.005, [&](const TickResult& r) {
+    EXPECT_NEAR(r.cutting_force_N, 0.6, 1e-12);
+    EXPECT_NEAR(r.tip_force_N, 0.1, 1e-12);
+  });
+  for (int i = 0; i < 10; ++i) {
+    t += 1e-3;
+    const TickResult& r = sim.tick(needle_at(4.7e-3, 0.0, t));
+    EXPECT_NEAR(r.total_force_N, 0.6, 1e-12);
+    EXPECT_EQ(r.tip_force_N, 0.0);
+  }
+}
+
 TEST(ForceLaw, ALayerBrokenBelowTheNextSurfaceIsCutWhileTheNextIsPressed) {
   // A 1 mm layer that breaks at 1 N with the tip about 1.5 mm deep, below the rest
   // surface of the 20 mm layer under it (no layer interaction: that surface

@@ -52,15 +52,58 @@ TEST(ShaftForces, CrackIsCutWhileOpenAndReleasesOnRetraction) {
   law.cutting_release_m = 0.2e-3;
   double front = 5e-3;
   // Open (next layer untouched): the front follows the tip, the force is C.
-  EXPECT_DOUBLE_EQ(open_crack_force_N(law, front, 6e-3, NextLayerContact::None), 1.5);
+  EXPECT_DOUBLE_EQ(open_crack_force_N(law, front, 6e-3, 0.01, NextLayerContact::None).total_N(), 1.5);
   EXPECT_DOUBLE_EQ(front, 6e-3);
   // Backing off by half the release distance: half the force, front kept.
-  EXPECT_NEAR(open_crack_force_N(law, front, 5.9e-3, NextLayerContact::MetAtTip), 0.75, 1e-9);
+  EXPECT_NEAR(open_crack_force_N(law, front, 5.9e-3, -0.01, NextLayerContact::MetAtTip).total_N(), 0.75, 1e-9);
   EXPECT_DOUBLE_EQ(front, 6e-3);
   // The next layer touched at its surface: the crack is closed, no force, front kept.
-  EXPECT_EQ(open_crack_force_N(law, front, 7e-3, NextLayerContact::Touched), 0.0);
+  EXPECT_EQ(open_crack_force_N(law, front, 7e-3, 0.01, NextLayerContact::Touched).total_N(), 0.0);
   EXPECT_DOUBLE_EQ(front, 6e-3);
   // Re-opened (met at the tip: the broken layer squeezed between): C again at the new front.
-  EXPECT_DOUBLE_EQ(open_crack_force_N(law, front, 7e-3, NextLayerContact::MetAtTip), 1.5);
+  EXPECT_DOUBLE_EQ(open_crack_force_N(law, front, 7e-3, 0.01, NextLayerContact::MetAtTip).total_N(), 1.5);
   EXPECT_DOUBLE_EQ(front, 7e-3);
+}
+
+TEST(ShaftForces, CuttingRateSplitsTheCrackForceIntoFractureAndViscousParts) {
+  // C(v) = C [(1 - b) + b v / v_ref] (cutting.hpp), by hand: C = 1.2 N, b = 0.25, v_ref = 10 mm/s.
+  ForceLaw law;
+  law.cutting_force_N = 1.2;
+  law.cutting_release_m = 0.2e-3;
+  law.cutting_rate.viscous_fraction = 0.25;
+  law.cutting_rate.reference_speed_m_per_s = 0.01;
+  double front = 5e-3;
+  // At v_ref the whole C, of it b C viscous.
+  CuttingForceParts c = open_crack_force_N(law, front, 6e-3, 0.01, NextLayerContact::None);
+  EXPECT_NEAR(c.fracture_N, 0.9, 1e-12);
+  EXPECT_NEAR(c.viscous_N, 0.3, 1e-12);
+  // At 20 mm/s: 0.9 + 0.3 x 2 = 1.5 N; at 3 mm/s 0.9 + 0.09 N.
+  EXPECT_NEAR(open_crack_force_N(law, front, 6.1e-3, 0.02, NextLayerContact::None).total_N(), 1.5, 1e-12);
+  EXPECT_NEAR(open_crack_force_N(law, front, 6.2e-3, 0.003, NextLayerContact::None).total_N(), 0.99, 1e-12);
+  // Standing still (a dwell) or backing off: the fracture part only, released on retraction.
+  c = open_crack_force_N(law, front, 6.2e-3, 0.0, NextLayerContact::None);
+  EXPECT_NEAR(c.total_N(), 0.9, 1e-12);
+  c = open_crack_force_N(law, front, 6.1e-3, -0.01, NextLayerContact::None);
+  EXPECT_NEAR(c.fracture_N, 0.45, 1e-9);
+  EXPECT_EQ(c.viscous_N, 0.0);
+  // The speed is clamped to 100 v_ref.
+  EXPECT_NEAR(rate_cutting_force(law, 5.0).viscous_N, 0.3 * 100.0, 1e-9);
+  // b = 0: the paper's constant C at any speed.
+  law.cutting_rate.viscous_fraction = 0.0;
+  EXPECT_EQ(rate_cutting_force(law, 0.02).total_N(), 1.2);
+  EXPECT_EQ(rate_cutting_force(law, 0.02).viscous_N, 0.0);
+}
+
+TEST(ShaftForces, RuptureReleaseIsTheLoadBeyondTheCuttingForceAtTheBreakSpeed) {
+  ForceLaw law;
+  law.cutting_force_N = 1.0;
+  law.rupture_release_m = 0.5e-3;
+  EXPECT_NEAR(rupture_release_N(law, 2.5, 0.02), 1.5, 1e-12);
+  law.cutting_rate.viscous_fraction = 0.5;
+  // C(20 mm/s) = 0.5 + 0.5 x 2 = 1.5 N: R = 2.5 - 1.5.
+  EXPECT_NEAR(rupture_release_N(law, 2.5, 0.02), 1.0, 1e-12);
+  // Never negative; none without a release length.
+  EXPECT_EQ(rupture_release_N(law, 1.0, 0.02), 0.0);
+  law.rupture_release_m = 0.0;
+  EXPECT_EQ(rupture_release_N(law, 2.5, 0.02), 0.0);
 }

@@ -180,10 +180,22 @@ struct ShaftFrictionLaw {
   double presliding_m = 0.0;
 };
 
+/// Rate dependence of a layer's cutting force (cutting.hpp):
+///     C(v) = C [(1 - b) + b v / v_ref],
+/// v the needle's axial speed while the tip cuts (clamped to [0, 100 v_ref]).
+/// The part b C v / v_ref is the viscous resistance of the tissue the bevel
+/// wedges apart (reported with the tip force); the rest is the fracture
+/// energy G_c w. b = 0: a rate-independent cutting force (the default).
+struct CuttingRate {
+  double viscous_fraction = 0.0;          ///< b in [0, 1]: the viscous part of C at v_ref
+  double reference_speed_m_per_s = 0.01;  ///< v_ref (m/s): the speed at which C is the whole cutting force
+};
+
 struct ForceLaw {
   BreakthroughCriterion breakthrough;
   StiffeningLaw stiffening;
-  double cutting_force_N = 0.0;         ///< force to advance the crack through the layer (~ G_c x cut width)
+  double cutting_force_N = 0.0;         ///< C: force to advance the crack through the layer at v_ref (~ G_c x cut width)
+  CuttingRate cutting_rate;             ///< C's rate dependence (b = 0: none)
   double cutting_release_m = 0.1e-3;    ///< retraction over which the cutting force falls to 0
   /// l (m, >= 0): tip travel past the break over which the surface force the
   /// layer carried beyond its cutting force is released (exp(-s / l), the

@@ -15,6 +15,7 @@
 // crack goes on while the tip presses the next layer).
 #pragma once
 
+#include "puncture/cutting.hpp"
 #include "puncture/needle.hpp"
 #include "puncture/scene.hpp"
 #include "puncture/shaft_friction.hpp"
@@ -42,10 +43,12 @@ enum class NextLayerContact {
   Touched    ///< touched at its surface
 };
 
-/// Cutting force (N) of the deepest punctured layer with force law `law` and
-/// crack front front_m (m along the needle axis; advanced to the tip while
-/// the crack is open) for the tip at tip_axial_m: cutting_force_N of
-/// cutting.hpp while the crack is open (next != Touched), else 0.
-double open_crack_force_N(const ForceLaw& law, double& front_m, double tip_axial_m, NextLayerContact next);
+/// Cutting force (N, by part) of the deepest punctured layer with force law
+/// `law` and crack front front_m (m along the needle axis; advanced to the tip
+/// while the crack is open) for the tip at tip_axial_m moving at
+/// axial_speed_m_per_s (m/s): C(v) of cutting.hpp times its release factor
+/// while the crack is open (next != Touched), else 0.
+CuttingForceParts open_crack_force_N(const ForceLaw& law, double& front_m, double tip_axial_m,
+                                     double axial_speed_m_per_s, NextLayerContact next);
 
 }  // namespace puncture

@@ -234,8 +234,9 @@ class PunctureSimulator {
   /// The tick's phases (tick() calls them in this order; see the header comment).
   void resume_broken_layers(double time_s);
   void update_needle_contact(const NeedleState& needle);
-  /// Cutting force of the deepest punctured layer (shaft_forces.hpp), its crack front advanced.
-  double crack_force(double tip_axial_m);
+  /// Cutting force (N) of the deepest punctured layer at axial speed v (shaft_forces.hpp), its crack
+  /// front advanced; its viscous part is left in crack_viscous_N_.
+  double crack_force(double tip_axial_m, double axial_speed_m_per_s);
   /// Rupture release of every punctured layer (cutting.hpp), written to each
   /// layer's cutting force of this tick; returns their sum (N).
   double rupture_release(double tip_axial_m);
@@ -270,6 +271,7 @@ class PunctureSimulator {
   bool cutting_on_ = false;
   bool interaction_ = false;
   bool first_tick_ = true;
+  double crack_viscous_N_ = 0.0;  ///< viscous part of the last crack_force() (N; cutting.hpp)
   double deepest_axial_m_ = -std::numeric_limits<double>::infinity();  ///< deepest tip position so far (m along the axis)
   double contact_search_height_m_ = 0.0;
   double relayout_tolerance_m_ = 0.0;

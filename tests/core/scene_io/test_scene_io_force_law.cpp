@@ -28,6 +28,7 @@ json with_force_law() {
                         {"reference_speed_mm_per_s", 5.0}}},
       {"stiffening", {{"law", "polynomial"}, {"quadratic_N_per_mm2", 0.2}, {"cubic_N_per_mm3", 0.03}}},
       {"cutting_force_N", 1.44},
+      {"cutting_rate", {{"viscous_fraction", 0.3}, {"reference_speed_mm_per_s", 8.0}}},
       {"cutting_release_mm", 0.05},
       {"rupture_release_mm", 1.2},
       {"friction", {{"static_N_per_mm", 0.015}, {"dynamic_N_per_mm", 0.01}, {"velocity_band_mm_per_s", 0.2},
@@ -63,6 +64,9 @@ TEST(SceneIoForceLaw, KeysAreReadInSiUnits) {
   EXPECT_NEAR(skin.rupture_release_m, 1.2e-3, 1e-18);
   EXPECT_EQ(s.layers[1].force_law.rupture_release_m, 0.0);  // default: released at once
   EXPECT_DOUBLE_EQ(skin.breakthrough.rate_exponent, 0.12);
+  EXPECT_DOUBLE_EQ(skin.cutting_rate.viscous_fraction, 0.3);
+  EXPECT_NEAR(skin.cutting_rate.reference_speed_m_per_s, 8e-3, 1e-18);  // mm/s -> m/s
+  EXPECT_EQ(s.layers[2].force_law.cutting_rate.viscous_fraction, 0.0);  // default: rate-independent cutting
   EXPECT_NEAR(skin.breakthrough.reference_speed_m_per_s, 5e-3, 1e-18);   // mm/s -> m/s
   EXPECT_EQ(s.layers[1].force_law.breakthrough.rate_exponent, 0.0);     // default: rate-independent
   EXPECT_NEAR(s.layers[1].force_law.breakthrough.reference_speed_m_per_s, 10e-3, 1e-18);
@@ -99,6 +103,8 @@ TEST(SceneIoForceLaw, RoundTripKeepsEveryForceLawValue) {
     EXPECT_DOUBLE_EQ(x.stiffening.exponential_stiffness_N_per_m, y.stiffening.exponential_stiffness_N_per_m);
     EXPECT_DOUBLE_EQ(x.stiffening.strain_scale_m, y.stiffening.strain_scale_m);
     EXPECT_DOUBLE_EQ(x.cutting_force_N, y.cutting_force_N);
+    EXPECT_DOUBLE_EQ(x.cutting_rate.viscous_fraction, y.cutting_rate.viscous_fraction);
+    EXPECT_DOUBLE_EQ(x.cutting_rate.reference_speed_m_per_s, y.cutting_rate.reference_speed_m_per_s);
     EXPECT_DOUBLE_EQ(x.cutting_release_m, y.cutting_release_m);
     EXPECT_DOUBLE_EQ(x.rupture_release_m, y.rupture_release_m);
     EXPECT_DOUBLE_EQ(x.friction.static_N_per_m, y.friction.static_N_per_m);
@@ -191,6 +197,14 @@ const BadForceLaw kBad[] = {
     {"rate_law_with_rings",  // the ring rule has no threshold to scale: an unknown key
      [](json& j) { j["layers"][0]["force_law"]["breakthrough"] = {{"criterion", "rings"}, {"rate_exponent", 0.1}}; },
      "/layers/0/force_law/breakthrough/rate_exponent"},
+    {"cutting_viscous_fraction_above_one",
+     [](json& j) { j["layers"][0]["force_law"]["cutting_rate"]["viscous_fraction"] = 1.2; },
+     "/layers/0/force_law/cutting_rate/viscous_fraction"},
+    {"zero_cutting_reference_speed",
+     [](json& j) { j["layers"][0]["force_law"]["cutting_rate"]["reference_speed_mm_per_s"] = 0.0; },
+     "/layers/0/force_law/cutting_rate/reference_speed_mm_per_s"},
+    {"unknown_cutting_rate_key", [](json& j) { j["layers"][0]["force_law"]["cutting_rate"]["exponent"] = 0.5; },
+     "/layers/0/force_law/cutting_rate/exponent"},
     {"unknown_law", [](json& j) { j["layers"][0]["force_law"]["stiffening"]["law"] = "ogden"; },
      "/layers/0/force_law/stiffening/law"},
     {"unknown_force_law_key", [](json& j) { j["layers"][0]["force_law"]["cuting_force_N"] = 1.0; },

@@ -253,6 +253,51 @@ TEST(Calibration, BreakthroughRateExponentIsTunedWithDFromTwoSpeeds) {
   EXPECT_NEAR(tuned.tuned_scene.layers[0].damping_N_s_per_m2 / truth.layers[0].damping_N_s_per_m2, 1.0, 0.05);
 }
 
+TEST(Calibration, CuttingViscousFractionIsTunedWithDFromTwoSpeeds) {
+  // The fat is cut with C [(1 - b) + b v / v_ref], C = 0.5 N, b = 0.4 at
+  // v_ref = 10 mm/s (cutting.hpp): while the tip cuts the fat the force at 4
+  // and 10 mm/s differs by b C 0.6 = 0.12 N besides d h v. Started at b = 0
+  // (with d 30 % low and C kept), the rate stage finds b and d again from the
+  // two speeds; at one speed b is not tuned and the report says why.
+  Scene truth = truth_scene();
+  truth.effects.cutting = true;
+  puncture::ForceLaw& fat = truth.layers[1].force_law;
+  fat.cutting_force_N = 0.5;
+  fat.cutting_rate.viscous_fraction = 0.4;
+  fat.cutting_rate.reference_speed_m_per_s = 0.01;
+  pv::InsertionCurve fast = pv::simulate_insertion_curve(truth);
+  pv::InsertionCurve slow = pv::simulate_insertion_curve(pv::scene_at_insertion_speed(truth, 0.004));
+  fast.metadata["rate_dependent"] = slow.metadata["rate_dependent"] = "true";
+  fast.metadata["speed_mm_per_s"] = "10";
+  slow.metadata["speed_mm_per_s"] = "4";
+
+  Scene start = truth;
+  start.layers[1].force_law.cutting_rate = puncture::CuttingRate{};
+  start.layers[1].force_law.cutting_rate.reference_speed_m_per_s = 0.02;  // reset to the scene's speed by the stage
+  start.layers[1].damping_N_s_per_m2 *= 0.7;
+  pv::CalibrationOptions options;
+  options.layers = {"fat"};
+  options.parameters.virtual_stiffness = false;
+  options.parameters.deformed_threshold = false;
+  options.parameters.cutting = false;
+
+  const pv::CalibrationResult one_speed = pv::calibrate(start, fast, options);
+  EXPECT_EQ(one_speed.tuned_scene.layers[1].force_law.cutting_rate.viscous_fraction, 0.0);
+  bool withheld = false;
+  for (const auto& p : one_speed.identifiability.parameters)
+    withheld = withheld || (p.name == "cutting_viscous_fraction" && !p.reason.empty());
+  EXPECT_TRUE(withheld) << "the single-speed report does not say why b is not tuned";
+
+  const pv::CalibrationResult tuned =
+      pv::calibrate(start, std::vector<pv::ReferenceCurve>{{fast, "measured"}, {slow, "measured"}}, options);
+  ASSERT_TRUE(tuned.damping_tuned);
+  const puncture::ForceLaw& law = tuned.tuned_scene.layers[1].force_law;
+  EXPECT_NEAR(law.cutting_rate.viscous_fraction, 0.4, 0.03);
+  EXPECT_DOUBLE_EQ(law.cutting_rate.reference_speed_m_per_s, 0.01);
+  EXPECT_EQ(law.cutting_force_N, 0.5);  // kept
+  EXPECT_NEAR(tuned.tuned_scene.layers[1].damping_N_s_per_m2 / truth.layers[1].damping_N_s_per_m2, 1.0, 0.05);
+}
+
 TEST(Calibration, FemReferenceCurveCarriesSpeedAndRateInformation) {
   // The FEM's CSV read back with the scene's trajectory; rate_dependent
   // exactly when a layer relaxes (Prony terms), quasi_static otherwise.

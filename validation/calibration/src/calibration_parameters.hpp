@@ -39,7 +39,8 @@ enum class ParamKind {
   StiffeningExponential,
   Presliding,
   RuptureRelease,
-  BreakthroughRate  ///< n of the breakthrough threshold's rate law (breakthrough_rate.hpp); tuned with d
+  BreakthroughRate,  ///< n of the breakthrough threshold's rate law (breakthrough_rate.hpp); tuned with d
+  CuttingRate        ///< b, the viscous fraction of the cutting force (cutting.hpp); tuned with d
 };
 
 struct ParamInfo {

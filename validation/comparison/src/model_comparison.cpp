@@ -66,6 +66,7 @@ class ShaftForcesOfModel {
       post += f.friction_N + f.damping_N;
     }
     const double tip_axial_m = needle.tip_position_m.dot(needle.direction);
+    const double v = needle.axial_velocity_m_per_s;
     deepest_m_ = std::max(deepest_m_, tip_axial_m);
     for (std::size_t k = punctured_before_; k < punctured; ++k) {
       // The crack above still cut at the break (k met at the tip; the one
@@ -73,12 +74,13 @@ class ShaftForcesOfModel {
       double crack_above_N = 0.0;
       if (k > 0 && scene_.effects.cutting)
         crack_above_N = k > punctured_before_
-                            ? scene_.layers[k - 1].force_law.cutting_force_N
-                            : open_crack_force_N(scene_.layers[k - 1].force_law, front_m_[k - 1], tip_axial_m,
-                                                 met_at_break_[k] ? NextLayerContact::MetAtTip : NextLayerContact::Touched);
+                            ? rate_cutting_force(scene_.layers[k - 1].force_law, v).total_N()
+                            : open_crack_force_N(scene_.layers[k - 1].force_law, front_m_[k - 1], tip_axial_m, v,
+                                                 met_at_break_[k] ? NextLayerContact::MetAtTip : NextLayerContact::Touched)
+                                  .total_N();
       front_m_[k] = tip_axial_m;
       break_m_[k] = tip_axial_m;
-      release_N_[k] = rupture_release_N(scene_.layers[k].force_law, model.break_force_N(k) + crack_above_N);
+      release_N_[k] = rupture_release_N(scene_.layers[k].force_law, model.break_force_N(k) + crack_above_N, v);
       if (k + 1 < n_layers && !scene_.effects.layer_interaction && needle.depth_m() > scene_.layer_top_depth_m(k + 1))
         met_at_break_[k + 1] = 1;
     }
@@ -87,7 +89,8 @@ class ShaftForcesOfModel {
       const NextLayerContact next = punctured == n_layers || !model.layer_touched(punctured) ? NextLayerContact::None
                                     : met_at_break_[punctured]                               ? NextLayerContact::MetAtTip
                                                                                              : NextLayerContact::Touched;
-      post += open_crack_force_N(scene_.layers[punctured - 1].force_law, front_m_[punctured - 1], tip_axial_m, next);
+      post += open_crack_force_N(scene_.layers[punctured - 1].force_law, front_m_[punctured - 1], tip_axial_m, v, next)
+                  .total_N();
       for (std::size_t k = 0; k < punctured; ++k) {
         const ForceLaw& law = scene_.layers[k].force_law;
         post += rupture_release_force_N(release_N_[k], law.rupture_release_m, law.cutting_release_m, break_m_[k],
