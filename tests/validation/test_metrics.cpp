@@ -265,6 +265,38 @@ TEST(Metrics, CurveFromRunCopiesTicks) {
   EXPECT_DOUBLE_EQ(e.force_N, 0.1);
 }
 
+TEST(Metrics, PunctureForceIsThePeakOfTheRiseToTheBreakNotOfAnEarlierBreak) {
+  // A layer pressed from the moment the layer above gave way: its pressed
+  // samples start on the fall after that break (1.6 -> 0.9 N), then rise to its
+  // own break at 1.2 N. Its puncture force is 1.2 N (the peak of the rise), not
+  // the 1.6 N of the break above. A dip of less than 10 % of the peak on the
+  // rise (1.15 -> 1.10 -> 1.2 N) is noise, not a trough.
+  puncture::Scene scene;
+  puncture::Layer muscle;
+  muscle.name = "muscle";
+  scene.layers = {muscle};
+  const std::vector<double> force = {1.6, 1.3, 1.0, 0.9, 0.95, 1.05, 1.15, 1.10, 1.2, 0.8};
+  puncture::ScriptedRunResult run;
+  for (std::size_t i = 0; i < force.size(); ++i) {
+    puncture::TickResult t;
+    t.time_s = i * 1e-3;
+    t.depth_m = i * 1e-5;
+    t.velocity_m_per_s = 0.01;
+    t.total_force_N = force[i];
+    t.layers.resize(1);
+    t.layers[0].state = i + 1 == force.size() ? LayerState::Punctured : LayerState::Pressed;
+    run.ticks.push_back(t);
+  }
+  const pv::InsertionCurve c = pv::curve_from_run(scene, run);
+  const pv::PunctureEventMetrics e = pv::puncture_event(c, "muscle");
+  ASSERT_TRUE(e.found);
+  EXPECT_DOUBLE_EQ(e.force_N, 1.2);
+  // Pressed from the trough on, or rising all the way: the plain maximum.
+  pv::InsertionCurve rising = c;
+  rising.force_N = {0.2, 0.4, 0.6, 0.9, 1.0, 1.1, 1.3, 1.25, 1.2, 0.8};
+  EXPECT_DOUBLE_EQ(pv::puncture_event(rising, "muscle").force_N, 1.3);
+}
+
 TEST(Metrics, DeflectionProfileErrorAgainstLinearProfile) {
   // Reference u_z(r) = -a (1 - r / R) on r = 0..R (deflection a (1 - r/R)),
   // R = 10 mm. Rings at r_j = (j - 1) L, L = 2 mm, w = 8: rings 1..6 lie

@@ -384,11 +384,20 @@ PunctureEventMetrics puncture_event(const InsertionCurve& curve, const std::stri
     if (states[phase[p]] != LayerState::Punctured) continue;
     e.found = true;
     e.depth_m = curve.depth_m[phase[p]];
-    // Maximum force over the contiguous pressed samples just before the event;
+    // Maximum force over the contiguous pressed samples just before the event,
+    // back to the trough before the rise to the break (the header comment);
     // the previous sample's force if the layer broke without a pressed sample.
     double peak = -std::numeric_limits<double>::infinity();
+    double low_since_peak = std::numeric_limits<double>::infinity();
     std::size_t q = p;
-    while (q > 0 && states[phase[q - 1]] == LayerState::Pressed) peak = std::max(peak, curve.force_N[phase[--q]]);
+    while (q > 0 && states[phase[q - 1]] == LayerState::Pressed) {
+      const double f = curve.force_N[phase[q - 1]];
+      const double tol = kPunctureTroughFraction * std::abs(peak);
+      if (std::isfinite(peak) && low_since_peak < peak - tol && f > low_since_peak + tol) break;
+      --q;
+      if (f > peak) peak = low_since_peak = f;
+      else low_since_peak = std::min(low_since_peak, f);
+    }
     if (!std::isfinite(peak)) peak = curve.force_N[phase[p > 0 ? p - 1 : p]];
     e.force_N = peak;
     return e;

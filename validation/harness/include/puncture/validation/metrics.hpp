@@ -41,7 +41,12 @@
 //     force RMSE inside it (N, and relative to the reference peak force); the
 //     puncture event of a curve is the first insertion sample whose state is
 //     "punctured": its depth, and as its force the maximum force over that
-//     layer's pressed samples just before it.
+//     layer's pressed samples just before it, on the branch that rises to
+//     the break: walking back from the break, the walk stops at a trough
+//     (a fall from the largest force so far by more than 10 % of it, then a
+//     rise by as much), so a layer met while the force still falls after the
+//     break above (a layer pressed from the moment the one above gave way) is
+//     not given the force of that earlier break.
 #pragma once
 
 #include <filesystem>
@@ -172,6 +177,9 @@ struct LayerGeometry;
 CurveComparison compare_curves(const InsertionCurve& model, const InsertionCurve& reference,
                                double max_depth_m = std::numeric_limits<double>::infinity(),
                                const std::vector<LayerGeometry>* geometry = nullptr);
+
+/// Trough tolerance of puncture_event (fraction of the largest force so far).
+constexpr double kPunctureTroughFraction = 0.1;
 
 /// Puncture event of one layer on a curve (see the header comment).
 PunctureEventMetrics puncture_event(const InsertionCurve& curve, const std::string& layer);
