@@ -290,6 +290,13 @@ ForceLaw read_force_law(ObjectReader r, const std::string& file) {
   }
   law.cutting_release_m = r.number("cutting_release_mm", law.cutting_release_m / kMm) * kMm;
   law.rupture_release_m = r.number("rupture_release_mm", law.rupture_release_m / kMm) * kMm;
+  if (r.has("rupture_release_rate")) {
+    ObjectReader c(r.raw("rupture_release_rate"), r.child("rupture_release_rate"), file);
+    law.rupture_release_rate.exponent = c.number("exponent", law.rupture_release_rate.exponent);
+    law.rupture_release_rate.reference_speed_m_per_s =
+        c.number("reference_speed_mm_per_s", law.rupture_release_rate.reference_speed_m_per_s / kMm) * kMm;
+    c.reject_unknown_keys();
+  }
   if (r.has("friction")) law.friction = read_friction(ObjectReader(r.raw("friction"), r.child("friction"), file));
   r.reject_unknown_keys();
   return law;

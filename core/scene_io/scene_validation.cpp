@@ -71,6 +71,11 @@ void validate_force_law(const ForceLaw& law, const std::string& file, const std:
           "> 0 and at most the layer thickness + 1 mm", law.cutting_release_m / kMm);
   require(law.rupture_release_m >= 0 && law.rupture_release_m <= kMaxRuptureRelease_m, file, p + "/rupture_release_mm",
           "in [0, 50]", law.rupture_release_m / kMm);
+  require(law.rupture_release_rate.exponent >= 0 && law.rupture_release_rate.exponent <= 1, file,
+          p + "/rupture_release_rate/exponent", "in [0, 1]", law.rupture_release_rate.exponent);
+  require(law.rupture_release_rate.reference_speed_m_per_s > 0 && law.rupture_release_rate.reference_speed_m_per_s <= 10.0,
+          file, p + "/rupture_release_rate/reference_speed_mm_per_s", "in (0, 10000]",
+          law.rupture_release_rate.reference_speed_m_per_s / kMm);
   const ShaftFrictionLaw& f = law.friction;
   require(f.dynamic_N_per_m >= 0, file, p + "/friction/dynamic_N_per_mm", ">= 0", f.dynamic_N_per_m * kMm);
   require(f.static_N_per_m >= f.dynamic_N_per_m, file, p + "/friction/static_N_per_mm",

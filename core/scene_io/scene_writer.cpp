@@ -51,6 +51,9 @@ json force_law_json(const ForceLaw& law) {
                          {"reference_speed_mm_per_s", law.cutting_rate.reference_speed_m_per_s / kMm}};
   j["cutting_release_mm"] = law.cutting_release_m / kMm;
   j["rupture_release_mm"] = law.rupture_release_m / kMm;
+  if (law.rupture_release_rate.exponent != 0.0)  // written when used
+    j["rupture_release_rate"] = {{"exponent", law.rupture_release_rate.exponent},
+                                 {"reference_speed_mm_per_s", law.rupture_release_rate.reference_speed_m_per_s / kMm}};
   j["friction"] = {{"static_N_per_mm", law.friction.static_N_per_m * kMm},
                    {"dynamic_N_per_mm", law.friction.dynamic_N_per_m * kMm},
                    {"velocity_band_mm_per_s", law.friction.velocity_band_m_per_s / kMm},

@@ -337,6 +337,7 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   // (a layer met at the tip), passes to this layer's crack.
   layer.release_N =
       cutting_on_ ? rupture_release_N(layer.law, surface_force_N + crack_above_N, needle.axial_velocity_m_per_s) : 0.0;
+  layer.release_length_m = rupture_release_length_m(layer.law, needle.axial_velocity_m_per_s);
   ++active_;
   if (active_ < layers_.size() && !interaction_) {
     LayerModel& next = layers_[active_];
@@ -389,7 +390,7 @@ double PunctureSimulator::rupture_release(double tip_axial_m) {
   double total = 0.0;
   for (std::size_t k = 0; k < active_; ++k) {
     const LayerModel& p = layers_[k];
-    const double f = rupture_release_force_N(p.release_N, p.law.rupture_release_m, p.law.cutting_release_m,
+    const double f = rupture_release_force_N(p.release_N, p.release_length_m, p.law.cutting_release_m,
                                              p.break_axial_m, deepest_axial_m_, tip_axial_m);
     result_.layers[k].cutting_force_N = f;
     total += f;

@@ -558,6 +558,34 @@ TEST(RuptureRelease, TheLoadAtTheBreakIsLetGoOverTheReleaseLengthWhateverTheLaye
   EXPECT_EQ(sim.tick(needle_at(2.9e-3, 0.01, t + 1e-3)).total_force_N, 0.0);
 }
 
+TEST(RuptureRelease, TheReleaseLengthFollowsTheSpeedAtTheBreak) {
+  // The layer of the test above with l = 0.7 mm at v_ref = 10 mm/s and
+  // m = 0.5 (cutting.hpp): inserted at 20 mm/s it breaks at 20 mm/s and lets
+  // its load go over l sqrt(2) = 0.99 mm of tip travel, at 5 mm/s over
+  // l / sqrt(2) = 0.49 mm; at 10 mm/s over l.
+  const double C = 0.4, l = 0.7e-3;
+  for (double speed : {0.02, 0.005, 0.01}) {
+    Scene scene = cut_layer_over_b(3e-3, C);
+    scene.effects.cutting = true;
+    scene.layers[0].force_law.rupture_release_m = l;
+    scene.layers[0].force_law.rupture_release_rate.exponent = 0.5;
+    scene.layers[0].force_law.rupture_release_rate.reference_speed_m_per_s = 0.01;
+    const double l_v = l * std::sqrt(speed / 0.01);
+    PunctureSimulator sim(scene, test::plane_surfaces(scene));
+    double t = 0.0;
+    int checked = 0;
+    drive(sim, t, -0.2e-3, 2.95e-3, speed, [&](const TickResult& r) {
+      if (sim.puncture_events().empty()) return;
+      const PunctureEvent& e = sim.puncture_events()[0];
+      const double s = r.depth_m - e.depth_m;
+      if (!(s > 0.0)) return;
+      EXPECT_NEAR(r.cutting_force_N, C + (e.surface_force_N - C) * std::exp(-s / l_v), 1e-12) << speed;
+      ++checked;
+    });
+    EXPECT_GT(checked, 5) << speed;
+  }
+}
+
 TEST(RuptureRelease, ALayerMetAtTheTipTakesOverTheLoadOfTheCrackAboveAtItsBreak) {
   // The 1 mm layer a of the cutting test above breaks below b's rest surface,
   // so b is pressed from the tip while a's crack (C_a) is still cut. When b

@@ -1,5 +1,6 @@
 // The shaft-force rule shared by the haptic tick and the comparison harness
 // (shaft_forces.hpp), against hand values of phi h, d h v and the crack law.
+#include <cmath>
 #include <gtest/gtest.h>
 
 #include "puncture/shaft_forces.hpp"
@@ -92,6 +93,27 @@ TEST(ShaftForces, CuttingRateSplitsTheCrackForceIntoFractureAndViscousParts) {
   law.cutting_rate.viscous_fraction = 0.0;
   EXPECT_EQ(rate_cutting_force(law, 0.02).total_N(), 1.2);
   EXPECT_EQ(rate_cutting_force(law, 0.02).viscous_N, 0.0);
+}
+
+TEST(ShaftForces, RuptureReleaseLengthIsAPowerOfTheBreakSpeed) {
+  // l(v_b) = l (v_b / v_ref)^m (cutting.hpp), by hand: l = 0.9 mm, m = 0.35, v_ref = 10 mm/s.
+  ForceLaw law;
+  law.rupture_release_m = 0.9e-3;
+  law.rupture_release_rate.exponent = 0.35;
+  law.rupture_release_rate.reference_speed_m_per_s = 0.01;
+  EXPECT_NEAR(rupture_release_length_m(law, 0.01), 0.9e-3, 1e-15);
+  EXPECT_NEAR(rupture_release_length_m(law, 0.02), 0.9e-3 * std::pow(2.0, 0.35), 1e-15);  // 1.15 mm
+  EXPECT_NEAR(rupture_release_length_m(law, 0.001), 0.9e-3 * std::pow(0.1, 0.35), 1e-15);  // 0.40 mm
+  // Clamped to [v_ref / 100, 100 v_ref]: a break at rest or backing off keeps a length.
+  EXPECT_NEAR(rupture_release_length_m(law, 0.0), 0.9e-3 * std::pow(0.01, 0.35), 1e-15);
+  EXPECT_NEAR(rupture_release_length_m(law, -0.01), 0.9e-3 * std::pow(0.01, 0.35), 1e-15);
+  EXPECT_NEAR(rupture_release_length_m(law, 10.0), 0.9e-3 * std::pow(100.0, 0.35), 1e-15);
+  // m = 0 or no release: l as given.
+  law.rupture_release_rate.exponent = 0.0;
+  EXPECT_EQ(rupture_release_length_m(law, 0.02), 0.9e-3);
+  law.rupture_release_rate.exponent = 0.35;
+  law.rupture_release_m = 0.0;
+  EXPECT_EQ(rupture_release_length_m(law, 0.02), 0.0);
 }
 
 TEST(ShaftForces, RuptureReleaseIsTheLoadBeyondTheCuttingForceAtTheBreakSpeed) {

@@ -191,6 +191,15 @@ struct CuttingRate {
   double reference_speed_m_per_s = 0.01;  ///< v_ref (m/s): the speed at which C is the whole cutting force
 };
 
+/// Rate dependence of a layer's rupture release length (cutting.hpp):
+///     l(v_b) = l (v_b / v_ref)^m,
+/// v_b the needle's axial speed at the layer's break, clamped to
+/// [v_ref / 100, 100 v_ref]. m = 0: l at every speed (the default).
+struct ReleaseRate {
+  double exponent = 0.0;                  ///< m in [0, 1]
+  double reference_speed_m_per_s = 0.01;  ///< v_ref (m/s): the speed at which the length is l
+};
+
 struct ForceLaw {
   BreakthroughCriterion breakthrough;
   StiffeningLaw stiffening;
@@ -201,6 +210,7 @@ struct ForceLaw {
   /// layer carried beyond its cutting force is released (exp(-s / l), the
   /// crack's cohesive process zone; cutting.hpp). 0: at once (the paper).
   double rupture_release_m = 0.0;
+  ReleaseRate rupture_release_rate;     ///< l's rate dependence (m = 0: none)
   ShaftFrictionLaw friction;
 };
 

@@ -214,6 +214,7 @@ class PunctureSimulator {
     double front_m = 0.0;         ///< crack front along the needle axis (punctured layers)
     double break_axial_m = 0.0;   ///< tip position along the needle axis at the break (punctured layers)
     double release_N = 0.0;       ///< R of the rupture release (cutting.hpp): load at the tip at the break beyond C
+    double release_length_m = 0.0;  ///< l(v_b) of the rupture release at the break speed (cutting.hpp)
     mutable Eigen::Matrix3Xd shifted_positions;
   };
 

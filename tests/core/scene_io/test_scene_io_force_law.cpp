@@ -31,6 +31,7 @@ json with_force_law() {
       {"cutting_rate", {{"viscous_fraction", 0.3}, {"reference_speed_mm_per_s", 8.0}}},
       {"cutting_release_mm", 0.05},
       {"rupture_release_mm", 1.2},
+      {"rupture_release_rate", {{"exponent", 0.35}, {"reference_speed_mm_per_s", 12.0}}},
       {"friction", {{"static_N_per_mm", 0.015}, {"dynamic_N_per_mm", 0.01}, {"velocity_band_mm_per_s", 0.2},
                     {"presliding_mm", 2.5}}}};
   j["layers"][1]["force_law"] = {{"breakthrough", {{"criterion", "critical_energy"}, {"critical_energy_mJ", 2.5}}},
@@ -65,6 +66,9 @@ TEST(SceneIoForceLaw, KeysAreReadInSiUnits) {
   EXPECT_EQ(s.layers[1].force_law.rupture_release_m, 0.0);  // default: released at once
   EXPECT_DOUBLE_EQ(skin.breakthrough.rate_exponent, 0.12);
   EXPECT_DOUBLE_EQ(skin.cutting_rate.viscous_fraction, 0.3);
+  EXPECT_DOUBLE_EQ(skin.rupture_release_rate.exponent, 0.35);
+  EXPECT_NEAR(skin.rupture_release_rate.reference_speed_m_per_s, 12e-3, 1e-18);
+  EXPECT_EQ(s.layers[2].force_law.rupture_release_rate.exponent, 0.0);  // default: a fixed release length
   EXPECT_NEAR(skin.cutting_rate.reference_speed_m_per_s, 8e-3, 1e-18);  // mm/s -> m/s
   EXPECT_EQ(s.layers[2].force_law.cutting_rate.viscous_fraction, 0.0);  // default: rate-independent cutting
   EXPECT_NEAR(skin.breakthrough.reference_speed_m_per_s, 5e-3, 1e-18);   // mm/s -> m/s
@@ -105,6 +109,8 @@ TEST(SceneIoForceLaw, RoundTripKeepsEveryForceLawValue) {
     EXPECT_DOUBLE_EQ(x.cutting_force_N, y.cutting_force_N);
     EXPECT_DOUBLE_EQ(x.cutting_rate.viscous_fraction, y.cutting_rate.viscous_fraction);
     EXPECT_DOUBLE_EQ(x.cutting_rate.reference_speed_m_per_s, y.cutting_rate.reference_speed_m_per_s);
+    EXPECT_DOUBLE_EQ(x.rupture_release_rate.exponent, y.rupture_release_rate.exponent);
+    EXPECT_DOUBLE_EQ(x.rupture_release_rate.reference_speed_m_per_s, y.rupture_release_rate.reference_speed_m_per_s);
     EXPECT_DOUBLE_EQ(x.cutting_release_m, y.cutting_release_m);
     EXPECT_DOUBLE_EQ(x.rupture_release_m, y.rupture_release_m);
     EXPECT_DOUBLE_EQ(x.friction.static_N_per_m, y.friction.static_N_per_m);
@@ -203,6 +209,12 @@ const BadForceLaw kBad[] = {
     {"zero_cutting_reference_speed",
      [](json& j) { j["layers"][0]["force_law"]["cutting_rate"]["reference_speed_mm_per_s"] = 0.0; },
      "/layers/0/force_law/cutting_rate/reference_speed_mm_per_s"},
+    {"release_rate_exponent_above_one",
+     [](json& j) { j["layers"][0]["force_law"]["rupture_release_rate"]["exponent"] = 1.5; },
+     "/layers/0/force_law/rupture_release_rate/exponent"},
+    {"negative_release_reference_speed",
+     [](json& j) { j["layers"][0]["force_law"]["rupture_release_rate"]["reference_speed_mm_per_s"] = -1.0; },
+     "/layers/0/force_law/rupture_release_rate/reference_speed_mm_per_s"},
     {"unknown_cutting_rate_key", [](json& j) { j["layers"][0]["force_law"]["cutting_rate"]["exponent"] = 0.5; },
      "/layers/0/force_law/cutting_rate/exponent"},
     {"unknown_law", [](json& j) { j["layers"][0]["force_law"]["stiffening"]["law"] = "ogden"; },

@@ -50,6 +50,7 @@ Scene scene_with_every_block() {
   l.material.viscoelastic.terms = {{0.3, 1.0}};
   l.force_law.breakthrough.rate_exponent = 0.1;
   l.force_law.cutting_rate.viscous_fraction = 0.2;  // written when used
+  l.force_law.rupture_release_rate.exponent = 0.3;   // written when used
   s.comparison.mass_spring_stiffness_scale.assign(s.layers.size(), 1.0);
   s.comparison.stiffness_scale.assign(s.layers.size(), 1.0);
   s.comparison.prescribed_puncture_depths_m = {1e-3};

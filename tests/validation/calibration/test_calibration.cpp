@@ -298,6 +298,42 @@ TEST(Calibration, CuttingViscousFractionIsTunedWithDFromTwoSpeeds) {
   EXPECT_NEAR(tuned.tuned_scene.layers[1].damping_N_s_per_m2 / truth.layers[1].damping_N_s_per_m2, 1.0, 0.05);
 }
 
+TEST(Calibration, ReleaseRateExponentIsTunedWithDFromTwoSpeeds) {
+  // The fat lets its load at the break go over l (v_b / v_ref)^m, l = 1 mm,
+  // m = 0.5, v_ref = 10 mm/s (cutting.hpp): 1 mm at 10 mm/s, 0.63 mm at 4 mm/s.
+  // Started at m = 0 (with d 30 % low, l and C kept), the rate stage finds m
+  // and d again from the two speeds.
+  Scene truth = truth_scene();
+  truth.effects.cutting = true;
+  puncture::ForceLaw& fat = truth.layers[1].force_law;
+  fat.cutting_force_N = 0.2;
+  fat.rupture_release_m = 1e-3;
+  fat.rupture_release_rate.exponent = 0.5;
+  fat.rupture_release_rate.reference_speed_m_per_s = 0.01;
+  pv::InsertionCurve fast = pv::simulate_insertion_curve(truth);
+  pv::InsertionCurve slow = pv::simulate_insertion_curve(pv::scene_at_insertion_speed(truth, 0.004));
+  fast.metadata["rate_dependent"] = slow.metadata["rate_dependent"] = "true";
+  fast.metadata["speed_mm_per_s"] = "10";
+  slow.metadata["speed_mm_per_s"] = "4";
+
+  Scene start = truth;
+  start.layers[1].force_law.rupture_release_rate = puncture::ReleaseRate{};
+  start.layers[1].damping_N_s_per_m2 *= 0.7;
+  pv::CalibrationOptions options;
+  options.layers = {"fat"};
+  options.parameters.virtual_stiffness = false;
+  options.parameters.deformed_threshold = false;
+  options.parameters.cutting = false;
+  const pv::CalibrationResult tuned =
+      pv::calibrate(start, std::vector<pv::ReferenceCurve>{{fast, "measured"}, {slow, "measured"}}, options);
+  ASSERT_TRUE(tuned.damping_tuned);
+  const puncture::ForceLaw& law = tuned.tuned_scene.layers[1].force_law;
+  EXPECT_NEAR(law.rupture_release_rate.exponent, 0.5, 0.05);
+  EXPECT_DOUBLE_EQ(law.rupture_release_rate.reference_speed_m_per_s, 0.01);
+  EXPECT_EQ(law.rupture_release_m, 1e-3);  // kept
+  EXPECT_NEAR(tuned.tuned_scene.layers[1].damping_N_s_per_m2 / truth.layers[1].damping_N_s_per_m2, 1.0, 0.05);
+}
+
 TEST(Calibration, FemReferenceCurveCarriesSpeedAndRateInformation) {
   // The FEM's CSV read back with the scene's trajectory; rate_dependent
   // exactly when a layer relaxes (Prony terms), quasi_static otherwise.

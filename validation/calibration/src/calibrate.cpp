@@ -228,8 +228,8 @@ void decide_damping(const Calibration& c, CalibrationResult& result) {
     case DampingPolicy::Auto:
       result.damping_tuned = speeds.size() >= 2;
       if (speeds.size() >= 2)
-        result.damping_note = "d (and the breakthrough rate exponents n and cutting viscous fractions b) tuned: "
-                              "rate-dependent references at " + listed + " mm/s";
+        result.damping_note = "d (and the breakthrough rate exponents n, cutting viscous fractions b and release "
+                              "rate exponents m) tuned: rate-dependent references at " + listed + " mm/s";
       else if (speeds.size() == 1)
         result.damping_note = "d kept fixed: rate-dependent references at one speed only (" + listed +
                               " mm/s); at one speed d h v cannot be told apart from the shaft friction, so d "
@@ -391,13 +391,21 @@ bool tunes_cutting_rate(const Calibration& c, std::size_t k) {
   return c.scene.effects.cutting && c.identifiable[k].cut();
 }
 
+/// True when layer k's rupture release length gets a rate law in the rate
+/// stage: the scene uses a release (a length > 0) and the references cut
+/// through the layer.
+bool tunes_release_rate(const Calibration& c, std::size_t k) {
+  return tunes_cutting_rate(c, k) && c.scene.layers[k].force_law.rupture_release_m > 0.0;
+}
+
 /// The rate stage: d of every calibrated layer, the rate exponent n of every
-/// breakthrough threshold that has one (breakthrough_rate.hpp) and the viscous
-/// fraction b of every cutting force the references cut (cutting.hpp), on the
+/// breakthrough threshold that has one (breakthrough_rate.hpp), the viscous
+/// fraction b of every cutting force the references cut and the rate exponent
+/// m of every rupture release length in use (cutting.hpp), on the
 /// whole trajectory of references at two or more speeds; every other
-/// parameter as the layer stages left it. A cutting force without a rate law
-/// yet gets the scene's insertion speed (the calibration trajectory's, where
-/// the layer stages fitted it) as its reference speed v_ref.
+/// parameter as the layer stages left it. A cutting force or release length
+/// without a rate law yet gets the scene's insertion speed (the calibration
+/// trajectory's, where the layer stages fitted it) as its reference speed v_ref.
 Scene run_rate_stage(Calibration& c, CalibrationResult& result, const Scene& current_in) {
   Scene current = current_in;
   std::vector<Parameter> ds;
@@ -409,8 +417,13 @@ Scene run_rate_stage(Calibration& c, CalibrationResult& result, const Scene& cur
       CuttingRate& rate = current.layers[k].force_law.cutting_rate;
       if (rate.viscous_fraction == 0.0) rate.reference_speed_m_per_s = c.scene.insertion.speed_m_per_s;
     }
+    if (tunes_release_rate(c, k)) {
+      ds.push_back(c.parameter(k, ParamKind::ReleaseRate));
+      ReleaseRate& rate = current.layers[k].force_law.rupture_release_rate;
+      if (rate.exponent == 0.0) rate.reference_speed_m_per_s = c.scene.insertion.speed_m_per_s;
+    }
   }
-  StageObjective stage = whole_objective_stage(c, result, "rate (d, n, b)", current, ds);
+  StageObjective stage = whole_objective_stage(c, result, "rate (d, n, b, m)", current, ds);
   const std::vector<double> x0 = x_values(current, stage.parameters);
   CalibrationStageRecord rec;
   rec.stage = stage.name();
@@ -490,7 +503,8 @@ TunedParameterRecord parameter_record(const Calibration& c, const Scene& tuned, 
 void record_parameters(const Calibration& c, CalibrationResult& result) {
   for (std::size_t i = 0; i < c.parameters.size(); ++i) {
     if (!c.calibrated(c.parameters[i].layer) && c.parameters[i].kind != ParamKind::Damping &&
-        c.parameters[i].kind != ParamKind::BreakthroughRate && c.parameters[i].kind != ParamKind::CuttingRate)
+        c.parameters[i].kind != ParamKind::BreakthroughRate && c.parameters[i].kind != ParamKind::CuttingRate &&
+        c.parameters[i].kind != ParamKind::ReleaseRate)
       continue;
     const TunedParameterRecord rec = parameter_record(c, result.tuned_scene, i);
     if (rec.start_moved_inside)
@@ -544,6 +558,8 @@ void report_identifiability(Calibration& c, CalibrationResult& result) {
         withheld.push_back({k, ParamKind::BreakthroughRate, "tuned with d only; " + result.damping_note});
       if (tunes_cutting_rate(c, k))
         withheld.push_back({k, ParamKind::CuttingRate, "tuned with d only; " + result.damping_note});
+      if (tunes_release_rate(c, k))
+        withheld.push_back({k, ParamKind::ReleaseRate, "tuned with d only; " + result.damping_note});
     }
   result.identifiability = identifiability_report(whole, withheld, c.options);
 }

@@ -28,6 +28,7 @@ ParamInfo info(ParamKind k) {
     case ParamKind::RuptureRelease: return {"rupture_release", "mm", 1.0 / kMm, true, 0.0};
     case ParamKind::BreakthroughRate: return {"breakthrough_rate_exponent", "-", 1.0, false, 0.1};
     case ParamKind::CuttingRate: return {"cutting_viscous_fraction", "-", 1.0, false, 0.1};
+    case ParamKind::ReleaseRate: return {"rupture_release_rate_exponent", "-", 1.0, false, 0.1};
   }
   throw std::logic_error("info");
 }
@@ -51,6 +52,7 @@ double& param_ref(Scene& s, std::size_t layer, ParamKind k) {
     case ParamKind::RuptureRelease: return l.force_law.rupture_release_m;
     case ParamKind::BreakthroughRate: return l.force_law.breakthrough.rate_exponent;
     case ParamKind::CuttingRate: return l.force_law.cutting_rate.viscous_fraction;
+    case ParamKind::ReleaseRate: return l.force_law.rupture_release_rate.exponent;
   }
   throw std::logic_error("param_ref");
 }
@@ -97,6 +99,7 @@ void physical_range(const Scene& s, std::size_t layer, ParamKind k, double& lo, 
     }
     case ParamKind::BreakthroughRate: lo = 0.0, hi = 1.0; return;                  // n in [0, 1] (the scene's limit)
     case ParamKind::CuttingRate: lo = 0.0, hi = 1.0; return;                       // b in [0, 1]: a fraction of C
+    case ParamKind::ReleaseRate: lo = 0.0, hi = 1.0; return;                       // m in [0, 1]: fixed travel .. fixed time
   }
 }
 
@@ -148,7 +151,7 @@ std::string unidentified_reason(const LayerIdentifiability& id, ParamKind kind) 
              : id.pressing() ? "" : fewer + " pressing samples of this layer before its puncture";
     case ParamKind::Cutting: case ParamKind::Friction: case ParamKind::Presliding: case ParamKind::RuptureRelease:
       return id.cut() ? "" : fewer + " samples of the cut through this layer";
-    case ParamKind::CuttingRate:  // and by the speeds
+    case ParamKind::CuttingRate: case ParamKind::ReleaseRate:  // and by the speeds
       return id.cut() ? "" : fewer + " samples of the cut through this layer";
     case ParamKind::Damping: case ParamKind::BreakthroughRate: return "";  // decided by the references' speeds
     default: return id.pressing() ? "" : fewer + " pressing samples of this layer";

@@ -40,7 +40,8 @@ enum class ParamKind {
   Presliding,
   RuptureRelease,
   BreakthroughRate,  ///< n of the breakthrough threshold's rate law (breakthrough_rate.hpp); tuned with d
-  CuttingRate        ///< b, the viscous fraction of the cutting force (cutting.hpp); tuned with d
+  CuttingRate,       ///< b, the viscous fraction of the cutting force (cutting.hpp); tuned with d
+  ReleaseRate        ///< m, the rate exponent of the rupture release length (cutting.hpp); tuned with d
 };
 
 struct ParamInfo {

@@ -45,6 +45,7 @@ class ShaftForcesOfModel {
   explicit ShaftForcesOfModel(const Scene& scene)
       : scene_(scene), friction_(scene.layers.size()), front_m_(scene.layers.size(), 0.0),
         break_m_(scene.layers.size(), 0.0), release_N_(scene.layers.size(), 0.0),
+        release_length_m_(scene.layers.size(), 0.0),
         met_at_break_(scene.layers.size(), 0) {
     if (scene.effects.friction)
       for (std::size_t k = 0; k < scene.layers.size(); ++k) friction_[k].emplace(scene.layers[k].force_law.friction);
@@ -81,6 +82,7 @@ class ShaftForcesOfModel {
       front_m_[k] = tip_axial_m;
       break_m_[k] = tip_axial_m;
       release_N_[k] = rupture_release_N(scene_.layers[k].force_law, model.break_force_N(k) + crack_above_N, v);
+      release_length_m_[k] = rupture_release_length_m(scene_.layers[k].force_law, v);
       if (k + 1 < n_layers && !scene_.effects.layer_interaction && needle.depth_m() > scene_.layer_top_depth_m(k + 1))
         met_at_break_[k + 1] = 1;
     }
@@ -93,7 +95,7 @@ class ShaftForcesOfModel {
                   .total_N();
       for (std::size_t k = 0; k < punctured; ++k) {
         const ForceLaw& law = scene_.layers[k].force_law;
-        post += rupture_release_force_N(release_N_[k], law.rupture_release_m, law.cutting_release_m, break_m_[k],
+        post += rupture_release_force_N(release_N_[k], release_length_m_[k], law.cutting_release_m, break_m_[k],
                                         deepest_m_, tip_axial_m);
       }
     }
@@ -104,7 +106,7 @@ class ShaftForcesOfModel {
   const Scene& scene_;
   std::vector<std::optional<KarnoppFriction>> friction_;
   std::vector<double> front_m_;
-  std::vector<double> break_m_, release_N_;  ///< rupture release per layer (cutting.hpp)
+  std::vector<double> break_m_, release_N_, release_length_m_;  ///< rupture release per layer (cutting.hpp)
   double deepest_m_ = -std::numeric_limits<double>::infinity();
   std::vector<char> met_at_break_;
   std::size_t punctured_before_ = 0;
