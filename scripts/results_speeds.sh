@@ -12,7 +12,7 @@ out=results/validation_speeds
 write_speeds() {
   mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json \
     --cases validation/cases/default_speeds.json -o "$out" --no-vtk -q \
-    --model-note "d and the breakthrough rate exponents n identified at 1 and 10 mm/s, every other parameter at 10 mm/s only; 3 and 20 mm/s never seen"
+    --model-note "d, the breakthrough rate exponents n and the cutting viscous fractions b identified at 1 and 10 mm/s, every other parameter at 10 mm/s only; 3 and 20 mm/s never seen"
   "$(command -v /usr/bin/python3 || command -v python3)" scripts/speed_law.py results/tuned_preset/default_tuned.json "$out"
 }
 source scripts/results_folder.sh
