@@ -8,8 +8,9 @@ one at a time, the tuned preset's stiffening (in the mesh: k_a and z_v where
 the surface fit identified them; of the tip spring elsewhere), cutting, shaft
 friction, the critical-force breakthrough, the rupture release (the load at a
 break let go over the release length instead of at once), the breakthrough's
-rate law (its threshold x (v / v_ref)^n, n identified with d at two speeds), the cutting force's
-rate law (C [(1 - b) + b v / v_ref], b identified with d and n), the coupled surfaces
+rate law (its threshold x (v / v_ref)^n, n identified with d at two speeds), the rate laws of
+the cutting force (C [(1 - b) + b v / v_ref]) and of the release length (l (v_b / v_ref)^m), b
+and m identified with d and n, the coupled surfaces
 (= the tuned preset as calibrated) and layer interaction in place of the coupled surfaces. Each row is validated (`puncture validate SCENE --cases
 CASES_JSON`, FEM from out/.fem_cache) on every case of the cases file; its tick
 cost is the wall time of `puncture run` on the default trajectory (ticks with
@@ -35,6 +36,7 @@ def rows(tuned, paper):
         if not cutting_rate:
             for l in s["layers"]:
                 l["force_law"].pop("cutting_rate", None)
+                l["force_law"].pop("rupture_release_rate", None)
         if not release:
             for l in s["layers"]:
                 l["force_law"]["rupture_release_mm"] = 0.0
@@ -62,7 +64,7 @@ def rows(tuned, paper):
          variant(base + ["stiffening", "cutting", "friction"], False, False, False, cutting_rate=False)),
         ("+ rupture release", variant(base + ["stiffening", "cutting", "friction"], False, True, False, cutting_rate=False)),
         ("+ breakthrough rate law", variant(base + ["stiffening", "cutting", "friction"], False, cutting_rate=False)),
-        ("+ cutting rate law", variant(base + ["stiffening", "cutting", "friction"], False)),
+        ("+ rate laws of cutting and release", variant(base + ["stiffening", "cutting", "friction"], False)),
         ("+ coupled surfaces (the tuned preset)",
          variant(base + ["stiffening", "cutting", "friction", "coupled_surfaces"], False)),
         ("+ layer interaction (in place of coupled surfaces)",

@@ -11,8 +11,9 @@
 #                                muscle from the FEM's force and surface profiles together
 #                                (--surface-fit), then everything but d on the FEM
 #                                reference at the scene's 10 mm/s (d cannot be told from the
-#                                friction at one speed); then d and the breakthrough rate
-#                                exponents n from the viscoelastic FEM references at 1 and
+#                                friction at one speed); then d, the breakthrough rate
+#                                exponents n, the cutting viscous fractions b and the release
+#                                rate exponents m from the viscoelastic FEM references at 1 and
 #                                10 mm/s (3 and 20 mm/s stay held
 #                                out, scripts/results_heldout.sh): default_tuned.json;
 #                                provenance, identifiability, before/after plot, wall time
@@ -51,7 +52,8 @@ rate=()
 # the FEM's force and surface profiles together, no tip stiffening.
 "$build/apps/puncture" calibrate scenes/default_force_law.json -o results/tuned_preset/single_speed --name default_tuned_single_speed \
   --integrator implicit --force-weight 4 --depth-weight 1 --surface-fit
-# d and the breakthrough rate exponents n (core/include/puncture/breakthrough_rate.hpp)
+# d, the breakthrough rate exponents n (core/include/puncture/breakthrough_rate.hpp), the
+# cutting viscous fractions b and release rate exponents m (core/include/puncture/cutting.hpp)
 # from two speeds, every other parameter kept at the single-speed values
 # (tuning them on both speeds at once let the muscle stop puncturing).
 "${mpi[@]}" "$build/apps/puncture" calibrate results/tuned_preset/single_speed/default_tuned_single_speed.json -o results/tuned_preset \
