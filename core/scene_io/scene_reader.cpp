@@ -274,6 +274,17 @@ ShaftFrictionLaw read_friction(ObjectReader r) {
   return f;
 }
 
+/// A rate law of the force law, `key: {coefficient_key: c, "reference_speed_mm_per_s": v_ref}`
+/// (cutting_rate, rupture_release_rate), read into c and v_ref (m/s) when present.
+void read_rate_law(ObjectReader& r, const std::string& key, const std::string& coefficient_key, const std::string& file,
+                   double& coefficient, double& reference_speed_m_per_s) {
+  if (!r.has(key)) return;
+  ObjectReader c(r.raw(key), r.child(key), file);
+  coefficient = c.number(coefficient_key, coefficient);
+  reference_speed_m_per_s = c.number("reference_speed_mm_per_s", reference_speed_m_per_s / kMm) * kMm;
+  c.reject_unknown_keys();
+}
+
 ForceLaw read_force_law(ObjectReader r, const std::string& file) {
   ForceLaw law;
   if (r.has("breakthrough"))
@@ -281,22 +292,12 @@ ForceLaw read_force_law(ObjectReader r, const std::string& file) {
   if (r.has("stiffening"))
     law.stiffening = read_stiffening(ObjectReader(r.raw("stiffening"), r.child("stiffening"), file));
   law.cutting_force_N = r.number("cutting_force_N", law.cutting_force_N);
-  if (r.has("cutting_rate")) {
-    ObjectReader c(r.raw("cutting_rate"), r.child("cutting_rate"), file);
-    law.cutting_rate.viscous_fraction = c.number("viscous_fraction", law.cutting_rate.viscous_fraction);
-    law.cutting_rate.reference_speed_m_per_s =
-        c.number("reference_speed_mm_per_s", law.cutting_rate.reference_speed_m_per_s / kMm) * kMm;
-    c.reject_unknown_keys();
-  }
+  read_rate_law(r, "cutting_rate", "viscous_fraction", file, law.cutting_rate.viscous_fraction,
+                law.cutting_rate.reference_speed_m_per_s);
   law.cutting_release_m = r.number("cutting_release_mm", law.cutting_release_m / kMm) * kMm;
   law.rupture_release_m = r.number("rupture_release_mm", law.rupture_release_m / kMm) * kMm;
-  if (r.has("rupture_release_rate")) {
-    ObjectReader c(r.raw("rupture_release_rate"), r.child("rupture_release_rate"), file);
-    law.rupture_release_rate.exponent = c.number("exponent", law.rupture_release_rate.exponent);
-    law.rupture_release_rate.reference_speed_m_per_s =
-        c.number("reference_speed_mm_per_s", law.rupture_release_rate.reference_speed_m_per_s / kMm) * kMm;
-    c.reject_unknown_keys();
-  }
+  read_rate_law(r, "rupture_release_rate", "exponent", file, law.rupture_release_rate.exponent,
+                law.rupture_release_rate.reference_speed_m_per_s);
   if (r.has("friction")) law.friction = read_friction(ObjectReader(r.raw("friction"), r.child("friction"), file));
   r.reject_unknown_keys();
   return law;
