@@ -20,12 +20,19 @@ LayerShaftForce punctured_layer_shaft_force(double top_depth_m, double thickness
 }
 
 CuttingForceParts open_crack_force_N(const ForceLaw& law, double& front_m, double tip_axial_m,
-                                     double axial_speed_m_per_s, NextLayerContact next) {
+                                     double axial_speed_m_per_s, NextLayerContact next, double fracture_limit_N) {
   if (next == NextLayerContact::Touched) return {};
   const double release = cutting_force_N(1.0, law.cutting_release_m, front_m, tip_axial_m);
   front_m = std::max(front_m, tip_axial_m);
   const CuttingForceParts c = rate_cutting_force(law, axial_speed_m_per_s);
-  return {c.fracture_N * release, c.viscous_N * release};
+  const double fracture = std::min(c.fracture_N, fracture_limit_N);
+  return {fracture * release, (c.bevel_N + c.fracture_N - fracture) * release};
+}
+
+double fracture_limit_N(const Layer& layer, const Needle& needle) {
+  if (layer.puncture.kind != PunctureCriterion::Kind::FractureEnergy || !(layer.puncture.toughness_J_per_m2 > 0.0))
+    return std::numeric_limits<double>::infinity();
+  return layer.puncture.toughness_J_per_m2 * 2.0 * needle.radius_m;
 }
 
 }  // namespace puncture

@@ -45,6 +45,7 @@ PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique
     layer.top_depth_m = scene.layer_top_depth_m(k);
     layer.thickness_m = in.thickness_m;
     layer.law = in.force_law;
+    layer.fracture_limit_N = fracture_limit_N(in, scene.needle);
     layer.surface = std::move(layer_surfaces[k]);
     if (damping_on_) {
       if (!(in.damping_N_s_per_m2 >= 0.0)) throw std::invalid_argument("layer \"" + in.name + "\": damping must be >= 0");
@@ -373,15 +374,16 @@ double PunctureSimulator::crack_force(double tip_axial_m, double axial_speed_m_p
   // The punctured layer the tip is in is cut until the next layer is touched,
   // or, when that layer was met at the break (contact at the tip, the broken
   // layer squeezed between them), while the tip presses it.
-  crack_viscous_N_ = 0.0;
+  crack_bevel_N_ = 0.0;
   if (!cutting_on_ || active_ == 0) return 0.0;
   const std::size_t n = layers_.size();
   const NextLayerContact next = active_ == n || !layers_[active_].contact_set ? NextLayerContact::None
                                 : layers_[active_].contact_at_tip          ? NextLayerContact::MetAtTip
                                                                            : NextLayerContact::Touched;
   LayerModel& p = layers_[active_ - 1];
-  const CuttingForceParts c = open_crack_force_N(p.law, p.front_m, tip_axial_m, axial_speed_m_per_s, next);
-  crack_viscous_N_ = c.viscous_N;
+  const CuttingForceParts c =
+      open_crack_force_N(p.law, p.front_m, tip_axial_m, axial_speed_m_per_s, next, p.fracture_limit_N);
+  crack_bevel_N_ = c.bevel_N;
   return c.total_N();
 }
 
@@ -516,8 +518,9 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   // 5. Shaft friction and damping of the punctured layers.
   const double friction_total = shaft_friction_and_damping(needle);
   // The crack's viscous part (cutting.hpp) is the tissue the bevel wedges apart: tip force.
-  result_.tip_force_N = surface_force + crack_viscous_N_;
-  result_.cutting_force_N = cut - crack_viscous_N_;
+  result_.surface_force_N = surface_force;
+  result_.tip_force_N = surface_force + crack_bevel_N_;
+  result_.cutting_force_N = cut - crack_bevel_N_;
   result_.friction_force_N = friction_total;
   result_.total_force_N = surface_force + cut + friction_total;
   if (broke) add_shaft_forces_to_events(needle.time_s);

@@ -77,7 +77,7 @@ TEST(ShaftForces, CuttingRateSplitsTheCrackForceIntoFractureAndViscousParts) {
   // At v_ref the whole C, of it b C viscous.
   CuttingForceParts c = open_crack_force_N(law, front, 6e-3, 0.01, NextLayerContact::None);
   EXPECT_NEAR(c.fracture_N, 0.9, 1e-12);
-  EXPECT_NEAR(c.viscous_N, 0.3, 1e-12);
+  EXPECT_NEAR(c.bevel_N, 0.3, 1e-12);
   // At 20 mm/s: 0.9 + 0.3 x 2 = 1.5 N; at 3 mm/s 0.9 + 0.09 N.
   EXPECT_NEAR(open_crack_force_N(law, front, 6.1e-3, 0.02, NextLayerContact::None).total_N(), 1.5, 1e-12);
   EXPECT_NEAR(open_crack_force_N(law, front, 6.2e-3, 0.003, NextLayerContact::None).total_N(), 0.99, 1e-12);
@@ -86,13 +86,44 @@ TEST(ShaftForces, CuttingRateSplitsTheCrackForceIntoFractureAndViscousParts) {
   EXPECT_NEAR(c.total_N(), 0.9, 1e-12);
   c = open_crack_force_N(law, front, 6.1e-3, -0.01, NextLayerContact::None);
   EXPECT_NEAR(c.fracture_N, 0.45, 1e-9);
-  EXPECT_EQ(c.viscous_N, 0.0);
+  EXPECT_EQ(c.bevel_N, 0.0);
   // The speed is clamped to 100 v_ref.
-  EXPECT_NEAR(rate_cutting_force(law, 5.0).viscous_N, 0.3 * 100.0, 1e-9);
+  EXPECT_NEAR(rate_cutting_force(law, 5.0).bevel_N, 0.3 * 100.0, 1e-9);
   // b = 0: the paper's constant C at any speed.
   law.cutting_rate.viscous_fraction = 0.0;
   EXPECT_EQ(rate_cutting_force(law, 0.02).total_N(), 1.2);
-  EXPECT_EQ(rate_cutting_force(law, 0.02).viscous_N, 0.0);
+  EXPECT_EQ(rate_cutting_force(law, 0.02).bevel_N, 0.0);
+}
+
+TEST(ShaftForces, OfTheCuttingForceOnlyGcTimesTheCutWidthIsFracture) {
+  // C = 1.2 N, b = 0.25 at 10 mm/s: fracture part 0.9 N, bevel 0.3 N. With a
+  // fracture limit G_c w = 550 J/m^2 x 1.27 mm = 0.6985 N, 0.2015 N of the
+  // static part goes to the bevel; the total stays; released alike.
+  ForceLaw law;
+  law.cutting_force_N = 1.2;
+  law.cutting_release_m = 0.2e-3;
+  law.cutting_rate.viscous_fraction = 0.25;
+  law.cutting_rate.reference_speed_m_per_s = 0.01;
+  Layer muscle;
+  muscle.puncture.kind = PunctureCriterion::Kind::FractureEnergy;
+  muscle.puncture.toughness_J_per_m2 = 550.0;
+  Needle needle;
+  needle.radius_m = 0.635e-3;
+  const double limit = fracture_limit_N(muscle, needle);
+  EXPECT_NEAR(limit, 0.6985, 1e-12);
+  double front = 5e-3;
+  CuttingForceParts c = open_crack_force_N(law, front, 6e-3, 0.01, NextLayerContact::None, limit);
+  EXPECT_NEAR(c.fracture_N, 0.6985, 1e-12);
+  EXPECT_NEAR(c.bevel_N, 0.3 + 0.2015, 1e-12);
+  EXPECT_NEAR(c.total_N(), 1.2, 1e-12);
+  c = open_crack_force_N(law, front, 5.9e-3, 0.0, NextLayerContact::None, limit);  // half released, at rest
+  EXPECT_NEAR(c.fracture_N, 0.5 * 0.6985, 1e-9);
+  EXPECT_NEAR(c.bevel_N, 0.5 * 0.2015, 1e-9);
+  // A limit above the fracture part changes nothing; no toughness in the scene: no limit.
+  c = open_crack_force_N(law, front, 6e-3, 0.01, NextLayerContact::None, 2.0);
+  EXPECT_NEAR(c.fracture_N, 0.9, 1e-12);
+  muscle.puncture.kind = PunctureCriterion::Kind::CriticalForce;
+  EXPECT_TRUE(std::isinf(fracture_limit_N(muscle, needle)));
 }
 
 TEST(ShaftForces, RuptureReleaseLengthIsAPowerOfTheBreakSpeed) {

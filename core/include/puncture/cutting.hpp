@@ -28,6 +28,14 @@
 // 20 mm/s, a power law through them 0.36 N and 0.71 N. b = 0: C at every
 // speed (the paper).
 //
+// Fracture limit. Advancing the crack costs G_c w whatever else the tip does,
+// so of a fitted C (1 - b) only up to G_c w (the layer's measured toughness
+// times the cut width 2a, when the scene gives it: PunctureCriterion) is
+// fracture; the rest is the bevel's static resistance, reported with the
+// viscous part as tip force (shaft_forces.hpp). The FEM's cutting column is
+// exactly its cohesive energy per unit advance (reference_fem/README.md), so the
+// parts are compared like for like. The total force does not change.
+//
 // Rupture release (ForceLaw::rupture_release_m, l > 0). A layer does not let
 // go of its load at once when it breaks: the crack opens through a cohesive
 // process zone whose traction softens with the opening (a bilinear law of
@@ -69,11 +77,11 @@ namespace puncture {
 /// v clamp of the cutting rate law: 0 .. kCuttingRateClamp v_ref.
 constexpr double kCuttingRateClamp = 100.0;
 
-/// A cutting force split into its fracture part and its viscous part (N).
+/// A cutting force split into its fracture part and the bevel's part (N).
 struct CuttingForceParts {
-  double fracture_N = 0.0;  ///< C (1 - b) (the whole C with b = 0)
-  double viscous_N = 0.0;   ///< b C v / v_ref
-  double total_N() const { return fracture_N + viscous_N; }
+  double fracture_N = 0.0;  ///< C (1 - b) (the whole C with b = 0), at most the fracture limit
+  double bevel_N = 0.0;     ///< b C v / v_ref, plus any of C (1 - b) beyond the fracture limit
+  double total_N() const { return fracture_N + bevel_N; }
 };
 
 /// C(v) of force law `law` at axial speed axial_speed_m_per_s (m/s, > 0

@@ -15,6 +15,8 @@
 // crack goes on while the tip presses the next layer).
 #pragma once
 
+#include <limits>
+
 #include "puncture/cutting.hpp"
 #include "puncture/needle.hpp"
 #include "puncture/scene.hpp"
@@ -47,8 +49,15 @@ enum class NextLayerContact {
 /// `law` and crack front front_m (m along the needle axis; advanced to the tip
 /// while the crack is open) for the tip at tip_axial_m moving at
 /// axial_speed_m_per_s (m/s): C(v) of cutting.hpp times its release factor
-/// while the crack is open (next != Touched), else 0.
+/// while the crack is open (next != Touched), else 0; of its fracture part
+/// at most fracture_limit_N (N, before the release factor; G_c w, cutting.hpp)
+/// counts as fracture, the rest goes to the bevel's part.
 CuttingForceParts open_crack_force_N(const ForceLaw& law, double& front_m, double tip_axial_m,
-                                     double axial_speed_m_per_s, NextLayerContact next);
+                                     double axial_speed_m_per_s, NextLayerContact next,
+                                     double fracture_limit_N = std::numeric_limits<double>::infinity());
+
+/// G_c w (N) of `layer` for `needle`: its measured toughness (a fracture-energy
+/// puncture criterion) times the cut width 2a; infinity without one.
+double fracture_limit_N(const Layer& layer, const Needle& needle);
 
 }  // namespace puncture

@@ -125,7 +125,8 @@ struct TickResult {
   double depth_m = 0.0;           ///< tip depth below the undeformed skin surface
   double velocity_m_per_s = 0.0;  ///< along the needle axis, > 0 inserting
   double total_force_N = 0.0;     ///< tip + cutting + friction
-  double tip_force_N = 0.0;       ///< surface force of the needle layer
+  double tip_force_N = 0.0;       ///< surface force of the needle layer + the open crack's bevel part (cutting.hpp)
+  double surface_force_N = 0.0;   ///< surface force of the needle layer alone
   double cutting_force_N = 0.0;   ///< sum of the layers' cutting forces
   double friction_force_N = 0.0;  ///< sum of shaft friction and damping d h v
   std::vector<LayerTickResult> layers;  ///< one per layer, sized at construction
@@ -215,6 +216,7 @@ class PunctureSimulator {
     double break_axial_m = 0.0;   ///< tip position along the needle axis at the break (punctured layers)
     double release_N = 0.0;       ///< R of the rupture release (cutting.hpp): load at the tip at the break beyond C
     double release_length_m = 0.0;  ///< l(v_b) of the rupture release at the break speed (cutting.hpp)
+    double fracture_limit_N = 0.0;  ///< G_c w: the most of its cutting force that is fracture (cutting.hpp)
     mutable Eigen::Matrix3Xd shifted_positions;
   };
 
@@ -236,7 +238,7 @@ class PunctureSimulator {
   void resume_broken_layers(double time_s);
   void update_needle_contact(const NeedleState& needle);
   /// Cutting force (N) of the deepest punctured layer at axial speed v (shaft_forces.hpp), its crack
-  /// front advanced; its viscous part is left in crack_viscous_N_.
+  /// front advanced; the bevel's part of it is left in crack_bevel_N_.
   double crack_force(double tip_axial_m, double axial_speed_m_per_s);
   /// Rupture release of every punctured layer (cutting.hpp), written to each
   /// layer's cutting force of this tick; returns their sum (N).
@@ -272,7 +274,7 @@ class PunctureSimulator {
   bool cutting_on_ = false;
   bool interaction_ = false;
   bool first_tick_ = true;
-  double crack_viscous_N_ = 0.0;  ///< viscous part of the last crack_force() (N; cutting.hpp)
+  double crack_bevel_N_ = 0.0;  ///< the bevel's part of the last crack_force() (N; cutting.hpp)
   double deepest_axial_m_ = -std::numeric_limits<double>::infinity();  ///< deepest tip position so far (m along the axis)
   double contact_search_height_m_ = 0.0;
   double relayout_tolerance_m_ = 0.0;

@@ -37,10 +37,12 @@ class RealtimeComparisonModel final : public ComparisonModel {
     return s.str();
   }
   /// The tick with the scene's whole force law; the contact force is the
-  /// needle layer's surface force (TickResult::tip_force_N). Cutting, shaft
-  /// friction and damping are added by the harness with the same formulas
-  /// for every model (run_comparison_model, model_comparison.hpp).
-  double step(const NeedleState& needle) override { return model_.simulator->tick(needle).tip_force_N; }
+  /// needle layer's surface force (TickResult::surface_force_N; its tip force
+  /// also holds the open crack's bevel part, which the harness counts with the
+  /// cutting). Cutting, shaft friction and damping are added by the harness
+  /// with the same formulas for every model (run_comparison_model,
+  /// model_comparison.hpp).
+  double step(const NeedleState& needle) override { return model_.simulator->tick(needle).surface_force_N; }
   LayerState layer_state(std::size_t k) const override { return model_.simulator->layer_state(k); }
   double break_force_N(std::size_t k) const override {
     for (const PunctureEvent& e : model_.simulator->puncture_events())
