@@ -111,7 +111,7 @@ struct LayerTickResult {
   LayerState state = LayerState::Untouched;
   double surface_force_N = 0.0;       ///< force of the layer's surface on the tip (the needle layer only)
   double support_force_N = 0.0;       ///< load carried from the layer above (layer interaction; not on the needle)
-  double cutting_force_N = 0.0;       ///< crack advance (the punctured layer the tip is in)
+  double cutting_force_N = 0.0;       ///< crack advance (the punctured layer the tip is in), both parts (cutting.hpp)
   double friction_force_N = 0.0;      ///< Karnopp shaft friction phi h (0 unless Punctured)
   double damping_force_N = 0.0;       ///< d h v (0 unless Punctured)
   int deformed_rings = 0;             ///< rings whose mean deflection exceeds the threshold
@@ -127,7 +127,7 @@ struct TickResult {
   double total_force_N = 0.0;     ///< tip + cutting + friction
   double tip_force_N = 0.0;       ///< surface force of the needle layer + the open crack's bevel part (cutting.hpp)
   double surface_force_N = 0.0;   ///< surface force of the needle layer alone
-  double cutting_force_N = 0.0;   ///< sum of the layers' cutting forces
+  double cutting_force_N = 0.0;   ///< sum of the layers' cutting forces less the open crack's bevel part (in tip_force_N)
   double friction_force_N = 0.0;  ///< sum of shaft friction and damping d h v
   std::vector<LayerTickResult> layers;  ///< one per layer, sized at construction
 };
