@@ -370,21 +370,17 @@ void PunctureSimulator::update_needle_contact(const NeedleState& needle) {
   first_tick_ = false;
 }
 
-double PunctureSimulator::crack_force(double tip_axial_m, double axial_speed_m_per_s) {
+CuttingForceParts PunctureSimulator::crack_force(double tip_axial_m, double axial_speed_m_per_s) {
   // The punctured layer the tip is in is cut until the next layer is touched,
   // or, when that layer was met at the break (contact at the tip, the broken
   // layer squeezed between them), while the tip presses it.
-  crack_bevel_N_ = 0.0;
-  if (!cutting_on_ || active_ == 0) return 0.0;
+  if (!cutting_on_ || active_ == 0) return {};
   const std::size_t n = layers_.size();
   const NextLayerContact next = active_ == n || !layers_[active_].contact_set ? NextLayerContact::None
                                 : layers_[active_].contact_at_tip          ? NextLayerContact::MetAtTip
                                                                            : NextLayerContact::Touched;
   LayerModel& p = layers_[active_ - 1];
-  const CuttingForceParts c =
-      open_crack_force_N(p.law, p.front_m, tip_axial_m, axial_speed_m_per_s, next, p.fracture_limit_N);
-  crack_bevel_N_ = c.bevel_N;
-  return c.total_N();
+  return open_crack_force_N(p.law, p.front_m, tip_axial_m, axial_speed_m_per_s, next, p.fracture_limit_N);
 }
 
 double PunctureSimulator::rupture_release(double tip_axial_m) {
@@ -503,24 +499,24 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   resume_broken_layers(needle.time_s);
   // 2. Contact of the needle layer; the crack ahead of the tip.
   update_needle_contact(needle);
-  double crack = crack_force(tip_axial_m, needle.axial_velocity_m_per_s);
-  double cut = crack + rupture_release(tip_axial_m);
+  CuttingForceParts crack = crack_force(tip_axial_m, needle.axial_velocity_m_per_s);
+  double cut = crack.total_N() + rupture_release(tip_axial_m);
   // 3. The chain under the needle (or the needle layer alone).
   double surface_force = press_needle_layer(needle, interaction_ ? cut : 0.0);
   // 4. Breakthrough: the crack through the layer that just broke starts at the tip.
-  const bool broke = break_through(needle, surface_force, cut, crack);
+  const bool broke = break_through(needle, surface_force, cut, crack.total_N());
   if (broke) {
     surface_force = 0.0;
     crack = crack_force(tip_axial_m, needle.axial_velocity_m_per_s);
-    cut = crack + rupture_release(tip_axial_m);
+    cut = crack.total_N() + rupture_release(tip_axial_m);
   }
-  if (active_ > 0) result_.layers[active_ - 1].cutting_force_N += crack;
+  if (active_ > 0) result_.layers[active_ - 1].cutting_force_N += crack.total_N();
   // 5. Shaft friction and damping of the punctured layers.
   const double friction_total = shaft_friction_and_damping(needle);
   // The crack's viscous part (cutting.hpp) is the tissue the bevel wedges apart: tip force.
   result_.surface_force_N = surface_force;
-  result_.tip_force_N = surface_force + crack_bevel_N_;
-  result_.cutting_force_N = cut - crack_bevel_N_;
+  result_.tip_force_N = surface_force + crack.bevel_N;
+  result_.cutting_force_N = cut - crack.bevel_N;
   result_.friction_force_N = friction_total;
   result_.total_force_N = surface_force + cut + friction_total;
   if (broke) add_shaft_forces_to_events(needle.time_s);

@@ -42,12 +42,19 @@ inline double mean_pressing_speed_m_per_s(double contact_axial_m, double contact
   return (tip_axial_m - contact_axial_m) / dt;
 }
 
+/// (v / v_ref)^n with v (m/s) clamped to [v_ref / kBreakthroughRateClamp,
+/// kBreakthroughRateClamp v_ref]; 1 for n = 0. The power rate law of the
+/// breakthrough threshold and of the rupture release length (cutting.hpp).
+inline double clamped_rate_power(double speed_m_per_s, double reference_speed_m_per_s, double exponent) {
+  if (exponent == 0.0) return 1.0;
+  const double v_ref = reference_speed_m_per_s;
+  const double v = std::clamp(speed_m_per_s, v_ref / kBreakthroughRateClamp, v_ref * kBreakthroughRateClamp);
+  return std::pow(v / v_ref, exponent);
+}
+
 /// s(v) (dimensionless, > 0) of criterion c at the mean pressing speed v (m/s).
 inline double breakthrough_rate_factor(const BreakthroughCriterion& c, double speed_m_per_s) {
-  if (c.rate_exponent == 0.0) return 1.0;
-  const double v_ref = c.reference_speed_m_per_s;
-  const double v = std::clamp(speed_m_per_s, v_ref / kBreakthroughRateClamp, v_ref * kBreakthroughRateClamp);
-  return std::pow(v / v_ref, c.rate_exponent);
+  return clamped_rate_power(speed_m_per_s, c.reference_speed_m_per_s, c.rate_exponent);
 }
 
 }  // namespace puncture

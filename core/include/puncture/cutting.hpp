@@ -70,6 +70,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "puncture/breakthrough_rate.hpp"
 #include "puncture/scene.hpp"
 
 namespace puncture {
@@ -96,12 +97,8 @@ inline CuttingForceParts rate_cutting_force(const ForceLaw& law, double axial_sp
 
 /// l(v_b) (m) of force law `law` for a break at axial speed break_speed_m_per_s (m/s).
 inline double rupture_release_length_m(const ForceLaw& law, double break_speed_m_per_s) {
-  const double l = law.rupture_release_m;
-  const double m = law.rupture_release_rate.exponent;
-  if (m == 0.0 || !(l > 0.0)) return l;
-  const double v_ref = law.rupture_release_rate.reference_speed_m_per_s;
-  const double v = std::clamp(break_speed_m_per_s, v_ref / kCuttingRateClamp, v_ref * kCuttingRateClamp);
-  return l * std::pow(v / v_ref, m);
+  const ReleaseRate& r = law.rupture_release_rate;
+  return law.rupture_release_m * clamped_rate_power(break_speed_m_per_s, r.reference_speed_m_per_s, r.exponent);
 }
 
 /// F_cut (N) for cutting force C (N), release distance r_c (m > 0), front and

@@ -96,6 +96,7 @@
 #include <vector>
 
 #include "puncture/contact_surface.hpp"
+#include "puncture/cutting.hpp"
 #include "puncture/force_mesh.hpp"
 #include "puncture/coupled_surfaces.hpp"
 #include "puncture/layer_chain.hpp"
@@ -237,9 +238,9 @@ class PunctureSimulator {
   /// The tick's phases (tick() calls them in this order; see the header comment).
   void resume_broken_layers(double time_s);
   void update_needle_contact(const NeedleState& needle);
-  /// Cutting force (N) of the deepest punctured layer at axial speed v (shaft_forces.hpp), its crack
-  /// front advanced; the bevel's part of it is left in crack_bevel_N_.
-  double crack_force(double tip_axial_m, double axial_speed_m_per_s);
+  /// Cutting force (N, by part) of the deepest punctured layer at axial speed v (shaft_forces.hpp),
+  /// its crack front advanced.
+  CuttingForceParts crack_force(double tip_axial_m, double axial_speed_m_per_s);
   /// Rupture release of every punctured layer (cutting.hpp), written to each
   /// layer's cutting force of this tick; returns their sum (N).
   double rupture_release(double tip_axial_m);
@@ -274,7 +275,6 @@ class PunctureSimulator {
   bool cutting_on_ = false;
   bool interaction_ = false;
   bool first_tick_ = true;
-  double crack_bevel_N_ = 0.0;  ///< the bevel's part of the last crack_force() (N; cutting.hpp)
   double deepest_axial_m_ = -std::numeric_limits<double>::infinity();  ///< deepest tip position so far (m along the axis)
   double contact_search_height_m_ = 0.0;
   double relayout_tolerance_m_ = 0.0;
