@@ -270,6 +270,12 @@ ShaftFrictionLaw read_friction(ObjectReader r) {
   f.static_N_per_m = r.number("static_N_per_mm", f.dynamic_N_per_m * kMm) / kMm;
   f.velocity_band_m_per_s = r.number("velocity_band_mm_per_s", f.velocity_band_m_per_s / kMm) * kMm;
   f.presliding_m = r.number("presliding_mm", 0.0) * kMm;
+  const std::string relaxation = r.string("pressure_relaxation", "none");
+  if (relaxation == "layer_material")
+    f.pressure_relaxes_with_material = true;
+  else if (relaxation != "none")
+    r.fail(r.child("pressure_relaxation"),
+           "unknown pressure relaxation '" + relaxation + "' (known: none, layer_material)");
   r.reject_unknown_keys();
   return f;
 }

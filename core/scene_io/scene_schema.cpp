@@ -90,6 +90,7 @@ std::vector<SceneField> force_law_fields() {
       {"/layers/*/force_law/friction/velocity_band_mm_per_s", T::Number, "mm/s", kOptional, above(0), kRealtime,
        kWritten},
       {"/layers/*/force_law/friction/presliding_mm", T::Number, "mm", kOptional, at_least(0), kRealtime, kWritten},
+      {"/layers/*/force_law/friction/pressure_relaxation", T::String, "", kOptional, any(), kRealtime, kWritten},
   };
 }
 

@@ -203,6 +203,9 @@ void validate_layers(const Scene& s, const std::string& file) {
             l.resumption_time_s);
     validate_force_law(l.force_law, file, p + "/force_law", l.thickness_m);
     validate_material(l.material, file, p);
+    if (l.force_law.friction.pressure_relaxes_with_material && !l.material.viscoelastic.enabled())
+      throw SceneError(file, p + "/force_law/friction/pressure_relaxation",
+                       "'layer_material' needs the layer's material/viscoelastic/prony terms (the layer has none)");
     validate_puncture(l, file, p);
   }
 }

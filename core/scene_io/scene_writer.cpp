@@ -58,6 +58,7 @@ json force_law_json(const ForceLaw& law) {
                    {"dynamic_N_per_mm", law.friction.dynamic_N_per_m * kMm},
                    {"velocity_band_mm_per_s", law.friction.velocity_band_m_per_s / kMm},
                    {"presliding_mm", law.friction.presliding_m / kMm}};
+  if (law.friction.pressure_relaxes_with_material) j["friction"]["pressure_relaxation"] = "layer_material";  // written when used
   return j;
 }
 

@@ -7,13 +7,25 @@
 
 namespace puncture {
 
-LayerShaftForce punctured_layer_shaft_force(double top_depth_m, double thickness_m, KarnoppFriction* friction,
+namespace {
+std::vector<PronyRelaxationTerm> relaxation_terms(const ShaftFrictionLaw& law, const Viscoelasticity& material) {
+  if (!law.pressure_relaxes_with_material) return {};
+  return material.terms;
+}
+}  // namespace
+
+LayerShaftFriction::LayerShaftFriction(const ShaftFrictionLaw& law, const Viscoelasticity& material)
+    : stick_slip(law), contact_pressure(relaxation_terms(law, material)) {}
+
+LayerShaftForce punctured_layer_shaft_force(double top_depth_m, double thickness_m, LayerShaftFriction* friction,
                                             bool damping_on, double damping_N_s_per_m2, const NeedleState& needle) {
   LayerShaftForce out;
   if (!damping_on && !friction) return out;
   const double depth_m = needle.depth_m();
   out.shaft_length_m = shaft_length_in_layer_m(depth_m, top_depth_m, thickness_m);
-  if (friction) out.friction_N = friction->update(needle.axial_velocity_m_per_s, depth_m) * out.shaft_length_m;
+  if (friction)
+    out.friction_N = friction->stick_slip.update(needle.axial_velocity_m_per_s, depth_m) *
+                     friction->contact_pressure.update(out.shaft_length_m, needle.time_s);
   if (damping_on)
     out.damping_N = puncture_damping_force_N(damping_N_s_per_m2, out.shaft_length_m, needle.axial_velocity_m_per_s);
   return out;

@@ -52,7 +52,7 @@ PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique
       layer.damping_N_s_per_m2 = in.damping_N_s_per_m2;
     }
     layer.tip_contact_from_m = std::numeric_limits<double>::infinity();
-    if (scene.effects.friction) layer.friction.emplace(in.force_law.friction);
+    if (scene.effects.friction) layer.friction.emplace(in.force_law.friction, in.material.viscoelastic);
     if (cutting_on_ && !(in.force_law.cutting_force_N >= 0.0 && in.force_law.cutting_release_m > 0.0 &&
                          in.force_law.rupture_release_m >= 0.0))
       throw std::invalid_argument("layer \"" + in.name +

@@ -23,7 +23,7 @@ TEST(ShaftForces, FrictionAndDampingOfAPuncturedLayerAreThePaperTerms) {
   ShaftFrictionLaw law;
   law.static_N_per_m = 300.0;
   law.dynamic_N_per_m = 200.0;
-  KarnoppFriction friction(law);
+  LayerShaftFriction friction(law, Viscoelasticity{});
   const double d = 500.0;  // N s / m^2
   const LayerShaftForce f = punctured_layer_shaft_force(2e-3, 8e-3, &friction, true, d, needle_at(6e-3, 0.01));
   EXPECT_DOUBLE_EQ(f.shaft_length_m, 4e-3);

@@ -178,6 +178,11 @@ struct ShaftFrictionLaw {
   /// slips: an elastic-plastic "presliding" interface of stiffness f_d / delta
   /// per metre of shaft). 0: Karnopp's instant reversal.
   double presliding_m = 0.0;
+  /// The shaft's contact pressure, and with it the friction per metre, relaxes
+  /// with the layer's own Prony series (material.viscoelastic) from the moment
+  /// the tip passed each point of the shaft (shaft_pressure_relaxation.hpp).
+  /// JSON "pressure_relaxation": "layer_material"; false ("none"): it does not.
+  bool pressure_relaxes_with_material = false;
 };
 
 /// Rate dependence of a layer's cutting force (cutting.hpp):

@@ -6,7 +6,9 @@
 // Per punctured layer with h (m) of shaft inside it (shaft_length_in_layer_m)
 // and axial velocity v (m/s, > 0 inserting), forces on the needle in N,
 // positive resisting insertion:
-//     friction  phi h      (Effects::friction, shaft_friction.hpp)
+//     friction  phi h_eff  (Effects::friction, shaft_friction.hpp; h_eff = h
+//                          unless the contact pressure relaxes,
+//                          shaft_pressure_relaxation.hpp)
 //     damping   d h v      (Effects::damping, the seed's Table 1)
 // The deepest punctured layer is cut (Effects::cutting, cutting.hpp) while
 // its crack is open: every layer is punctured, or the next layer is not yet
@@ -21,21 +23,32 @@
 #include "puncture/needle.hpp"
 #include "puncture/scene.hpp"
 #include "puncture/shaft_friction.hpp"
+#include "puncture/shaft_pressure_relaxation.hpp"
 
 namespace puncture {
 
 /// The shaft forces of one punctured layer.
 struct LayerShaftForce {
   double shaft_length_m = 0.0;  ///< h; 0 when neither friction nor damping is on
-  double friction_N = 0.0;      ///< phi h
+  double friction_N = 0.0;      ///< phi h_eff
   double damping_N = 0.0;       ///< d h v
 };
 
-/// Friction (updated: `friction` keeps its stick / presliding state; nullptr
-/// when friction is off) and damping (damping_N_s_per_m2 d, used when
+/// The friction state of one punctured layer: Karnopp's stick / slip (and
+/// presliding) level phi, and the relaxed contact length when the law's
+/// pressure relaxes with the layer's material (else h_eff = h).
+struct LayerShaftFriction {
+  /// Throws std::invalid_argument for an invalid law or Prony series.
+  LayerShaftFriction(const ShaftFrictionLaw& law, const Viscoelasticity& material);
+  KarnoppFriction stick_slip;
+  ShaftPressureRelaxation contact_pressure;
+};
+
+/// Friction (updated: `friction` keeps its stick / presliding state and the
+/// shaft's pass times; nullptr when friction is off) and damping (damping_N_s_per_m2 d, used when
 /// damping_on) of a punctured layer whose top lies top_depth_m below the skin
 /// surface, thickness thickness_m, for the needle state `needle`.
-LayerShaftForce punctured_layer_shaft_force(double top_depth_m, double thickness_m, KarnoppFriction* friction,
+LayerShaftForce punctured_layer_shaft_force(double top_depth_m, double thickness_m, LayerShaftFriction* friction,
                                             bool damping_on, double damping_N_s_per_m2, const NeedleState& needle);
 
 /// What the tip meets below the deepest punctured layer.

@@ -104,7 +104,7 @@
 #include "puncture/puncture_force.hpp"
 #include "puncture/resumption.hpp"
 #include "puncture/scene.hpp"
-#include "puncture/shaft_friction.hpp"
+#include "puncture/shaft_forces.hpp"
 
 namespace puncture {
 
@@ -173,7 +173,11 @@ class PunctureSimulator {
   /// Crack front of a punctured layer along the needle axis (m), see cutting.hpp.
   double crack_front_m(std::size_t k) const { return layers_[k].front_m; }
   const KarnoppFriction* friction(std::size_t k) const {
-    return layers_[k].friction ? &*layers_[k].friction : nullptr;
+    return layers_[k].friction ? &layers_[k].friction->stick_slip : nullptr;
+  }
+  /// Layer k's relaxed shaft contact length h_eff (m, shaft_pressure_relaxation.hpp) of the last tick; nullptr without friction.
+  const ShaftPressureRelaxation* shaft_contact_pressure(std::size_t k) const {
+    return layers_[k].friction ? &layers_[k].friction->contact_pressure : nullptr;
   }
 
   /// Force-mesh node rest positions (3 x N, m); empty (3 x 0) without force meshes.
@@ -199,7 +203,7 @@ class PunctureSimulator {
     std::unique_ptr<ContactSurface> surface;
     std::optional<ForceMesh> mesh;
     std::optional<SurfaceResumption> resumption;
-    std::optional<KarnoppFriction> friction;
+    std::optional<LayerShaftFriction> friction;
     const StiffeningLaw* stiffening = nullptr;  ///< &law.stiffening when the effect is on
     LayerState state = LayerState::Untouched;
     bool contact_set = false;

@@ -33,7 +33,7 @@ json with_force_law() {
       {"rupture_release_mm", 1.2},
       {"rupture_release_rate", {{"exponent", 0.35}, {"reference_speed_mm_per_s", 12.0}}},
       {"friction", {{"static_N_per_mm", 0.015}, {"dynamic_N_per_mm", 0.01}, {"velocity_band_mm_per_s", 0.2},
-                    {"presliding_mm", 2.5}}}};
+                    {"presliding_mm", 2.5}, {"pressure_relaxation", "layer_material"}}}};
   j["layers"][1]["force_law"] = {{"breakthrough", {{"criterion", "critical_energy"}, {"critical_energy_mJ", 2.5}}},
                                  {"stiffening", {{"law", "exponential"}, {"stiffness_N_per_mm", 0.3}, {"strain_scale_mm", 1.5}}}};
   j["layers"][2]["force_law"] = {{"breakthrough", {{"criterion", "critical_force"}, {"critical_force_N", 2.0}}},
@@ -77,6 +77,8 @@ TEST(SceneIoForceLaw, KeysAreReadInSiUnits) {
   EXPECT_NEAR(skin.friction.static_N_per_m, 15.0, 1e-12);  // N/mm -> N/m
   EXPECT_NEAR(skin.friction.dynamic_N_per_m, 10.0, 1e-12);
   EXPECT_NEAR(skin.friction.presliding_m, 2.5e-3, 1e-15);
+  EXPECT_TRUE(skin.friction.pressure_relaxes_with_material);
+  EXPECT_FALSE(s.layers[2].force_law.friction.pressure_relaxes_with_material);  // absent: none
   EXPECT_NEAR(skin.friction.velocity_band_m_per_s, 0.2e-3, 1e-18);
   const ForceLaw& fat = s.layers[1].force_law;
   EXPECT_EQ(fat.breakthrough.kind, BreakthroughCriterion::Kind::CriticalEnergy);
@@ -116,6 +118,7 @@ TEST(SceneIoForceLaw, RoundTripKeepsEveryForceLawValue) {
     EXPECT_DOUBLE_EQ(x.friction.static_N_per_m, y.friction.static_N_per_m);
     EXPECT_DOUBLE_EQ(x.friction.dynamic_N_per_m, y.friction.dynamic_N_per_m);
     EXPECT_DOUBLE_EQ(x.friction.velocity_band_m_per_s, y.friction.velocity_band_m_per_s);
+    EXPECT_EQ(x.friction.pressure_relaxes_with_material, y.friction.pressure_relaxes_with_material);
     EXPECT_DOUBLE_EQ(a.layers[i].resumption_time_s, b.layers[i].resumption_time_s);
   }
   EXPECT_EQ(a.effects.cutting, b.effects.cutting);
@@ -185,6 +188,11 @@ const BadForceLaw kBad[] = {
      "/layers/0/force_law/friction/velocity_band_mm_per_s"},
     {"negative_presliding", [](json& j) { j["layers"][0]["force_law"]["friction"]["presliding_mm"] = -1.0; },
      "/layers/0/force_law/friction/presliding_mm"},
+    {"unknown_pressure_relaxation",
+     [](json& j) { j["layers"][0]["force_law"]["friction"]["pressure_relaxation"] = "bulk"; },
+     "/layers/0/force_law/friction/pressure_relaxation"},
+    {"pressure_relaxation_without_prony", [](json& j) { j["layers"][0]["material"].erase("viscoelastic"); },
+     "/layers/0/force_law/friction/pressure_relaxation"},
     {"negative_quadratic", [](json& j) { j["layers"][0]["force_law"]["stiffening"]["quadratic_N_per_mm2"] = -0.1; },
      "/layers/0/force_law/stiffening/quadratic_N_per_mm2"},
     {"exponential_without_scale", [](json& j) { j["layers"][1]["force_law"]["stiffening"].erase("strain_scale_mm"); },

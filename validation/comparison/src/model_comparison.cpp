@@ -48,7 +48,8 @@ class ShaftForcesOfModel {
         release_length_m_(scene.layers.size(), 0.0),
         met_at_break_(scene.layers.size(), 0) {
     if (scene.effects.friction)
-      for (std::size_t k = 0; k < scene.layers.size(); ++k) friction_[k].emplace(scene.layers[k].force_law.friction);
+      for (std::size_t k = 0; k < scene.layers.size(); ++k)
+        friction_[k].emplace(scene.layers[k].force_law.friction, scene.layers[k].material.viscoelastic);
   }
 
   /// Friction, damping and cutting (N) after the model's step to `needle`.
@@ -104,7 +105,7 @@ class ShaftForcesOfModel {
 
  private:
   const Scene& scene_;
-  std::vector<std::optional<KarnoppFriction>> friction_;
+  std::vector<std::optional<LayerShaftFriction>> friction_;
   std::vector<double> front_m_;
   std::vector<double> break_m_, release_N_, release_length_m_;  ///< rupture release per layer (cutting.hpp)
   double deepest_m_ = -std::numeric_limits<double>::infinity();
