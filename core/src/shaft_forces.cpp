@@ -35,9 +35,12 @@ CuttingForceParts open_crack_force_N(const ForceLaw& law, double& front_m, doubl
                                      double axial_speed_m_per_s, NextLayerContact next, double fracture_limit_N) {
   if (next == NextLayerContact::Touched) return {};
   const double release = cutting_force_N(1.0, law.cutting_release_m, front_m, tip_axial_m);
+  // The crack grows (and costs its fracture energy) only while the tip moves
+  // in at its front; otherwise the same force is the bevel's pressure.
+  const bool advancing = axial_speed_m_per_s > 0.0 && tip_axial_m >= front_m;
   front_m = std::max(front_m, tip_axial_m);
   const CuttingForceParts c = rate_cutting_force(law, axial_speed_m_per_s);
-  const double fracture = std::min(c.fracture_N, fracture_limit_N);
+  const double fracture = advancing ? std::min(c.fracture_N, fracture_limit_N) : 0.0;
   return {fracture * release, (c.bevel_N + c.fracture_N - fracture) * release};
 }
 

@@ -379,16 +379,20 @@ TEST(ForceLaw, CuttingPlusFrictionAfterThePunctureReversingOnWithdrawal) {
     EXPECT_NEAR(r.total_force_N, 0.8 + 20.0 * r.depth_m, 1e-12);
     EXPECT_EQ(r.tip_force_N, 0.0);
   });
-  // Dwell: the same force.
+  // Dwell: the same force; the crack does not grow, so it is the bevel's (tip) force.
   for (int i = 0; i < 50; ++i) {
     t += 1e-3;
     const TickResult& r = sim.tick(needle_at(4.8e-3, 0.0, t));
     EXPECT_NEAR(r.total_force_N, 0.8 + 20.0 * 4.8e-3, 1e-12);
+    EXPECT_EQ(r.cutting_force_N, 0.0);
+    EXPECT_NEAR(r.tip_force_N, 0.8, 1e-12);
   }
-  // Withdrawal: cutting released linearly over 0.1 mm, friction reversed at once.
+  // Withdrawal: the crack's force released linearly over 0.1 mm (as tip
+  // force: no growth), friction reversed at once.
   drive(sim, t, 4.8e-3, 1e-3, 0.01, [&](const TickResult& r) {
     const double backed_off = 4.8e-3 - r.depth_m;
-    EXPECT_NEAR(r.cutting_force_N, 0.8 * std::max(0.0, 1.0 - backed_off / 0.1e-3), 1e-9);
+    EXPECT_EQ(r.cutting_force_N, 0.0);
+    EXPECT_NEAR(r.tip_force_N, 0.8 * std::max(0.0, 1.0 - backed_off / 0.1e-3), 1e-9);
     EXPECT_NEAR(r.friction_force_N, -20.0 * r.depth_m, 1e-12);
   });
   // Re-insertion inside the existing crack: no cutting until the old front.
@@ -402,7 +406,8 @@ TEST(ForceLaw, ARateDependentCutIsSplitIntoTipAndCuttingForceAndFollowsTheSpeed)
   // The 5 mm layer of the test above cut with C = 0.8 N, b = 0.25 at
   // v_ref = 10 mm/s (cutting.hpp): at 20 mm/s the tick reports the fracture part
   // 0.6 N as cutting and the viscous part 0.2 x 2 = 0.4 N as tip force; at
-  // 5 mm/s 0.6 + 0.1 N; standing on the crack front (a dwell) 0.6 N only.
+  // 5 mm/s 0.6 + 0.1 N; standing on the crack front (a dwell) 0.6 N only,
+  // as tip force: the crack does not grow.
   Scene scene = single_layer_scene();
   scene.layers.push_back(test::table2_layer("b", 20e-3, 200.0, 0.0, 4, 1e-3, 100.0, 1.0, 0.05));
   scene.layers[1].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
@@ -431,7 +436,8 @@ TEST(ForceLaw, ARateDependentCutIsSplitIntoTipAndCuttingForceAndFollowsTheSpeed)
     t += 1e-3;
     const TickResult& r = sim.tick(needle_at(4.7e-3, 0.0, t));
     EXPECT_NEAR(r.total_force_N, 0.6, 1e-12);
-    EXPECT_EQ(r.tip_force_N, 0.0);
+    EXPECT_NEAR(r.tip_force_N, 0.6, 1e-12);
+    EXPECT_EQ(r.cutting_force_N, 0.0);
   }
 }
 

@@ -34,7 +34,10 @@
 // fracture; the rest is the bevel's static resistance, reported with the
 // viscous part as tip force (shaft_forces.hpp). The FEM's cutting column is
 // exactly its cohesive energy per unit advance (reference_fem/README.md), so the
-// parts are compared like for like. The total force does not change.
+// parts are compared like for like; for the same reason nothing is fracture
+// while the crack does not grow (the needle dwells or backs off): the force
+// the tip still feels is the bevel's pressure on uncut tissue. The total
+// force does not change.
 //
 // Rupture release (ForceLaw::rupture_release_m, l > 0). A layer does not let
 // go of its load at once when it breaks: the crack opens through a cohesive

@@ -64,7 +64,11 @@ enum class NextLayerContact {
 /// axial_speed_m_per_s (m/s): C(v) of cutting.hpp times its release factor
 /// while the crack is open (next != Touched), else 0; of its fracture part
 /// at most fracture_limit_N (N, before the release factor; G_c w, cutting.hpp)
-/// counts as fracture, the rest goes to the bevel's part.
+/// counts as fracture, the rest goes to the bevel's part. The crack grows only
+/// while the tip moves in (speed > 0) at its front: otherwise (a dwell, a
+/// retraction) nothing is fracture and the whole force is the bevel's part,
+/// as the FEM's cutting column (its cohesive energy per unit advance) is 0
+/// there. The total does not depend on the split.
 CuttingForceParts open_crack_force_N(const ForceLaw& law, double& front_m, double tip_axial_m,
                                      double axial_speed_m_per_s, NextLayerContact next,
                                      double fracture_limit_N = std::numeric_limits<double>::infinity());
