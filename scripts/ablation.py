@@ -10,7 +10,8 @@ friction, the critical-force breakthrough, the rupture release (the load at a
 break let go over the release length instead of at once), the breakthrough's
 rate law (its threshold x (v / v_ref)^n, n identified with d at two speeds), the rate laws of
 the cutting force (C [(1 - b) + b v / v_ref]) and of the release length (l (v_b / v_ref)^m), b
-and m identified with d and n, the coupled surfaces
+and m identified with d and n, the shaft's contact pressure relaxing with each layer's Prony
+series (no fitted parameter), the coupled surfaces
 (= the tuned preset as calibrated) and layer interaction in place of the coupled surfaces. Each row is validated (`puncture validate SCENE --cases
 CASES_JSON`, FEM from out/.fem_cache) on every case of the cases file; its tick
 cost is the wall time of `puncture run` on the default trajectory (ticks with
@@ -30,9 +31,12 @@ import results_io
 
 
 def rows(tuned, paper):
-    def variant(effects, ring_rule, release=True, rate=True, cutting_rate=True):
+    def variant(effects, ring_rule, release=True, rate=True, cutting_rate=True, relaxation=True):
         s = json.loads(json.dumps(tuned), object_pairs_hook=collections.OrderedDict)
         s["effects"] = effects
+        if not relaxation:
+            for l in s["layers"]:
+                l["force_law"].get("friction", {}).pop("pressure_relaxation", None)
         if not cutting_rate:
             for l in s["layers"]:
                 l["force_law"].pop("cutting_rate", None)
@@ -58,13 +62,15 @@ def rows(tuned, paper):
         ("tuned force meshes, linear springs, ring rule, no other mechanism", variant(base, True)),
         ("+ stiffening (in the mesh where identified from the surface, else of the tip spring)",
          variant(base + ["stiffening"], True)),
-        ("+ cutting", variant(base + ["stiffening", "cutting"], True, False, cutting_rate=False)),
-        ("+ shaft friction", variant(base + ["stiffening", "cutting", "friction"], True, False, cutting_rate=False)),
+        ("+ cutting", variant(base + ["stiffening", "cutting"], True, False, cutting_rate=False, relaxation=False)),
+        ("+ shaft friction", variant(base + ["stiffening", "cutting", "friction"], True, False, cutting_rate=False, relaxation=False)),
         ("+ critical-force breakthrough",
-         variant(base + ["stiffening", "cutting", "friction"], False, False, False, cutting_rate=False)),
-        ("+ rupture release", variant(base + ["stiffening", "cutting", "friction"], False, True, False, cutting_rate=False)),
-        ("+ breakthrough rate law", variant(base + ["stiffening", "cutting", "friction"], False, cutting_rate=False)),
-        ("+ rate laws of cutting and release", variant(base + ["stiffening", "cutting", "friction"], False)),
+         variant(base + ["stiffening", "cutting", "friction"], False, False, False, cutting_rate=False, relaxation=False)),
+        ("+ rupture release", variant(base + ["stiffening", "cutting", "friction"], False, True, False, cutting_rate=False, relaxation=False)),
+        ("+ breakthrough rate law", variant(base + ["stiffening", "cutting", "friction"], False, cutting_rate=False, relaxation=False)),
+        ("+ rate laws of cutting and release", variant(base + ["stiffening", "cutting", "friction"], False, relaxation=False)),
+        ("+ shaft pressure relaxation (the layers' Prony series)",
+         variant(base + ["stiffening", "cutting", "friction"], False)),
         ("+ coupled surfaces (the tuned preset)",
          variant(base + ["stiffening", "cutting", "friction", "coupled_surfaces"], False)),
         ("+ layer interaction (in place of coupled surfaces)",

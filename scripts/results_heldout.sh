@@ -13,5 +13,5 @@ out=results/validation_heldout
 source scripts/results_folder.sh
 replace_results_folder "$out" mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json \
   --cases validation/cases/default_heldout.json -o "$out" --no-vtk -q \
-  --model-note "every parameter but d, n and b calibrated on the calibration trajectory (10 mm/s) only, results/tuned_preset/single_speed; d, the breakthrough rate exponents n and the cutting viscous fractions b then from the viscoelastic FEM at 1 and 10 mm/s with the rest kept; 3 and 20 mm/s, the 25 mm hold and the other slab never seen"
+  --model-note "every parameter but d, n, b, m and the shaft friction calibrated on the calibration trajectory (10 mm/s) only, results/tuned_preset/single_speed; d, the breakthrough rate exponents n, the cutting viscous fractions b, the release rate exponents m and the shaft friction (f_d, presliding; its pressure relaxes with each layer's Prony series, not fitted) then from the viscoelastic FEM at 1 and 10 mm/s with the rest kept; 3 and 20 mm/s, the 25 mm hold and the other slab never seen"
 echo "wrote $out"

@@ -54,11 +54,13 @@ rate=()
   --integrator implicit --force-weight 4 --depth-weight 1 --surface-fit
 # d, the breakthrough rate exponents n (core/include/puncture/breakthrough_rate.hpp), the
 # cutting viscous fractions b and release rate exponents m (core/include/puncture/cutting.hpp)
-# from two speeds, every other parameter kept at the single-speed values
-# (tuning them on both speeds at once let the muscle stop puncturing).
+# from two speeds, with the shaft friction (f_d and presliding): at one speed the
+# friction cannot be told from d h v, so the single-speed step's split (d at its start
+# value) would stay; every other parameter kept at the single-speed values (tuning
+# them on both speeds at once let the muscle stop puncturing).
 "${mpi[@]}" "$build/apps/puncture" calibrate results/tuned_preset/single_speed/default_tuned_single_speed.json -o results/tuned_preset \
   --name default_tuned --integrator implicit --force-weight 4 --depth-weight 1 --fem-speeds 1,10 \
-  --keep K,breakthrough,cutting,friction,stiffening
+  --keep K,breakthrough,cutting,stiffening
 shared="${PUNCTURE_SHARED_DATA_DIR:-$root/../shared/data}"
 "$build/apps/puncture" calibrate scenes/liver_okamura.json -o results/liver_calibration --name liver_tuned \
   --reference "$shared/okamura2004_liver_depth_force.csv" --reference-depth-offset 9.5 --puncture-depths 9.65,9.66
