@@ -156,17 +156,62 @@ SundialsIntegrator::SundialsIntegrator(OdeSystem& system, const IntegratorSettin
 
 SundialsIntegrator::~SundialsIntegrator() = default;
 
-void SundialsIntegrator::advance(double t_out, Eigen::VectorXd& y) {
-  if (!(t_out > time_)) throw std::invalid_argument("SundialsIntegrator::advance: t_out must be after the current time");
-  realtype t_reached = time_;
+int SundialsIntegrator::integrate_to(double t_out, double& t_reached) {
+  realtype reached = time_;
   impl_->last_error.clear();
   const int flag = settings_.kind == IntegratorKind::ImplicitBdf
-                       ? CVode(impl_->memory, t_out, impl_->y, &t_reached, CV_NORMAL)
-                       : ERKStepEvolve(impl_->memory, t_out, impl_->y, &t_reached, ARK_NORMAL);
+                       ? CVode(impl_->memory, t_out, impl_->y, &reached, CV_NORMAL)
+                       : ERKStepEvolve(impl_->memory, t_out, impl_->y, &reached, ARK_NORMAL);
+  t_reached = reached;
+  return flag;
+}
+
+namespace {
+/// Failures a restart with smaller steps can cure (not a fatal rhs, not too much work).
+bool restartable(IntegratorKind kind, int flag) {
+  if (kind == IntegratorKind::ImplicitBdf)
+    return flag == CV_ERR_FAILURE || flag == CV_CONV_FAILURE || flag == CV_REPTD_RHSFUNC_ERR ||
+           flag == CV_FIRST_RHSFUNC_ERR || flag == CV_LSETUP_FAIL || flag == CV_LSOLVE_FAIL;
+  return flag == ARK_ERR_FAILURE || flag == ARK_REPTD_RHSFUNC_ERR || flag == ARK_FIRST_RHSFUNC_ERR;
+}
+}  // namespace
+
+void SundialsIntegrator::advance(double t_out, Eigen::VectorXd& y) {
+  if (!(t_out > time_)) throw std::invalid_argument("SundialsIntegrator::advance: t_out must be after the current time");
+  const double t_start = time_;
+  const Eigen::VectorXd y_start = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(impl_->y), impl_->n);
+  double t_reached = t_start;
+  int flag = integrate_to(t_out, t_reached);
+  const bool bdf = settings_.kind == IntegratorKind::ImplicitBdf;
+  for (int attempt = 1; flag < 0 && attempt <= kRecoveryAttempts && restartable(settings_.kind, flag); ++attempt) {
+    // Restart the interval from its start with smaller first and largest steps.
+    ++recoveries_;
+    const std::string failure = impl_->last_error;
+    const double cut = std::pow(kRecoveryStepCut, attempt);
+    const double span = t_out - t_start;
+    const double max_step = settings_.max_step_s > 0.0 ? std::min(settings_.max_step_s, span) / cut : span / cut;
+    reinit(t_start, y_start, FirstStep::Estimate);
+    if (bdf) {
+      check(CVodeSetInitStep(impl_->memory, max_step / cut), "CVodeSetInitStep");
+      check(CVodeSetMaxStep(impl_->memory, max_step), "CVodeSetMaxStep");
+    } else {
+      check(ERKStepSetInitStep(impl_->memory, max_step / cut), "ERKStepSetInitStep");
+      check(ERKStepSetMaxStep(impl_->memory, max_step), "ERKStepSetMaxStep");
+    }
+    flag = integrate_to(t_out, t_reached);
+    if (flag < 0 && impl_->last_error.empty()) impl_->last_error = failure;
+    // The caps hold for the interval only.
+    const double settings_max = settings_.max_step_s > 0.0 ? settings_.max_step_s : 0.0;  // 0: no limit
+    if (bdf)
+      check(CVodeSetMaxStep(impl_->memory, settings_max), "CVodeSetMaxStep");
+    else
+      check(ERKStepSetMaxStep(impl_->memory, settings_max), "ERKStepSetMaxStep");
+  }
   if (flag < 0) {
     std::ostringstream s;
     s << "time integration (" << to_string(settings_.kind) << ") failed at t = " << t_reached << " s on the way to "
-      << t_out << " s: " << (impl_->last_error.empty() ? "flag " + std::to_string(flag) : impl_->last_error);
+      << t_out << " s" << (restartable(settings_.kind, flag) ? " (also after restarts with smaller steps)" : "") << ": "
+      << (impl_->last_error.empty() ? "flag " + std::to_string(flag) : impl_->last_error);
     throw std::runtime_error(s.str());
   }
   time_ = t_out;

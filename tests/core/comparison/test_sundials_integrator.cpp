@@ -188,5 +188,62 @@ TEST(SundialsIntegrator, NonFiniteRightHandSideIsAClearError) {
   EXPECT_THROW(parse_integrator_kind("rk45"), std::invalid_argument);
 }
 
+/// y' = -y whose rhs fails (recoverably) when evaluated at `failing_time`:
+/// `failures` times, or always (-1). A restart of the integrator at that
+/// time makes its first evaluation fail, which CVODE does not retry.
+class FlakySystem : public OdeSystem {
+ public:
+  int size() const override { return 1; }
+  int rhs(double t, const double* y, double* ydot) override {
+    if (t == failing_time && failures != 0) {
+      if (failures > 0) --failures;
+      return 1;
+    }
+    ydot[0] = -y[0];
+    return 0;
+  }
+  double failing_time = -1.0;
+  long failures = 0;
+};
+
+TEST(SundialsIntegrator, AnIntervalSundialsGivesUpOnIsRestartedWithSmallerSteps) {
+  IntegratorSettings settings;
+  settings.kind = IntegratorKind::ImplicitBdf;
+  settings.absolute_tolerance = Eigen::VectorXd::Constant(1, 1e-10);
+  settings.relative_tolerance = 1e-8;
+  {
+    FlakySystem system;
+    Eigen::VectorXd y = Eigen::VectorXd::Ones(1);
+    SundialsIntegrator integrator(system, settings, 0.0, y);
+    integrator.advance(0.1, y);
+    // A restart (as after a contact change) whose first evaluation fails once.
+    system.failing_time = 0.1;
+    system.failures = 1;
+    integrator.reinit(0.1, y);
+    integrator.advance(0.2, y);
+    EXPECT_EQ(integrator.recoveries(), 1);
+    EXPECT_NEAR(y[0], std::exp(-0.2), 1e-6);
+    integrator.advance(1.0, y);
+    EXPECT_NEAR(y[0], std::exp(-1.0), 1e-6);
+  }
+  {
+    FlakySystem system;  // failing every time: a clear error naming the restarts
+    Eigen::VectorXd y = Eigen::VectorXd::Ones(1);
+    SundialsIntegrator integrator(system, settings, 0.0, y);
+    integrator.advance(0.1, y);
+    system.failing_time = 0.1;
+    system.failures = -1;
+    integrator.reinit(0.1, y);
+    try {
+      integrator.advance(0.2, y);
+      ADD_FAILURE() << "expected a failure";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("also after restarts with smaller steps"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(integrator.recoveries(), SundialsIntegrator::kRecoveryAttempts);
+    EXPECT_TRUE(y.allFinite());
+  }
+}
+
 }  // namespace
 }  // namespace puncture::comparison

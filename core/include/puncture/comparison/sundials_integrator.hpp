@@ -16,8 +16,13 @@
 // In:  an OdeSystem (size, rhs, optional preconditioner / J v), settings,
 //      t0, y0. Out: advance(t_out, y) = y(t_out) (dense output of the
 //      integrator when it stepped past t_out), statistics.
-// Failures (rhs returning a fatal error, too many steps, error test or
-// convergence failures at the minimum step) throw std::runtime_error with
+// Recovery: when SUNDIALS gives up on an interval (error test or
+// convergence failures, repeated recoverable rhs failures), advance()
+// restarts it from the state at its start with a first step and a largest
+// step kRecoveryStepCut times smaller at each of kRecoveryAttempts attempts
+// (a restart also drops the BDF order back to 1); the caps are lifted again
+// once the interval is done. What still fails (rhs returning a fatal error,
+// too many steps, every attempt failing) throws std::runtime_error with
 // SUNDIALS's message and the time reached; nothing non-finite is returned:
 // a non-finite rhs is reported to SUNDIALS as recoverable, so it retries with
 // a smaller step.
@@ -94,8 +99,14 @@ class SundialsIntegrator {
   SundialsIntegrator(const SundialsIntegrator&) = delete;
   SundialsIntegrator& operator=(const SundialsIntegrator&) = delete;
 
+  /// Restarts of one interval after SUNDIALS gave up on it (see above).
+  static constexpr int kRecoveryAttempts = 3;
+  static constexpr double kRecoveryStepCut = 10.0;
+
   /// Integrates to t_out (> current time) and returns y(t_out).
   void advance(double t_out, Eigen::VectorXd& y);
+  /// Intervals restarted after a failure (each attempt counts), since construction.
+  long recoveries() const { return recoveries_; }
   /// How a restart chooses its first step.
   enum class FirstStep {
     /// A quarter of the last step taken (the integrator's own estimate when
@@ -125,6 +136,8 @@ class SundialsIntegrator {
   IntegratorSettings settings_;
   double time_ = 0.0;
   long reinits_ = 0;
+  long recoveries_ = 0;
+  int integrate_to(double t_out, double& t_reached);
   IntegratorStats before_restarts_;  ///< totals of the runs before the last restart
   IntegratorStats current_stats() const;
   std::unique_ptr<Impl> impl_;
