@@ -83,6 +83,7 @@ bool writes_vtk(const ValidateOptions& options) {
 struct SceneValidation {
   std::vector<validation::LayerAcceptance> acceptance;
   nlohmann::json layers;
+  nlohmann::json trajectory_terms;  ///< trajectory_terms_json
 };
 
 /// The real-time run along the FEM's trajectory: every tick's ring
@@ -352,7 +353,7 @@ std::optional<SceneValidation> validate_scene(const Scene& scene, const std::str
                                       puncture_force_shares_markdown(shares)));
   summary_session.commit();
   print_result(out, scene, reference, c.cmp, c.acceptance, layers, dir);
-  return SceneValidation{c.acceptance, layers};
+  return SceneValidation{c.acceptance, layers, trajectory_terms_json(c.trajectory)};
 }
 
 std::string vtk_flag(const ValidateOptions& options) { return writes_vtk(options) ? "" : " --no-vtk"; }
@@ -389,7 +390,7 @@ int validate_cases(const ValidateOptions& options, const std::filesystem::path& 
     const std::string scene_file = (case_dir / "scene.json").string();
     const auto result = validate_scene(scenes[i].scene, scene_file, case_dir, command_line, options, out, err);
     if (!result) continue;
-    outcomes.push_back({c, scene_file, result->acceptance, result->layers});
+    outcomes.push_back({c, scene_file, result->acceptance, result->layers, result->trajectory_terms});
   }
   if (!validation::is_mpi_root()) return 0;
   const io::Provenance provenance = io::make_provenance(command_line);

@@ -66,8 +66,10 @@ TEST_P(NoAllocationTick, FullInsertionAllocatesNothing) {
 
 INSTANTIATE_TEST_SUITE_P(Integrators, NoAllocationTick, ::testing::Values("quasi_static", "explicit", "implicit"));
 
-// Every force-law effect on (layer interaction, cutting, Karnopp friction,
-// tip stiffening, critical-force and critical-energy breakthrough) and the
+// Every force-law effect on (layer interaction, cutting, Karnopp friction
+// whose contact pressure relaxes, with a tau short enough that every tick
+// pushes a pass-time entry, tip stiffening, critical-force and
+// critical-energy breakthrough) and the
 // needle off the scene axis, so that the force meshes are laid out again at
 // the contact point inside the counted ticks.
 TEST_P(NoAllocationTick, EveryForceLawEffectOffAxisAllocatesNothing) {
@@ -80,6 +82,8 @@ TEST_P(NoAllocationTick, EveryForceLawEffectOffAxisAllocatesNothing) {
     law.breakthrough.critical_energy_J = 0.2e-3;
     law.cutting_force_N = 0.3;
     law.friction.dynamic_N_per_m = law.friction.static_N_per_m = 10.0;
+    law.friction.pressure_relaxes_with_material = true;
+    scene.layers[k].material.viscoelastic.terms = {{0.5, 0.02}};  // merge window 0.2 ms < the 1 ms tick
     law.stiffening.quadratic_N_per_m2 = 2e4;
   }
   scene.layers[0].force_mesh.virtual_stiffness_N_per_m = 2000.0;
@@ -107,6 +111,8 @@ TEST_P(NoAllocationTick, EveryForceLawEffectOffAxisAllocatesNothing) {
   EXPECT_EQ(sim.puncture_events().size(), 3u);
   EXPECT_GT(cutting, 0.0);
   EXPECT_GT(friction, 0.0);
+  ASSERT_NE(sim.shaft_contact_pressure(2), nullptr);
+  EXPECT_TRUE(sim.shaft_contact_pressure(2)->relaxes());
   EXPECT_NEAR(sim.force_mesh(0)->rest_positions()(0, 0), 2e-3, 1e-15);  // laid where the needle touched
   EXPECT_NEAR(sim.force_mesh(2)->rest_positions()(1, 0), -1e-3, 1e-15);
 }

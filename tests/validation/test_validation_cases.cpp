@@ -194,5 +194,31 @@ TEST(ValidationCases, SummaryRowsNameEveryMissAndCountHeldOutLayers) {
   EXPECT_NE(md.find("`fast` (rule): keep them."), std::string::npos) << md;
 }
 
+TEST(ValidationCases, SummaryListsEachCasesWholeTrajectoryTermsWithoutTheLayerTerms) {
+  CaseOutcome hold;
+  hold.validation_case.name = "hold";
+  hold.validation_case.held_out = true;
+  hold.trajectory_terms = nlohmann::json::array(
+      {{{"term", "overall"}, {"layer", ""}, {"available", true}, {"value", 0.0486}, {"samples", 127}},
+       {{"term", "force_rmse"}, {"layer", "skin"}, {"available", true}, {"value", 0.051}, {"samples", 40}},
+       {{"term", "dwell"}, {"layer", ""}, {"available", true}, {"value", 0.0429}, {"samples", 9}},
+       {{"term", "withdrawal"}, {"layer", ""}, {"available", false}, {"samples", 0}}});
+  CaseOutcome none;  // a case without terms (e.g. an older outcome): n/a in every column
+  none.validation_case.name = "none";
+  const nlohmann::json summary = heldout_summary_json({hold, none}, "model.json", "", "cases.json", {});
+  const nlohmann::json& rows = summary["cases"][0]["whole_trajectory"];
+  ASSERT_EQ(rows.size(), 3u) << rows.dump();  // the skin's layer term is left out
+  EXPECT_EQ(rows[0]["term"], "overall");
+  EXPECT_DOUBLE_EQ(rows[0]["force_rmse_relative"].get<double>(), 0.0486);
+  EXPECT_EQ(rows[1]["term"], "dwell");
+  EXPECT_EQ(rows[1]["samples"], 9);
+  EXPECT_TRUE(rows[2]["force_rmse_relative"].is_null());  // not available
+  EXPECT_TRUE(summary["cases"][1]["whole_trajectory"].empty());
+  const std::string md = heldout_summary_markdown(summary, "puncture validate model.json --cases cases.json", "git x");
+  EXPECT_NE(md.find("| case | held out | overall | dwell | withdrawal |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| hold | yes | 0.049 | 0.043 | n/a |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| none | no (in sample) | n/a | n/a | n/a |"), std::string::npos) << md;
+}
+
 }  // namespace
 }  // namespace puncture::validation

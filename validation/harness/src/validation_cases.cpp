@@ -180,6 +180,24 @@ json case_layer_rows(const CaseOutcome& outcome) {
   return rows;
 }
 
+namespace {
+
+/// The whole-trajectory terms of one case (those without a layer): term ->
+/// force RMSE over the FEM's peak (null where the term is not available).
+json whole_trajectory_rows(const json& terms) {
+  json rows = json::array();
+  for (const json& t : terms) {
+    if (!t.value("layer", std::string()).empty()) continue;
+    const bool available = t.value("available", false) && t.contains("value");
+    rows.push_back({{"term", t.value("term", std::string())},
+                    {"force_rmse_relative", available ? t["value"] : json(nullptr)},
+                    {"samples", t.value("samples", 0)}});
+  }
+  return rows;
+}
+
+}  // namespace
+
 json heldout_summary_json(const std::vector<CaseOutcome>& outcomes, const std::string& model_file,
                           const std::string& model_note, const std::string& cases_file, const json& provenance) {
   json cases = json::array();
@@ -190,7 +208,8 @@ json heldout_summary_json(const std::vector<CaseOutcome>& outcomes, const std::s
                      {"scene", o.scene_file},
                      {"rule", c.rule.empty() ? json(nullptr) : json(c.rule)},
                      {"note", c.note.empty() ? json(nullptr) : json(c.note)},
-                     {"layers", case_layer_rows(o)}});
+                     {"layers", case_layer_rows(o)},
+                     {"whole_trajectory", whole_trajectory_rows(o.trajectory_terms)}});
   }
   return {{"model", model_file},
           {"model_note", model_note},
@@ -236,6 +255,32 @@ std::string heldout_summary_markdown(const json& summary, const std::string& com
   md << "\nHeld out: " << accepted << " of " << held
      << " layer-cases accepted. Rules for cases that change the slab are in the cases file. Each case's report "
         "(validation_summary.md, plots, the case's scene.json) is in its folder.\n";
+  // The whole trajectory per case: the columns are the first case's terms.
+  std::vector<std::string> terms;
+  for (const json& c : summary["cases"])
+    if (terms.empty() && c.contains("whole_trajectory"))
+      for (const json& t : c["whole_trajectory"]) terms.push_back(t["term"].get<std::string>());
+  if (!terms.empty()) {
+    md << "\n## The whole trajectory, per case\n\nForce RMSE over the FEM's peak of each case (the real-time "
+          "model's whole force, d h v included; `overall` and the parts over the insertion, `dwell` and "
+          "`withdrawal` over those phases; not part of the acceptance above).\n\n| case | held out |";
+    for (const std::string& t : terms) md << " " << t << " |";
+    md << "\n|---|---|";
+    for (std::size_t i = 0; i < terms.size(); ++i) md << "---|";
+    md << "\n";
+    for (const json& c : summary["cases"]) {
+      md << "| " << c["name"].get<std::string>() << " | " << (c["held_out"].get<bool>() ? "yes" : "no (in sample)")
+         << " |";
+      for (const std::string& name : terms) {
+        json value = nullptr;
+        if (c.contains("whole_trajectory"))
+          for (const json& t : c["whole_trajectory"])
+            if (t["term"] == name) value = t["force_rmse_relative"];
+        md << " " << fixed(value, 3) << " |";
+      }
+      md << "\n";
+    }
+  }
   for (const json& c : summary["cases"])
     for (const char* key : {"rule", "note"})
       if (c.contains(key) && c[key].is_string())

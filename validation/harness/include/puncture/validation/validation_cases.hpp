@@ -63,13 +63,17 @@ struct CaseScene {
 /// differs from its layers).
 CaseScene case_scene(const std::string& model_json_text, const std::string& model_file, const ValidationCase& c);
 
-/// One case's outcome: the acceptance per layer and the layer metrics JSON of
-/// `puncture validate` (layer_metrics_json, for the puncture depth error).
+/// One case's outcome: the acceptance per layer, the layer metrics JSON of
+/// `puncture validate` (layer_metrics_json, for the puncture depth error) and
+/// its whole-trajectory terms (validation_metrics.json "trajectory_terms":
+/// {"term", "layer", "available", "value", ...}; those without a layer are
+/// summarised: the insertion, the force's parts, the dwell, the withdrawal).
 struct CaseOutcome {
   ValidationCase validation_case;
   std::string scene_file;  ///< where the case's scene was written
   std::vector<LayerAcceptance> acceptance;
   nlohmann::json layers = nlohmann::json::array();
+  nlohmann::json trajectory_terms = nlohmann::json::array();
 };
 
 /// The "layers" rows of one case (see above).
@@ -79,7 +83,8 @@ nlohmann::json heldout_summary_json(const std::vector<CaseOutcome>& outcomes, co
                                     const std::string& model_note, const std::string& cases_file,
                                     const nlohmann::json& provenance);
 /// heldout_summary.md from the summary JSON: one row per case and layer, the
-/// count of held-out layer-cases accepted, each case's rule and note.
+/// count of held-out layer-cases accepted, one row per case of its
+/// whole-trajectory force errors, each case's rule and note.
 std::string heldout_summary_markdown(const nlohmann::json& summary, const std::string& command,
                                      const std::string& provenance_line);
 
