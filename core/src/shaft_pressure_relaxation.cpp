@@ -39,15 +39,6 @@ void ShaftPressureRelaxation::halve_stack() {
   stack_.resize(n);
 }
 
-void ShaftPressureRelaxation::reset() {
-  stack_.clear();
-  std::fill(weighted_m_.begin(), weighted_m_.end(), 0.0);
-  length_m_ = 0.0;
-  time_s_ = 0.0;
-  started_ = false;
-  relaxed_m_ = 0.0;
-}
-
 double ShaftPressureRelaxation::update(double shaft_length_m, double time_s) {
   const double h = std::max(shaft_length_m, 0.0);
   if (terms_.empty()) return relaxed_m_ = h;

@@ -41,8 +41,6 @@ TEST(ShaftPressureRelaxation, WithoutTermsTheContactLengthIsTheShaftLength) {
 }
 
 TEST(ShaftPressureRelaxation, InsertionAtConstantSpeedMatchesTheClosedForm) {
-  ShaftPressureRelaxation p(muscle());
-  p.update(0.0, 0.0);
   for (double t : {0.5, 2.0, 6.0, 20.0}) {
     ShaftPressureRelaxation q(muscle());
     q.update(0.0, 0.0);

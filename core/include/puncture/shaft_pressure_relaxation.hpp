@@ -60,7 +60,6 @@ class ShaftPressureRelaxation {
   bool relaxes() const { return !terms_.empty(); }
   /// Stack entries held (for tests of the memory bound).
   std::size_t entries() const { return stack_.size(); }
-  void reset();
 
  private:
   void halve_stack();
