@@ -5,6 +5,7 @@
 //   puncture calibrate [SCENE] [--reference CSV] [-o DIR]   tuned preset
 //   puncture sweep     [SCENE] [-o DIR]   accuracy versus time of every fidelity knob
 //   puncture grade SCORES.csv [-o DIR]    comprehensive weighted grading (paper Sec. 3.3)
+//   puncture slab-rule PRESET... [-o DIR] each layer's parameters from its thickness, fitted on a family of slabs
 //   puncture compare   [SCENE] [-o DIR]   comparison models of both papers against the FEM
 //   puncture --version
 // Exit codes: 0 success, 1 the run failed, 2 bad input (scene, CSV, command
@@ -39,6 +40,7 @@ struct CommandLine {
   CalibrateOptions calibrate;
   SweepOptions sweep;
   GradeOptions grade;
+  SlabRuleOptions slab_rule;
 #ifdef PUNCTURE_HAVE_COMPARE
   CompareOptions compare;
 #endif
@@ -149,6 +151,11 @@ CLI::App* add_calibrate(CLI::App& app, CommandLine& c) {
                             "Keep at the scene's values: K, breakthrough, cutting, friction, stiffening (comma "
                             "separated); default: tune each whose effect is on")
       ->delimiter(',');
+  calibrate_cmd->add_option("--layer-thickness", c.calibrate.layer_thickness_mm,
+                            "Calibrate on another slab: the scene with these layer thicknesses (mm, one per layer "
+                            "from the top, comma separated) and that slab's FEM reference; for the family of a slab "
+                            "rule; default: the scene's")
+      ->delimiter(',');
   calibrate_cmd->add_flag("-q,--quiet", c.calibrate.quiet, "Nothing on stdout (warnings and errors still on stderr)");
   return calibrate_cmd;
 }
@@ -160,6 +167,17 @@ CLI::App* add_sweep(CLI::App& app, CommandLine& c) {
                       "Do not sweep FEM refinement and degree");
   sweep_cmd->add_flag("-q,--quiet", c.sweep.quiet, "Nothing on stdout (warnings and errors still on stderr)");
   return sweep_cmd;
+}
+
+CLI::App* add_slab_rule(CLI::App& app, CommandLine& c) {
+  CLI::App* cmd = app.add_subcommand(
+      "slab-rule", "Each layer's real-time parameters as a power law in its thickness, fitted on presets calibrated "
+                   "on a family of slabs (for validation cases on other slabs)");
+  cmd->add_option("presets", c.slab_rule.presets, "Tuned presets, one per slab; the first gives the reference thicknesses")
+      ->required();
+  cmd->add_option("-o,--output", c.output, "Output directory; default: out/slab_rule");
+  cmd->add_flag("-q,--quiet", c.slab_rule.quiet, "Nothing on stdout");
+  return cmd;
 }
 
 CLI::App* add_grade(CLI::App& app, CommandLine& c) {
@@ -196,7 +214,7 @@ CLI::App* add_compare(CLI::App& app, CommandLine& c) {
 
 /// The subcommands, in the order of the help text.
 struct Subcommands {
-  CLI::App *run, *fem, *validate, *calibrate, *sweep, *grade, *compare = nullptr;
+  CLI::App *run, *fem, *validate, *calibrate, *sweep, *grade, *slab_rule, *compare = nullptr;
 };
 
 /// Runs the subcommand that was parsed; returns its exit code.
@@ -232,6 +250,10 @@ int dispatch(const Subcommands& sub, CommandLine& c) {
     c.grade.scores = c.scores, c.grade.output_dir = c.output;
     return grade_command(c.grade, std::cout, std::cerr);
   }
+  if (*sub.slab_rule) {
+    c.slab_rule.output_dir = c.output;
+    return slab_rule_command(c.slab_rule, std::cout, std::cerr);
+  }
   return kExitFailure;
 }
 
@@ -254,6 +276,7 @@ int main(int argc, char** argv) {
   sub.calibrate = add_calibrate(app, c);
   sub.sweep = add_sweep(app, c);
   sub.grade = add_grade(app, c);
+  sub.slab_rule = add_slab_rule(app, c);
 #ifdef PUNCTURE_HAVE_COMPARE
   sub.compare = add_compare(app, c);
 #endif

@@ -22,6 +22,9 @@
 #include "puncture/validation/fem_comparison.hpp"
 #include "puncture/validation/fem_reference_curve.hpp"
 #include "puncture/validation/surface_identification.hpp"
+#include "puncture/validation/number_format.hpp"
+#include "puncture/validation/validation_cases.hpp"
+#include "puncture/io/atomic_file.hpp"
 
 namespace puncture::apps {
 namespace {
@@ -49,6 +52,8 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
     c << (i ? "," : " --fem-speeds ") << options.fem_speeds_mm_per_s[i];
   if (options.surface_fit) c << " --surface-fit";
   if (options.cutting_from_next_puncture) c << " --cutting-from-next-puncture";
+  for (std::size_t i = 0; i < options.layer_thickness_mm.size(); ++i)
+    c << (i ? "," : " --layer-thickness ") << options.layer_thickness_mm[i];
   return c.str();
 }
 
@@ -193,6 +198,24 @@ validation::CalibrationOptions calibration_options(const CalibrateOptions& optio
   return c;
 }
 
+/// --layer-thickness: the scene with other layer thicknesses (the override of
+/// a validation case, validation_cases.hpp; named <scene>_slab_<thicknesses>).
+Scene scene_on_slab(const std::filesystem::path& scene_path, const std::vector<double>& thickness_mm) {
+  validation::ValidationCase slab;
+  slab.name = "slab";
+  for (double t : thickness_mm) {
+    if (!(t > 0.0) || !std::isfinite(t)) throw UsageError("--layer-thickness: thicknesses must be finite and > 0 (mm)");
+    slab.name += "_" + validation::significant_digits(t, 4);
+  }
+  slab.layer_thickness_mm = thickness_mm;
+  try {
+    Scene s = validation::case_scene(io::read_text_file(scene_path), scene_path.string(), slab).scene;
+    return s;
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--layer-thickness: ") + e.what());
+  }
+}
+
 }  // namespace
 
 int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stream, std::ostream& err) {
@@ -201,6 +224,7 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
   return report_errors(err, "", [&]() -> int {
     Scene scene = load_scene(scene_path);
+    if (!options.layer_thickness_mm.empty()) scene = scene_on_slab(scene_path, options.layer_thickness_mm);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_calibration") : options.output_dir;
     std::vector<validation::ReferenceCurve> references;

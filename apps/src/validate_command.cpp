@@ -390,7 +390,9 @@ int validate_cases(const ValidateOptions& options, const std::filesystem::path& 
     const std::string scene_file = (case_dir / "scene.json").string();
     const auto result = validate_scene(scenes[i].scene, scene_file, case_dir, command_line, options, out, err);
     if (!result) continue;
-    outcomes.push_back({c, scene_file, result->acceptance, result->layers, result->trajectory_terms});
+    validation::ValidationCase shown = c;
+    for (const std::string& note : scenes[i].rule_notes) shown.rule += "; " + note;
+    outcomes.push_back({shown, scene_file, result->acceptance, result->layers, result->trajectory_terms});
   }
   if (!validation::is_mpi_root()) return 0;
   const io::Provenance provenance = io::make_provenance(command_line);

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -282,6 +283,61 @@ TEST(GradeCommand, GradesModelsFromAScoresFile) {
   options.mu = 0.4;
   options.scores = dir / "missing.csv";
   EXPECT_NE(grade_command(options, out, err), 0);
+  fs::remove_all(dir);
+}
+
+TEST(SlabRuleCommand, FitsThePresetsOfAFamilyAndRejectsBadInput) {
+  const fs::path dir = fresh_dir("slab_rule");
+  fs::create_directories(dir);
+  // Three "calibrated" presets: the default scene on three slabs with the
+  // skin's K = 100 N/m (h / 0.8 mm)^2.
+  const double skin_mm[3] = {0.8, 1.6, 1.2};
+  std::vector<fs::path> presets;
+  for (int i = 0; i < 3; ++i) {
+    Scene s = load_scene(kSourceDir / "scenes" / "default.json");
+    s.layers[0].thickness_m = skin_mm[i] * 1e-3;
+    s.layers[0].force_mesh.virtual_stiffness_N_per_m = 100.0 * std::pow(skin_mm[i] / 0.8, 2.0);
+    presets.push_back(dir / ("p" + std::to_string(i) + ".json"));
+    std::ofstream(presets.back()) << scene_to_json_text(s);
+  }
+  SlabRuleOptions options;
+  options.presets = presets;
+  options.output_dir = dir / "rule";
+  std::ostringstream out, err;
+  ASSERT_EQ(slab_rule_command(options, out, err), 0) << err.str();
+  std::ifstream in(dir / "rule" / "slab_rule.json");
+  const nlohmann::json rule = nlohmann::json::parse(in);
+  ASSERT_EQ(rule["layers"].size(), 1u);
+  EXPECT_EQ(rule["layers"][0]["layer"], "skin");
+  EXPECT_EQ(rule["layers"][0]["parameters"][0]["pointer"], "/force_mesh/K_N_per_mm");
+  EXPECT_NEAR(rule["layers"][0]["parameters"][0]["exponent"].get<double>(), 2.0, 1e-9);
+  EXPECT_TRUE(rule.contains("provenance"));
+  EXPECT_TRUE(fs::exists(dir / "rule" / "slab_rule.md"));
+
+  // One preset: a usage error, nothing written.
+  options.presets = {presets[0]};
+  options.output_dir = dir / "one";
+  EXPECT_EQ(slab_rule_command(options, out, err), kExitBadInput);
+  EXPECT_FALSE(fs::exists(dir / "one"));
+  // A negative K in one preset: bad input naming the file and the field.
+  Scene bad = load_scene(presets[1]);
+  bad.layers[0].force_mesh.virtual_stiffness_N_per_m = 0.0;
+  std::ofstream(dir / "bad.json") << scene_to_json_text(bad);
+  options.presets = {presets[0], dir / "bad.json"};
+  options.output_dir = dir / "bad";
+  std::ostringstream bad_err;
+  EXPECT_EQ(slab_rule_command(options, out, bad_err), kExitBadInput);
+  EXPECT_NE(bad_err.str().find("bad.json"), std::string::npos) << bad_err.str();
+  EXPECT_FALSE(fs::exists(dir / "bad" / "slab_rule.json"));
+
+  // calibrate --layer-thickness with one value per layer only.
+  CalibrateOptions calibrate;
+  calibrate.scene = kSourceDir / "scenes" / "default.json";
+  calibrate.output_dir = dir / "calibrate";
+  calibrate.layer_thickness_mm = {1.0, 5.0};
+  std::ostringstream calibrate_err;
+  EXPECT_EQ(calibrate_command(calibrate, out, calibrate_err), kExitBadInput);
+  EXPECT_NE(calibrate_err.str().find("--layer-thickness"), std::string::npos) << calibrate_err.str();
   fs::remove_all(dir);
 }
 

@@ -32,7 +32,7 @@ std::string optional_text(const json& c, const char* key, const std::filesystem:
 ValidationCase read_case(const json& c, const std::filesystem::path& file, const std::string& pointer) {
   if (!c.is_object()) fail(file, pointer, "a case must be an object");
   for (auto it = c.begin(); it != c.end(); ++it)
-    if (!std::set<std::string>{"name", "overrides", "held_out", "rule", "note"}.count(it.key()))
+    if (!std::set<std::string>{"name", "overrides", "held_out", "slab_rule", "rule", "note"}.count(it.key()))
       fail(file, pointer + "/" + it.key(), "unknown key");
   ValidationCase v;
   if (!c.contains("name") || !c["name"].is_string()) fail(file, pointer + "/name", "missing or not a string");
@@ -71,6 +71,29 @@ ValidationCase read_case(const json& c, const std::filesystem::path& file, const
   }
   v.rule = optional_text(c, "rule", file, pointer);
   v.note = optional_text(c, "note", file, pointer);
+  const std::string rule_file = optional_text(c, "slab_rule", file, pointer);
+  if (!rule_file.empty()) {
+    if (v.layer_thickness_mm.empty())
+      fail(file, pointer + "/slab_rule", "a slab rule needs overrides/layer_thickness_mm (the slab it is applied to)");
+    const std::filesystem::path resolved = (file.parent_path() / rule_file).lexically_normal();
+    try {
+      v.slab_rule = read_slab_rule(resolved);
+    } catch (const std::invalid_argument& e) {
+      fail(file, pointer + "/slab_rule", e.what());
+    }
+    v.slab_rule_file = resolved.string();
+    if (v.rule.empty()) {
+      std::string family;
+      for (const SlabRulePreset& p : v.slab_rule->presets) {
+        family += family.empty() ? "" : ", ";
+        for (std::size_t k = 0; k < p.thickness_mm.size(); ++k)
+          family += (k ? "/" : "") + significant_digits(p.thickness_mm[k], 3);
+      }
+      v.rule = "each layer's real-time parameters from its thickness by the slab rule " + v.slab_rule_file +
+               " (p = p_ref (h / h_ref)^alpha per layer, fitted on presets calibrated on the slabs " + family +
+               " mm; the parameters it does not name are the model's)";
+    }
+  }
   return v;
 }
 
@@ -145,8 +168,9 @@ CaseScene case_scene(const std::string& model_json_text, const std::string& mode
                                   std::to_string(s.contains("layers") ? s["layers"].size() : 0) + " layers");
     for (std::size_t k = 0; k < c.layer_thickness_mm.size(); ++k) s["layers"][k]["thickness_mm"] = c.layer_thickness_mm[k];
   }
-  s["name"] = s.value("name", std::string("scene")) + "_" + c.name;
   CaseScene out;
+  if (c.slab_rule) out.rule_notes = apply_slab_rule(s, *c.slab_rule, where);
+  s["name"] = s.value("name", std::string("scene")) + "_" + c.name;
   out.json_text = s.dump(2) + "\n";
   out.scene = parse_scene(out.json_text, where);
   return out;
@@ -207,6 +231,7 @@ json heldout_summary_json(const std::vector<CaseOutcome>& outcomes, const std::s
                      {"held_out", c.held_out},
                      {"scene", o.scene_file},
                      {"rule", c.rule.empty() ? json(nullptr) : json(c.rule)},
+                     {"slab_rule", c.slab_rule_file.empty() ? json(nullptr) : json(c.slab_rule_file)},
                      {"note", c.note.empty() ? json(nullptr) : json(c.note)},
                      {"layers", case_layer_rows(o)},
                      {"whole_trajectory", whole_trajectory_rows(o.trajectory_terms)}});

@@ -114,6 +114,10 @@ struct CalibrateOptions {
   /// Parameters kept at the scene's values: "K", "breakthrough", "cutting",
   /// "friction", "stiffening" (by default each is tuned where its effect is on).
   std::vector<std::string> keep;
+  /// Calibrate on another slab: the scene with these layer thicknesses (mm,
+  /// one per layer from the top; its FEM reference is that slab's). Empty:
+  /// the scene's own. For the family of a slab rule (slab-rule below).
+  std::vector<double> layer_thickness_mm;
   bool quiet = false;
 };
 
@@ -133,6 +137,17 @@ struct GradeOptions {
 
 /// `puncture grade`: comprehensive weighted grading (seed paper Sec. 3.3).
 int grade_command(const GradeOptions& options, std::ostream& out, std::ostream& err);
+
+struct SlabRuleOptions {
+  std::vector<std::filesystem::path> presets;  ///< calibrated on a family of slabs; the first is the reference
+  std::filesystem::path output_dir;            ///< empty: out/slab_rule
+  bool quiet = false;
+};
+
+/// `puncture slab-rule`: fits each layer's parameters as a power law in its
+/// thickness on presets calibrated on a family of slabs
+/// (validation/slab_rule.hpp); writes slab_rule.json and slab_rule.md.
+int slab_rule_command(const SlabRuleOptions& options, std::ostream& out, std::ostream& err);
 
 struct SweepOptions {
   std::filesystem::path scene;

@@ -8,19 +8,23 @@
 //               "overrides": {"insertion": {"speed_mm_per_s": 3, ...},   (fields of the scene's /insertion)
 //                             "layer_thickness_mm": [1.2, 5, 30]},       (one per layer, > 0)
 //               "held_out": true,                        (optional; default: overrides not empty)
+//               "slab_rule": "../../results/slab_rule/slab_rule.json",   (optional; relative to
+//                            the cases file: each layer's real-time parameters from its
+//                            thickness by a rule fitted on a family of slabs, slab_rule.hpp)
 //               "rule": "...", "note": "..."}]}          (optional text for the page)
 // A case without overrides is the model's own trajectory (in sample when the
 // model was calibrated on it). read_validation_cases throws
 // std::invalid_argument naming the file and the JSON path of what is wrong.
 //
 // case_scene(model_json_text, model_file, case): the model scene's JSON with
-// the case's overrides, parsed (and so checked) as a scene; its text is
-// returned too, to be written beside the case's report.
+// the case's overrides (and its slab rule applied to the overridden
+// thicknesses), parsed (and so checked) as a scene; its text is returned too,
+// to be written beside the case's report.
 //
 // Held-out summary (heldout_summary.json, the schema of the real-time
 // physics issue plus "misses", "rule", "note"):
 //   {"model", "model_note", "cases_file", "cases": [{"name", "held_out",
-//    "scene", "rule", "note", "layers": [{"layer", "force_rmse_relative",
+//    "scene", "rule", "slab_rule" (file or null), "note", "layers": [{"layer", "force_rmse_relative",
 //    "deflection_relative_rmse", "deflection_after_break_relative_rmse",
 //    "puncture_depth_error_mm", "puncture_force_error_relative",
 //    "accepted", "misses": [text]}]}], "provenance"}
@@ -28,6 +32,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +40,7 @@
 
 #include "puncture/scene.hpp"
 #include "puncture/validation/acceptance.hpp"
+#include "puncture/validation/slab_rule.hpp"
 
 namespace puncture::validation {
 
@@ -43,7 +49,9 @@ struct ValidationCase {
   bool held_out = false;
   nlohmann::json insertion_overrides = nlohmann::json::object();  ///< keys of the scene's /insertion
   std::vector<double> layer_thickness_mm;                          ///< empty: the model's thicknesses
-  std::string rule, note;
+  std::string slab_rule_file;        ///< as resolved (empty: none)
+  std::optional<SlabRule> slab_rule;  ///< read from slab_rule_file
+  std::string rule, note;  ///< rule: given, or written from the slab rule
 };
 
 struct ValidationCases {
@@ -56,6 +64,7 @@ ValidationCases read_validation_cases(const std::filesystem::path& file);
 struct CaseScene {
   Scene scene;
   std::string json_text;  ///< the scene as validated (model JSON with the overrides)
+  std::vector<std::string> rule_notes;  ///< from the slab rule (a thickness outside its family)
 };
 /// Throws SceneError (file = "<model_file> (case <name>)") when an override
 /// makes the scene invalid, std::invalid_argument for an override the model

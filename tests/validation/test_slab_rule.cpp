@@ -1,0 +1,194 @@
+// Slab rule (slab_rule.hpp): power laws in each layer's thickness fitted on
+// presets of a family of slabs, checked against closed forms (exact power
+// laws, the least-squares slope and its standard error by hand), applied to a
+// scene and through a validation case, and its errors.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "puncture/io/atomic_file.hpp"
+#include "puncture/scene_io.hpp"
+#include "puncture/validation/slab_rule.hpp"
+#include "puncture/validation/validation_cases.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace puncture::validation {
+namespace {
+
+json default_scene() {
+  return json::parse(io::read_text_file(fs::path(PUNCTURE_SOURCE_DIR) / "scenes" / "default.json"));
+}
+
+/// The default scene on slab (skin, fat, muscle) with K and the skin's
+/// cutting force set by exact power laws of each layer's thickness.
+json family_member(double skin_mm, double fat_mm, double muscle_mm) {
+  json s = default_scene();
+  const double h[3] = {skin_mm, fat_mm, muscle_mm};
+  for (int k = 0; k < 3; ++k) {
+    s["layers"][k]["thickness_mm"] = h[k];
+    s["layers"][k]["force_mesh"]["K_N_per_mm"] = 0.05 * std::pow(h[k], 1.5 - 0.5 * k);  // alpha 1.5, 1, 0.5
+  }
+  s["layers"][0]["force_law"]["cutting_force_N"] = 2.0 * std::pow(skin_mm / 0.8, 2.0);
+  return s;
+}
+
+const SlabRuleParameter* find(const SlabRule& rule, const std::string& layer, const std::string& pointer) {
+  for (const SlabRuleLayer& l : rule.layers)
+    if (l.layer == layer)
+      for (const SlabRuleParameter& p : l.parameters)
+        if (p.pointer == pointer) return &p;
+  return nullptr;
+}
+
+TEST(SlabRule, RecoversExactPowerLawsAndOnlyTheParametersThatDiffer) {
+  const SlabRule rule = fit_slab_rule({family_member(0.8, 8.4, 39), family_member(1.6, 4, 33), family_member(1.0, 6.5, 28)},
+                                      {"a.json", "b.json", "c.json"});
+  ASSERT_EQ(rule.layers.size(), 3u);
+  EXPECT_EQ(rule.presets[1].thickness_mm, (std::vector<double>{1.6, 4, 33}));
+  const SlabRuleParameter* k_skin = find(rule, "skin", "/force_mesh/K_N_per_mm");
+  const SlabRuleParameter* k_muscle = find(rule, "muscle", "/force_mesh/K_N_per_mm");
+  const SlabRuleParameter* cut = find(rule, "skin", "/force_law/cutting_force_N");
+  ASSERT_TRUE(k_skin && k_muscle && cut);
+  EXPECT_NEAR(k_skin->exponent, 1.5, 1e-10);
+  EXPECT_NEAR(k_skin->value_at_reference, 0.05 * std::pow(0.8, 1.5), 1e-12);
+  EXPECT_NEAR(k_muscle->exponent, 0.5, 1e-10);
+  EXPECT_NEAR(cut->exponent, 2.0, 1e-10);
+  EXPECT_NEAR(cut->value_at_reference, 2.0, 1e-10);
+  ASSERT_TRUE(cut->exponent_standard_error && cut->log_residual_rms);
+  EXPECT_NEAR(*cut->exponent_standard_error, 0.0, 1e-8);
+  for (const SlabRuleSample& s : cut->samples) {
+    ASSERT_TRUE(s.leave_one_out_relative_error);
+    EXPECT_NEAR(*s.leave_one_out_relative_error, 0.0, 1e-9);  // an exact law predicts the slab it did not see
+  }
+  // Only K and the skin's cutting force differ: the rest of each layer is not ruled.
+  EXPECT_EQ(rule.layers[0].parameters.size(), 2u);
+  EXPECT_EQ(rule.layers[1].parameters.size(), 1u);
+  EXPECT_DOUBLE_EQ(rule.layers[2].min_thickness_mm, 28.0);
+  EXPECT_DOUBLE_EQ(rule.layers[2].max_thickness_mm, 39.0);
+  EXPECT_NEAR(slab_rule_value(*k_muscle, 39.0, 30.0), 0.05 * std::sqrt(30.0), 1e-12);
+}
+
+TEST(SlabRule, NoisyValuesGiveTheLeastSquaresSlopeAndItsStandardError) {
+  // ln p = y at x = ln(h / h_ref): slope, standard error and leave-one-out by hand.
+  const double h[3] = {1.0, 2.0, 4.0};
+  const double p[3] = {1.0, 2.2, 3.8};
+  std::vector<json> presets;
+  for (int i = 0; i < 3; ++i) {
+    json s = default_scene();
+    s["layers"][0]["thickness_mm"] = h[i];
+    s["layers"][0]["force_law"]["cutting_force_N"] = p[i];
+    presets.push_back(s);
+  }
+  const SlabRule rule = fit_slab_rule(presets, {"a", "b", "c"});
+  const SlabRuleParameter* cut = find(rule, "skin", "/force_law/cutting_force_N");
+  ASSERT_NE(cut, nullptr);
+  const double x[3] = {0.0, std::log(2.0), std::log(4.0)};
+  const double y[3] = {0.0, std::log(2.2), std::log(3.8)};
+  const double mx = (x[0] + x[1] + x[2]) / 3, my = (y[0] + y[1] + y[2]) / 3;
+  double sxx = 0, sxy = 0;
+  for (int i = 0; i < 3; ++i) sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
+  const double slope = sxy / sxx, intercept = my - slope * mx;
+  double rss = 0;
+  for (int i = 0; i < 3; ++i) rss += std::pow(y[i] - intercept - slope * x[i], 2);
+  EXPECT_NEAR(cut->exponent, slope, 1e-12);
+  EXPECT_NEAR(cut->value_at_reference, std::exp(intercept), 1e-12);
+  EXPECT_NEAR(*cut->exponent_standard_error, std::sqrt(rss / 1.0 / sxx), 1e-12);
+  EXPECT_NEAR(*cut->log_residual_rms, std::sqrt(rss / 3.0), 1e-12);
+  // Without the middle slab the rule is the line through the outer two: p = 3.8^(x / ln 4).
+  const double loo_middle = std::exp(std::log(3.8) * 0.5) / 2.2 - 1.0;
+  EXPECT_NEAR(*cut->samples[1].leave_one_out_relative_error, loo_middle, 1e-12);
+}
+
+TEST(SlabRule, AppliedToASceneAndThroughAValidationCase) {
+  const SlabRule rule = fit_slab_rule({family_member(0.8, 8.4, 39), family_member(1.6, 4, 33)}, {"a.json", "b.json"});
+  json scene = default_scene();
+  scene["layers"][0]["thickness_mm"] = 1.2;
+  scene["layers"][1]["thickness_mm"] = 5.0;
+  scene["layers"][2]["thickness_mm"] = 30.0;
+  const double fat_before = scene["layers"][1]["force_law"]["cutting_force_N"].get<double>();
+  const std::vector<std::string> notes = apply_slab_rule(scene, rule, "scene.json");
+  EXPECT_NEAR(scene["layers"][0]["force_mesh"]["K_N_per_mm"].get<double>(), 0.05 * std::pow(1.2, 1.5), 1e-12);
+  EXPECT_NEAR(scene["layers"][0]["force_law"]["cutting_force_N"].get<double>(), 2.0 * std::pow(1.5, 2.0), 1e-10);
+  EXPECT_EQ(scene["layers"][1]["force_law"]["cutting_force_N"].get<double>(), fat_before);  // not ruled
+  ASSERT_EQ(notes.size(), 1u);  // the muscle's 30 mm lies outside the family's 33-39 mm
+  EXPECT_NE(notes[0].find("muscle"), std::string::npos);
+  EXPECT_NE(notes[0].find("extrapolated"), std::string::npos);
+
+  // Written, read back, and named by a validation case: the case's scene has the rule's values.
+  const fs::path dir = fs::temp_directory_path() / ("puncture_slab_rule_" + std::to_string(::getpid()));
+  fs::create_directories(dir / "rule");
+  std::ofstream(dir / "rule" / "slab_rule.json") << slab_rule_json(rule, json::object()).dump(2);
+  std::ofstream(dir / "cases.json") << R"({"cases": [{"name": "slab",
+      "overrides": {"layer_thickness_mm": [1.2, 5, 30]}, "slab_rule": "rule/slab_rule.json"}]})";
+  const ValidationCases cases = read_validation_cases(dir / "cases.json");
+  ASSERT_TRUE(cases.cases[0].slab_rule.has_value());
+  EXPECT_NE(cases.cases[0].rule.find("slab rule"), std::string::npos);
+  const CaseScene cs = case_scene(default_scene().dump(), "default.json", cases.cases[0]);
+  EXPECT_NEAR(cs.scene.layers[0].force_mesh.virtual_stiffness_N_per_m, 1e3 * 0.05 * std::pow(1.2, 1.5), 1e-6);
+  EXPECT_NEAR(cs.scene.layers[2].force_mesh.virtual_stiffness_N_per_m, 1e3 * 0.05 * std::sqrt(30.0), 1e-6);
+  EXPECT_EQ(cs.rule_notes.size(), 1u);
+  fs::remove_all(dir);
+}
+
+std::string fit_error(std::vector<json> presets) {
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < presets.size(); ++i) names.push_back("p" + std::to_string(i) + ".json");
+  try {
+    fit_slab_rule(presets, names);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(SlabRule, ErrorsNameThePresetAndTheField) {
+  EXPECT_NE(fit_error({family_member(0.8, 8.4, 39)}).find("two slabs"), std::string::npos);
+  json zero = family_member(1.6, 4, 33);
+  zero["layers"][0]["force_law"]["cutting_force_N"] = 0.0;
+  const std::string e1 = fit_error({family_member(0.8, 8.4, 39), zero});
+  EXPECT_NE(e1.find("p1.json: /layers/0/force_law/cutting_force_N"), std::string::npos) << e1;
+  EXPECT_NE(e1.find("positive"), std::string::npos) << e1;
+  json same = family_member(0.8, 8.4, 39);
+  same["layers"][0]["force_law"]["cutting_force_N"] = 3.0;  // differs, but the skin's thickness does not
+  same["layers"][1]["thickness_mm"] = 4.0;
+  same["layers"][2]["thickness_mm"] = 33.0;
+  const std::string e2 = fit_error({family_member(0.8, 8.4, 39), same});
+  EXPECT_NE(e2.find("same thickness"), std::string::npos) << e2;
+  json rings = family_member(1.6, 4, 33);
+  rings["layers"][0]["force_mesh"]["w"] = 9;
+  EXPECT_NE(fit_error({family_member(0.8, 8.4, 39), rings}).find("/layers/0/force_mesh/w"), std::string::npos);
+  json renamed = family_member(1.6, 4, 33);
+  renamed["layers"][1]["name"] = "adipose";
+  EXPECT_NE(fit_error({family_member(0.8, 8.4, 39), renamed}).find("/layers/1/name"), std::string::npos);
+
+  // A rule naming a parameter the scene lacks; a malformed rule file.
+  SlabRule rule = fit_slab_rule({family_member(0.8, 8.4, 39), family_member(1.6, 4, 33)}, {"a", "b"});
+  rule.layers[0].parameters[0].pointer = "/force_mesh/no_such_field";
+  json scene = default_scene();
+  try {
+    apply_slab_rule(scene, rule, "scene.json");
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.json: /layers/0/force_mesh/no_such_field"), std::string::npos) << e.what();
+  }
+  const fs::path bad = fs::temp_directory_path() / ("puncture_bad_rule_" + std::to_string(::getpid()) + ".json");
+  std::ofstream(bad) << R"({"layers": [{"layer": "skin", "reference_thickness_mm": -1,
+      "thickness_range_mm": [1, 2], "parameters": []}]})";
+  try {
+    read_slab_rule(bad);
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("/layers/0/reference_thickness_mm"), std::string::npos) << e.what();
+  }
+  fs::remove(bad);
+}
+
+}  // namespace
+}  // namespace puncture::validation
