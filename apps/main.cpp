@@ -84,6 +84,9 @@ CLI::App* add_validate(CLI::App& app, CommandLine& c) {
                            "Cases file (JSON; validation/cases/default_heldout.json): validate the scene, without "
                            "retuning, on each case (other speeds, depths, slabs); one report per case and "
                            "heldout_summary.json / .md");
+  validate_cmd->add_option("--slab-rule", c.validate.slab_rule,
+                           "With --cases: the model's slab rule (slab_rule.json of puncture slab-rule); cases that "
+                           "change the layer thicknesses take each layer's ruled parameters from it");
   validate_cmd->add_option("--model-note", c.validate.model_note,
                            "With --cases: how the model was calibrated (which references), for the summary page");
   validate_cmd->add_flag("--no-vtk", [&c](std::int64_t) { c.validate.write_vtk = false; },

@@ -9,10 +9,12 @@
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/results_env.sh"
 out=results/validation_speeds
+# (set -e does not act inside a command that replace_results_folder tests: the
+# validate step returns on failure itself.)
 write_speeds() {
   mpirun --oversubscribe -np "${RANKS:-2}" "$build/apps/puncture" validate results/tuned_preset/default_tuned.json \
     --cases validation/cases/default_speeds.json -o "$out" --no-vtk -q \
-    --model-note "d, the breakthrough rate exponents n, the cutting viscous fractions b, the release rate exponents m and the shaft friction identified at 1 and 10 mm/s, every other parameter at 10 mm/s only; 3 and 20 mm/s never seen"
+    --model-note "d, the breakthrough rate exponents n, the cutting viscous fractions b, the release rate exponents m and the shaft friction identified at 1 and 10 mm/s, every other parameter at 10 mm/s only; 3 and 20 mm/s never seen" || return 1
   "$(command -v /usr/bin/python3 || command -v python3)" scripts/speed_law.py results/tuned_preset/default_tuned.json "$out"
 }
 source scripts/results_folder.sh

@@ -1,7 +1,8 @@
 // `puncture slab-rule`: fits the slab rule (validation/harness/include/
 // puncture/validation/slab_rule.hpp) on presets calibrated on a family of
-// slabs and writes slab_rule.json (what a validation case's "slab_rule"
-// reads) and slab_rule.md.
+// slabs and writes slab_rule.json (what `puncture validate --cases FILE
+// --slab-rule slab_rule.json` applies to the cases on other slabs) and
+// slab_rule.md.
 #include <iostream>
 
 #include <nlohmann/json.hpp>

@@ -363,20 +363,24 @@ std::string vtk_flag(const ValidateOptions& options) { return writes_vtk(options
 int validate_cases(const ValidateOptions& options, const std::filesystem::path& model_path, std::ostream& out,
                    std::ostream& err) {
   validation::ValidationCases cases;
+  std::optional<validation::SlabRule> slab_rule;
   std::vector<validation::CaseScene> scenes;
   const Scene model = load_scene(model_path);  // the model itself must be valid
   try {
     cases = validation::read_validation_cases(options.cases);
+    if (!options.slab_rule.empty()) slab_rule = validation::read_slab_rule(options.slab_rule);
     const std::string model_text = io::read_text_file(model_path);
     for (const validation::ValidationCase& c : cases.cases)
-      scenes.push_back(validation::case_scene(model_text, model_path.string(), c));
+      scenes.push_back(validation::case_scene(model_text, model_path.string(), c, slab_rule ? &*slab_rule : nullptr));
   } catch (const std::invalid_argument& e) {  // SceneError is a runtime_error: it passes through
     throw InputError(e.what());  // the cases file, or an override the model scene does not have
   }
   const std::filesystem::path dir =
       options.output_dir.empty() ? std::filesystem::path("out") / (model.name + "_cases") : options.output_dir;
   const std::string command_line = "puncture validate " + model_path.string() + " --cases " +
-                                   options.cases.string() + " -o " + dir.string() + vtk_flag(options);
+                                   options.cases.string() +
+                                   (options.slab_rule.empty() ? "" : " --slab-rule " + options.slab_rule.string()) +
+                                   " -o " + dir.string() + vtk_flag(options);
   std::vector<validation::CaseOutcome> outcomes;
   for (std::size_t i = 0; i < cases.cases.size(); ++i) {
     const validation::ValidationCase& c = cases.cases[i];
@@ -391,8 +395,12 @@ int validate_cases(const ValidateOptions& options, const std::filesystem::path& 
     const auto result = validate_scene(scenes[i].scene, scene_file, case_dir, command_line, options, out, err);
     if (!result) continue;
     validation::ValidationCase shown = c;
-    for (const std::string& note : scenes[i].rule_notes) shown.rule += "; " + note;
-    outcomes.push_back({shown, scene_file, result->acceptance, result->layers, result->trajectory_terms});
+    std::string rule_file;
+    if (scenes[i].slab_rule_applied) {
+      rule_file = options.slab_rule.string();
+      shown.rule = validation::slab_rule_case_text(*slab_rule, rule_file, scenes[i].rule_notes);
+    }
+    outcomes.push_back({shown, scene_file, rule_file, result->acceptance, result->layers, result->trajectory_terms});
   }
   if (!validation::is_mpi_root()) return 0;
   const io::Provenance provenance = io::make_provenance(command_line);

@@ -82,7 +82,8 @@ std::optional<double> optional_number(const json& j, const char* key) {
 }  // namespace
 
 double slab_rule_value(const SlabRuleParameter& parameter, double reference_thickness_mm, double thickness_mm) {
-  return parameter.value_at_reference * std::pow(thickness_mm / reference_thickness_mm, parameter.exponent);
+  const double p = parameter.value_at_reference * std::pow(thickness_mm / reference_thickness_mm, parameter.exponent);
+  return parameter.integer ? std::max(1.0, std::round(p)) : p;
 }
 
 SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::string>& names) {
@@ -137,12 +138,10 @@ SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::
       }
       if (!differs) continue;
       std::vector<double> y;
+      bool integer = true;
       for (std::size_t i = 0; i < presets.size(); ++i) {
         const json& v = leaves[i].at(pointer);
-        if (v.is_number_integer())
-          fail(names[i], layer_pointer + pointer,
-               "an integer (a count) that differs between the presets: a power law in the thickness cannot "
-               "give it; calibrate it equal on every slab (keep it)");
+        integer = integer && v.is_number_integer();
         if (!(v.get<double>() > 0.0) || !std::isfinite(v.get<double>()))
           fail(names[i], layer_pointer + pointer,
                "differs between the presets but is not positive (" + significant_digits(v.get<double>(), 4) +
@@ -162,6 +161,7 @@ SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::
       p.exponent = f.slope;
       p.exponent_standard_error = f.slope_standard_error;
       p.log_residual_rms = f.residual_rms;
+      p.integer = integer;
       for (std::size_t i = 0; i < presets.size(); ++i) {
         SlabRuleSample s;
         s.thickness_mm = rule.presets[i].thickness_mm[k];
@@ -206,7 +206,8 @@ std::vector<std::string> apply_slab_rule(json& scene, const SlabRule& rule, cons
       const json::json_pointer ptr(layer_pointer + p.pointer);
       if (!scene.contains(ptr) || !scene[ptr].is_number())
         fail(where, layer_pointer + p.pointer, "the slab rule sets it, but the scene has no such number");
-      scene[ptr] = slab_rule_value(p, r->reference_thickness_mm, h);
+      const double value = slab_rule_value(p, r->reference_thickness_mm, h);
+      scene[ptr] = p.integer ? json(static_cast<long long>(value)) : json(value);
     }
   }
   return notes;
@@ -230,6 +231,7 @@ json slab_rule_json(const SlabRule& rule, const json& provenance) {
                             {"exponent", p.exponent},
                             {"exponent_standard_error", or_null(p.exponent_standard_error)},
                             {"log_residual_rms", or_null(p.log_residual_rms)},
+                            {"integer", p.integer},
                             {"samples", samples}});
     }
     layers.push_back({{"layer", l.layer},
@@ -302,6 +304,7 @@ SlabRule read_slab_rule(const std::filesystem::path& file) {
       parameter.exponent = p["exponent"].get<double>();
       parameter.exponent_standard_error = optional_number(p, "exponent_standard_error");
       parameter.log_residual_rms = optional_number(p, "log_residual_rms");
+      parameter.integer = p.contains("integer") && p["integer"].is_boolean() && p["integer"].get<bool>();
       if (p.contains("samples") && p["samples"].is_array())
         for (const json& s : p["samples"]) {
           SlabRuleSample sample;
@@ -325,7 +328,7 @@ std::string slab_rule_markdown(const SlabRule& rule, const std::string& command,
      << "Each preset below is the same model calibrated on its own slab. For every parameter whose calibrated "
         "value differs between them, p(h) = p_ref (h / h_ref)^alpha in the layer's own thickness h, least squares "
         "in ln p (h_ref: the first preset's thickness). Parameters not listed keep the scene's value. A slab the "
-        "family never saw takes its parameters from this rule (`\"slab_rule\"` of a validation case), never from a "
+        "family never saw takes its parameters from this rule (`puncture validate MODEL --cases FILE --slab-rule slab_rule.json`), never from a "
         "calibration on that slab.\n\n## The family\n\n| preset | thickness (mm) |\n|---|---|\n";
   for (const SlabRulePreset& p : rule.presets) {
     md << "| " << p.file << " | ";
@@ -339,7 +342,7 @@ std::string slab_rule_markdown(const SlabRule& rule, const std::string& command,
      << "|---|---|---|---|---|---|---|\n";
   for (const SlabRuleLayer& l : rule.layers)
     for (const SlabRuleParameter& p : l.parameters) {
-      md << "| " << l.layer << " | `" << p.pointer << "` | " << significant_digits(l.reference_thickness_mm, 4) << " | "
+      md << "| " << l.layer << " | `" << p.pointer << "`" << (p.integer ? " (a count: rounded)" : "") << " | " << significant_digits(l.reference_thickness_mm, 4) << " | "
          << significant_digits(p.value_at_reference, 4) << " | " << significant_digits(p.exponent, 3);
       if (p.exponent_standard_error) md << " +- " << significant_digits(*p.exponent_standard_error, 2);
       md << " | ";

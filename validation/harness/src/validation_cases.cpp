@@ -32,7 +32,7 @@ std::string optional_text(const json& c, const char* key, const std::filesystem:
 ValidationCase read_case(const json& c, const std::filesystem::path& file, const std::string& pointer) {
   if (!c.is_object()) fail(file, pointer, "a case must be an object");
   for (auto it = c.begin(); it != c.end(); ++it)
-    if (!std::set<std::string>{"name", "overrides", "held_out", "slab_rule", "rule", "note"}.count(it.key()))
+    if (!std::set<std::string>{"name", "overrides", "held_out", "rule", "note"}.count(it.key()))
       fail(file, pointer + "/" + it.key(), "unknown key");
   ValidationCase v;
   if (!c.contains("name") || !c["name"].is_string()) fail(file, pointer + "/name", "missing or not a string");
@@ -71,29 +71,6 @@ ValidationCase read_case(const json& c, const std::filesystem::path& file, const
   }
   v.rule = optional_text(c, "rule", file, pointer);
   v.note = optional_text(c, "note", file, pointer);
-  const std::string rule_file = optional_text(c, "slab_rule", file, pointer);
-  if (!rule_file.empty()) {
-    if (v.layer_thickness_mm.empty())
-      fail(file, pointer + "/slab_rule", "a slab rule needs overrides/layer_thickness_mm (the slab it is applied to)");
-    const std::filesystem::path resolved = (file.parent_path() / rule_file).lexically_normal();
-    try {
-      v.slab_rule = read_slab_rule(resolved);
-    } catch (const std::invalid_argument& e) {
-      fail(file, pointer + "/slab_rule", e.what());
-    }
-    v.slab_rule_file = resolved.string();
-    if (v.rule.empty()) {
-      std::string family;
-      for (const SlabRulePreset& p : v.slab_rule->presets) {
-        family += family.empty() ? "" : ", ";
-        for (std::size_t k = 0; k < p.thickness_mm.size(); ++k)
-          family += (k ? "/" : "") + significant_digits(p.thickness_mm[k], 3);
-      }
-      v.rule = "each layer's real-time parameters from its thickness by the slab rule " + v.slab_rule_file +
-               " (p = p_ref (h / h_ref)^alpha per layer, fitted on presets calibrated on the slabs " + family +
-               " mm; the parameters it does not name are the model's)";
-    }
-  }
   return v;
 }
 
@@ -149,7 +126,22 @@ ValidationCases read_validation_cases(const std::filesystem::path& file) {
   return out;
 }
 
-CaseScene case_scene(const std::string& model_json_text, const std::string& model_file, const ValidationCase& c) {
+std::string slab_rule_case_text(const SlabRule& rule, const std::string& rule_file,
+                                const std::vector<std::string>& notes) {
+  std::string family;
+  for (const SlabRulePreset& p : rule.presets) {
+    family += family.empty() ? "" : ", ";
+    for (std::size_t k = 0; k < p.thickness_mm.size(); ++k) family += (k ? "/" : "") + significant_digits(p.thickness_mm[k], 3);
+  }
+  std::string text = "each layer's real-time parameters from its thickness by the model's slab rule " + rule_file +
+                     " (p = p_ref (h / h_ref)^alpha per layer, fitted on the model calibrated on the slabs " + family +
+                     " mm; the parameters it does not name are the model's)";
+  for (const std::string& n : notes) text += "; " + n;
+  return text;
+}
+
+CaseScene case_scene(const std::string& model_json_text, const std::string& model_file, const ValidationCase& c,
+                     const SlabRule* slab_rule) {
   json s = json::parse(model_json_text);
   const std::string where = model_file + " (case " + c.name + ")";
   if (!c.insertion_overrides.empty()) {
@@ -169,7 +161,10 @@ CaseScene case_scene(const std::string& model_json_text, const std::string& mode
     for (std::size_t k = 0; k < c.layer_thickness_mm.size(); ++k) s["layers"][k]["thickness_mm"] = c.layer_thickness_mm[k];
   }
   CaseScene out;
-  if (c.slab_rule) out.rule_notes = apply_slab_rule(s, *c.slab_rule, where);
+  if (slab_rule && !c.layer_thickness_mm.empty()) {
+    out.rule_notes = apply_slab_rule(s, *slab_rule, where);
+    out.slab_rule_applied = true;
+  }
   s["name"] = s.value("name", std::string("scene")) + "_" + c.name;
   out.json_text = s.dump(2) + "\n";
   out.scene = parse_scene(out.json_text, where);
@@ -231,7 +226,7 @@ json heldout_summary_json(const std::vector<CaseOutcome>& outcomes, const std::s
                      {"held_out", c.held_out},
                      {"scene", o.scene_file},
                      {"rule", c.rule.empty() ? json(nullptr) : json(c.rule)},
-                     {"slab_rule", c.slab_rule_file.empty() ? json(nullptr) : json(c.slab_rule_file)},
+                     {"slab_rule", o.slab_rule_file.empty() ? json(nullptr) : json(o.slab_rule_file)},
                      {"note", c.note.empty() ? json(nullptr) : json(c.note)},
                      {"layers", case_layer_rows(o)},
                      {"whole_trajectory", whole_trajectory_rows(o.trajectory_terms)}});
@@ -278,7 +273,8 @@ std::string heldout_summary_markdown(const json& summary, const std::string& com
     }
   }
   md << "\nHeld out: " << accepted << " of " << held
-     << " layer-cases accepted. Rules for cases that change the slab are in the cases file. Each case's report "
+     << " layer-cases accepted. Each case that changes the slab says below where its real-time parameters come from "
+        "(the model's slab rule, or the cases file's rule). Each case's report "
         "(validation_summary.md, plots, the case's scene.json) is in its folder.\n";
   // The whole trajectory per case: the columns are the first case's terms.
   std::vector<std::string> terms;

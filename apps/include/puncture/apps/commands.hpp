@@ -59,6 +59,9 @@ struct ValidateOptions {
   /// output_dir holds one report per case and the held-out summary.
   std::filesystem::path cases;
   std::string model_note;             ///< with cases: how the model was calibrated, for the summary
+  /// With cases: the model's slab rule (slab_rule.json of `puncture slab-rule`);
+  /// cases that change the layer thicknesses take the ruled parameters from it.
+  std::filesystem::path slab_rule;
 };
 
 /// `puncture validate`: real-time model and FEM reference (cached) on the

@@ -9,8 +9,10 @@
 //     p(h) = p_ref * (h / h_ref)^alpha,
 // fitted by least squares in ln p over the presets; h_ref is the first
 // preset's thickness of that layer. Parameters equal in every preset (what the
-// calibrations kept: the material's rate and friction parameters, the ring
-// count w) are not part of the rule: a scene keeps its own.
+// calibrations kept: the material's rate and friction parameters) are not
+// part of the rule: a scene keeps its own. A count (the ring count w, which
+// the surface fit may choose per slab) is fitted the same way and applied
+// rounded to the nearest integer, at least 1.
 //
 // In:  presets: scene JSON objects (the schema of scenes/) with the same
 //      layer names in the same order, "thickness_mm" > 0 per layer; a ruled
@@ -30,7 +32,7 @@
 //                "parameters": [{"pointer" (e.g. "/force_mesh/K_N_per_mm"),
 //                                "value_at_reference", "exponent",
 //                                "exponent_standard_error" (null below 3 presets),
-//                                "log_residual_rms" (null below 3 presets),
+//                                "log_residual_rms" (null below 3 presets), "integer",
 //                                "samples": [{"thickness_mm", "value", "fitted",
 //                                             "leave_one_out_relative_error" (null below 3)}]}]}],
 //    "provenance"}
@@ -58,6 +60,7 @@ struct SlabRuleParameter {
   double exponent = 0.0;            ///< alpha
   std::optional<double> exponent_standard_error;
   std::optional<double> log_residual_rms;  ///< RMS of ln(p_fitted / p) over the presets
+  bool integer = false;  ///< a count: applied rounded to the nearest integer >= 1
   std::vector<SlabRuleSample> samples;
 };
 
@@ -82,7 +85,7 @@ struct SlabRule {
 /// in messages and in the rule). Needs two presets or more.
 SlabRule fit_slab_rule(const std::vector<nlohmann::json>& presets, const std::vector<std::string>& names);
 
-/// p_ref * (h / h_ref)^alpha.
+/// p_ref * (h / h_ref)^alpha (rounded to the nearest integer >= 1 for a count).
 double slab_rule_value(const SlabRuleParameter& parameter, double reference_thickness_mm, double thickness_mm);
 
 /// Sets each ruled parameter of `scene` (a scene JSON) from its layer's

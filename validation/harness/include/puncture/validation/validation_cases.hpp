@@ -8,18 +8,18 @@
 //               "overrides": {"insertion": {"speed_mm_per_s": 3, ...},   (fields of the scene's /insertion)
 //                             "layer_thickness_mm": [1.2, 5, 30]},       (one per layer, > 0)
 //               "held_out": true,                        (optional; default: overrides not empty)
-//               "slab_rule": "../../results/slab_rule/slab_rule.json",   (optional; relative to
-//                            the cases file: each layer's real-time parameters from its
-//                            thickness by a rule fitted on a family of slabs, slab_rule.hpp)
 //               "rule": "...", "note": "..."}]}          (optional text for the page)
 // A case without overrides is the model's own trajectory (in sample when the
 // model was calibrated on it). read_validation_cases throws
 // std::invalid_argument naming the file and the JSON path of what is wrong.
 //
-// case_scene(model_json_text, model_file, case): the model scene's JSON with
-// the case's overrides (and its slab rule applied to the overridden
-// thicknesses), parsed (and so checked) as a scene; its text is returned too,
-// to be written beside the case's report.
+// case_scene(model_json_text, model_file, case, slab_rule): the model scene's
+// JSON with the case's overrides, parsed (and so checked) as a scene; its text
+// is returned too, to be written beside the case's report. A slab rule
+// (slab_rule.hpp: the model's parameters as functions of each layer's
+// thickness, fitted on a family of slabs) belongs to the model, not to the
+// cases: given one, a case that changes the thicknesses takes the ruled
+// parameters from it.
 //
 // Held-out summary (heldout_summary.json, the schema of the real-time
 // physics issue plus "misses", "rule", "note"):
@@ -32,7 +32,6 @@
 #pragma once
 
 #include <filesystem>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,9 +48,7 @@ struct ValidationCase {
   bool held_out = false;
   nlohmann::json insertion_overrides = nlohmann::json::object();  ///< keys of the scene's /insertion
   std::vector<double> layer_thickness_mm;                          ///< empty: the model's thicknesses
-  std::string slab_rule_file;        ///< as resolved (empty: none)
-  std::optional<SlabRule> slab_rule;  ///< read from slab_rule_file
-  std::string rule, note;  ///< rule: given, or written from the slab rule
+  std::string rule, note;
 };
 
 struct ValidationCases {
@@ -64,13 +61,20 @@ ValidationCases read_validation_cases(const std::filesystem::path& file);
 struct CaseScene {
   Scene scene;
   std::string json_text;  ///< the scene as validated (model JSON with the overrides)
+  bool slab_rule_applied = false;
   std::vector<std::string> rule_notes;  ///< from the slab rule (a thickness outside its family)
 };
 /// Throws SceneError (file = "<model_file> (case <name>)") when an override
 /// makes the scene invalid, std::invalid_argument for an override the model
 /// scene does not have (an /insertion key it lacks, a thickness count that
 /// differs from its layers).
-CaseScene case_scene(const std::string& model_json_text, const std::string& model_file, const ValidationCase& c);
+CaseScene case_scene(const std::string& model_json_text, const std::string& model_file, const ValidationCase& c,
+                     const SlabRule* slab_rule = nullptr);
+
+/// The page's text for a case whose slab came from `rule` (read from
+/// rule_file): the rule, its family and the notes of case_scene.
+std::string slab_rule_case_text(const SlabRule& rule, const std::string& rule_file,
+                                const std::vector<std::string>& notes);
 
 /// One case's outcome: the acceptance per layer, the layer metrics JSON of
 /// `puncture validate` (layer_metrics_json, for the puncture depth error) and
@@ -80,6 +84,7 @@ CaseScene case_scene(const std::string& model_json_text, const std::string& mode
 struct CaseOutcome {
   ValidationCase validation_case;
   std::string scene_file;  ///< where the case's scene was written
+  std::string slab_rule_file;  ///< the slab rule its scene took parameters from (empty: none)
   std::vector<LayerAcceptance> acceptance;
   nlohmann::json layers = nlohmann::json::array();
   nlohmann::json trajectory_terms = nlohmann::json::array();
