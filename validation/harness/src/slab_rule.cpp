@@ -19,6 +19,10 @@ using nlohmann::json;
   throw std::invalid_argument(where + ": " + pointer + ": " + what);
 }
 
+/// Values within this relative difference are the same value: a calibration
+/// that ended where it started moves a kept parameter by round-off only.
+constexpr double kSameValue = 1e-4;
+
 /// The parameter blocks of a layer the rule may set.
 constexpr const char* kBlocks[] = {"force_mesh", "force_law"};
 
@@ -134,7 +138,7 @@ SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::
         if (it == leaves[i].end())
           fail(names[i], layer_pointer + pointer, "missing (" + names.front() + " has it)");
         const double a = first_value.get<double>(), b = it->second.get<double>();
-        if (std::abs(a - b) > 1e-12 * std::max(std::abs(a), std::abs(b))) differs = true;
+        if (std::abs(a - b) > kSameValue * std::max(std::abs(a), std::abs(b))) differs = true;
       }
       if (!differs) continue;
       std::vector<double> y;

@@ -9,8 +9,8 @@
 //     p(h) = p_ref * (h / h_ref)^alpha,
 // fitted by least squares in ln p over the presets; h_ref is the first
 // preset's thickness of that layer. Parameters equal in every preset (what the
-// calibrations kept: the material's rate and friction parameters) are not
-// part of the rule: a scene keeps its own. A count (the ring count w, which
+// calibrations kept: the material's rate and friction parameters; within
+// 0.01 %) are not part of the rule: a scene keeps its own. A count (the ring count w, which
 // the surface fit may choose per slab) is fitted the same way and applied
 // rounded to the nearest integer, at least 1.
 //
