@@ -426,6 +426,8 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
   if (!options.cases.empty())
     return report_errors(err, options.cases.string(), [&]() { return validate_cases(options, scene_path, out, err); });
   return report_errors(err, scene_path.string(), [&]() -> int {
+    if (!options.slab_rule.empty())
+      throw UsageError("--slab-rule applies to the cases that change the slab: it needs --cases");
     const Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_validation") : options.output_dir;

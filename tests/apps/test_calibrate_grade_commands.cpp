@@ -338,6 +338,16 @@ TEST(SlabRuleCommand, FitsThePresetsOfAFamilyAndRejectsBadInput) {
   std::ostringstream calibrate_err;
   EXPECT_EQ(calibrate_command(calibrate, out, calibrate_err), kExitBadInput);
   EXPECT_NE(calibrate_err.str().find("--layer-thickness"), std::string::npos) << calibrate_err.str();
+
+  // validate --slab-rule without cases: a usage error before any FEM runs.
+  ValidateOptions validate;
+  validate.scene = kSourceDir / "scenes" / "default.json";
+  validate.output_dir = dir / "validate";
+  validate.slab_rule = dir / "rule" / "slab_rule.json";
+  std::ostringstream validate_err;
+  EXPECT_EQ(validate_command(validate, out, validate_err), kExitBadInput);
+  EXPECT_NE(validate_err.str().find("--slab-rule"), std::string::npos) << validate_err.str();
+  EXPECT_FALSE(fs::exists(dir / "validate"));
   fs::remove_all(dir);
 }
 
