@@ -5,7 +5,7 @@
 //   puncture calibrate [SCENE] [--reference CSV] [-o DIR]   tuned preset
 //   puncture sweep     [SCENE] [-o DIR]   accuracy versus time of every fidelity knob
 //   puncture grade SCORES.csv [-o DIR]    comprehensive weighted grading (paper Sec. 3.3)
-//   puncture slab-rule PRESET... [-o DIR] each layer's parameters from its thickness, fitted on a family of slabs
+//   puncture slab-rule PRESET... [-o DIR] each layer's parameters from its thickness or depth, fitted on a family of slabs
 //   puncture compare   [SCENE] [-o DIR]   comparison models of both papers against the FEM
 //   puncture --version
 // Exit codes: 0 success, 1 the run failed, 2 bad input (scene, CSV, command
@@ -174,7 +174,7 @@ CLI::App* add_sweep(CLI::App& app, CommandLine& c) {
 
 CLI::App* add_slab_rule(CLI::App& app, CommandLine& c) {
   CLI::App* cmd = app.add_subcommand(
-      "slab-rule", "Each layer's real-time parameters as a power law in its thickness, fitted on presets calibrated "
+      "slab-rule", "Each layer's real-time parameters as power laws in its thickness or depth, fitted on presets calibrated "
                    "on a family of slabs (for validation cases on other slabs)");
   cmd->add_option("presets", c.slab_rule.presets, "Tuned presets, one per slab; the first gives the reference thicknesses")
       ->required();

@@ -11,7 +11,9 @@
 #                               then the critical forces, cutting and releases;
 #                               the shaft friction and the rate parameters (d, n,
 #                               b, m) are the material's and are kept
-#   results/slab_rule/slab_rule.{json,md}  puncture slab-rule on the three presets
+#   results/slab_rule/slab_rule.{json,md}  puncture slab-rule on the three presets: each
+#                               parameter that moved as a power law in its layer's
+#                               thickness or the depth of its top
 # The family brackets the held-out slab (skin 1.2, fat 5, muscle 30 mm): skin
 # 0.8-1.6 mm, fat 4.5-8.4 mm, muscle 28-39 mm. One FEM run per slab (cached in
 # out/.fem_cache, about 3 min each on 2 cores), then about 3 min of calibration

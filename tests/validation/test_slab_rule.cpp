@@ -76,7 +76,56 @@ TEST(SlabRule, RecoversExactPowerLawsAndOnlyTheParametersThatDiffer) {
   EXPECT_EQ(rule.layers[1].parameters.size(), 1u);
   EXPECT_DOUBLE_EQ(rule.layers[2].min_thickness_mm, 28.0);
   EXPECT_DOUBLE_EQ(rule.layers[2].max_thickness_mm, 39.0);
-  EXPECT_NEAR(slab_rule_value(*k_muscle, 39.0, 30.0), 0.05 * std::sqrt(30.0), 1e-12);
+  EXPECT_NEAR(slab_rule_value(*k_muscle, 30.0), 0.05 * std::sqrt(30.0), 1e-12);
+  // Exact in the own thickness: chosen over the depth of the layer's top.
+  EXPECT_EQ(k_muscle->variable, SlabRuleVariable::thickness);
+  ASSERT_TRUE(k_muscle->leave_one_out_log_rms_thickness && k_muscle->leave_one_out_log_rms_depth);
+  EXPECT_NEAR(*k_muscle->leave_one_out_log_rms_thickness, 0.0, 1e-9);
+  EXPECT_GT(*k_muscle->leave_one_out_log_rms_depth, 0.01);
+  EXPECT_EQ(k_skin->variable, SlabRuleVariable::thickness);  // the top layer has no depth
+  EXPECT_FALSE(k_skin->leave_one_out_log_rms_depth.has_value());
+}
+
+TEST(SlabRule, AParameterThatFollowsTheDepthOfItsLayerIsRuledByTheDepth) {
+  // The muscle's critical force = 0.9 N (d / 9.2 mm)^4, d the depth of its top
+  // (skin + fat): the rule picks the depth, predicts each slab left out exactly,
+  // and sets a new slab's value from its depth.
+  const double slabs[3][3] = {{0.8, 8.4, 39}, {1.6, 4.5, 36}, {1.0, 6.5, 28}};
+  std::vector<json> presets;
+  for (const auto& h : slabs) {
+    json s = family_member(h[0], h[1], h[2]);
+    s["layers"][2]["force_law"]["cutting_force_N"] = 0.9 * std::pow((h[0] + h[1]) / 9.2, 4.0);
+    presets.push_back(s);
+  }
+  const SlabRule rule = fit_slab_rule(presets, {"a", "b", "c"});
+  const SlabRuleParameter* c = find(rule, "muscle", "/force_law/cutting_force_N");
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->variable, SlabRuleVariable::depth);
+  EXPECT_NEAR(c->exponent, 4.0, 1e-10);
+  EXPECT_NEAR(c->reference_mm, 9.2, 1e-12);
+  EXPECT_DOUBLE_EQ(c->min_mm, 6.1);
+  EXPECT_NEAR(*c->leave_one_out_log_rms_depth, 0.0, 1e-9);
+  EXPECT_GT(*c->leave_one_out_log_rms_thickness, 0.1);
+  json scene = default_scene();
+  scene["layers"][0]["thickness_mm"] = 1.2;
+  scene["layers"][1]["thickness_mm"] = 5.0;
+  scene["layers"][2]["thickness_mm"] = 30.0;
+  const std::vector<std::string> notes = apply_slab_rule(scene, rule, "scene.json");
+  EXPECT_NEAR(scene["layers"][2]["force_law"]["cutting_force_N"].get<double>(), 0.9 * std::pow(6.2 / 9.2, 4.0), 1e-10);
+  // Its depth, 6.2 mm, lies inside the family's 6.1-9.2 mm: no extrapolation note for it.
+  for (const std::string& n : notes) EXPECT_EQ(n.find("muscle: its depth"), std::string::npos) << n;
+  // Read back from the file: the same value.
+  const fs::path f = fs::temp_directory_path() / ("puncture_rule_depth_" + std::to_string(::getpid()) + ".json");
+  std::ofstream(f) << slab_rule_json(rule, json::object()).dump();
+  const SlabRule read = read_slab_rule(f);
+  fs::remove(f);
+  ASSERT_NE(find(read, "muscle", "/force_law/cutting_force_N"), nullptr);
+  EXPECT_EQ(find(read, "muscle", "/force_law/cutting_force_N")->variable, SlabRuleVariable::depth);
+  json again = default_scene();
+  again["layers"][0]["thickness_mm"] = 1.2;
+  again["layers"][1]["thickness_mm"] = 5.0;
+  apply_slab_rule(again, read, "scene.json");
+  EXPECT_NEAR(again["layers"][2]["force_law"]["cutting_force_N"].get<double>(), 0.9 * std::pow(6.2 / 9.2, 4.0), 1e-10);
 }
 
 TEST(SlabRule, NoisyValuesGiveTheLeastSquaresSlopeAndItsStandardError) {
@@ -222,13 +271,14 @@ TEST(SlabRule, ErrorsNameThePresetAndTheField) {
     EXPECT_NE(std::string(e.what()).find("scene.json: /layers/0/force_mesh/no_such_field"), std::string::npos) << e.what();
   }
   const fs::path bad = fs::temp_directory_path() / ("puncture_bad_rule_" + std::to_string(::getpid()) + ".json");
-  std::ofstream(bad) << R"({"layers": [{"layer": "skin", "reference_thickness_mm": -1,
-      "thickness_range_mm": [1, 2], "parameters": []}]})";
+  std::ofstream(bad) << R"({"layers": [{"layer": "skin", "reference_thickness_mm": 1,
+      "thickness_range_mm": [1, 2], "parameters": [{"pointer": "/force_mesh/K_N_per_mm", "variable": "age",
+      "reference_mm": 1, "range_mm": [1, 2], "value_at_reference": 1, "exponent": 1}]}]})";
   try {
     read_slab_rule(bad);
     ADD_FAILURE() << "no error";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("/layers/0/reference_thickness_mm"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("/layers/0/parameters/0/variable"), std::string::npos) << e.what();
   }
   fs::remove(bad);
 }

@@ -78,6 +78,54 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
 
 json or_null(const std::optional<double>& x) { return x ? json(*x) : json(nullptr); }
 
+bool varies(const std::vector<double>& x) {
+  for (double xi : x)
+    if (std::abs(xi - x.front()) > 1e-9) return true;
+  return false;
+}
+
+/// The rule of one parameter in one variable: x_mm[i] > 0 and y[i] = ln p on
+/// preset i; the fit, its samples and the RMS leave-one-out error in ln p.
+SlabRuleParameter fit_in(SlabRuleVariable variable, const std::vector<double>& x_mm, const std::vector<double>& y,
+                         std::optional<double>& leave_one_out_log_rms) {
+  std::vector<double> x;
+  for (double v : x_mm) x.push_back(std::log(v / x_mm.front()));
+  const LineFit f = fit_line(x, y);
+  SlabRuleParameter p;
+  p.variable = variable;
+  p.reference_mm = x_mm.front();
+  p.min_mm = *std::min_element(x_mm.begin(), x_mm.end());
+  p.max_mm = *std::max_element(x_mm.begin(), x_mm.end());
+  p.value_at_reference = std::exp(f.intercept);
+  p.exponent = f.slope;
+  p.exponent_standard_error = f.slope_standard_error;
+  p.log_residual_rms = f.residual_rms;
+  double sum_sq = 0.0;
+  bool every_slab = x.size() >= 3;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    SlabRuleSample s;
+    s.x_mm = x_mm[i];
+    s.value = std::exp(y[i]);
+    s.fitted = std::exp(f.intercept + f.slope * x[i]);
+    if (x.size() >= 3) {
+      std::vector<double> xo, yo;
+      for (std::size_t j = 0; j < x.size(); ++j)
+        if (j != i) xo.push_back(x[j]), yo.push_back(y[j]);
+      if (varies(xo)) {
+        const LineFit g = fit_line(xo, yo);
+        const double predicted = g.intercept + g.slope * x[i];
+        s.leave_one_out_relative_error = std::exp(predicted - y[i]) - 1.0;
+        sum_sq += (predicted - y[i]) * (predicted - y[i]);
+      } else {
+        every_slab = false;
+      }
+    }
+    p.samples.push_back(s);
+  }
+  if (every_slab) leave_one_out_log_rms = std::sqrt(sum_sq / static_cast<double>(x.size()));
+  return p;
+}
+
 std::optional<double> optional_number(const json& j, const char* key) {
   if (!j.contains(key) || !j[key].is_number()) return std::nullopt;
   return j[key].get<double>();
@@ -85,8 +133,12 @@ std::optional<double> optional_number(const json& j, const char* key) {
 
 }  // namespace
 
-double slab_rule_value(const SlabRuleParameter& parameter, double reference_thickness_mm, double thickness_mm) {
-  const double p = parameter.value_at_reference * std::pow(thickness_mm / reference_thickness_mm, parameter.exponent);
+const char* slab_rule_variable_name(SlabRuleVariable variable) {
+  return variable == SlabRuleVariable::depth ? "depth" : "thickness";
+}
+
+double slab_rule_value(const SlabRuleParameter& parameter, double x_mm) {
+  const double p = parameter.value_at_reference * std::pow(x_mm / parameter.reference_mm, parameter.exponent);
   return parameter.integer ? std::max(1.0, std::round(p)) : p;
 }
 
@@ -121,8 +173,15 @@ SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::
       for (const char* block : kBlocks)
         if (presets[i]["layers"][k].contains(block))
           numeric_leaves(presets[i]["layers"][k][block], std::string("/") + block, leaves[i]);
-    std::vector<double> x;
-    for (const SlabRulePreset& p : rule.presets) x.push_back(std::log(p.thickness_mm[k] / rule.presets.front().thickness_mm[k]));
+    // The two variables on each preset: the layer's thickness and the depth of its top.
+    std::vector<double> thickness, depth;
+    for (const SlabRulePreset& p : rule.presets) {
+      thickness.push_back(p.thickness_mm[k]);
+      double above = 0.0;
+      for (std::size_t j = 0; j < k; ++j) above += p.thickness_mm[j];
+      depth.push_back(above);
+    }
+    const bool by_thickness = varies(thickness), by_depth = k > 0 && varies(depth);
     SlabRuleLayer layer;
     layer.layer = first_layers[k].value("name", std::string());
     layer.reference_thickness_mm = rule.presets.front().thickness_mm[k];
@@ -149,41 +208,25 @@ SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::
         if (!(v.get<double>() > 0.0) || !std::isfinite(v.get<double>()))
           fail(names[i], layer_pointer + pointer,
                "differs between the presets but is not positive (" + significant_digits(v.get<double>(), 4) +
-                   "): a power law in the thickness needs positive values");
+                   "): a power law needs positive values");
         y.push_back(std::log(v.get<double>()));
       }
-      double spread = 0.0;
-      for (double xi : x) spread = std::max(spread, std::abs(xi - x.front()));
-      if (spread < 1e-9)
+      if (!by_thickness && !by_depth)
         fail(names.back(), layer_pointer + pointer,
              "differs between the presets, but layer " + layer.layer +
-                 " has the same thickness in all of them: the rule needs the layer at two thicknesses or more");
-      const LineFit f = fit_line(x, y);
-      SlabRuleParameter p;
+                 " has the same thickness and depth in all of them: the rule needs the layer at two thicknesses "
+                 "or depths or more");
+      std::optional<double> loo_thickness, loo_depth;
+      std::optional<SlabRuleParameter> in_thickness, in_depth;
+      if (by_thickness) in_thickness = fit_in(SlabRuleVariable::thickness, thickness, y, loo_thickness);
+      if (by_depth) in_depth = fit_in(SlabRuleVariable::depth, depth, y, loo_depth);
+      // The depth only where it predicts the slabs left out better (and the thickness cannot be used).
+      const bool use_depth = in_depth && (!in_thickness || (loo_depth && loo_thickness && *loo_depth < *loo_thickness));
+      SlabRuleParameter p = use_depth ? *in_depth : *in_thickness;
       p.pointer = pointer;
-      p.value_at_reference = std::exp(f.intercept);
-      p.exponent = f.slope;
-      p.exponent_standard_error = f.slope_standard_error;
-      p.log_residual_rms = f.residual_rms;
       p.integer = integer;
-      for (std::size_t i = 0; i < presets.size(); ++i) {
-        SlabRuleSample s;
-        s.thickness_mm = rule.presets[i].thickness_mm[k];
-        s.value = std::exp(y[i]);
-        s.fitted = std::exp(f.intercept + f.slope * x[i]);
-        if (presets.size() >= 3) {
-          std::vector<double> xo, yo;
-          for (std::size_t j = 0; j < presets.size(); ++j)
-            if (j != i) xo.push_back(x[j]), yo.push_back(y[j]);
-          double spread_o = 0.0;
-          for (double xj : xo) spread_o = std::max(spread_o, std::abs(xj - xo.front()));
-          if (spread_o > 1e-9) {
-            const LineFit g = fit_line(xo, yo);
-            s.leave_one_out_relative_error = std::exp(g.intercept + g.slope * x[i]) / s.value - 1.0;
-          }
-        }
-        p.samples.push_back(s);
-      }
+      p.leave_one_out_log_rms_thickness = loo_thickness;
+      p.leave_one_out_log_rms_depth = loo_depth;
       layer.parameters.push_back(p);
     }
     if (!layer.parameters.empty()) rule.layers.push_back(layer);
@@ -201,16 +244,25 @@ std::vector<std::string> apply_slab_rule(json& scene, const SlabRule& rule, cons
     if (r == rule.layers.end()) continue;
     const std::string layer_pointer = "/layers/" + std::to_string(k);
     const double h = thickness_of(layers[k], where, layer_pointer);
-    const double tolerance = 1e-9 * r->max_thickness_mm;
-    if (h < r->min_thickness_mm - tolerance || h > r->max_thickness_mm + tolerance)
-      notes.push_back("layer " + name + ": " + significant_digits(h, 4) + " mm lies outside the family's " +
-                      significant_digits(r->min_thickness_mm, 4) + " - " + significant_digits(r->max_thickness_mm, 4) +
-                      " mm (extrapolated)");
+    double depth = 0.0;
+    for (std::size_t j = 0; j < k; ++j) depth += thickness_of(layers[j], where, "/layers/" + std::to_string(j));
+    bool noted[2] = {false, false};
     for (const SlabRuleParameter& p : r->parameters) {
       const json::json_pointer ptr(layer_pointer + p.pointer);
       if (!scene.contains(ptr) || !scene[ptr].is_number())
         fail(where, layer_pointer + p.pointer, "the slab rule sets it, but the scene has no such number");
-      const double value = slab_rule_value(p, r->reference_thickness_mm, h);
+      const bool by_depth = p.variable == SlabRuleVariable::depth;
+      const double x = by_depth ? depth : h;
+      if (!(x > 0.0)) fail(where, layer_pointer, std::string("the slab rule needs the layer's ") +
+                                                     slab_rule_variable_name(p.variable) + " > 0");
+      const double tolerance = 1e-9 * p.max_mm;
+      if ((x < p.min_mm - tolerance || x > p.max_mm + tolerance) && !noted[by_depth]) {
+        noted[by_depth] = true;
+        notes.push_back("layer " + name + ": its " + slab_rule_variable_name(p.variable) + " " +
+                        significant_digits(x, 4) + " mm lies outside the family's " + significant_digits(p.min_mm, 4) +
+                        " - " + significant_digits(p.max_mm, 4) + " mm (extrapolated)");
+      }
+      const double value = slab_rule_value(p, x);
       scene[ptr] = p.integer ? json(static_cast<long long>(value)) : json(value);
     }
   }
@@ -226,16 +278,22 @@ json slab_rule_json(const SlabRule& rule, const json& provenance) {
     for (const SlabRuleParameter& p : l.parameters) {
       json samples = json::array();
       for (const SlabRuleSample& s : p.samples)
-        samples.push_back({{"thickness_mm", s.thickness_mm},
+        samples.push_back({{"x_mm", s.x_mm},
                            {"value", s.value},
                            {"fitted", s.fitted},
                            {"leave_one_out_relative_error", or_null(s.leave_one_out_relative_error)}});
       parameters.push_back({{"pointer", p.pointer},
+                            {"variable", slab_rule_variable_name(p.variable)},
+                            {"reference_mm", p.reference_mm},
+                            {"range_mm", {p.min_mm, p.max_mm}},
                             {"value_at_reference", p.value_at_reference},
                             {"exponent", p.exponent},
                             {"exponent_standard_error", or_null(p.exponent_standard_error)},
                             {"log_residual_rms", or_null(p.log_residual_rms)},
                             {"integer", p.integer},
+                            {"leave_one_out_log_rms",
+                             {{"thickness", or_null(p.leave_one_out_log_rms_thickness)},
+                              {"depth", or_null(p.leave_one_out_log_rms_depth)}}},
                             {"samples", samples}});
     }
     layers.push_back({{"layer", l.layer},
@@ -244,8 +302,9 @@ json slab_rule_json(const SlabRule& rule, const json& provenance) {
                       {"parameters", parameters}});
   }
   return {{"description",
-           "Real-time parameters of a slab from each layer's thickness h: p(h) = value_at_reference * "
-           "(h / reference_thickness_mm)^exponent, least squares in ln p over presets calibrated on a family of "
+           "Real-time parameters of a slab from each layer's geometry: p(x) = value_at_reference * "
+           "(x / reference_mm)^exponent, x the layer's thickness or the depth of its top (\"variable\", the one "
+           "with the smaller leave-one-out error), least squares in ln p over presets calibrated on a family of "
            "slabs (validation/harness/include/puncture/validation/slab_rule.hpp). Parameters not listed are the "
            "scene's own."},
           {"presets", presets},
@@ -302,6 +361,17 @@ SlabRule read_slab_rule(const std::filesystem::path& file) {
         fail(where, pp + "/pointer", "missing or not a pointer into /force_mesh or /force_law");
       SlabRuleParameter parameter;
       parameter.pointer = p["pointer"].get<std::string>();
+      if (!p.contains("variable") || !p["variable"].is_string() ||
+          (p["variable"] != "thickness" && p["variable"] != "depth"))
+        fail(where, pp + "/variable", "missing or not \"thickness\" or \"depth\"");
+      parameter.variable = p["variable"] == "depth" ? SlabRuleVariable::depth : SlabRuleVariable::thickness;
+      parameter.reference_mm = positive(p, "reference_mm", pp);
+      if (!p.contains("range_mm") || !p["range_mm"].is_array() || p["range_mm"].size() != 2 ||
+          !p["range_mm"][0].is_number() || !p["range_mm"][1].is_number() ||
+          !(p["range_mm"][0].get<double>() <= p["range_mm"][1].get<double>()))
+        fail(where, pp + "/range_mm", "must be [min, max] in mm");
+      parameter.min_mm = p["range_mm"][0].get<double>();
+      parameter.max_mm = p["range_mm"][1].get<double>();
       parameter.value_at_reference = positive(p, "value_at_reference", pp);
       if (!p.contains("exponent") || !p["exponent"].is_number() || !std::isfinite(p["exponent"].get<double>()))
         fail(where, pp + "/exponent", "missing or not a finite number");
@@ -309,10 +379,14 @@ SlabRule read_slab_rule(const std::filesystem::path& file) {
       parameter.exponent_standard_error = optional_number(p, "exponent_standard_error");
       parameter.log_residual_rms = optional_number(p, "log_residual_rms");
       parameter.integer = p.contains("integer") && p["integer"].is_boolean() && p["integer"].get<bool>();
+      if (p.contains("leave_one_out_log_rms") && p["leave_one_out_log_rms"].is_object()) {
+        parameter.leave_one_out_log_rms_thickness = optional_number(p["leave_one_out_log_rms"], "thickness");
+        parameter.leave_one_out_log_rms_depth = optional_number(p["leave_one_out_log_rms"], "depth");
+      }
       if (p.contains("samples") && p["samples"].is_array())
         for (const json& s : p["samples"]) {
           SlabRuleSample sample;
-          sample.thickness_mm = s.value("thickness_mm", 0.0);
+          sample.x_mm = s.value("x_mm", 0.0);
           sample.value = s.value("value", 0.0);
           sample.fitted = s.value("fitted", 0.0);
           sample.leave_one_out_relative_error = optional_number(s, "leave_one_out_relative_error");
@@ -325,49 +399,60 @@ SlabRule read_slab_rule(const std::filesystem::path& file) {
   return rule;
 }
 
+namespace {
+
+std::string percent(const std::optional<double>& x) {
+  if (!x) return "n/a";
+  return (*x >= 0 ? "+" : "") + significant_digits(100.0 * *x, 3) + " %";
+}
+
+/// A leave-one-out RMS in ln p as the relative error it stands for.
+std::string log_rms_percent(const std::optional<double>& x) {
+  return x ? significant_digits(100.0 * (std::exp(*x) - 1.0), 3) + " %" : "n/a";
+}
+
+}  // namespace
+
 std::string slab_rule_markdown(const SlabRule& rule, const std::string& command, const std::string& provenance_line) {
   std::ostringstream md;
-  md << "# Slab rule: real-time parameters from each layer's thickness\n\n"
+  md << "# Slab rule: real-time parameters from each layer's geometry\n\n"
      << "Command: `" << command << "`, " << provenance_line << ".\n\n"
      << "Each preset below is the same model calibrated on its own slab. For every parameter whose calibrated "
-        "value differs between them, p(h) = p_ref (h / h_ref)^alpha in the layer's own thickness h, least squares "
-        "in ln p (h_ref: the first preset's thickness). Parameters not listed keep the scene's value. A slab the "
-        "family never saw takes its parameters from this rule (`puncture validate MODEL --cases FILE --slab-rule slab_rule.json`), never from a "
-        "calibration on that slab.\n\n## The family\n\n| preset | thickness (mm) |\n|---|---|\n";
+        "value differs between them, p(x) = p_ref (x / x_ref)^alpha, least squares in ln p (x_ref: the first "
+        "preset's), where x is the layer's own thickness or the depth of its top (the thickness of the layers "
+        "above it), whichever predicts the slabs left out better: the leave-one-out error of either is the rule "
+        "fitted without one slab, predicting it, RMS over the slabs (the own thickness when it cannot be told). "
+        "Parameters not listed keep the scene's value. A slab the family never saw takes its parameters from this "
+        "rule (`puncture validate MODEL --cases FILE --slab-rule slab_rule.json`), never from a calibration on "
+        "that slab.\n\n## The family\n\n| preset | thickness (mm) |\n|---|---|\n";
   for (const SlabRulePreset& p : rule.presets) {
     md << "| " << p.file << " | ";
     for (std::size_t k = 0; k < p.thickness_mm.size(); ++k) md << (k ? " / " : "") << significant_digits(p.thickness_mm[k], 4);
     md << " |\n";
   }
   md << "\n## The rule\n\nValues calibrated on each slab (in the family's order) -> the rule's; alpha +- its standard "
-        "error; the leave-one-out error is the rule fitted without that slab, at its thickness, relative to its "
-        "calibrated value (how well the rule predicts a slab it did not see).\n\n"
-     << "| layer | parameter | h_ref (mm) | p_ref | alpha | calibrated -> rule | leave-one-out error |\n"
-     << "|---|---|---|---|---|---|---|\n";
+        "error; per slab, the rule fitted without it, at its x, relative to its calibrated value; the leave-one-out "
+        "RMS of either variable (the chosen one in bold).\n\n"
+     << "| layer | parameter | x | x_ref (mm) | p_ref | alpha | calibrated -> rule | leave-one-out error per slab | "
+        "leave-one-out RMS: thickness / depth |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
   for (const SlabRuleLayer& l : rule.layers)
     for (const SlabRuleParameter& p : l.parameters) {
-      md << "| " << l.layer << " | `" << p.pointer << "`" << (p.integer ? " (a count: rounded)" : "") << " | " << significant_digits(l.reference_thickness_mm, 4) << " | "
-         << significant_digits(p.value_at_reference, 4) << " | " << significant_digits(p.exponent, 3);
+      const bool by_depth = p.variable == SlabRuleVariable::depth;
+      md << "| " << l.layer << " | `" << p.pointer << "`" << (p.integer ? " (a count: rounded)" : "") << " | "
+         << (by_depth ? "depth of its top" : "own thickness") << " | " << significant_digits(p.reference_mm, 4)
+         << " | " << significant_digits(p.value_at_reference, 4) << " | " << significant_digits(p.exponent, 3);
       if (p.exponent_standard_error) md << " +- " << significant_digits(*p.exponent_standard_error, 2);
       md << " | ";
       for (std::size_t i = 0; i < p.samples.size(); ++i)
         md << (i ? "; " : "") << significant_digits(p.samples[i].value, 4) << " -> " << significant_digits(p.samples[i].fitted, 4);
       md << " | ";
-      bool any = false;
-      for (std::size_t i = 0; i < p.samples.size(); ++i) {
-        md << (i ? "; " : "");
-        if (p.samples[i].leave_one_out_relative_error) {
-          md << (*p.samples[i].leave_one_out_relative_error >= 0 ? "+" : "")
-             << significant_digits(100.0 * *p.samples[i].leave_one_out_relative_error, 3) << " %";
-          any = true;
-        } else {
-          md << "n/a";
-        }
-      }
-      if (!any) md << " (needs 3 slabs)";
-      md << " |\n";
+      for (std::size_t i = 0; i < p.samples.size(); ++i) md << (i ? "; " : "") << percent(p.samples[i].leave_one_out_relative_error);
+      const std::string t = log_rms_percent(p.leave_one_out_log_rms_thickness);
+      const std::string d = log_rms_percent(p.leave_one_out_log_rms_depth);
+      md << " | " << (by_depth ? t : "**" + t + "**") << " / " << (by_depth ? "**" + d + "**" : d) << " |\n";
     }
-  if (rule.layers.empty()) md << "| - | no parameter differs between the presets | | | | | |\n";
+  if (rule.layers.empty()) md << "| - | no parameter differs between the presets | | | | | | | |\n";
   return md.str();
 }
 

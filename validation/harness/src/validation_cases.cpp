@@ -133,8 +133,9 @@ std::string slab_rule_case_text(const SlabRule& rule, const std::string& rule_fi
     family += family.empty() ? "" : ", ";
     for (std::size_t k = 0; k < p.thickness_mm.size(); ++k) family += (k ? "/" : "") + significant_digits(p.thickness_mm[k], 3);
   }
-  std::string text = "each layer's real-time parameters from its thickness by the model's slab rule " + rule_file +
-                     " (p = p_ref (h / h_ref)^alpha per layer, fitted on the model calibrated on the slabs " + family +
+  std::string text = "each layer's real-time parameters from its geometry by the model's slab rule " + rule_file +
+                     " (p = p_ref (x / x_ref)^alpha per parameter, x the layer's thickness or the depth of its top, "
+                     "fitted on the model calibrated on the slabs " + family +
                      " mm; the parameters it does not name are the model's)";
   for (const std::string& n : notes) text += "; " + n;
   return text;
