@@ -220,7 +220,7 @@ SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::
       std::optional<SlabRuleParameter> in_thickness, in_depth;
       if (by_thickness) in_thickness = fit_in(SlabRuleVariable::thickness, thickness, y, loo_thickness);
       if (by_depth) in_depth = fit_in(SlabRuleVariable::depth, depth, y, loo_depth);
-      // The depth only where it predicts the slabs left out better (and the thickness cannot be used).
+      // The depth where it predicts the slabs left out better, or where the thickness does not vary.
       const bool use_depth = in_depth && (!in_thickness || (loo_depth && loo_thickness && *loo_depth < *loo_thickness));
       SlabRuleParameter p = use_depth ? *in_depth : *in_thickness;
       p.pointer = pointer;
