@@ -209,8 +209,7 @@ Scene scene_on_slab(const std::filesystem::path& scene_path, const std::vector<d
   }
   slab.layer_thickness_mm = thickness_mm;
   try {
-    Scene s = validation::case_scene(io::read_text_file(scene_path), scene_path.string(), slab).scene;
-    return s;
+    return validation::case_scene(io::read_text_file(scene_path), scene_path.string(), slab).scene;
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--layer-thickness: ") + e.what());
   }

@@ -6,6 +6,8 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 #include "puncture/validation/number_format.hpp"
 
@@ -339,6 +341,12 @@ SlabRule read_slab_rule(const std::filesystem::path& file) {
       fail(where, pointer + "/" + key, "missing or not a positive number");
     return j[key].get<double>();
   };
+  const auto range = [&](const json& j, const char* key, const std::string& pointer) {
+    if (!j.contains(key) || !j[key].is_array() || j[key].size() != 2 || !j[key][0].is_number() ||
+        !j[key][1].is_number() || !(j[key][0].get<double>() <= j[key][1].get<double>()))
+      fail(where, pointer + "/" + key, "must be [min, max] in mm");
+    return std::pair<double, double>(j[key][0].get<double>(), j[key][1].get<double>());
+  };
   for (std::size_t k = 0; k < root["layers"].size(); ++k) {
     const json& l = root["layers"][k];
     const std::string lp = "/layers/" + std::to_string(k);
@@ -346,12 +354,7 @@ SlabRule read_slab_rule(const std::filesystem::path& file) {
     SlabRuleLayer layer;
     layer.layer = l["layer"].get<std::string>();
     layer.reference_thickness_mm = positive(l, "reference_thickness_mm", lp);
-    if (!l.contains("thickness_range_mm") || !l["thickness_range_mm"].is_array() || l["thickness_range_mm"].size() != 2 ||
-        !l["thickness_range_mm"][0].is_number() || !l["thickness_range_mm"][1].is_number() ||
-        !(l["thickness_range_mm"][0].get<double>() <= l["thickness_range_mm"][1].get<double>()))
-      fail(where, lp + "/thickness_range_mm", "must be [min, max] in mm");
-    layer.min_thickness_mm = l["thickness_range_mm"][0].get<double>();
-    layer.max_thickness_mm = l["thickness_range_mm"][1].get<double>();
+    std::tie(layer.min_thickness_mm, layer.max_thickness_mm) = range(l, "thickness_range_mm", lp);
     if (!l.contains("parameters") || !l["parameters"].is_array()) fail(where, lp + "/parameters", "missing or not an array");
     for (std::size_t j = 0; j < l["parameters"].size(); ++j) {
       const json& p = l["parameters"][j];
@@ -366,12 +369,7 @@ SlabRule read_slab_rule(const std::filesystem::path& file) {
         fail(where, pp + "/variable", "missing or not \"thickness\" or \"depth\"");
       parameter.variable = p["variable"] == "depth" ? SlabRuleVariable::depth : SlabRuleVariable::thickness;
       parameter.reference_mm = positive(p, "reference_mm", pp);
-      if (!p.contains("range_mm") || !p["range_mm"].is_array() || p["range_mm"].size() != 2 ||
-          !p["range_mm"][0].is_number() || !p["range_mm"][1].is_number() ||
-          !(p["range_mm"][0].get<double>() <= p["range_mm"][1].get<double>()))
-        fail(where, pp + "/range_mm", "must be [min, max] in mm");
-      parameter.min_mm = p["range_mm"][0].get<double>();
-      parameter.max_mm = p["range_mm"][1].get<double>();
+      std::tie(parameter.min_mm, parameter.max_mm) = range(p, "range_mm", pp);
       parameter.value_at_reference = positive(p, "value_at_reference", pp);
       if (!p.contains("exponent") || !p["exponent"].is_number() || !std::isfinite(p["exponent"].get<double>()))
         fail(where, pp + "/exponent", "missing or not a finite number");
