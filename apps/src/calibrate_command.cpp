@@ -247,7 +247,11 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
     io::OutputSession session(dir);
     const std::string name = options.preset_name.empty() ? scene.name + "_tuned" : options.preset_name;
     const io::Provenance provenance = io::make_provenance(command_line(options, scene_path, dir, name, calibration.integrator));
-    validation::write_tuned_preset(session, name, result, references, calibration);
+    std::vector<validation::CalibratedValue> surface_values;
+    for (const validation::SurfaceIdentificationResult& r : surfaces)
+      for (const validation::SurfaceParameterStatus& st : validation::surface_parameter_statuses(r))
+        surface_values.push_back({r.layer, st.pointer, st.status, st.reason, "surface fit"});
+    validation::write_tuned_preset(session, name, result, references, calibration, surface_values);
     // The model curves the objective compared, before and after, for the report.
     session.write_text("calibration_curves.csv", validation::calibration_curves_csv(curve_list(references, result), provenance));
     if (options.surface_fit)

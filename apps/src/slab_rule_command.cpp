@@ -25,14 +25,32 @@ int slab_rule_command(const SlabRuleOptions& options, std::ostream& stdout_strea
     if (options.presets.size() < 2) throw UsageError("slab-rule needs presets calibrated on two slabs or more");
     std::vector<nlohmann::json> presets;
     std::vector<std::string> names;
-    for (const std::filesystem::path& p : options.presets) {
-      load_scene(p);  // each preset must be a valid scene (SceneError names the file and field)
-      presets.push_back(nlohmann::json::parse(io::read_text_file(p)));
-      names.push_back(p.string());
-    }
+    std::vector<validation::PresetCalibration> calibrations;
     validation::SlabRule rule;
     try {
-      rule = validation::fit_slab_rule(presets, names);
+      for (const std::filesystem::path& p : options.presets) {
+        load_scene(p);  // each preset must be a valid scene (SceneError names the file and field)
+        presets.push_back(nlohmann::json::parse(io::read_text_file(p)));
+        names.push_back(p.string());
+        // What its calibration identified: <stem>.provenance.json beside it (puncture calibrate).
+        std::filesystem::path record = p;
+        record.replace_extension(".provenance.json");
+        validation::PresetCalibration c;
+        if (std::filesystem::exists(record)) {
+          nlohmann::json provenance;
+          try {
+            provenance = nlohmann::json::parse(io::read_text_file(record));
+          } catch (const nlohmann::json::parse_error& e) {
+            throw InputError(record.string() + ": not valid JSON: " + e.what());
+          }
+          c = validation::read_preset_calibration(provenance, record.string());
+        }
+        if (!c.known)
+          err << "warning: " << p.string() << ": no calibration record (" << record.string()
+              << " with calibrated_values): every value is taken as identified\n";
+        calibrations.push_back(c);
+      }
+      rule = validation::fit_slab_rule(presets, names, calibrations);
     } catch (const std::invalid_argument& e) {
       throw InputError(e.what());
     }
@@ -47,10 +65,10 @@ int slab_rule_command(const SlabRuleOptions& options, std::ostream& stdout_strea
                                                                       "git " + provenance.git_revision + ", " +
                                                                           provenance.machine + ", " + provenance.date_utc));
     session.commit();
-    std::size_t count = 0;
-    for (const auto& l : rule.layers) count += l.parameters.size();
+    std::size_t count = 0, not_ruled = 0;
+    for (const auto& l : rule.layers) count += l.parameters.size(), not_ruled += l.not_ruled.size();
     out << "Slab rule: " << count << " parameter(s) in " << rule.layers.size() << " layer(s) from " << presets.size()
-        << " presets\nOutputs in " << dir.string() << "/ (slab_rule.json, slab_rule.md)\n";
+        << " presets (" << not_ruled << " not ruled: identified on too few slabs)\nOutputs in " << dir.string() << "/ (slab_rule.json, slab_rule.md)\n";
     return 0;
   });
 }

@@ -313,6 +313,40 @@ TEST(SlabRuleCommand, FitsThePresetsOfAFamilyAndRejectsBadInput) {
   EXPECT_NEAR(rule["layers"][0]["parameters"][0]["exponent"].get<double>(), 2.0, 1e-9);
   EXPECT_TRUE(rule.contains("provenance"));
   EXPECT_TRUE(fs::exists(dir / "rule" / "slab_rule.md"));
+  EXPECT_NE(err.str().find("no calibration record"), std::string::npos) << err.str();  // said, not silent
+
+  // With calibration records beside the presets (<stem>.provenance.json, as
+  // `puncture calibrate` writes): a value its calibration left at a bound
+  // stays out of the fit however wild it is.
+  {
+    Scene wild = load_scene(presets[2]);
+    wild.layers[0].force_mesh.virtual_stiffness_N_per_m = 1e6;
+    std::ofstream(presets[2]) << scene_to_json_text(wild);
+    for (int i = 0; i < 3; ++i)
+      std::ofstream(dir / ("p" + std::to_string(i) + ".provenance.json"))
+          << nlohmann::json{{"calibrated_values",
+                             {{{"layer", "skin"}, {"pointer", "/force_mesh/K_N_per_mm"},
+                               {"status", i == 2 ? "at a bound" : "identified"}}}}}.dump();
+    options.output_dir = dir / "recorded";
+    std::ostringstream recorded_err;
+    ASSERT_EQ(slab_rule_command(options, out, recorded_err), 0) << recorded_err.str();
+    EXPECT_EQ(recorded_err.str().find("no calibration record"), std::string::npos) << recorded_err.str();
+    std::ifstream rin(dir / "recorded" / "slab_rule.json");
+    const nlohmann::json recorded = nlohmann::json::parse(rin);
+    const nlohmann::json& k = recorded["layers"][0]["parameters"][0];
+    EXPECT_NEAR(k["exponent"].get<double>(), 2.0, 1e-9);
+    ASSERT_EQ(k["excluded"].size(), 1u);
+    EXPECT_EQ(k["excluded"][0]["file"], presets[2].string());
+    EXPECT_EQ(k["excluded"][0]["status"], "at a bound");
+    // A record that is not JSON: bad input naming it, nothing written.
+    std::ofstream(dir / "p1.provenance.json") << "{not json";
+    options.output_dir = dir / "broken_record";
+    std::ostringstream broken_err;
+    EXPECT_EQ(slab_rule_command(options, out, broken_err), kExitBadInput);
+    EXPECT_NE(broken_err.str().find("p1.provenance.json"), std::string::npos) << broken_err.str();
+    EXPECT_FALSE(fs::exists(dir / "broken_record"));
+    fs::remove(dir / "p1.provenance.json");
+  }
 
   // One preset: a usage error, nothing written.
   options.presets = {presets[0]};

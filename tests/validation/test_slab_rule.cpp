@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -241,6 +242,98 @@ TEST(SlabRule, ACountSuchAsTheRingNumberIsRuledAndRounded) {
   ASSERT_NE(find(read, "skin", "/force_mesh/w"), nullptr);
   EXPECT_TRUE(find(read, "skin", "/force_mesh/w")->integer);
   EXPECT_FALSE(find(read, "skin", "/force_mesh/K_N_per_mm")->integer);
+}
+
+/// A calibration record (a provenance's "calibrated_values") with each
+/// (layer, pointer, status) given.
+PresetCalibration record(const std::vector<std::array<std::string, 3>>& entries) {
+  json values = json::array();
+  for (const auto& e : entries) values.push_back({{"layer", e[0]}, {"pointer", e[1]}, {"status", e[2]}, {"reason", ""}});
+  return read_preset_calibration(json{{"calibrated_values", values}}, "p.provenance.json");
+}
+
+TEST(SlabRule, OnlyValuesTheCalibrationIdentifiedEnterTheFit) {
+  // The muscle's K is an exact power law (alpha 0.5) on three slabs; on the
+  // fourth its calibration ended at a bound with a wild value, which must not
+  // move the rule. The skin's cutting force is identified on one slab only:
+  // not ruled. The fat's K was not set by the fourth slab's calibration (kept):
+  // left out, and a non-positive value there is no error.
+  std::vector<json> family = {family_member(0.8, 8.4, 39), family_member(1.6, 4, 33), family_member(1.0, 6.5, 28),
+                              family_member(1.3, 7.5, 32)};
+  family[3]["layers"][2]["force_mesh"]["K_N_per_mm"] = 1e3;
+  family[3]["layers"][1]["force_mesh"]["K_N_per_mm"] = 0.0;
+  const std::vector<std::string> names = {"a.json", "b.json", "c.json", "d.json"};
+  std::vector<PresetCalibration> records;
+  for (int i = 0; i < 4; ++i) {
+    std::vector<std::array<std::string, 3>> e = {
+        {"skin", "/force_mesh/K_N_per_mm", "identified"},
+        {"muscle", "/force_mesh/K_N_per_mm", i == 3 ? "at a bound" : "identified"},
+        {"skin", "/force_law/cutting_force_N", i == 1 ? "identified" : "not identifiable"}};
+    if (i < 3) e.push_back({"fat", "/force_mesh/K_N_per_mm", "identified"});
+    records.push_back(record(e));
+  }
+  const SlabRule rule = fit_slab_rule(family, names, records);
+  const SlabRuleParameter* k_muscle = find(rule, "muscle", "/force_mesh/K_N_per_mm");
+  ASSERT_NE(k_muscle, nullptr);
+  EXPECT_NEAR(k_muscle->exponent, 0.5, 1e-10);  // exact: the wild value is out
+  ASSERT_EQ(k_muscle->samples.size(), 3u);
+  EXPECT_EQ(k_muscle->samples[2].file, "c.json");
+  ASSERT_EQ(k_muscle->excluded.size(), 1u);
+  EXPECT_EQ(k_muscle->excluded[0], (std::pair<std::string, std::string>{"d.json", "at a bound"}));
+  const SlabRuleParameter* k_fat = find(rule, "fat", "/force_mesh/K_N_per_mm");
+  ASSERT_NE(k_fat, nullptr);
+  EXPECT_NEAR(k_fat->exponent, 1.0, 1e-10);
+  ASSERT_EQ(k_fat->excluded.size(), 1u);
+  EXPECT_EQ(k_fat->excluded[0].second, "not calibrated (kept)");
+  EXPECT_NEAR(find(rule, "skin", "/force_mesh/K_N_per_mm")->exponent, 1.5, 1e-10);  // identified everywhere
+  EXPECT_EQ(find(rule, "skin", "/force_law/cutting_force_N"), nullptr);
+  ASSERT_EQ(rule.layers[0].not_ruled.size(), 1u);
+  EXPECT_EQ(rule.layers[0].not_ruled[0].pointer, "/force_law/cutting_force_N");
+  EXPECT_NE(rule.layers[0].not_ruled[0].reason.find("identified on 1 of 4 slabs"), std::string::npos)
+      << rule.layers[0].not_ruled[0].reason;
+  EXPECT_NE(rule.layers[0].not_ruled[0].reason.find("a.json: not identifiable"), std::string::npos);
+  EXPECT_TRUE(rule.presets[0].calibration_record);
+
+  // A scene keeps its own value of what is not ruled.
+  json scene = default_scene();
+  const double cut = scene["layers"][0]["force_law"]["cutting_force_N"].get<double>();
+  scene["layers"][2]["thickness_mm"] = 30.0;
+  apply_slab_rule(scene, rule, "scene.json");
+  EXPECT_DOUBLE_EQ(scene["layers"][0]["force_law"]["cutting_force_N"].get<double>(), cut);
+  EXPECT_NEAR(scene["layers"][2]["force_mesh"]["K_N_per_mm"].get<double>(), 0.05 * std::sqrt(30.0), 1e-12);
+
+  // The file keeps the excluded slabs and what is not ruled; the page shows both.
+  const fs::path f = fs::temp_directory_path() / ("puncture_rule_excl_" + std::to_string(::getpid()) + ".json");
+  std::ofstream(f) << slab_rule_json(rule, json::object()).dump();
+  const SlabRule read = read_slab_rule(f);
+  fs::remove(f);
+  ASSERT_NE(find(read, "muscle", "/force_mesh/K_N_per_mm"), nullptr);
+  EXPECT_EQ(find(read, "muscle", "/force_mesh/K_N_per_mm")->excluded, k_muscle->excluded);
+  ASSERT_EQ(read.layers[0].not_ruled.size(), 1u);
+  EXPECT_EQ(read.layers[0].not_ruled[0].reason, rule.layers[0].not_ruled[0].reason);
+  const std::string md = slab_rule_markdown(rule, "cmd", "here");
+  EXPECT_NE(md.find("(at a bound)"), std::string::npos) << md;
+  EXPECT_NE(md.find("## Not ruled"), std::string::npos);
+
+  // Without records every value counts: the wild value moves the rule.
+  family[3]["layers"][1]["force_mesh"]["K_N_per_mm"] = 0.05 * 7.5;
+  const SlabRule blind = fit_slab_rule(family, names);
+  EXPECT_GT(std::abs(find(blind, "muscle", "/force_mesh/K_N_per_mm")->exponent - 0.5), 1.0);
+  EXPECT_FALSE(blind.presets[0].calibration_record);
+}
+
+TEST(SlabRule, ACalibrationRecordIsReadFromTheProvenance) {
+  EXPECT_FALSE(read_preset_calibration(json{{"preset", "p"}}, "p.provenance.json").known);
+  const PresetCalibration c = record({{"skin", "/force_mesh/w", "not identifiable"}});
+  EXPECT_TRUE(c.known);
+  EXPECT_EQ(c.status.at({"skin", "/force_mesh/w"}), "not identifiable");
+  try {
+    read_preset_calibration(json{{"calibrated_values", json::array({json{{"layer", "skin"}, {"status", "identified"}}})}},
+                            "p.provenance.json");
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("p.provenance.json: /calibrated_values/0/pointer"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SlabRule, ErrorsNameThePresetAndTheField) {

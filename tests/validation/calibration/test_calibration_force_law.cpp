@@ -326,6 +326,53 @@ TEST(CalibrationForceLaw, ProvenanceListsEveryTermWithNaAsNull) {
   EXPECT_TRUE(j.contains("warnings"));
 }
 
+TEST(CalibrationForceLaw, CalibratedValuesPointIntoThePresetAndTheStagesStatusWins) {
+  const Scene truth = truth_scene(false);
+  pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  pv::CalibrationOptions o;
+  o.layers = {"skin"};
+  o.max_evaluations_per_stage = 30;
+  const pv::ReferenceCurve reference{depth_and_force_only(ref), "measured"};
+  const pv::CalibrationResult r = pv::calibrate(perturbed(truth), std::vector<pv::ReferenceCurve>{reference}, o);
+  ASSERT_FALSE(r.identifiability.parameters.empty());
+  // A surface fit's entry for a value the stages tune again takes the stages' status;
+  // one they do not tune keeps the surface fit's.
+  const std::string skin = r.identifiability.parameters.front().layer;
+  const std::string tuned_again = r.identifiability.parameters.front().preset_pointers.at(0);
+  const std::vector<pv::CalibratedValue> surface{{skin, tuned_again, "at a bound", "", "surface fit"},
+                                                 {skin, "/force_mesh/virtual_stiffening_mm", "identified", "", "surface fit"}};
+  const std::vector<pv::CalibratedValue> values = pv::calibrated_values(r, surface);
+  const nlohmann::json preset = nlohmann::json::parse(scene_to_json_text(r.tuned_scene));
+  std::size_t stages = 0;
+  for (const pv::CalibratedValue& v : values) {
+    if (v.pointer == tuned_again) {
+      EXPECT_EQ(v.step, "stages");
+      EXPECT_EQ(v.status, r.identifiability.parameters.front().status);
+    }
+    if (v.pointer == "/force_mesh/virtual_stiffening_mm") EXPECT_EQ(v.status, "identified");
+    if (v.step != "stages") continue;
+    ++stages;
+    // Every pointer names a number of that layer in the written preset.
+    std::size_t k = 0;
+    while (k < r.tuned_scene.layers.size() && r.tuned_scene.layers[k].name != v.layer) ++k;
+    ASSERT_LT(k, r.tuned_scene.layers.size()) << v.layer;
+    const nlohmann::json::json_pointer ptr("/layers/" + std::to_string(k) + v.pointer);
+    if (!preset.contains(ptr)) {
+      // The writer leaves out only a rate law's zero exponent (unused).
+      for (const auto& p : r.identifiability.parameters)
+        for (const std::string& q : p.preset_pointers)
+          if (p.layer == v.layer && q == v.pointer) EXPECT_EQ(p.value, 0.0) << v.pointer << " missing from the preset";
+      continue;
+    }
+    EXPECT_TRUE(preset[ptr].is_number()) << v.pointer;
+  }
+  std::size_t pointers = 0;
+  for (const auto& p : r.identifiability.parameters) pointers += p.preset_pointers.size();
+  EXPECT_EQ(stages, pointers);  // one entry per pointer of every reported parameter
+  const nlohmann::json j = nlohmann::json::parse(pv::tuned_preset_provenance_json("p", r, {reference}, o, surface));
+  EXPECT_EQ(j.at("calibrated_values").size(), values.size());
+}
+
 TEST(PunctureEvents, GivenDepthsOverrideDetectionAndBadOnesAreRejected) {
   const Scene truth = truth_scene(true);
   const pv::InsertionCurve ref = depth_and_force_only(pv::simulate_insertion_curve(truth));

@@ -33,6 +33,29 @@ ParamInfo info(ParamKind k) {
   throw std::logic_error("info");
 }
 
+std::vector<std::string> preset_pointers(ParamKind k) {
+  switch (k) {
+    case ParamKind::VirtualStiffness: return {"/force_mesh/K_N_per_mm"};
+    case ParamKind::DeformedThreshold: return {"/force_mesh/deformed_threshold_mm"};
+    case ParamKind::CriticalForce: return {"/force_law/breakthrough/critical_force_N"};
+    case ParamKind::CriticalEnergy: return {"/force_law/breakthrough/critical_energy_mJ"};
+    case ParamKind::SurfaceStiffness: return {"/force_mesh/surface_stiffness_N_per_mm"};
+    case ParamKind::Spacing: return {"/force_mesh/L_mm"};
+    case ParamKind::Damping: return {"/damping_d_N_s_per_m2"};
+    case ParamKind::Cutting: return {"/force_law/cutting_force_N"};
+    case ParamKind::Friction: return {"/force_law/friction/dynamic_N_per_mm", "/force_law/friction/static_N_per_mm"};
+    case ParamKind::StiffeningQuadratic: return {"/force_law/stiffening/quadratic_N_per_mm2"};
+    case ParamKind::StiffeningCubic: return {"/force_law/stiffening/cubic_N_per_mm3"};
+    case ParamKind::StiffeningExponential: return {"/force_law/stiffening/stiffness_N_per_mm"};
+    case ParamKind::Presliding: return {"/force_law/friction/presliding_mm"};
+    case ParamKind::RuptureRelease: return {"/force_law/rupture_release_mm"};
+    case ParamKind::BreakthroughRate: return {"/force_law/breakthrough/rate_exponent"};
+    case ParamKind::CuttingRate: return {"/force_law/cutting_rate/viscous_fraction"};
+    case ParamKind::ReleaseRate: return {"/force_law/rupture_release_rate/exponent"};
+  }
+  throw std::logic_error("preset_pointers");
+}
+
 double& param_ref(Scene& s, std::size_t layer, ParamKind k) {
   Layer& l = s.layers[layer];
   switch (k) {

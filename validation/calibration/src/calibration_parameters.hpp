@@ -53,6 +53,8 @@ struct ParamInfo {
 };
 
 ParamInfo info(ParamKind k);
+/// The JSON pointers (relative to a layer of a scene file) of what a parameter sets.
+std::vector<std::string> preset_pointers(ParamKind k);
 double& param_ref(Scene& s, std::size_t layer, ParamKind k);
 double param_value(const Scene& s, std::size_t layer, ParamKind k);
 /// Physical range of a parameter (SI); see calibration.hpp.

@@ -11,11 +11,13 @@ namespace puncture::validation::calibration_detail {
 
 namespace {
 
-ParameterIdentifiability named(const Scene& s, std::size_t layer, const ParamInfo& in) {
+ParameterIdentifiability named(const Scene& s, std::size_t layer, ParamKind kind) {
+  const ParamInfo in = info(kind);
   ParameterIdentifiability p;
   p.layer = s.layers[layer].name;
   p.name = in.name;
   p.unit = in.unit;
+  p.preset_pointers = preset_pointers(kind);
   return p;
 }
 
@@ -65,7 +67,7 @@ IdentifiabilityReport identifiability_report(StageObjective& whole, const std::v
       const double smax = st.sensitivity.size() ? st.sensitivity.maxCoeff() : 0.0;
       for (std::size_t j = 0; j < ps.size(); ++j) {
         const ParamInfo in = info(ps[j].kind);
-        ParameterIdentifiability pi = named(s, ps[j].layer, in);
+        ParameterIdentifiability pi = named(s, ps[j].layer, ps[j].kind);
         const double value = param_value(s, ps[j].layer, ps[j].kind);
         pi.value = value * in.to_unit;
         pi.sensitivity = st.sensitivity(static_cast<Eigen::Index>(j));
@@ -91,7 +93,7 @@ IdentifiabilityReport identifiability_report(StageObjective& whole, const std::v
   }
   for (const WithheldParameter& w : withheld) {
     const ParamInfo in = info(w.kind);
-    ParameterIdentifiability pi = named(s, w.layer, in);
+    ParameterIdentifiability pi = named(s, w.layer, w.kind);
     pi.value = param_value(s, w.layer, w.kind) * in.to_unit;
     pi.standard_error = std::numeric_limits<double>::infinity();
     pi.status = "not identifiable";

@@ -289,10 +289,32 @@ std::string with_error(double value, double se_ln, bool at_bound) {
   std::string s = number(value);
   if (at_bound) return s + " (**at a bound**)";
   if (!std::isfinite(se_ln)) return s + " (not determined)";
-  return s + " +- " + number(100.0 * se_ln, 2) + " %";
+  return s + " +- " + number(100.0 * se_ln, 2) + " %" + (se_ln > 1.0 ? " (**not identifiable**)" : "");
 }
 
 }  // namespace
+
+std::vector<SurfaceParameterStatus> surface_parameter_statuses(const SurfaceIdentificationResult& r) {
+  static const char* const pointers[4] = {"/force_mesh/K_N_per_mm", "/force_mesh/surface_stiffness_N_per_mm",
+                                          "/force_mesh/surface_axial_stiffness_N_per_mm",
+                                          "/force_mesh/virtual_stiffening_mm"};
+  std::vector<SurfaceParameterStatus> out;
+  for (std::size_t i = 0; i < 4 && i < r.standard_error_ln.size() && i < r.at_bound.size(); ++i) {
+    SurfaceParameterStatus st{pointers[i], "identified", ""};
+    if (r.at_bound[i]) {
+      st.status = "at a bound", st.reason = "ended at a bound of the surface fit";
+    } else if (!std::isfinite(r.standard_error_ln[i])) {
+      st.status = "not identifiable", st.reason = "standard error not determined (the fit does not see it)";
+    } else if (r.standard_error_ln[i] > 1.0) {
+      st.status = "not identifiable", st.reason = "relative standard error above 100 %";
+    }
+    out.push_back(st);
+  }
+  if (r.rings_costs.size() > 1)
+    out.push_back({"/force_mesh/w", r.rings_identified ? "identified" : "not identifiable",
+                   r.rings_identified ? "" : "the candidates' objectives differ by < 2 %: kept at its start"});
+  return out;
+}
 
 std::string surface_identification_markdown(const std::vector<SurfaceIdentificationResult>& results) {
   std::ostringstream s;

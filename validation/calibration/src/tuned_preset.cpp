@@ -1,4 +1,5 @@
 // The tuned preset and its provenance (calibration.hpp, write_tuned_preset).
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -246,9 +247,25 @@ nlohmann::json optimiser_json(const CalibrationResult& result, const Calibration
 
 }  // namespace
 
+std::vector<CalibratedValue> calibrated_values(const CalibrationResult& result,
+                                               const std::vector<CalibratedValue>& surface_fit) {
+  std::vector<CalibratedValue> values = surface_fit;
+  for (const ParameterIdentifiability& p : result.identifiability.parameters)
+    for (const std::string& pointer : p.preset_pointers) {
+      const CalibratedValue v{p.layer, pointer, p.status, p.reason, "stages"};
+      const auto same = std::find_if(values.begin(), values.end(), [&](const CalibratedValue& o) {
+        return o.layer == v.layer && o.pointer == v.pointer;
+      });
+      if (same != values.end()) *same = v;
+      else values.push_back(v);
+    }
+  return values;
+}
+
 std::string tuned_preset_provenance_json(const std::string& name, const CalibrationResult& result,
                                          const std::vector<ReferenceCurve>& references,
-                                         const CalibrationOptions& options) {
+                                         const CalibrationOptions& options,
+                                         const std::vector<CalibratedValue>& surface_fit) {
   nlohmann::json j;
   j["preset"] = name;
   j["scene_file"] = name + ".json";
@@ -262,6 +279,10 @@ std::string tuned_preset_provenance_json(const std::string& name, const Calibrat
   j["critical_force_start"] = result.critical_force_note;
   j["tuned_parameters"] = tuned_parameters_json(result);
   j["identifiability"] = identifiability_json(result.identifiability);
+  nlohmann::json values = nlohmann::json::array();
+  for (const CalibratedValue& v : calibrated_values(result, surface_fit))
+    values.push_back({{"layer", v.layer}, {"pointer", v.pointer}, {"status", v.status}, {"reason", v.reason}, {"step", v.step}});
+  j["calibrated_values"] = values;
   j["warnings"] = result.warnings;
   j["optimiser"] = optimiser_json(result, options);
   j["date_utc"] = io::utc_timestamp();
@@ -272,7 +293,8 @@ std::string tuned_preset_provenance_json(const std::string& name, const Calibrat
 }
 
 void write_tuned_preset(io::OutputSession& session, const std::string& name, const CalibrationResult& result,
-                        const std::vector<ReferenceCurve>& references, const CalibrationOptions& options) {
+                        const std::vector<ReferenceCurve>& references, const CalibrationOptions& options,
+                        const std::vector<CalibratedValue>& surface_fit) {
   if (name.empty() || name.find('/') != std::string::npos)
     throw std::invalid_argument("write_tuned_preset: preset name must be a plain file stem (got '" + name + "')");
   Scene preset = result.tuned_scene;
@@ -282,7 +304,7 @@ void write_tuned_preset(io::OutputSession& session, const std::string& name, con
   const std::string text = scene_to_json_text(preset);
   parse_scene(text, name + ".json");  // the preset must load: fail before writing anything
   session.write_text(name + ".json", text);
-  session.write_text(name + ".provenance.json", tuned_preset_provenance_json(name, result, references, options));
+  session.write_text(name + ".provenance.json", tuned_preset_provenance_json(name, result, references, options, surface_fit));
   session.write_text(name + ".identifiability.md", calibration_identifiability_report(result, name));
 }
 

@@ -89,7 +89,7 @@ bool varies(const std::vector<double>& x) {
 /// The rule of one parameter in one variable: x_mm[i] > 0 and y[i] = ln p on
 /// preset i; the fit, its samples and the RMS leave-one-out error in ln p.
 SlabRuleParameter fit_in(SlabRuleVariable variable, const std::vector<double>& x_mm, const std::vector<double>& y,
-                         std::optional<double>& leave_one_out_log_rms) {
+                         const std::vector<std::string>& files, std::optional<double>& leave_one_out_log_rms) {
   std::vector<double> x;
   for (double v : x_mm) x.push_back(std::log(v / x_mm.front()));
   const LineFit f = fit_line(x, y);
@@ -106,6 +106,7 @@ SlabRuleParameter fit_in(SlabRuleVariable variable, const std::vector<double>& x
   bool every_slab = x.size() >= 3;
   for (std::size_t i = 0; i < x.size(); ++i) {
     SlabRuleSample s;
+    s.file = files[i];
     s.x_mm = x_mm[i];
     s.value = std::exp(y[i]);
     s.fitted = std::exp(f.intercept + f.slope * x[i]);
@@ -144,8 +145,27 @@ double slab_rule_value(const SlabRuleParameter& parameter, double x_mm) {
   return parameter.integer ? std::max(1.0, std::round(p)) : p;
 }
 
-SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::string>& names) {
+PresetCalibration read_preset_calibration(const json& provenance, const std::string& where) {
+  PresetCalibration c;
+  if (!provenance.is_object() || !provenance.contains("calibrated_values")) return c;
+  const json& values = provenance["calibrated_values"];
+  if (!values.is_array()) fail(where, "/calibrated_values", "not an array");
+  c.known = true;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const json& v = values[i];
+    const std::string pointer = "/calibrated_values/" + std::to_string(i);
+    for (const char* key : {"layer", "pointer", "status"})
+      if (!v.is_object() || !v.contains(key) || !v[key].is_string()) fail(where, pointer + "/" + key, "missing or not a string");
+    c.status[{v["layer"].get<std::string>(), v["pointer"].get<std::string>()}] = v["status"].get<std::string>();
+  }
+  return c;
+}
+
+SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::string>& names,
+                       const std::vector<PresetCalibration>& calibrations) {
   if (presets.size() != names.size()) throw std::invalid_argument("fit_slab_rule: one name per preset");
+  if (!calibrations.empty() && calibrations.size() != presets.size())
+    throw std::invalid_argument("fit_slab_rule: one calibration record per preset, or none");
   if (presets.size() < 2) throw std::invalid_argument("a slab rule needs presets calibrated on two slabs or more");
   SlabRule rule;
   const json& first_layers = layers_of(presets.front(), names.front());
@@ -156,6 +176,7 @@ SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::
                                     std::to_string(first_layers.size()));
     SlabRulePreset p;
     p.file = names[i];
+    p.calibration_record = !calibrations.empty() && calibrations[i].known;
     for (std::size_t k = 0; k < layers.size(); ++k) {
       const std::string pointer = "/layers/" + std::to_string(k);
       const std::string name = layers[k].value("name", std::string());
@@ -202,9 +223,28 @@ SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::
         if (std::abs(a - b) > kSameValue * std::max(std::abs(a), std::abs(b))) differs = true;
       }
       if (!differs) continue;
-      std::vector<double> y;
-      bool integer = true;
+      if (!by_thickness && !by_depth)
+        fail(names.back(), layer_pointer + pointer,
+             "differs between the presets, but layer " + layer.layer +
+                 " has the same thickness and depth in all of them: the rule needs the layer at two thicknesses "
+                 "or depths or more");
+      // Only the slabs whose calibration identified the value enter the fit.
+      std::vector<std::size_t> used;
+      std::vector<std::pair<std::string, std::string>> excluded;
       for (std::size_t i = 0; i < presets.size(); ++i) {
+        if (calibrations.empty() || !calibrations[i].known) {
+          used.push_back(i);
+          continue;
+        }
+        const auto st = calibrations[i].status.find({layer.layer, pointer});
+        const std::string status = st == calibrations[i].status.end() ? "not calibrated (kept)" : st->second;
+        if (status == "identified") used.push_back(i);
+        else excluded.emplace_back(names[i], status);
+      }
+      std::vector<double> y, x_thickness, x_depth;
+      std::vector<std::string> files;
+      bool integer = true;
+      for (std::size_t i : used) {
         const json& v = leaves[i].at(pointer);
         integer = integer && v.is_number_integer();
         if (!(v.get<double>() > 0.0) || !std::isfinite(v.get<double>()))
@@ -212,26 +252,35 @@ SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::
                "differs between the presets but is not positive (" + significant_digits(v.get<double>(), 4) +
                    "): a power law needs positive values");
         y.push_back(std::log(v.get<double>()));
+        x_thickness.push_back(thickness[i]);
+        x_depth.push_back(depth[i]);
+        files.push_back(names[i]);
       }
-      if (!by_thickness && !by_depth)
-        fail(names.back(), layer_pointer + pointer,
-             "differs between the presets, but layer " + layer.layer +
-                 " has the same thickness and depth in all of them: the rule needs the layer at two thicknesses "
-                 "or depths or more");
+      const bool used_thickness = used.size() >= 2 && varies(x_thickness);
+      const bool used_depth = used.size() >= 2 && k > 0 && varies(x_depth);
+      if (!used_thickness && !used_depth) {
+        std::string why = used.size() < 2 ? "identified on " + std::to_string(used.size()) + " of " +
+                                                std::to_string(presets.size()) + " slabs"
+                                          : "identified only on slabs where the layer has the same thickness and depth";
+        for (const auto& [file, status] : excluded) why += "; " + file + ": " + status;
+        layer.not_ruled.push_back({pointer, why});
+        continue;
+      }
       std::optional<double> loo_thickness, loo_depth;
       std::optional<SlabRuleParameter> in_thickness, in_depth;
-      if (by_thickness) in_thickness = fit_in(SlabRuleVariable::thickness, thickness, y, loo_thickness);
-      if (by_depth) in_depth = fit_in(SlabRuleVariable::depth, depth, y, loo_depth);
+      if (used_thickness) in_thickness = fit_in(SlabRuleVariable::thickness, x_thickness, y, files, loo_thickness);
+      if (used_depth) in_depth = fit_in(SlabRuleVariable::depth, x_depth, y, files, loo_depth);
       // The depth where it predicts the slabs left out better, or where the thickness does not vary.
       const bool use_depth = in_depth && (!in_thickness || (loo_depth && loo_thickness && *loo_depth < *loo_thickness));
       SlabRuleParameter p = use_depth ? *in_depth : *in_thickness;
       p.pointer = pointer;
       p.integer = integer;
+      p.excluded = excluded;
       p.leave_one_out_log_rms_thickness = loo_thickness;
       p.leave_one_out_log_rms_depth = loo_depth;
       layer.parameters.push_back(p);
     }
-    if (!layer.parameters.empty()) rule.layers.push_back(layer);
+    if (!layer.parameters.empty() || !layer.not_ruled.empty()) rule.layers.push_back(layer);
   }
   return rule;
 }
@@ -271,16 +320,28 @@ std::vector<std::string> apply_slab_rule(json& scene, const SlabRule& rule, cons
   return notes;
 }
 
+namespace {
+
+json excluded_json(const std::vector<std::pair<std::string, std::string>>& excluded) {
+  json a = json::array();
+  for (const auto& [file, status] : excluded) a.push_back({{"file", file}, {"status", status}});
+  return a;
+}
+
+}  // namespace
+
 json slab_rule_json(const SlabRule& rule, const json& provenance) {
   json presets = json::array();
-  for (const SlabRulePreset& p : rule.presets) presets.push_back({{"file", p.file}, {"thickness_mm", p.thickness_mm}});
+  for (const SlabRulePreset& p : rule.presets)
+    presets.push_back({{"file", p.file}, {"thickness_mm", p.thickness_mm}, {"calibration_record", p.calibration_record}});
   json layers = json::array();
   for (const SlabRuleLayer& l : rule.layers) {
     json parameters = json::array();
     for (const SlabRuleParameter& p : l.parameters) {
       json samples = json::array();
       for (const SlabRuleSample& s : p.samples)
-        samples.push_back({{"x_mm", s.x_mm},
+        samples.push_back({{"file", s.file},
+                           {"x_mm", s.x_mm},
                            {"value", s.value},
                            {"fitted", s.fitted},
                            {"leave_one_out_relative_error", or_null(s.leave_one_out_relative_error)}});
@@ -296,19 +357,24 @@ json slab_rule_json(const SlabRule& rule, const json& provenance) {
                             {"leave_one_out_log_rms",
                              {{"thickness", or_null(p.leave_one_out_log_rms_thickness)},
                               {"depth", or_null(p.leave_one_out_log_rms_depth)}}},
-                            {"samples", samples}});
+                            {"samples", samples},
+                            {"excluded", excluded_json(p.excluded)}});
     }
+    json not_ruled = json::array();
+    for (const SlabRuleNotRuled& n : l.not_ruled) not_ruled.push_back({{"pointer", n.pointer}, {"reason", n.reason}});
     layers.push_back({{"layer", l.layer},
                       {"reference_thickness_mm", l.reference_thickness_mm},
                       {"thickness_range_mm", {l.min_thickness_mm, l.max_thickness_mm}},
-                      {"parameters", parameters}});
+                      {"parameters", parameters},
+                      {"not_ruled", not_ruled}});
   }
   return {{"description",
            "Real-time parameters of a slab from each layer's geometry: p(x) = value_at_reference * "
            "(x / reference_mm)^exponent, x the layer's thickness or the depth of its top (\"variable\", the one "
            "with the smaller leave-one-out error), least squares in ln p over presets calibrated on a family of "
-           "slabs (validation/harness/include/puncture/validation/slab_rule.hpp). Parameters not listed are the "
-           "scene's own."},
+           "slabs (validation/harness/include/puncture/validation/slab_rule.hpp), each slab's value only where its "
+           "calibration identified it (\"excluded\": the others, with their status). Parameters not listed, and "
+           "those \"not_ruled\", are the scene's own."},
           {"presets", presets},
           {"layers", layers},
           {"provenance", provenance}};
@@ -331,6 +397,7 @@ SlabRule read_slab_rule(const std::filesystem::path& file) {
     for (const json& p : root["presets"]) {
       SlabRulePreset preset;
       preset.file = p.value("file", std::string());
+      preset.calibration_record = p.value("calibration_record", false);
       if (p.contains("thickness_mm") && p["thickness_mm"].is_array())
         for (const json& t : p["thickness_mm"])
           if (t.is_number()) preset.thickness_mm.push_back(t.get<double>());
@@ -384,14 +451,21 @@ SlabRule read_slab_rule(const std::filesystem::path& file) {
       if (p.contains("samples") && p["samples"].is_array())
         for (const json& s : p["samples"]) {
           SlabRuleSample sample;
+          sample.file = s.value("file", std::string());
           sample.x_mm = s.value("x_mm", 0.0);
           sample.value = s.value("value", 0.0);
           sample.fitted = s.value("fitted", 0.0);
           sample.leave_one_out_relative_error = optional_number(s, "leave_one_out_relative_error");
           parameter.samples.push_back(sample);
         }
+      if (p.contains("excluded") && p["excluded"].is_array())
+        for (const json& e : p["excluded"])
+          parameter.excluded.emplace_back(e.value("file", std::string()), e.value("status", std::string()));
       layer.parameters.push_back(parameter);
     }
+    if (l.contains("not_ruled") && l["not_ruled"].is_array())
+      for (const json& n : l["not_ruled"])
+        layer.not_ruled.push_back({n.value("pointer", std::string()), n.value("reason", std::string())});
     rule.layers.push_back(layer);
   }
   return rule;
@@ -420,15 +494,20 @@ std::string slab_rule_markdown(const SlabRule& rule, const std::string& command,
         "preset's), where x is the layer's own thickness or the depth of its top (the thickness of the layers "
         "above it), whichever predicts the slabs left out better: the leave-one-out error of either is the rule "
         "fitted without one slab, predicting it, RMS over the slabs (the own thickness when it cannot be told). "
-        "Parameters not listed keep the scene's value. A slab the family never saw takes its parameters from this "
-        "rule (`puncture validate MODEL --cases FILE --slab-rule slab_rule.json`), never from a calibration on "
-        "that slab.\n\n## The family\n\n| preset | thickness (mm) |\n|---|---|\n";
+        "A slab's value enters the fit only where its calibration identified it (its provenance's "
+        "`calibrated_values`); values at a bound, not identifiable or not set by that calibration are left out "
+        "(shown as such), and a parameter identified on fewer than two slabs is not ruled (listed below with "
+        "why). Parameters not listed, and those not ruled, keep the scene's value. A slab the family never saw "
+        "takes its parameters from this rule (`puncture validate MODEL --cases FILE --slab-rule slab_rule.json`), "
+        "never from a calibration on that slab.\n\n## The family\n\n| preset | thickness (mm) | which values "
+        "its calibration identified |\n|---|---|---|\n";
   for (const SlabRulePreset& p : rule.presets) {
     md << "| " << p.file << " | ";
     for (std::size_t k = 0; k < p.thickness_mm.size(); ++k) md << (k ? " / " : "") << significant_digits(p.thickness_mm[k], 4);
-    md << " |\n";
+    md << " | " << (p.calibration_record ? "from its provenance" : "no record: every value taken as identified") << " |\n";
   }
-  md << "\n## The rule\n\nValues calibrated on each slab (in the family's order) -> the rule's; alpha +- its standard "
+  md << "\n## The rule\n\nValues calibrated on each slab (in the family's order; in brackets, a slab left out and its "
+        "calibration's status of the value) -> the rule's; alpha +- its standard "
         "error; per slab, the rule fitted without it, at its x, relative to its calibrated value; the leave-one-out "
         "RMS of either variable (the chosen one in bold).\n\n"
      << "| layer | parameter | x | x_ref (mm) | p_ref | alpha | calibrated -> rule | leave-one-out error per slab | "
@@ -441,16 +520,38 @@ std::string slab_rule_markdown(const SlabRule& rule, const std::string& command,
          << (by_depth ? "depth of its top" : "own thickness") << " | " << significant_digits(p.reference_mm, 4)
          << " | " << significant_digits(p.value_at_reference, 4) << " | " << significant_digits(p.exponent, 3);
       if (p.exponent_standard_error) md << " +- " << significant_digits(*p.exponent_standard_error, 2);
+      // One entry per slab of the family: its sample, or why it was left out.
+      std::vector<std::string> fitted, left_out;
+      for (const SlabRulePreset& preset : rule.presets) {
+        const auto sample = std::find_if(p.samples.begin(), p.samples.end(),
+                                         [&](const SlabRuleSample& x) { return x.file == preset.file; });
+        if (sample != p.samples.end()) {
+          fitted.push_back(significant_digits(sample->value, 4) + " -> " + significant_digits(sample->fitted, 4));
+          left_out.push_back(percent(sample->leave_one_out_relative_error));
+          continue;
+        }
+        const auto why = std::find_if(p.excluded.begin(), p.excluded.end(),
+                                      [&](const auto& e) { return e.first == preset.file; });
+        fitted.push_back("(" + (why != p.excluded.end() ? why->second : std::string("not in the fit")) + ")");
+        left_out.push_back("-");
+      }
       md << " | ";
-      for (std::size_t i = 0; i < p.samples.size(); ++i)
-        md << (i ? "; " : "") << significant_digits(p.samples[i].value, 4) << " -> " << significant_digits(p.samples[i].fitted, 4);
+      for (std::size_t i = 0; i < fitted.size(); ++i) md << (i ? "; " : "") << fitted[i];
       md << " | ";
-      for (std::size_t i = 0; i < p.samples.size(); ++i) md << (i ? "; " : "") << percent(p.samples[i].leave_one_out_relative_error);
+      for (std::size_t i = 0; i < left_out.size(); ++i) md << (i ? "; " : "") << left_out[i];
       const std::string t = log_rms_percent(p.leave_one_out_log_rms_thickness);
       const std::string d = log_rms_percent(p.leave_one_out_log_rms_depth);
       md << " | " << (by_depth ? t : "**" + t + "**") << " / " << (by_depth ? "**" + d + "**" : d) << " |\n";
     }
   if (rule.layers.empty()) md << "| - | no parameter differs between the presets | | | | | | | |\n";
+  bool any_not_ruled = false;
+  for (const SlabRuleLayer& l : rule.layers) any_not_ruled = any_not_ruled || !l.not_ruled.empty();
+  if (any_not_ruled) {
+    md << "\n## Not ruled\n\nThese differ between the presets, but too few slabs identified them: a scene keeps its "
+          "own value.\n\n| layer | parameter | why |\n|---|---|---|\n";
+    for (const SlabRuleLayer& l : rule.layers)
+      for (const SlabRuleNotRuled& n : l.not_ruled) md << "| " << l.layer << " | `" << n.pointer << "` | " << n.reason << " |\n";
+  }
   return md.str();
 }
 

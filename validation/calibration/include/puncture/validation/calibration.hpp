@@ -341,17 +341,37 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
 CalibrationResult calibrate(const Scene& scene, const InsertionCurve& reference, const CalibrationOptions& options = {},
                             const CalibrationProgressCallback& progress = {});
 
+/// What a calibration step determined of one value of the preset: the
+/// layer, the value's JSON pointer relative to the layer (e.g.
+/// "/force_mesh/K_N_per_mm"), its status ("identified", "at a bound" or "not
+/// identifiable"), why, and the step ("surface fit" or "stages").
+struct CalibratedValue {
+  std::string layer, pointer, status, reason, step;
+};
+
+/// Every value the calibration set, with its status: the force meshes'
+/// values from `surface_fit` (when --surface-fit ran before the stages),
+/// then every parameter of the identifiability report (a value set by both
+/// takes the stages' status: they set it last). Values the calibration did
+/// not set are not listed. This is what tells a user of the preset (e.g.
+/// the slab rule) which of its values the reference determined.
+std::vector<CalibratedValue> calibrated_values(const CalibrationResult& result,
+                                               const std::vector<CalibratedValue>& surface_fit = {});
+
 /// Writes <name>.json (a scene file `puncture run` accepts: the tuned scene,
 /// renamed to `name`), <name>.provenance.json (references with kind,
 /// source and FNV-1a 64 content hash, trajectory, metrics before and after,
-/// optimiser and settings, parameters before and after, identifiability, UTC
-/// date, project version and git revision) and <name>.identifiability.md
-/// into the session; the caller commits.
+/// optimiser and settings, parameters before and after, identifiability,
+/// "calibrated_values" (calibrated_values() above), UTC date, project version
+/// and git revision) and <name>.identifiability.md into the session; the
+/// caller commits.
 void write_tuned_preset(io::OutputSession& session, const std::string& name, const CalibrationResult& result,
-                        const std::vector<ReferenceCurve>& references, const CalibrationOptions& options);
+                        const std::vector<ReferenceCurve>& references, const CalibrationOptions& options,
+                        const std::vector<CalibratedValue>& surface_fit = {});
 /// Provenance JSON text as written by write_tuned_preset.
 std::string tuned_preset_provenance_json(const std::string& name, const CalibrationResult& result,
                                          const std::vector<ReferenceCurve>& references,
-                                         const CalibrationOptions& options);
+                                         const CalibrationOptions& options,
+                                         const std::vector<CalibratedValue>& surface_fit = {});
 
 }  // namespace puncture::validation

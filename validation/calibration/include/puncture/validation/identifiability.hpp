@@ -49,6 +49,10 @@ struct ParameterIdentifiability {
   std::string status;               ///< "identified", "at a bound" or "not identifiable"
   bool insensitive = false;         ///< tuned, and the objective does not change with it
   std::string reason;               ///< why, for the latter two
+  /// Where the value lives in a layer of the tuned preset (JSON pointers
+  /// relative to the layer, e.g. "/force_law/cutting_force_N"; the friction
+  /// sets its dynamic and static coefficients).
+  std::vector<std::string> preset_pointers;
 };
 
 struct IdentifiabilityReport {

@@ -95,6 +95,17 @@ SurfaceIdentificationResult identify_force_mesh(const ForceMeshParams& start, do
                                                 const SurfacePressingReference& reference,
                                                 const SurfaceIdentificationOptions& options = {});
 
+/// What the fit determined of one force-mesh value of `result`, for the
+/// preset's provenance: the value's JSON pointer relative to the layer, its
+/// status ("identified"; "at a bound"; "not identifiable": relative standard
+/// error not determined or above 100 %, or w when the candidates' objectives
+/// differ by < 2 %) and why. Index 0-3: K, k_s, k_a, z_v (parameter_names);
+/// 4: w (only when w was searched: rings_costs.size() > 1).
+struct SurfaceParameterStatus {
+  std::string pointer, status, reason;
+};
+std::vector<SurfaceParameterStatus> surface_parameter_statuses(const SurfaceIdentificationResult& result);
+
 /// Markdown table: one row per identified layer (parameters before -> after
 /// with relative standard errors, force and deflection RMSE before -> after).
 std::string surface_identification_markdown(const std::vector<SurfaceIdentificationResult>& results);

@@ -19,10 +19,21 @@
 // ring count w, which the surface fit may choose per slab) is fitted the same
 // way and applied rounded to the nearest integer, at least 1.
 //
+// Only calibrated values count. A preset written by `puncture calibrate`
+// has, in its provenance ("calibrated_values"), the status of every value
+// its calibration set: a slab's value enters the rule only when its
+// calibration identified it; a value at a bound, not identifiable, or not
+// set by that calibration (kept from the start preset) is left out of the
+// fit (listed as excluded, with its status). A parameter identified on fewer
+// than two slabs, or only on slabs where its variables do not vary, is not
+// ruled (listed, with why): a scene keeps its own value. A preset without
+// such a record has every value taken as calibrated (the page says so).
+//
 // In:  presets: scene JSON objects (the schema of scenes/) with the same
 //      layer names in the same order, "thickness_mm" > 0 per layer; a ruled
-//      parameter positive in every preset, and its variable at two or more
-//      values. Names (files) for the messages.
+//      parameter positive in every preset that identified it. Names (files)
+//      for the messages. Optionally, per preset, what its calibration
+//      determined (read_preset_calibration of its provenance).
 // Out: SlabRule (exponents with their standard error and each preset's
 //      leave-one-out error when there are three presets or more).
 //      apply_slab_rule sets every ruled parameter of a scene JSON from the
@@ -42,12 +53,17 @@
 //                                "log_residual_rms" (null below 3 presets), "integer",
 //                                "leave_one_out_log_rms": {"thickness", "depth"} (null
 //                                where not computable),
-//                                "samples": [{"x_mm", "value", "fitted",
-//                                             "leave_one_out_relative_error" (null below 3)}]}]}],
+//                                "samples": [{"file", "x_mm", "value", "fitted",
+//                                             "leave_one_out_relative_error" (null below 3)}],
+//                                "excluded": [{"file", "status"}]}],
+//                "not_ruled": [{"pointer", "reason"}]}],
 //    "provenance"}
+// (each preset: "calibration_record": whether its provenance said which
+// values its calibration identified).
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -57,6 +73,7 @@
 namespace puncture::validation {
 
 struct SlabRuleSample {
+  std::string file;     ///< the preset calibrated on that slab
   double x_mm = 0.0;    ///< the rule's variable on that slab
   double value = 0.0;   ///< calibrated on that slab
   double fitted = 0.0;  ///< the rule's value at that thickness
@@ -80,7 +97,15 @@ struct SlabRuleParameter {
   /// RMS over the slabs of ln(p_leave_one_out / p) with either variable (how
   /// the choice was made); empty where not computable.
   std::optional<double> leave_one_out_log_rms_thickness, leave_one_out_log_rms_depth;
-  std::vector<SlabRuleSample> samples;
+  std::vector<SlabRuleSample> samples;  ///< the slabs whose calibration identified it
+  /// The slabs left out of the fit: (preset, its calibration's status of the value).
+  std::vector<std::pair<std::string, std::string>> excluded;
+};
+
+/// A parameter that differs between the presets but is not ruled, and why
+/// (e.g. identified on one slab only).
+struct SlabRuleNotRuled {
+  std::string pointer, reason;
 };
 
 struct SlabRuleLayer {
@@ -88,12 +113,27 @@ struct SlabRuleLayer {
   double reference_thickness_mm = 0.0;                     ///< the first preset's (for the page)
   double min_thickness_mm = 0.0, max_thickness_mm = 0.0;  ///< the family's range (for the page)
   std::vector<SlabRuleParameter> parameters;
+  std::vector<SlabRuleNotRuled> not_ruled;
 };
 
 struct SlabRulePreset {
   std::string file;
   std::vector<double> thickness_mm;
+  bool calibration_record = false;  ///< whether its calibration said which values it identified
 };
+
+/// What the calibration of one preset determined of its values.
+struct PresetCalibration {
+  bool known = false;  ///< false: no record, every value is taken as calibrated
+  /// (layer name, JSON pointer relative to the layer) -> "identified", "at a
+  /// bound" or "not identifiable"; a value not listed was not set by the calibration.
+  std::map<std::pair<std::string, std::string>, std::string> status;
+};
+
+/// From a preset's provenance JSON (<name>.provenance.json of `puncture
+/// calibrate`): its "calibrated_values"; known = false when there is none.
+/// Throws std::invalid_argument (`where` and the pointer) for a malformed entry.
+PresetCalibration read_preset_calibration(const nlohmann::json& provenance, const std::string& where);
 
 struct SlabRule {
   std::vector<SlabRulePreset> presets;
@@ -101,8 +141,10 @@ struct SlabRule {
 };
 
 /// Fits the rule on a family of calibrated presets (names[i] names presets[i]
-/// in messages and in the rule). Needs two presets or more.
-SlabRule fit_slab_rule(const std::vector<nlohmann::json>& presets, const std::vector<std::string>& names);
+/// in messages and in the rule; calibrations[i], when given (one per preset),
+/// what its calibration determined). Needs two presets or more.
+SlabRule fit_slab_rule(const std::vector<nlohmann::json>& presets, const std::vector<std::string>& names,
+                       const std::vector<PresetCalibration>& calibrations = {});
 
 /// p_ref * (x / x_ref)^alpha (rounded to the nearest integer >= 1 for a count).
 double slab_rule_value(const SlabRuleParameter& parameter, double x_mm);
