@@ -289,11 +289,11 @@ TEST(GradeCommand, GradesModelsFromAScoresFile) {
 TEST(SlabRuleCommand, FitsThePresetsOfAFamilyAndRejectsBadInput) {
   const fs::path dir = fresh_dir("slab_rule");
   fs::create_directories(dir);
-  // Three "calibrated" presets: the default scene on three slabs with the
+  // Four "calibrated" presets: the default scene on four slabs with the
   // skin's K = 100 N/m (h / 0.8 mm)^2.
-  const double skin_mm[3] = {0.8, 1.6, 1.2};
+  const double skin_mm[4] = {0.8, 1.6, 1.2, 1.0};
   std::vector<fs::path> presets;
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < 4; ++i) {
     Scene s = load_scene(kSourceDir / "scenes" / "default.json");
     s.layers[0].thickness_m = skin_mm[i] * 1e-3;
     s.layers[0].force_mesh.virtual_stiffness_N_per_m = 100.0 * std::pow(skin_mm[i] / 0.8, 2.0);
@@ -309,6 +309,7 @@ TEST(SlabRuleCommand, FitsThePresetsOfAFamilyAndRejectsBadInput) {
   const nlohmann::json rule = nlohmann::json::parse(in);
   ASSERT_EQ(rule["layers"].size(), 1u);
   EXPECT_EQ(rule["layers"][0]["layer"], "skin");
+  ASSERT_EQ(rule["layers"][0]["parameters"].size(), 1u);
   EXPECT_EQ(rule["layers"][0]["parameters"][0]["pointer"], "/force_mesh/K_N_per_mm");
   EXPECT_NEAR(rule["layers"][0]["parameters"][0]["exponent"].get<double>(), 2.0, 1e-9);
   EXPECT_TRUE(rule.contains("provenance"));
@@ -322,7 +323,7 @@ TEST(SlabRuleCommand, FitsThePresetsOfAFamilyAndRejectsBadInput) {
     Scene wild = load_scene(presets[2]);
     wild.layers[0].force_mesh.virtual_stiffness_N_per_m = 1e6;
     std::ofstream(presets[2]) << scene_to_json_text(wild);
-    for (int i = 0; i < 3; ++i)
+    for (int i = 0; i < 4; ++i)
       std::ofstream(dir / ("p" + std::to_string(i) + ".provenance.json"))
           << nlohmann::json{{"calibrated_values",
                              {{{"layer", "skin"}, {"pointer", "/force_mesh/K_N_per_mm"},
@@ -333,6 +334,8 @@ TEST(SlabRuleCommand, FitsThePresetsOfAFamilyAndRejectsBadInput) {
     EXPECT_EQ(recorded_err.str().find("no calibration record"), std::string::npos) << recorded_err.str();
     std::ifstream rin(dir / "recorded" / "slab_rule.json");
     const nlohmann::json recorded = nlohmann::json::parse(rin);
+    ASSERT_EQ(recorded["layers"].size(), 1u);
+    ASSERT_EQ(recorded["layers"][0]["parameters"].size(), 1u);
     const nlohmann::json& k = recorded["layers"][0]["parameters"][0];
     EXPECT_NEAR(k["exponent"].get<double>(), 2.0, 1e-9);
     ASSERT_EQ(k["excluded"].size(), 1u);

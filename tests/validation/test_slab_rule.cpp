@@ -292,6 +292,14 @@ TEST(SlabRule, OnlyValuesTheCalibrationIdentifiedEnterTheFit) {
   EXPECT_NE(rule.layers[0].not_ruled[0].reason.find("identified on 1 of 4 slabs"), std::string::npos)
       << rule.layers[0].not_ruled[0].reason;
   EXPECT_NE(rule.layers[0].not_ruled[0].reason.find("a.json: not identifiable"), std::string::npos);
+  // Two identified slabs of four: no leave-one-out check, not ruled either.
+  records[2].status[{"muscle", "/force_mesh/K_N_per_mm"}] = "not identifiable";
+  const SlabRule two = fit_slab_rule(family, names, records);
+  EXPECT_EQ(find(two, "muscle", "/force_mesh/K_N_per_mm"), nullptr);
+  ASSERT_EQ(two.layers[2].not_ruled.size(), 1u);
+  EXPECT_NE(two.layers[2].not_ruled[0].reason.find("identified on 2 of 4 slabs (a rule needs 3"), std::string::npos)
+      << two.layers[2].not_ruled[0].reason;
+  records[2].status[{"muscle", "/force_mesh/K_N_per_mm"}] = "identified";
   EXPECT_TRUE(rule.presets[0].calibration_record);
 
   // A scene keeps its own value of what is not ruled.

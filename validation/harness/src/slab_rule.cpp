@@ -256,12 +256,17 @@ SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::
         x_depth.push_back(depth[i]);
         files.push_back(names[i]);
       }
-      const bool used_thickness = used.size() >= 2 && varies(x_thickness);
-      const bool used_depth = used.size() >= 2 && k > 0 && varies(x_depth);
+      // Enough slabs for a leave-one-out check where the family has them (3),
+      // else every slab of a family of two.
+      const std::size_t needed = std::min<std::size_t>(3, presets.size());
+      const bool used_thickness = used.size() >= needed && varies(x_thickness);
+      const bool used_depth = used.size() >= needed && k > 0 && varies(x_depth);
       if (!used_thickness && !used_depth) {
-        std::string why = used.size() < 2 ? "identified on " + std::to_string(used.size()) + " of " +
-                                                std::to_string(presets.size()) + " slabs"
-                                          : "identified only on slabs where the layer has the same thickness and depth";
+        std::string why = used.size() < needed
+                              ? "identified on " + std::to_string(used.size()) + " of " + std::to_string(presets.size()) +
+                                    " slabs (a rule needs " + std::to_string(needed) +
+                                    (needed == 3 ? ", so that each slab can be predicted by the others" : "") + ")"
+                              : "identified only on slabs where the layer has the same thickness and depth";
         for (const auto& [file, status] : excluded) why += "; " + file + ": " + status;
         layer.not_ruled.push_back({pointer, why});
         continue;
@@ -496,8 +501,8 @@ std::string slab_rule_markdown(const SlabRule& rule, const std::string& command,
         "fitted without one slab, predicting it, RMS over the slabs (the own thickness when it cannot be told). "
         "A slab's value enters the fit only where its calibration identified it (its provenance's "
         "`calibrated_values`); values at a bound, not identifiable or not set by that calibration are left out "
-        "(shown as such), and a parameter identified on fewer than two slabs is not ruled (listed below with "
-        "why). Parameters not listed, and those not ruled, keep the scene's value. A slab the family never saw "
+        "(shown as such), and a parameter identified on fewer than three slabs (two in a family of two: a power "
+        "law through two points has no leave-one-out check) is not ruled (listed below with why). Parameters not listed, and those not ruled, keep the scene's value. A slab the family never saw "
         "takes its parameters from this rule (`puncture validate MODEL --cases FILE --slab-rule slab_rule.json`), "
         "never from a calibration on that slab.\n\n## The family\n\n| preset | thickness (mm) | which values "
         "its calibration identified |\n|---|---|---|\n";

@@ -25,8 +25,11 @@
 // calibration identified it; a value at a bound, not identifiable, or not
 // set by that calibration (kept from the start preset) is left out of the
 // fit (listed as excluded, with its status). A parameter identified on fewer
-// than two slabs, or only on slabs where its variables do not vary, is not
-// ruled (listed, with why): a scene keeps its own value. A preset without
+// than three slabs (two in a family of two), or only on slabs where its
+// variables do not vary, is not ruled (listed, with why): a scene keeps its
+// own value. Three, so that every rule of a family of three or more has been
+// checked by predicting each of its slabs from the others (a power law
+// through two points has no such check). A preset without
 // such a record has every value taken as calibrated (the page says so).
 //
 // In:  presets: scene JSON objects (the schema of scenes/) with the same
