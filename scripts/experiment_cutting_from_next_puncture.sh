@@ -60,6 +60,16 @@ for key in a:
     lines.append(f"| {key[0]} | {key[1]} | {la['force_rmse_relative']:.3f}, {lb['force_rmse_relative']:.3f} | "
                  f"{f(la.get('puncture_force_error_relative'))}, {f(lb.get('puncture_force_error_relative'))} | "
                  f"{'yes' if la['accepted'] else 'no'}, {'yes' if lb['accepted'] else 'no'} |")
+# A case whose parameters came by another rule in the two runs (the committed
+# preset's slab rule; this preset has none of its own) compares the rules too.
+rules = {c["name"]: (c.get("slab_rule"), c.get("rule")) for c in old["cases"]}
+for c in new["cases"]:
+    before = rules.get(c["name"])
+    if before and before[0] and not c.get("slab_rule"):
+        lines += ["", f"`{c['name']}`: the committed preset takes its parameters there from its slab rule "
+                  f"({before[0]}); this preset has no slab rule of its own (that would need its own family of "
+                  f"calibrations), so it keeps them ({c.get('rule') or 'the case file rule'}): that row compares the "
+                  "rules as well as the option."]
 lines += ["", "Files: the preset (`cutting_from_next_puncture.json`, provenance), both calibration summaries, "
           "`heldout_summary.md/.json` (every metric of every case).", ""]
 open(os.path.join(out, "README.md"), "w").write("\n".join(lines))

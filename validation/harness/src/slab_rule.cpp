@@ -496,7 +496,7 @@ std::string slab_rule_markdown(const SlabRule& rule, const std::string& command,
      << "Command: `" << command << "`, " << provenance_line << ".\n\n"
      << "Each preset below is the same model calibrated on its own slab. For every parameter whose calibrated "
         "value differs between them, p(x) = p_ref (x / x_ref)^alpha, least squares in ln p (x_ref: the first "
-        "preset's), where x is the layer's own thickness or the depth of its top (the thickness of the layers "
+        "fitted slab's), where x is the layer's own thickness or the depth of its top (the thickness of the layers "
         "above it), whichever predicts the slabs left out better: the leave-one-out error of either is the rule "
         "fitted without one slab, predicting it, RMS over the slabs (the own thickness when it cannot be told). "
         "A slab's value enters the fit only where its calibration identified it (its provenance's "

@@ -8,7 +8,7 @@
 // power law in one geometric variable x of the layer:
 //     p(x) = p_ref * (x / x_ref)^alpha,
 // fitted by least squares in ln p over the presets; x_ref is the first
-// preset's value. x is the layer's own thickness h, or the depth of its top
+// fitted preset's value. x is the layer's own thickness h, or the depth of its top
 // surface (the thickness of the layers above it; not for the top layer):
 // with three presets or more, the one whose leave-one-out error (the rule
 // fitted without one slab, predicting it; RMS in ln p over the slabs) is the
@@ -90,7 +90,7 @@ enum class SlabRuleVariable { thickness, depth };
 struct SlabRuleParameter {
   std::string pointer;  ///< JSON pointer inside the layer, e.g. "/force_law/breakthrough/critical_force_N"
   SlabRuleVariable variable = SlabRuleVariable::thickness;
-  double reference_mm = 0.0;           ///< x_ref (the first preset's)
+  double reference_mm = 0.0;           ///< x_ref (the first fitted preset's)
   double min_mm = 0.0, max_mm = 0.0;   ///< the variable's range in the family
   double value_at_reference = 0.0;  ///< p_ref, the rule's value at x_ref
   double exponent = 0.0;            ///< alpha
