@@ -12,12 +12,15 @@ rate law (its threshold x (v / v_ref)^n, n identified with d at two speeds), the
 the cutting force (C [(1 - b) + b v / v_ref]) and of the release length (l (v_b / v_ref)^m), b
 and m identified with d and n, the shaft's contact pressure relaxing with each layer's Prony
 series (no fitted parameter), the coupled surfaces
-(= the tuned preset as calibrated) and layer interaction in place of the coupled surfaces. Each row is validated (`puncture validate SCENE --cases
+(= the tuned preset as calibrated), with --slab-rule the tuned preset with its
+slab rule on the cases that change the slab (`validate --slab-rule`: only the
+other slab's parameters differ from the row before), and layer interaction in
+place of the coupled surfaces (without the slab rule). Each row is validated (`puncture validate SCENE --cases
 CASES_JSON`, FEM from out/.fem_cache) on every case of the cases file; its tick
 cost is the wall time of `puncture run` on the default trajectory (ticks with
 contact: mean and p99).
 
-Usage: ablation.py TUNED_PRESET PAPER_SCENE CASES_JSON OUT_DIR PUNCTURE_BIN [--ranks 2]
+Usage: ablation.py TUNED_PRESET PAPER_SCENE CASES_JSON OUT_DIR PUNCTURE_BIN [--ranks 2] [--slab-rule RULE]
 Writes OUT_DIR/README.md (table) and OUT_DIR/ablation.json.
 """
 import argparse
@@ -30,7 +33,8 @@ import provenance
 import results_io
 
 
-def rows(tuned, paper):
+def rows(tuned, paper, slab_rule=None):
+    """(label, scene, slab rule file or None) per row."""
     def variant(effects, ring_rule, release=True, rate=True, cutting_rate=True, relaxation=True):
         s = json.loads(json.dumps(tuned), object_pairs_hook=collections.OrderedDict)
         s["effects"] = effects
@@ -57,7 +61,8 @@ def rows(tuned, paper):
                 l["force_law"]["breakthrough"] = p["force_law"]["breakthrough"]
         return s
     base = ["surface_force", "damping", "resumption"]
-    return [
+    tuned_row = variant(base + ["stiffening", "cutting", "friction", "coupled_surfaces"], False)
+    table = [
         ("paper model (Table 1 law, Table 2 values, ring rule)", paper),
         ("tuned force meshes, linear springs, ring rule, no other mechanism", variant(base, True)),
         ("+ stiffening (in the mesh where identified from the surface, else of the tip spring)",
@@ -71,11 +76,14 @@ def rows(tuned, paper):
         ("+ rate laws of cutting and release", variant(base + ["stiffening", "cutting", "friction"], False, relaxation=False)),
         ("+ shaft pressure relaxation (the layers' Prony series)",
          variant(base + ["stiffening", "cutting", "friction"], False)),
-        ("+ coupled surfaces (the tuned preset)",
-         variant(base + ["stiffening", "cutting", "friction", "coupled_surfaces"], False)),
-        ("+ layer interaction (in place of coupled surfaces)",
-         variant(base + ["stiffening", "cutting", "friction", "layer_interaction"], False)),
+        ("+ coupled surfaces (the tuned preset)", tuned_row),
     ]
+    rows_ = [(label, scene, None) for label, scene in table]
+    if slab_rule:
+        rows_.append((f"+ slab rule on the other slab ({slab_rule})", tuned_row, slab_rule))
+    rows_.append(("+ layer interaction (in place of coupled surfaces" + (", without the slab rule)" if slab_rule else ")"),
+                  variant(base + ["stiffening", "cutting", "friction", "layer_interaction"], False), None))
+    return rows_
 
 
 def tick_cost(scene_path, puncture, work):
@@ -85,13 +93,14 @@ def tick_cost(scene_path, puncture, work):
     return t["contact_mean"], t["contact_p99"]
 
 
-def validate_cases(scene_path, cases_path, work, puncture, ranks, label):
+def validate_cases(scene_path, cases_path, work, puncture, ranks, label, slab_rule=None):
     """`puncture validate` on every case: (held-out summary, {case: validation_metrics.json})."""
     out = os.path.join(work, "cases")
     print(f"{label}: puncture validate --cases", flush=True)
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    rule = ["--slab-rule", slab_rule] if slab_rule else []
     r = subprocess.run(["mpirun", "--oversubscribe", "-np", str(ranks), puncture, "validate", scene_path,
-                        "--cases", cases_path, "-o", out, "--no-vtk", "-q"], env=env)
+                        "--cases", cases_path, "-o", out, "--no-vtk", "-q"] + rule, env=env)
     if r.returncode != 0:
         raise SystemExit(f"{label}: puncture validate failed (exit {r.returncode})")
     summary = json.load(open(os.path.join(out, "heldout_summary.json")))
@@ -114,18 +123,19 @@ def main():
     for a in ("tuned", "paper", "cases", "out_dir", "puncture"):
         ap.add_argument(a)
     ap.add_argument("--ranks", type=int, default=2)
+    ap.add_argument("--slab-rule", default=None, help="the tuned preset's slab rule (adds a row)")
     args = ap.parse_args()
     tuned = json.load(open(args.tuned), object_pairs_hook=collections.OrderedDict)
     paper = json.load(open(args.paper), object_pairs_hook=collections.OrderedDict)
     result = []
-    for i, (label, scene) in enumerate(rows(tuned, paper)):
+    for i, (label, scene, slab_rule) in enumerate(rows(tuned, paper, args.slab_rule)):
         work = os.path.join("out", "ablation", f"row{i}")
         os.makedirs(work, exist_ok=True)
         base_path = os.path.join(work, "scene.json")
         json.dump(scene, open(base_path, "w"), indent=2, ensure_ascii=False)
         mean_us, p99_us = tick_cost(base_path, args.puncture, work)
         summary, metrics = validate_cases(base_path, args.cases, work, args.puncture, args.ranks,
-                                          f"ablation row {i + 1} ({label})")
+                                          f"ablation row {i + 1} ({label})", slab_rule)
         per_case = []
         for case in summary["cases"]:
             layers = case["layers"]
@@ -134,13 +144,14 @@ def main():
                              "deflection_relative_rmse": mean(l["deflection_relative_rmse"] for l in layers),
                              "layers_accepted": sum(1 for l in layers if l["accepted"]), "layers": len(layers)})
         held = [c for c in per_case if c["held_out"]]
-        result.append({"row": label, "tick_contact_mean_us": mean_us, "tick_contact_p99_us": p99_us,
+        result.append({"row": label, "slab_rule": slab_rule, "tick_contact_mean_us": mean_us, "tick_contact_p99_us": p99_us,
                        "heldout_force_rmse_relative": mean(c["force_rmse_relative"] for c in held),
                        "heldout_deflection_relative_rmse": mean(c["deflection_relative_rmse"] for c in held),
                        "in_sample_force_rmse_relative": mean(c["force_rmse_relative"] for c in per_case if not c["held_out"]),
                        "heldout_layers_accepted": f"{sum(c['layers_accepted'] for c in held)} of {sum(c['layers'] for c in held)}",
                        "cases": per_case})
-    command = f"scripts/results_ablation.sh (ablation.py {args.tuned} {args.paper} {args.cases} {args.out_dir})"
+    command = (f"scripts/results_ablation.sh (ablation.py {args.tuned} {args.paper} {args.cases} {args.out_dir}"
+               + (f" --slab-rule {args.slab_rule}" if args.slab_rule else "") + ")")
     L = ["# What each mechanism of the real-time model buys\n",
          f"Command: `{command}`, git {provenance.git_revision()}, {provenance.machine()}, {provenance.utc_now()} UTC.\n",
          "Rows are cumulative. Errors are over the whole insertion against the FEM reference of each case, as a fraction "
@@ -156,6 +167,11 @@ def main():
     L += ["", "The stiffening, cutting, friction and breakthrough values are the tuned preset's (calibrated with all of them "
           "on), so a row with a mechanism off is that preset without it, not a model refitted without it (d, for one, "
           "was identified with the rate laws on)."]
+    if args.slab_rule:
+        L += ["", f"Cases that change the slab take the preset's own parameters in every row but the slab-rule row, "
+              f"where they come from its slab rule ({args.slab_rule}, fitted on the preset calibrated on a family of "
+              "other slabs: `bash scripts/results_slab_rule.sh`); that row differs from the one before only there. "
+              "The other rows' models have no slab rule of their own."]
     os.makedirs(args.out_dir, exist_ok=True)
     for name, text in (("ablation.json", json.dumps({"command": command, "rows": result}, indent=2) + "\n"),
                        ("README.md", "\n".join(L) + "\n")):

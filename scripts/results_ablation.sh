@@ -4,7 +4,8 @@
 # (validation/cases/default_heldout.json) with the tick cost of each:
 # results/ablation/ (README.md, ablation.json). Run after
 # scripts/results_validation.sh and scripts/results_heldout.sh (the FEM of
-# every case is then cached); about 1 min per row and case.
+# every case is then cached) and scripts/results_slab_rule.sh (the tuned
+# preset's slab rule: a row of its own); about 1 min per row and case.
 #   bash scripts/results_ablation.sh          (RANKS=2)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -13,4 +14,4 @@ cd "$root"
 [ -x "$build/apps/puncture" ] || bash scripts/build.sh
 "$(command -v /usr/bin/python3 || command -v python3)" scripts/ablation.py results/tuned_preset/default_tuned.json \
   scenes/paper_table2.json validation/cases/default_heldout.json results/ablation "$build/apps/puncture" \
-  --ranks "${RANKS:-2}"
+  --ranks "${RANKS:-2}" --slab-rule results/slab_rule/slab_rule.json
