@@ -300,14 +300,28 @@ TEST(CalibrationForceLaw, ParametersThatEndAtABoundAreReported) {
   EXPECT_TRUE(moved);
 }
 
-TEST(CalibrationForceLaw, ProvenanceListsEveryTermWithNaAsNull) {
+/// The skin of a perturbed truth scene calibrated (30 runs per stage) on the
+/// truth's depth-force curve only: what the provenance tests read.
+struct SkinCalibration {
+  pv::CalibrationOptions o;
+  pv::ReferenceCurve reference;
+  pv::CalibrationResult r;
+};
+SkinCalibration skin_calibration() {
   const Scene truth = truth_scene(false);
-  pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
   pv::CalibrationOptions o;
   o.layers = {"skin"};
   o.max_evaluations_per_stage = 30;
-  const pv::ReferenceCurve reference{depth_and_force_only(ref), "measured"};
-  const pv::CalibrationResult r = pv::calibrate(perturbed(truth), std::vector<pv::ReferenceCurve>{reference}, o);
+  const pv::ReferenceCurve reference{depth_and_force_only(pv::simulate_insertion_curve(truth)), "measured"};
+  pv::CalibrationResult r = pv::calibrate(perturbed(truth), std::vector<pv::ReferenceCurve>{reference}, o);
+  return {o, reference, std::move(r)};
+}
+
+TEST(CalibrationForceLaw, ProvenanceListsEveryTermWithNaAsNull) {
+  const SkinCalibration c = skin_calibration();
+  const pv::CalibrationOptions& o = c.o;
+  const pv::ReferenceCurve& reference = c.reference;
+  const pv::CalibrationResult& r = c.r;
   const nlohmann::json j = nlohmann::json::parse(pv::tuned_preset_provenance_json("p", r, {reference}, o));
   const auto& terms = j.at("references").at(0).at("objective_terms_after").at("terms");
   bool saw_null = false, saw_value = false;
@@ -327,13 +341,10 @@ TEST(CalibrationForceLaw, ProvenanceListsEveryTermWithNaAsNull) {
 }
 
 TEST(CalibrationForceLaw, CalibratedValuesPointIntoThePresetAndTheStagesStatusWins) {
-  const Scene truth = truth_scene(false);
-  pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
-  pv::CalibrationOptions o;
-  o.layers = {"skin"};
-  o.max_evaluations_per_stage = 30;
-  const pv::ReferenceCurve reference{depth_and_force_only(ref), "measured"};
-  const pv::CalibrationResult r = pv::calibrate(perturbed(truth), std::vector<pv::ReferenceCurve>{reference}, o);
+  const SkinCalibration c = skin_calibration();
+  const pv::CalibrationOptions& o = c.o;
+  const pv::ReferenceCurve& reference = c.reference;
+  const pv::CalibrationResult& r = c.r;
   ASSERT_FALSE(r.identifiability.parameters.empty());
   // A surface fit's entry for a value the stages tune again takes the stages' status;
   // one they do not tune keeps the surface fit's.
