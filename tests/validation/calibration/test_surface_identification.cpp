@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "puncture/contact_surface.hpp"
 #include "puncture/force_mesh.hpp"
@@ -147,4 +148,37 @@ TEST(SurfaceIdentification, PressingReferenceKeepsProfilesWhileTheSurfaceFollows
   EXPECT_NEAR(ref.contact_deflection_m[1], 2e-3, 1e-12);
   EXPECT_NEAR(ref.force_N[1], 0.4, 1e-12);  // the force at 4 mm
   EXPECT_EQ(pv::surface_pressing_reference(fem, scene, 0).size(), 0u);  // no skin profiles
+}
+
+TEST(SurfaceIdentification, StatusOfEachValueForThePresetsProvenance) {
+  // K identified (20 %), k_s not determined, k_a above 100 %, z_v at a bound;
+  // w searched but not told apart by the objective.
+  pv::SurfaceIdentificationResult r;
+  r.standard_error_ln = {0.2, std::numeric_limits<double>::infinity(), 1.5, 0.1};
+  r.at_bound = {false, false, false, true};
+  r.rings_costs = {{7, 0.0100}, {8, 0.0101}};
+  r.rings_identified = false;
+  const std::vector<pv::SurfaceParameterStatus> st = pv::surface_parameter_statuses(r);
+  ASSERT_EQ(st.size(), 5u);
+  EXPECT_EQ(st[0].pointer, "/force_mesh/K_N_per_mm");
+  EXPECT_EQ(st[0].status, "identified");
+  EXPECT_EQ(st[1].pointer, "/force_mesh/surface_stiffness_N_per_mm");
+  EXPECT_EQ(st[1].status, "not identifiable");
+  EXPECT_EQ(st[2].pointer, "/force_mesh/surface_axial_stiffness_N_per_mm");
+  EXPECT_EQ(st[2].status, "not identifiable");
+  EXPECT_EQ(st[3].pointer, "/force_mesh/virtual_stiffening_mm");
+  EXPECT_EQ(st[3].status, "at a bound");  // a bound wins over a small standard error
+  EXPECT_EQ(st[4].pointer, "/force_mesh/w");
+  EXPECT_EQ(st[4].status, "not identifiable");
+  // w identified by the candidates; not searched: not listed (the fit did not set it).
+  r.rings_identified = true;
+  EXPECT_EQ(pv::surface_parameter_statuses(r).back().status, "identified");
+  r.rings_costs = {{7, 0.01}};
+  EXPECT_EQ(pv::surface_parameter_statuses(r).size(), 4u);
+  // The summary table marks a value above 100 % as not identifiable too.
+  r.layer = "skin";
+  r.contact_deflection_m = {1e-3, 2e-3};
+  const std::string md = pv::surface_identification_markdown({r});
+  EXPECT_NE(md.find("+- 150 % (**not identifiable**)"), std::string::npos) << md;
+  EXPECT_NE(md.find("(**at a bound**)"), std::string::npos) << md;
 }

@@ -289,7 +289,9 @@ std::string with_error(double value, double se_ln, bool at_bound) {
   std::string s = number(value);
   if (at_bound) return s + " (**at a bound**)";
   if (!std::isfinite(se_ln)) return s + " (not determined)";
-  return s + " +- " + number(100.0 * se_ln, 2) + " %" + (se_ln > 1.0 ? " (**not identifiable**)" : "");
+  const double percent = 100.0 * se_ln;  // two digits, whole percent from 10 % on (150 %, not 1.5e+02 %)
+  return s + " +- " + (percent >= 10.0 ? number(std::round(percent), 6) : number(percent, 2)) + " %" +
+         (se_ln > 1.0 ? " (**not identifiable**)" : "");
 }
 
 }  // namespace
