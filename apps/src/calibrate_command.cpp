@@ -250,7 +250,7 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
     std::vector<validation::CalibratedValue> surface_values;
     for (const validation::SurfaceIdentificationResult& r : surfaces)
       for (const validation::SurfaceParameterStatus& st : validation::surface_parameter_statuses(r))
-        surface_values.push_back({r.layer, st.pointer, st.status, st.reason, "surface fit"});
+        surface_values.push_back({r.layer, st.pointer, st.status, st.reason, "surface fit", st.relative_standard_error});
     validation::write_tuned_preset(session, name, result, references, calibration, surface_values);
     // The model curves the objective compared, before and after, for the report.
     session.write_text("calibration_curves.csv", validation::calibration_curves_csv(curve_list(references, result), provenance));

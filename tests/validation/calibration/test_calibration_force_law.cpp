@@ -7,6 +7,7 @@
 // parameters at their bounds, given puncture depths, force-drop detection.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -363,6 +364,15 @@ TEST(CalibrationForceLaw, CalibratedValuesPointIntoThePresetAndTheStagesStatusWi
     if (v.pointer == "/force_mesh/virtual_stiffening_mm") EXPECT_EQ(v.status, "identified");
     if (v.step != "stages") continue;
     ++stages;
+    // Its relative standard error is the report's standard error over its value.
+    for (const auto& p : r.identifiability.parameters)
+      if (p.layer == v.layer && std::find(p.preset_pointers.begin(), p.preset_pointers.end(), v.pointer) !=
+                                    p.preset_pointers.end()) {
+        if (std::isfinite(p.standard_error) && p.value != 0.0)
+          EXPECT_NEAR(v.relative_standard_error, std::abs(p.standard_error / p.value), 1e-12) << v.pointer;
+        else
+          EXPECT_TRUE(std::isnan(v.relative_standard_error)) << v.pointer;
+      }
     // Every pointer names a number of that layer in the written preset.
     std::size_t k = 0;
     while (k < r.tuned_scene.layers.size() && r.tuned_scene.layers[k].name != v.layer) ++k;
@@ -382,6 +392,9 @@ TEST(CalibrationForceLaw, CalibratedValuesPointIntoThePresetAndTheStagesStatusWi
   EXPECT_EQ(stages, pointers);  // one entry per pointer of every reported parameter
   const nlohmann::json j = nlohmann::json::parse(pv::tuned_preset_provenance_json("p", r, {reference}, o, surface));
   EXPECT_EQ(j.at("calibrated_values").size(), values.size());
+  for (std::size_t i = 0; i < values.size(); ++i)  // NaN is written as null
+    EXPECT_EQ(j.at("calibrated_values").at(i).at("relative_standard_error").is_null(),
+              std::isnan(values[i].relative_standard_error));
 }
 
 TEST(PunctureEvents, GivenDepthsOverrideDetectionAndBadOnesAreRejected) {

@@ -162,6 +162,9 @@ TEST(SurfaceIdentification, StatusOfEachValueForThePresetsProvenance) {
   ASSERT_EQ(st.size(), 5u);
   EXPECT_EQ(st[0].pointer, "/force_mesh/K_N_per_mm");
   EXPECT_EQ(st[0].status, "identified");
+  EXPECT_DOUBLE_EQ(st[0].relative_standard_error, 0.2);
+  EXPECT_TRUE(std::isnan(st[1].relative_standard_error));  // not determined
+  EXPECT_TRUE(std::isnan(st[4].relative_standard_error));  // w: a count
   EXPECT_EQ(st[1].pointer, "/force_mesh/surface_stiffness_N_per_mm");
   EXPECT_EQ(st[1].status, "not identifiable");
   EXPECT_EQ(st[2].pointer, "/force_mesh/surface_axial_stiffness_N_per_mm");

@@ -302,7 +302,8 @@ std::vector<SurfaceParameterStatus> surface_parameter_statuses(const SurfaceIden
                                           "/force_mesh/virtual_stiffening_mm"};
   std::vector<SurfaceParameterStatus> out;
   for (std::size_t i = 0; i < 4 && i < r.standard_error_ln.size() && i < r.at_bound.size(); ++i) {
-    SurfaceParameterStatus st{pointers[i], "identified", ""};
+    SurfaceParameterStatus st{pointers[i], "identified", "", r.standard_error_ln[i]};
+    if (!std::isfinite(st.relative_standard_error)) st.relative_standard_error = std::numeric_limits<double>::quiet_NaN();
     if (r.at_bound[i]) {
       st.status = "at a bound", st.reason = "ended at a bound of the surface fit";
     } else if (!std::isfinite(r.standard_error_ln[i])) {

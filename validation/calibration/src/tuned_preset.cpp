@@ -1,6 +1,7 @@
 // The tuned preset and its provenance (calibration.hpp, write_tuned_preset).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -252,7 +253,9 @@ std::vector<CalibratedValue> calibrated_values(const CalibrationResult& result,
   std::vector<CalibratedValue> values = surface_fit;
   for (const ParameterIdentifiability& p : result.identifiability.parameters)
     for (const std::string& pointer : p.preset_pointers) {
-      const CalibratedValue v{p.layer, pointer, p.status, p.reason, "stages"};
+      const double relative = std::abs(p.standard_error / p.value);
+      const CalibratedValue v{p.layer, pointer, p.status, p.reason, "stages",
+                              std::isfinite(relative) ? relative : std::numeric_limits<double>::quiet_NaN()};
       const auto same = std::find_if(values.begin(), values.end(), [&](const CalibratedValue& o) {
         return o.layer == v.layer && o.pointer == v.pointer;
       });
@@ -281,7 +284,12 @@ std::string tuned_preset_provenance_json(const std::string& name, const Calibrat
   j["identifiability"] = identifiability_json(result.identifiability);
   nlohmann::json values = nlohmann::json::array();
   for (const CalibratedValue& v : calibrated_values(result, surface_fit))
-    values.push_back({{"layer", v.layer}, {"pointer", v.pointer}, {"status", v.status}, {"reason", v.reason}, {"step", v.step}});
+    values.push_back({{"layer", v.layer},
+                      {"pointer", v.pointer},
+                      {"status", v.status},
+                      {"reason", v.reason},
+                      {"step", v.step},
+                      {"relative_standard_error", finite_or_null(v.relative_standard_error)}});
   j["calibrated_values"] = values;
   j["warnings"] = result.warnings;
   j["optimiser"] = optimiser_json(result, options);

@@ -88,6 +88,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -344,9 +345,12 @@ CalibrationResult calibrate(const Scene& scene, const InsertionCurve& reference,
 /// What a calibration step determined of one value of the preset: the
 /// layer, the value's JSON pointer relative to the layer (e.g.
 /// "/force_mesh/K_N_per_mm"), its status ("identified", "at a bound" or "not
-/// identifiable"), why, and the step ("surface fit" or "stages").
+/// identifiable"), why, the step ("surface fit" or "stages") and its
+/// relative standard error (standard error / |value|; NaN where not
+/// determined, e.g. a value of 0 or a parameter withheld from the fit).
 struct CalibratedValue {
   std::string layer, pointer, status, reason, step;
+  double relative_standard_error = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Every value the calibration set, with its status: the force meshes'

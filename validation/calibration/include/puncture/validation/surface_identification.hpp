@@ -103,6 +103,7 @@ SurfaceIdentificationResult identify_force_mesh(const ForceMeshParams& start, do
 /// 4: w (only when w was searched: rings_costs.size() > 1).
 struct SurfaceParameterStatus {
   std::string pointer, status, reason;
+  double relative_standard_error = std::numeric_limits<double>::quiet_NaN();  ///< of ln p; NaN for w
 };
 std::vector<SurfaceParameterStatus> surface_parameter_statuses(const SurfaceIdentificationResult& result);
 
