@@ -12,48 +12,48 @@ double Parameter::value_of(double x) const { return log_space ? std::exp(x) : x 
 
 ParamInfo info(ParamKind k) {
   switch (k) {
-    case ParamKind::VirtualStiffness: return {"K", "N/mm", kMm, true, 0.0};
-    case ParamKind::DeformedThreshold: return {"deformed_threshold", "mm", 1.0 / kMm, true, 0.0};
-    case ParamKind::CriticalForce: return {"critical_force", "N", 1.0, true, 0.0};
-    case ParamKind::CriticalEnergy: return {"critical_energy", "mJ", 1e3, true, 0.0};
-    case ParamKind::SurfaceStiffness: return {"surface_stiffness", "N/mm", kMm, true, 0.0};
-    case ParamKind::Spacing: return {"L", "mm", 1.0 / kMm, true, 0.0};
-    case ParamKind::Damping: return {"d", "N s/m^2", 1.0, true, 0.0};
-    case ParamKind::Cutting: return {"cutting_force", "N", 1.0, false, 0.1};
-    case ParamKind::Friction: return {"friction_dynamic", "N/mm", kMm, false, 1.0};
-    case ParamKind::StiffeningQuadratic: return {"stiffening_quadratic", "N/mm^2", kMm * kMm, false, 1e4};
-    case ParamKind::StiffeningCubic: return {"stiffening_cubic", "N/mm^3", kMm * kMm * kMm, false, 1e6};
-    case ParamKind::StiffeningExponential: return {"stiffening_exponential", "N/mm", kMm, false, 10.0};
-    case ParamKind::Presliding: return {"friction_presliding", "mm", 1.0 / kMm, false, 1e-3};
-    case ParamKind::RuptureRelease: return {"rupture_release", "mm", 1.0 / kMm, true, 0.0};
-    case ParamKind::BreakthroughRate: return {"breakthrough_rate_exponent", "-", 1.0, false, 0.1};
-    case ParamKind::CuttingRate: return {"cutting_viscous_fraction", "-", 1.0, false, 0.1};
-    case ParamKind::ReleaseRate: return {"rupture_release_rate_exponent", "-", 1.0, false, 0.1};
+    case ParamKind::VirtualStiffness:
+      return {"K", "N/mm", kMm, true, 0.0, "/force_mesh/K_N_per_mm"};
+    case ParamKind::DeformedThreshold:
+      return {"deformed_threshold", "mm", 1.0 / kMm, true, 0.0, "/force_mesh/deformed_threshold_mm"};
+    case ParamKind::CriticalForce:
+      return {"critical_force", "N", 1.0, true, 0.0, "/force_law/breakthrough/critical_force_N"};
+    case ParamKind::CriticalEnergy:
+      return {"critical_energy", "mJ", 1e3, true, 0.0, "/force_law/breakthrough/critical_energy_mJ"};
+    case ParamKind::SurfaceStiffness:
+      return {"surface_stiffness", "N/mm", kMm, true, 0.0, "/force_mesh/surface_stiffness_N_per_mm"};
+    case ParamKind::Spacing:
+      return {"L", "mm", 1.0 / kMm, true, 0.0, "/force_mesh/L_mm"};
+    case ParamKind::Damping:
+      return {"d", "N s/m^2", 1.0, true, 0.0, "/damping_d_N_s_per_m2"};
+    case ParamKind::Cutting:
+      return {"cutting_force", "N", 1.0, false, 0.1, "/force_law/cutting_force_N"};
+    case ParamKind::Friction:
+      return {"friction_dynamic", "N/mm", kMm, false, 1.0, "/force_law/friction/dynamic_N_per_mm"};
+    case ParamKind::StiffeningQuadratic:
+      return {"stiffening_quadratic", "N/mm^2", kMm * kMm, false, 1e4, "/force_law/stiffening/quadratic_N_per_mm2"};
+    case ParamKind::StiffeningCubic:
+      return {"stiffening_cubic", "N/mm^3", kMm * kMm * kMm, false, 1e6, "/force_law/stiffening/cubic_N_per_mm3"};
+    case ParamKind::StiffeningExponential:
+      return {"stiffening_exponential", "N/mm", kMm, false, 10.0, "/force_law/stiffening/stiffness_N_per_mm"};
+    case ParamKind::Presliding:
+      return {"friction_presliding", "mm", 1.0 / kMm, false, 1e-3, "/force_law/friction/presliding_mm"};
+    case ParamKind::RuptureRelease:
+      return {"rupture_release", "mm", 1.0 / kMm, true, 0.0, "/force_law/rupture_release_mm"};
+    case ParamKind::BreakthroughRate:
+      return {"breakthrough_rate_exponent", "-", 1.0, false, 0.1, "/force_law/breakthrough/rate_exponent"};
+    case ParamKind::CuttingRate:
+      return {"cutting_viscous_fraction", "-", 1.0, false, 0.1, "/force_law/cutting_rate/viscous_fraction"};
+    case ParamKind::ReleaseRate:
+      return {"rupture_release_rate_exponent", "-", 1.0, false, 0.1, "/force_law/rupture_release_rate/exponent"};
   }
   throw std::logic_error("info");
 }
 
 std::vector<std::string> preset_pointers(ParamKind k) {
-  switch (k) {
-    case ParamKind::VirtualStiffness: return {"/force_mesh/K_N_per_mm"};
-    case ParamKind::DeformedThreshold: return {"/force_mesh/deformed_threshold_mm"};
-    case ParamKind::CriticalForce: return {"/force_law/breakthrough/critical_force_N"};
-    case ParamKind::CriticalEnergy: return {"/force_law/breakthrough/critical_energy_mJ"};
-    case ParamKind::SurfaceStiffness: return {"/force_mesh/surface_stiffness_N_per_mm"};
-    case ParamKind::Spacing: return {"/force_mesh/L_mm"};
-    case ParamKind::Damping: return {"/damping_d_N_s_per_m2"};
-    case ParamKind::Cutting: return {"/force_law/cutting_force_N"};
-    case ParamKind::Friction: return {"/force_law/friction/dynamic_N_per_mm", "/force_law/friction/static_N_per_mm"};
-    case ParamKind::StiffeningQuadratic: return {"/force_law/stiffening/quadratic_N_per_mm2"};
-    case ParamKind::StiffeningCubic: return {"/force_law/stiffening/cubic_N_per_mm3"};
-    case ParamKind::StiffeningExponential: return {"/force_law/stiffening/stiffness_N_per_mm"};
-    case ParamKind::Presliding: return {"/force_law/friction/presliding_mm"};
-    case ParamKind::RuptureRelease: return {"/force_law/rupture_release_mm"};
-    case ParamKind::BreakthroughRate: return {"/force_law/breakthrough/rate_exponent"};
-    case ParamKind::CuttingRate: return {"/force_law/cutting_rate/viscous_fraction"};
-    case ParamKind::ReleaseRate: return {"/force_law/rupture_release_rate/exponent"};
-  }
-  throw std::logic_error("preset_pointers");
+  std::vector<std::string> pointers{info(k).preset_pointer};
+  if (k == ParamKind::Friction) pointers.emplace_back("/force_law/friction/static_N_per_mm");  // set_param sets it too
+  return pointers;
 }
 
 double& param_ref(Scene& s, std::size_t layer, ParamKind k) {

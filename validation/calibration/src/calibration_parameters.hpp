@@ -50,10 +50,12 @@ struct ParamInfo {
   double to_unit;       ///< SI value x to_unit = reported value
   bool log_space;       ///< scale parameter (> 0), optimised in log space
   double typical;       ///< SI; linear-space parameters are optimised as value / max(|p0|, typical)
+  const char* preset_pointer;  ///< its JSON pointer relative to a layer of a scene file
 };
 
 ParamInfo info(ParamKind k);
-/// The JSON pointers (relative to a layer of a scene file) of what a parameter sets.
+/// The JSON pointers (relative to a layer of a scene file) of what a parameter
+/// sets: its own, and for the friction the static coefficient it sets too.
 std::vector<std::string> preset_pointers(ParamKind k);
 double& param_ref(Scene& s, std::size_t layer, ParamKind k);
 double param_value(const Scene& s, std::size_t layer, ParamKind k);

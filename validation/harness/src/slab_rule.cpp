@@ -134,6 +134,26 @@ std::optional<double> optional_number(const json& j, const char* key) {
   return j[key].get<double>();
 }
 
+/// The presets whose calibration identified (layer, pointer), every preset
+/// without a record among them; the others go to `excluded` as (name, status).
+std::vector<std::size_t> identified_slabs(const std::vector<PresetCalibration>& calibrations,
+                                          const std::vector<std::string>& names, const std::string& layer,
+                                          const std::string& pointer,
+                                          std::vector<std::pair<std::string, std::string>>& excluded) {
+  std::vector<std::size_t> used;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (calibrations.empty() || !calibrations[i].known) {
+      used.push_back(i);
+      continue;
+    }
+    const auto st = calibrations[i].status.find({layer, pointer});
+    const std::string status = st == calibrations[i].status.end() ? "not calibrated (kept)" : st->second;
+    if (status == "identified") used.push_back(i);
+    else excluded.emplace_back(names[i], status);
+  }
+  return used;
+}
+
 }  // namespace
 
 const char* slab_rule_variable_name(SlabRuleVariable variable) {
@@ -229,18 +249,8 @@ SlabRule fit_slab_rule(const std::vector<json>& presets, const std::vector<std::
                  " has the same thickness and depth in all of them: the rule needs the layer at two thicknesses "
                  "or depths or more");
       // Only the slabs whose calibration identified the value enter the fit.
-      std::vector<std::size_t> used;
       std::vector<std::pair<std::string, std::string>> excluded;
-      for (std::size_t i = 0; i < presets.size(); ++i) {
-        if (calibrations.empty() || !calibrations[i].known) {
-          used.push_back(i);
-          continue;
-        }
-        const auto st = calibrations[i].status.find({layer.layer, pointer});
-        const std::string status = st == calibrations[i].status.end() ? "not calibrated (kept)" : st->second;
-        if (status == "identified") used.push_back(i);
-        else excluded.emplace_back(names[i], status);
-      }
+      const std::vector<std::size_t> used = identified_slabs(calibrations, names, layer.layer, pointer, excluded);
       std::vector<double> y, x_thickness, x_depth;
       std::vector<std::string> files;
       bool integer = true;
