@@ -87,6 +87,9 @@ CLI::App* add_validate(CLI::App& app, CommandLine& c) {
   validate_cmd->add_option("--slab-rule", c.validate.slab_rule,
                            "With --cases: the model's slab rule (slab_rule.json of puncture slab-rule); cases that "
                            "change the layer thicknesses take each layer's ruled parameters from it");
+  validate_cmd->add_option("--why-misses", c.validate.why_misses,
+                           "With --cases: the model's reasons for its misses (JSON: reasons by case and layer; "
+                           "validation/cases/default_tuned_why_misses.json), shown under \"Why each miss\"");
   validate_cmd->add_option("--model-note", c.validate.model_note,
                            "With --cases: how the model was calibrated (which references), for the summary page");
   validate_cmd->add_flag("--no-vtk", [&c](std::int64_t) { c.validate.write_vtk = false; },

@@ -330,7 +330,7 @@ std::optional<SceneValidation> validate_scene(const Scene& scene, const std::str
   const RealtimeRun rt = run_realtime(model, scene, fem, vtk, provenance, session, options, out);
 
   const Comparison c = compare_with_fem(scene, rt, fem);
-  const std::vector<PunctureForceShares> shares = puncture_force_shares(rt.run.events);
+  const std::vector<PunctureForceShares> shares = puncture_force_shares(rt.run.events, &fem.curve);
   const nlohmann::json layers = write_report_files(session, scene, scene_file, reference, fem, c, shares, provenance);
   if (vtk) write_vtk_report(session, reference, fem, rt.frames, provenance);
   session.commit();
@@ -347,9 +347,11 @@ std::optional<SceneValidation> validate_scene(const Scene& scene, const std::str
                                       "\n## The real-time force at each puncture, by term\n\n"
                                       "Eq. 5 on the force mesh's own deflections; the mesh's "
                                       "inertia and damping (its reaction minus Eq. 5); the tip "
-                                      "spring's stiffening; the rest (shaft friction and d h v of "
-                                      "the layers above). Shares of the force just before the "
-                                      "break.\n\n" +
+                                      "spring's stiffening; the cutting force of the crack above; the "
+                                      "rest (shaft friction and d h v of the layers above). Shares of "
+                                      "the force just before the break; the last column is Eq. 5's "
+                                      "share of the layer's own pressing force (the first three "
+                                      "terms: the forces of the layers above left out).\n\n" +
                                       puncture_force_shares_markdown(shares)));
   summary_session.commit();
   print_result(out, scene, reference, c.cmp, c.acceptance, layers, dir);
@@ -365,10 +367,16 @@ int validate_cases(const ValidateOptions& options, const std::filesystem::path& 
   validation::ValidationCases cases;
   std::optional<validation::SlabRule> slab_rule;
   std::vector<validation::CaseScene> scenes;
+  std::vector<validation::MissReason> reasons;
   const Scene model = load_scene(model_path);  // the model itself must be valid
   try {
     cases = validation::read_validation_cases(options.cases);
     if (!options.slab_rule.empty()) slab_rule = validation::read_slab_rule(options.slab_rule);
+    if (!options.why_misses.empty()) {
+      std::vector<std::string> layer_names;
+      for (const Layer& l : model.layers) layer_names.push_back(l.name);
+      reasons = validation::read_miss_reasons(options.why_misses, cases, layer_names);
+    }
     const std::string model_text = io::read_text_file(model_path);
     for (const validation::ValidationCase& c : cases.cases)
       scenes.push_back(validation::case_scene(model_text, model_path.string(), c, slab_rule ? &*slab_rule : nullptr));
@@ -380,6 +388,7 @@ int validate_cases(const ValidateOptions& options, const std::filesystem::path& 
   const std::string command_line = "puncture validate " + model_path.string() + " --cases " +
                                    options.cases.string() +
                                    (options.slab_rule.empty() ? "" : " --slab-rule " + options.slab_rule.string()) +
+                                   (options.why_misses.empty() ? "" : " --why-misses " + options.why_misses.string()) +
                                    " -o " + dir.string() + vtk_flag(options);
   std::vector<validation::CaseOutcome> outcomes;
   for (std::size_t i = 0; i < cases.cases.size(); ++i) {
@@ -405,7 +414,18 @@ int validate_cases(const ValidateOptions& options, const std::filesystem::path& 
   if (!validation::is_mpi_root()) return 0;
   const io::Provenance provenance = io::make_provenance(command_line);
   const nlohmann::json summary = validation::heldout_summary_json(
-      outcomes, model_path.string(), options.model_note, options.cases.string(), io::provenance_json(provenance));
+      outcomes, model_path.string(), options.model_note, options.cases.string(), io::provenance_json(provenance),
+      reasons, options.why_misses.string());
+  if (!options.why_misses.empty()) {  // the reasons must follow the results
+    for (const nlohmann::json& c : summary["cases"])
+      for (const nlohmann::json& l : c["layers"])
+        if (!l["accepted"].get<bool>() && l["why"].is_null())
+          err << "warning: " << options.why_misses.string() << ": no reason for case " << c["name"].get<std::string>()
+              << ", layer " << l["layer"].get<std::string>() << ", which misses\n";
+    for (const nlohmann::json& r : summary["stale_reasons"])
+      err << "warning: " << options.why_misses.string() << ": case " << r["case"].get<std::string>() << ", layer "
+          << r["layer"].get<std::string>() << " is accepted now: its reason is stale\n";
+  }
   io::OutputSession session(dir);
   session.write_text("heldout_summary.json", summary.dump(2) + "\n");
   session.write_text("heldout_summary.md",
@@ -428,6 +448,7 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
   return report_errors(err, scene_path.string(), [&]() -> int {
     if (!options.slab_rule.empty())
       throw UsageError("--slab-rule applies to the cases that change the slab: it needs --cases");
+    if (!options.why_misses.empty()) throw UsageError("--why-misses explains the misses of cases: it needs --cases");
     const Scene scene = load_scene(scene_path);
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_validation") : options.output_dir;

@@ -491,6 +491,13 @@ TEST(ValidateCommand, CasesGiveOneReportPerCaseAndTheHeldOutSummary) {
   options.scene = scene_file;
   options.cases = work / "cases.json";
   options.model_note = "not calibrated";
+  // A reason for every layer of both cases: each shows where its layer
+  // misses; where it is accepted it is listed as stale, with a warning.
+  std::ofstream(work / "why.json") << R"({"reasons": [
+      {"case": "own", "layer": "skin", "why": "own skin"}, {"case": "own", "layer": "fat", "why": "own fat"},
+      {"case": "own", "layer": "muscle", "why": "own muscle"}, {"case": "fast", "layer": "skin", "why": "fast skin"},
+      {"case": "fast", "layer": "fat", "why": "fast fat"}, {"case": "fast", "layer": "muscle", "why": "fast muscle"}]})";
+  options.why_misses = work / "why.json";
   options.output_dir = work / "report";
   options.cache_dir = work / "cache";
   options.write_vtk = false;
@@ -518,14 +525,26 @@ TEST(ValidateCommand, CasesGiveOneReportPerCaseAndTheHeldOutSummary) {
   EXPECT_FALSE(summary["cases"][0]["held_out"].get<bool>());
   EXPECT_TRUE(summary["cases"][1]["held_out"].get<bool>());
   EXPECT_EQ(summary["model_note"], "not calibrated");
+  std::size_t accepted = 0;
   for (const auto& c : summary["cases"]) {
     ASSERT_EQ(c["layers"].size(), 3u);
     // Each row agrees with that case's own report.
     std::ifstream m(dir / c["name"].get<std::string>() / "validation_metrics.json");
     const nlohmann::json metrics = nlohmann::json::parse(m);
-    for (std::size_t k = 0; k < 3; ++k)
+    for (std::size_t k = 0; k < 3; ++k) {
       EXPECT_EQ(c["layers"][k]["accepted"].get<bool>(), metrics["acceptance"][k]["accepted"].get<bool>());
+      const std::string expected_why = c["name"].get<std::string>() + " " + c["layers"][k]["layer"].get<std::string>();
+      if (c["layers"][k]["accepted"].get<bool>()) {
+        EXPECT_TRUE(c["layers"][k]["why"].is_null());
+        ++accepted;
+      } else {
+        EXPECT_EQ(c["layers"][k]["why"], expected_why);
+      }
+    }
   }
+  EXPECT_EQ(summary["stale_reasons"].size(), accepted);
+  EXPECT_EQ(err.str().find("is accepted now") != std::string::npos, accepted > 0) << err.str();
+  EXPECT_EQ(summary["reasons_file"], (work / "why.json").string());
   EXPECT_TRUE(fs::is_regular_file(dir / "heldout_summary.md"));
   fs::remove_all(work);
 }
@@ -551,6 +570,22 @@ TEST(ValidateCommand, BadCasesFileExitsWithTwoAndWritesNothing) {
   EXPECT_NE(err.str().find("layer_thickness_mm"), std::string::npos) << err.str();
   EXPECT_FALSE(fs::exists(options.output_dir));
   EXPECT_FALSE(fs::exists(options.cache_dir));
+
+  // A reasons file naming a layer the model does not have: the same, before any FEM.
+  std::ofstream(work / "cases.json") << R"({"cases": [{"name": "own"}]})";
+  std::ofstream(work / "why.json") << R"({"reasons": [{"case": "own", "layer": "bone", "why": "w"}]})";
+  options.why_misses = work / "why.json";
+  std::ostringstream err2;
+  EXPECT_EQ(validate_command(options, out, err2), 2);
+  EXPECT_NE(err2.str().find("why.json: /reasons/0/layer"), std::string::npos) << err2.str();
+  EXPECT_FALSE(fs::exists(options.output_dir));
+  EXPECT_FALSE(fs::exists(options.cache_dir));
+  // --why-misses without --cases: a usage error.
+  options.cases.clear();
+  std::ostringstream err3;
+  EXPECT_NE(validate_command(options, out, err3), 0);
+  EXPECT_NE(err3.str().find("--why-misses"), std::string::npos) << err3.str();
+  EXPECT_FALSE(fs::exists(options.output_dir));
   fs::remove_all(work);
 }
 

@@ -220,5 +220,126 @@ TEST(ValidationCases, SummaryListsEachCasesWholeTrajectoryTermsWithoutTheLayerTe
   EXPECT_NE(md.find("| none | no (in sample) | n/a | n/a | n/a |"), std::string::npos) << md;
 }
 
+ValidationCases two_cases() {
+  ValidationCases cases;
+  cases.cases.resize(2);
+  cases.cases[0].name = "own";
+  cases.cases[1].name = "fast";
+  return cases;
+}
+
+std::string reasons_error_of(const std::string& name, const std::string& text) {
+  const fs::path p = write_temp(name, text);
+  try {
+    read_miss_reasons(p, two_cases(), {"skin", "fat", "muscle"});
+  } catch (const std::invalid_argument& e) {
+    fs::remove(p);
+    return e.what();
+  }
+  fs::remove(p);
+  return "no error";
+}
+
+TEST(ValidationCases, MissReasonsAreReadAndCheckedAgainstTheCasesAndTheModelsLayers) {
+  const fs::path p = write_temp("why.json",
+                                R"({"description": "d", "model": "m.json", "reasons": [
+      {"case": "fast", "layer": "fat", "why": "rate beyond the fitted speeds"},
+      {"case": "own", "layer": "skin", "why": "an old reason"}]})");
+  const std::vector<MissReason> reasons = read_miss_reasons(p, two_cases(), {"skin", "fat", "muscle"});
+  fs::remove(p);
+  ASSERT_EQ(reasons.size(), 2u);
+  EXPECT_EQ(reasons[0].case_name, "fast");
+  EXPECT_EQ(reasons[0].layer, "fat");
+  EXPECT_EQ(reasons[0].why, "rate beyond the fitted speeds");
+
+  struct Bad {
+    const char* name;
+    const char* text;
+    const char* expected;
+  };
+  const Bad bad[] = {
+      {"not_json", "{", "not valid JSON"},
+      {"no_reasons", R"({"description": "d"})", "/reasons: missing or not an array"},
+      {"unknown_top", R"({"reasons": [], "extra": 1})", "/extra: unknown key"},
+      {"unknown_case", R"({"reasons": [{"case": "slow", "layer": "fat", "why": "w"}]})",
+       "/reasons/0/case: \"slow\" is not a case of the cases file"},
+      {"unknown_layer", R"({"reasons": [{"case": "fast", "layer": "bone", "why": "w"}]})",
+       "/reasons/0/layer: \"bone\" is not a layer of the model"},
+      {"empty_why", R"({"reasons": [{"case": "fast", "layer": "fat", "why": ""}]})",
+       "/reasons/0/why: missing or not a non-empty string"},
+      {"unknown_key", R"({"reasons": [{"case": "fast", "layer": "fat", "why": "w", "when": 1}]})",
+       "/reasons/0/when: unknown key"},
+      {"twice", R"({"reasons": [{"case": "fast", "layer": "fat", "why": "w"}, {"case": "fast", "layer": "fat", "why": "v"}]})",
+       "/reasons/1: a second reason for case fast, layer fat"},
+  };
+  for (const Bad& b : bad) {
+    const std::string e = reasons_error_of(b.name, b.text);
+    EXPECT_NE(e.find(b.expected), std::string::npos) << b.name << ": " << e;
+    EXPECT_NE(e.find(b.name), std::string::npos) << "the error names the file: " << e;
+  }
+}
+
+TEST(ValidationCases, SummarySaysWhyEachMissAndListsReasonsThatWentStale) {
+  LayerAcceptance good, bad;
+  good.layer = "skin";
+  good.force_rmse = check(true, 0.05, 0.1);
+  good.puncture_depth = check(true, 0.4e-3, 2e-3);
+  good.puncture_force = check(true, -0.02, 0.1);
+  bad = good;
+  bad.layer = "fat";
+  bad.puncture_force = check(true, 0.25, 0.1);
+  LayerAcceptance unexplained = bad;
+  unexplained.layer = "muscle";
+  CaseOutcome own, fast;
+  own.validation_case.name = "own";
+  own.acceptance = {good};
+  fast.validation_case.name = "fast";
+  fast.validation_case.held_out = true;
+  fast.acceptance = {good, bad, unexplained};
+  const std::vector<MissReason> reasons = {{"fast", "fat", "rate beyond the fitted speeds"},
+                                           {"own", "skin", "an old reason"}};
+  const nlohmann::json summary =
+      heldout_summary_json({own, fast}, "model.json", "", "cases.json", {}, reasons, "why.json");
+  EXPECT_EQ(summary["reasons_file"], "why.json");
+  EXPECT_TRUE(summary["cases"][0]["layers"][0]["why"].is_null()) << "accepted: no reason shown";
+  EXPECT_EQ(summary["cases"][1]["layers"][1]["why"], "rate beyond the fitted speeds");
+  EXPECT_TRUE(summary["cases"][1]["layers"][2]["why"].is_null()) << "a miss without a reason";
+  ASSERT_EQ(summary["stale_reasons"].size(), 1u);
+  EXPECT_EQ(summary["stale_reasons"][0]["case"], "own");
+  EXPECT_EQ(summary["stale_reasons"][0]["layer"], "skin");
+  const std::string md = heldout_summary_markdown(summary, "puncture validate model.json --cases cases.json", "git x");
+  EXPECT_NE(md.find("## Why each miss"), std::string::npos) << md;
+  EXPECT_NE(md.find("- **fast, fat** (puncture force 0.25 beyond 0.1): rate beyond the fitted speeds"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("- **fast, muscle** (puncture force 0.25 beyond 0.1): no reason given"), std::string::npos) << md;
+  EXPECT_NE(md.find("(stale: the results moved since they were written)"), std::string::npos) << md;
+  EXPECT_NE(md.find("- own, skin: an old reason"), std::string::npos) << md;
+  EXPECT_EQ(md.find("- **own, skin**"), std::string::npos) << md;
+
+  // Without a reasons file: no section, every "why" null.
+  const nlohmann::json plain = heldout_summary_json({own, fast}, "model.json", "", "cases.json", {});
+  EXPECT_TRUE(plain["reasons_file"].is_null());
+  EXPECT_TRUE(plain["cases"][1]["layers"][1]["why"].is_null());
+  EXPECT_EQ(heldout_summary_markdown(plain, "c", "git x").find("Why each miss"), std::string::npos);
+}
+
+TEST(ValidationCases, TheCommittedHeldOutSummarySaysWhyEachMissAndHasNoStaleReason) {
+  // results/validation_heldout (scripts/results_heldout.sh): the acceptance
+  // lets a held-out layer-case miss only when the page says why.
+  std::ifstream in(fs::path(PUNCTURE_SOURCE_DIR) / "results" / "validation_heldout" / "heldout_summary.json");
+  ASSERT_TRUE(in) << "results/validation_heldout/heldout_summary.json is missing";
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  ASSERT_TRUE(summary.contains("reasons_file") && summary["reasons_file"].is_string())
+      << "made without --why-misses: run bash scripts/results_heldout.sh";
+  for (const nlohmann::json& c : summary["cases"])
+    for (const nlohmann::json& l : c["layers"])
+      if (!l["accepted"].get<bool>()) {
+        EXPECT_TRUE(l["why"].is_string() && !l["why"].get<std::string>().empty())
+            << c["name"] << ", " << l["layer"] << " misses without a reason";
+      }
+  EXPECT_TRUE(summary["stale_reasons"].empty()) << summary["stale_reasons"].dump();
+}
+
 }  // namespace
 }  // namespace puncture::validation

@@ -126,6 +126,46 @@ ValidationCases read_validation_cases(const std::filesystem::path& file) {
   return out;
 }
 
+std::vector<MissReason> read_miss_reasons(const std::filesystem::path& file, const ValidationCases& cases,
+                                          const std::vector<std::string>& layer_names) {
+  std::ifstream in(file);
+  if (!in) throw std::invalid_argument(file.string() + ": cannot open the reasons file");
+  json root;
+  try {
+    root = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw std::invalid_argument(file.string() + ": not valid JSON: " + e.what());
+  }
+  if (!root.is_object()) fail(file, "/", "must be an object with \"reasons\"");
+  for (auto it = root.begin(); it != root.end(); ++it)
+    if (it.key() != "description" && it.key() != "model" && it.key() != "reasons") fail(file, "/" + it.key(), "unknown key");
+  for (const char* key : {"description", "model"})
+    if (root.contains(key) && !root[key].is_string()) fail(file, std::string("/") + key, "must be a string");
+  if (!root.contains("reasons") || !root["reasons"].is_array()) fail(file, "/reasons", "missing or not an array");
+  std::set<std::string> case_names;
+  for (const ValidationCase& c : cases.cases) case_names.insert(c.name);
+  const std::set<std::string> layers(layer_names.begin(), layer_names.end());
+  std::vector<MissReason> out;
+  std::set<std::pair<std::string, std::string>> seen;
+  for (std::size_t i = 0; i < root["reasons"].size(); ++i) {
+    const json& r = root["reasons"][i];
+    const std::string pointer = "/reasons/" + std::to_string(i);
+    if (!r.is_object()) fail(file, pointer, "a reason must be an object with case, layer and why");
+    for (auto it = r.begin(); it != r.end(); ++it)
+      if (it.key() != "case" && it.key() != "layer" && it.key() != "why") fail(file, pointer + "/" + it.key(), "unknown key");
+    for (const char* key : {"case", "layer", "why"})
+      if (!r.contains(key) || !r[key].is_string() || r[key].get<std::string>().empty())
+        fail(file, pointer + "/" + key, "missing or not a non-empty string");
+    MissReason m{r["case"].get<std::string>(), r["layer"].get<std::string>(), r["why"].get<std::string>()};
+    if (!case_names.count(m.case_name)) fail(file, pointer + "/case", "\"" + m.case_name + "\" is not a case of the cases file");
+    if (!layers.count(m.layer)) fail(file, pointer + "/layer", "\"" + m.layer + "\" is not a layer of the model");
+    if (!seen.insert({m.case_name, m.layer}).second)
+      fail(file, pointer, "a second reason for case " + m.case_name + ", layer " + m.layer);
+    out.push_back(m);
+  }
+  return out;
+}
+
 std::string slab_rule_case_text(const SlabRule& rule, const std::string& rule_file,
                                 const std::vector<std::string>& notes) {
   std::string family;
@@ -172,7 +212,18 @@ CaseScene case_scene(const std::string& model_json_text, const std::string& mode
   return out;
 }
 
-json case_layer_rows(const CaseOutcome& outcome) {
+namespace {
+
+const MissReason* reason_for(const std::vector<MissReason>& reasons, const std::string& case_name,
+                             const std::string& layer) {
+  for (const MissReason& r : reasons)
+    if (r.case_name == case_name && r.layer == layer) return &r;
+  return nullptr;
+}
+
+}  // namespace
+
+json case_layer_rows(const CaseOutcome& outcome, const std::vector<MissReason>& reasons) {
   json rows = json::array();
   for (const LayerAcceptance& a : outcome.acceptance) {
     json depth_error = nullptr;
@@ -196,6 +247,8 @@ json case_layer_rows(const CaseOutcome& outcome) {
                     {"puncture_force_error_relative", or_null(value_of(a.puncture_force))},
                     {"accepted", a.accepted()},
                     {"misses", misses}});
+    const MissReason* why = reason_for(reasons, outcome.validation_case.name, a.layer);
+    rows.back()["why"] = why && !a.accepted() ? json(why->why) : json(nullptr);
   }
   return rows;
 }
@@ -219,8 +272,10 @@ json whole_trajectory_rows(const json& terms) {
 }  // namespace
 
 json heldout_summary_json(const std::vector<CaseOutcome>& outcomes, const std::string& model_file,
-                          const std::string& model_note, const std::string& cases_file, const json& provenance) {
+                          const std::string& model_note, const std::string& cases_file, const json& provenance,
+                          const std::vector<MissReason>& reasons, const std::string& reasons_file) {
   json cases = json::array();
+  json stale = json::array();
   for (const CaseOutcome& o : outcomes) {
     const ValidationCase& c = o.validation_case;
     cases.push_back({{"name", c.name},
@@ -229,13 +284,20 @@ json heldout_summary_json(const std::vector<CaseOutcome>& outcomes, const std::s
                      {"rule", c.rule.empty() ? json(nullptr) : json(c.rule)},
                      {"slab_rule", o.slab_rule_file.empty() ? json(nullptr) : json(o.slab_rule_file)},
                      {"note", c.note.empty() ? json(nullptr) : json(c.note)},
-                     {"layers", case_layer_rows(o)},
+                     {"layers", case_layer_rows(o, reasons)},
                      {"whole_trajectory", whole_trajectory_rows(o.trajectory_terms)}});
   }
+  for (const MissReason& r : reasons)
+    for (const CaseOutcome& o : outcomes)
+      for (const LayerAcceptance& a : o.acceptance)
+        if (o.validation_case.name == r.case_name && a.layer == r.layer && a.accepted())
+          stale.push_back({{"case", r.case_name}, {"layer", r.layer}, {"why", r.why}});
   return {{"model", model_file},
           {"model_note", model_note},
           {"cases_file", cases_file},
+          {"reasons_file", reasons_file.empty() ? json(nullptr) : json(reasons_file)},
           {"cases", cases},
+          {"stale_reasons", stale},
           {"provenance", provenance}};
 }
 
@@ -307,6 +369,26 @@ std::string heldout_summary_markdown(const json& summary, const std::string& com
     for (const char* key : {"rule", "note"})
       if (c.contains(key) && c[key].is_string())
         md << "\n`" << c["name"].get<std::string>() << "` (" << key << "): " << c[key].get<std::string>() << ".\n";
+  if (summary.contains("reasons_file") && summary["reasons_file"].is_string()) {
+    md << "\n## Why each miss\n\nThe model's reasons (`" << summary["reasons_file"].get<std::string>()
+       << "`, written after reading these results), for every layer-case that misses.\n\n";
+    for (const json& c : summary["cases"])
+      for (const json& l : c["layers"]) {
+        if (l["accepted"].get<bool>()) continue;
+        std::string misses;
+        for (const json& m : l["misses"]) misses += (misses.empty() ? "" : "; ") + m.get<std::string>();
+        md << "- **" << c["name"].get<std::string>() << ", " << l["layer"].get<std::string>() << "** (" << misses
+           << "): " << (l.contains("why") && l["why"].is_string() ? l["why"].get<std::string>() : "no reason given")
+           << "\n";
+      }
+    if (summary.contains("stale_reasons") && !summary["stale_reasons"].empty()) {
+      md << "\nReasons given for layer-cases that are now accepted (stale: the results moved since they were "
+            "written):\n\n";
+      for (const json& r : summary["stale_reasons"])
+        md << "- " << r["case"].get<std::string>() << ", " << r["layer"].get<std::string>() << ": "
+           << r["why"].get<std::string>() << "\n";
+    }
+  }
   return md.str();
 }
 

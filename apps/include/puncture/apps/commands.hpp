@@ -62,6 +62,9 @@ struct ValidateOptions {
   /// With cases: the model's slab rule (slab_rule.json of `puncture slab-rule`);
   /// cases that change the layer thicknesses take the ruled parameters from it.
   std::filesystem::path slab_rule;
+  /// With cases: why the model misses where it does (validation_cases.hpp
+  /// read_miss_reasons), for the summary's "Why each miss".
+  std::filesystem::path why_misses;
 };
 
 /// `puncture validate`: real-time model and FEM reference (cached) on the

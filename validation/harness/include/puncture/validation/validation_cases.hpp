@@ -29,6 +29,18 @@
 //    "puncture_depth_error_mm", "puncture_force_error_relative",
 //    "accepted", "misses": [text]}]}], "provenance"}
 // Values that could not be computed are null and named in "misses".
+//
+// Why a model misses (`puncture validate --why-misses FILE`; JSON,
+// validation/cases/default_tuned_why_misses.json): the model's reasons, by
+// case and layer, written after reading its held-out results:
+//   {"description": "...", "model": "results/tuned_preset/default_tuned.json",
+//    "reasons": [{"case": "speed_3_mm_per_s", "layer": "fat", "why": "..."}]}
+// read_miss_reasons checks each case against the cases file and each layer
+// against the model's layers (one reason per case and layer; errors name the
+// file and the JSON path). In the summary a layer-case that misses carries
+// its reason as "why" (null when none was given); a reason given for a
+// layer-case that is accepted is listed under "stale_reasons" (the results
+// moved; the reason must go), and the page has a section "Why each miss".
 #pragma once
 
 #include <filesystem>
@@ -76,6 +88,13 @@ CaseScene case_scene(const std::string& model_json_text, const std::string& mode
 std::string slab_rule_case_text(const SlabRule& rule, const std::string& rule_file,
                                 const std::vector<std::string>& notes);
 
+/// One reason of a --why-misses file.
+struct MissReason {
+  std::string case_name, layer, why;
+};
+std::vector<MissReason> read_miss_reasons(const std::filesystem::path& file, const ValidationCases& cases,
+                                          const std::vector<std::string>& layer_names);
+
 /// One case's outcome: the acceptance per layer, the layer metrics JSON of
 /// `puncture validate` (layer_metrics_json, for the puncture depth error) and
 /// its whole-trajectory terms (validation_metrics.json "trajectory_terms":
@@ -90,15 +109,18 @@ struct CaseOutcome {
   nlohmann::json trajectory_terms = nlohmann::json::array();
 };
 
-/// The "layers" rows of one case (see above).
-nlohmann::json case_layer_rows(const CaseOutcome& outcome);
-/// heldout_summary.json (provenance given as JSON).
+/// The "layers" rows of one case (see above; "why" from `reasons` where the layer misses).
+nlohmann::json case_layer_rows(const CaseOutcome& outcome, const std::vector<MissReason>& reasons = {});
+/// heldout_summary.json (provenance given as JSON); `reasons` (may be empty)
+/// from read_miss_reasons of `reasons_file`.
 nlohmann::json heldout_summary_json(const std::vector<CaseOutcome>& outcomes, const std::string& model_file,
                                     const std::string& model_note, const std::string& cases_file,
-                                    const nlohmann::json& provenance);
+                                    const nlohmann::json& provenance, const std::vector<MissReason>& reasons = {},
+                                    const std::string& reasons_file = {});
 /// heldout_summary.md from the summary JSON: one row per case and layer, the
 /// count of held-out layer-cases accepted, one row per case of its
-/// whole-trajectory force errors, each case's rule and note.
+/// whole-trajectory force errors, each case's rule and note; with a reasons
+/// file, "Why each miss" (and the stale reasons).
 std::string heldout_summary_markdown(const nlohmann::json& summary, const std::string& command,
                                      const std::string& provenance_line);
 
