@@ -18,6 +18,7 @@
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/model_comparison.hpp"
 #include "puncture/validation/model_identification.hpp"
+#include "puncture/validation/puncture_events.hpp"
 
 using namespace puncture;
 
@@ -148,7 +149,10 @@ TEST(ModelIdentification, ALayerWithFewerThanTwoReferenceSamplesWhilePressedIsNo
   const validation::ModelIdentification all =
       validation::identify_comparison_model("bem", scene, nullptr, full.data, true);
   validation::ReferenceData coarse = full.data;
-  coarse.curve = thinned(full.data.curve, first_puncture_depth(full.run, 0), first_puncture_depth(full.run, 1));
+  // (The skin's puncture sample goes too: the fat is pressed from it on, by
+  // the curve's states, so the reference's skin breaks on the one sample kept.)
+  coarse.curve =
+      thinned(full.data.curve, first_puncture_depth(full.run, 0) - 1e-9, first_puncture_depth(full.run, 1));
   ASSERT_LT(coarse.curve.size(), full.data.curve.size());
   const validation::ModelIdentification id =
       validation::identify_comparison_model("bem", scene, nullptr, coarse, true);
@@ -167,6 +171,38 @@ TEST(ModelIdentification, ALayerWithFewerThanTwoReferenceSamplesWhilePressedIsNo
   // The other layers are fitted as before.
   EXPECT_NEAR(id.layers[2].stiffness_scale, all.layers[2].stiffness_scale, 1e-9);
   EXPECT_GT(id.layers[0].window_samples, 10u);
+}
+
+TEST(ModelIdentification, ALayerPressedWhileTheTipForceStaysPositiveIsFittedOnItsPressedStates) {
+  // The FEM's curve: its tip force stays positive after the fat's break (the
+  // needle presses on through the cut fat), so the cut through the fat has
+  // no end by the force's parts and layer_segments gives the muscle no
+  // pressing window before its puncture; its state column says where the
+  // muscle is pressed. The reference here is the BEM with those parts: the
+  // whole force on the tip.
+  // The fat breaks below its undeformed bottom (9.2 mm), as the FEM's does:
+  // its cut then reaches to the muscle's puncture by the layers' geometry.
+  const std::vector<double> scale{2.0, 0.5, 1.5};
+  Reference reference = reference_of(scale, {4e-3, 6e-3, 5e-3});
+  ASSERT_GT(first_puncture_depth(reference.run, 1), 9.2e-3);
+  validation::InsertionCurve& curve = reference.data.curve;
+  ASSERT_TRUE(curve.has_layer_states());
+  curve.tip_force_N = curve.force_N;
+  for (double& f : curve.tip_force_N) f = std::max(f, 1e-3);  // never back to 0 after a break
+  curve.cutting_force_N.assign(curve.size(), 0.0);
+  curve.friction_force_N.assign(curve.size(), 0.0);
+  const Scene scene = default_scene();
+  const std::vector<validation::LayerSegments> segments = validation::layer_segments(
+      validation::reference_events(curve, validation::layer_geometry(scene)), validation::layer_geometry(scene));
+  ASSERT_LE(segments[2].pressing_from_m, segments[2].pressing_to_m);
+  ASSERT_GE(segments[2].pressing_from_m, first_puncture_depth(reference.run, 2) - 1e-12)
+      << "the segments give the muscle no window: the case this test is about";
+  const validation::ModelIdentification id =
+      validation::identify_comparison_model("bem", scene, nullptr, reference.data, true);
+  ASSERT_EQ(id.layers.size(), 3u);
+  const validation::LayerIdentification& muscle = id.layers[2];
+  EXPECT_GT(muscle.window_samples, 10u);
+  EXPECT_NEAR(muscle.stiffness_scale, scale[2], 1e-6 * scale[2]);  // pressed on the rigid base alone: exact
 }
 
 }  // namespace

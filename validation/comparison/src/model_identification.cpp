@@ -36,6 +36,25 @@ void set_critical_force(Scene& scene, std::size_t layer, double force_N) {
   b.critical_force_N = force_N;
 }
 
+/// Where the reference starts pressing layer k before its puncture at
+/// puncture_m: with state columns (the FEM's curve), its first insertion
+/// sample with the layer pressed; else the start of the layer's pressing
+/// segment (layer_segments: from the end of the cut through the layer above,
+/// which, when the reference's tip force stays positive after that break, is
+/// only the next puncture: the FEM's muscle, pressed from 12.2 mm on the
+/// default trajectory, would have no window). NaN when there is neither.
+double pressing_start_m(const InsertionCurve& curve, const std::string& layer, const LayerSegments& segment,
+                        double puncture_m) {
+  const int column = curve.layer_index(layer);
+  if (column >= 0) {
+    for (const std::size_t i : insertion_phase(curve))
+      if (curve.layer_states[static_cast<std::size_t>(column)][i] == LayerState::Pressed && curve.depth_m[i] < puncture_m)
+        return curve.depth_m[i];
+    return kNaN;
+  }
+  return segment.has_pressing ? segment.pressing_from_m : kNaN;
+}
+
 /// The model on `scene` until `until_s` (layer k's rule: never breaks).
 ModelRun run_until(const std::string& model, const Scene& scene, std::shared_ptr<const comparison::TetMesh> mesh,
                    double until_s) {
@@ -210,8 +229,8 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
   // 1. The factors, bottom up: a layer's force depends on the layers below it
   //    (and hardly on the punctured ones above), whose factors are then known.
   for (std::size_t k = depths_m.size(); identify_stiffness && k-- > 0;) {
-    const std::size_t samples =
-        segments[k].has_pressing ? reference_samples_in(reference, segments[k].pressing_from_m, depths_m[k]) : 0;
+    const double from_m = pressing_start_m(reference.curve, scene.layers[k].name, segments[k], depths_m[k]);
+    const std::size_t samples = std::isfinite(from_m) ? reference_samples_in(reference, from_m, depths_m[k]) : 0;
     if (samples < 2) {  // nothing to fit: the factor stays 1, no run
       result.layers[k].window_samples = samples;
       continue;
@@ -220,7 +239,7 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
     const ModelRun run = run_until(model, trial, mesh, until_s[k]);
     ++result.model_runs;
     const Window window =
-        run.failed() ? Window{} : window_of(run, reference, segments[k].pressing_from_m, depths_m[k]);
+        run.failed() ? Window{} : window_of(run, reference, from_m, depths_m[k]);
     if (window.depth_m.size() < 2) continue;
     LayerIdentification& layer = result.layers[k];
     layer.stiffness_scale =

@@ -19,7 +19,9 @@
 // parameters.
 //   1. The factors, bottom up (a pressed layer's force depends on the layers
 //      below it, whose factors are then known): run A with s_k = 1; over the
-//      reference's samples with layer k pressed (layer_segments), the model's
+//      reference's samples with layer k pressed (its state column's pressed
+//      samples before its puncture, the FEM's; without states the pressing
+//      segment of layer_segments), the model's
 //      contact force c_i and shaft force p_i at the sample's depth (linear in
 //      depth between steps) and the reference force f_i (with shaft forces
 //      when the reference has them, as the comparison compares totals). The
