@@ -205,4 +205,35 @@ TEST(ModelIdentification, ALayerPressedWhileTheTipForceStaysPositiveIsFittedOnIt
   EXPECT_NEAR(muscle.stiffness_scale, scale[2], 1e-6 * scale[2]);  // pressed on the rigid base alone: exact
 }
 
+TEST(ModelIdentification, AForceDropAtOneDepthIsLeftOutOfTheWindow) {
+  // A quasi-static reference records a break as two samples at one depth
+  // (before and after the drop), the second with the next layer pressed; the
+  // model's force at that depth is on either side of its own drop, so both
+  // are left out. Here the sample after the drop carries a wild force: the
+  // fat's factor is the one found without it.
+  const Reference reference = reference_of({2.0, 0.5, 1.5}, {4e-3, 3e-3, 5e-3});
+  const Scene scene = default_scene();
+  const validation::ModelIdentification clean =
+      validation::identify_comparison_model("bem", scene, nullptr, reference.data, true);
+  validation::ReferenceData dropped = reference.data;
+  validation::InsertionCurve& c = dropped.curve;
+  const int fat = c.layer_index("fat");
+  ASSERT_GE(fat, 0);
+  std::size_t i = 0;
+  while (i < c.size() && c.layer_states[static_cast<std::size_t>(fat)][i] != LayerState::Pressed) ++i;
+  ASSERT_LT(i, c.size());
+  auto duplicate = [&](auto& v) {
+    if (!v.empty()) v.insert(v.begin() + static_cast<std::ptrdiff_t>(i), v[i]);
+  };
+  duplicate(c.time_s), duplicate(c.depth_m), duplicate(c.velocity_m_per_s), duplicate(c.force_N), duplicate(c.phase);
+  duplicate(c.tip_force_N), duplicate(c.cutting_force_N), duplicate(c.friction_force_N);
+  for (auto& states : c.layer_states) duplicate(states);
+  c.force_N[i + 1] = 100.0;  // the second sample at that depth
+  const validation::ModelIdentification id =
+      validation::identify_comparison_model("bem", scene, nullptr, dropped, true);
+  ASSERT_EQ(id.layers.size(), 3u);
+  EXPECT_EQ(id.layers[1].window_samples + 1, clean.layers[1].window_samples);  // sample i left out with its twin
+  EXPECT_NEAR(id.layers[1].stiffness_scale, clean.layers[1].stiffness_scale, 1e-3 * clean.layers[1].stiffness_scale);
+}
+
 }  // namespace

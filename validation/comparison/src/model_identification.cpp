@@ -36,25 +36,6 @@ void set_critical_force(Scene& scene, std::size_t layer, double force_N) {
   b.critical_force_N = force_N;
 }
 
-/// Where the reference starts pressing layer k before its puncture at
-/// puncture_m: with state columns (the FEM's curve), its first insertion
-/// sample with the layer pressed; else the start of the layer's pressing
-/// segment (layer_segments: from the end of the cut through the layer above,
-/// which, when the reference's tip force stays positive after that break, is
-/// only the next puncture: the FEM's muscle, pressed from 12.2 mm on the
-/// default trajectory, would have no window). NaN when there is neither.
-double pressing_start_m(const InsertionCurve& curve, const std::string& layer, const LayerSegments& segment,
-                        double puncture_m) {
-  const int column = curve.layer_index(layer);
-  if (column >= 0) {
-    for (const std::size_t i : insertion_phase(curve))
-      if (curve.layer_states[static_cast<std::size_t>(column)][i] == LayerState::Pressed && curve.depth_m[i] < puncture_m)
-        return curve.depth_m[i];
-    return kNaN;
-  }
-  return segment.has_pressing ? segment.pressing_from_m : kNaN;
-}
-
 /// The model on `scene` until `until_s` (layer k's rule: never breaks).
 ModelRun run_until(const std::string& model, const Scene& scene, std::shared_ptr<const comparison::TetMesh> mesh,
                    double until_s) {
@@ -88,19 +69,48 @@ struct Window {
   double scale_N = 1.0;  ///< residuals are divided by this (the reference's peak force)
 };
 
-/// Whether sample i of the curve is on the insertion (loading) and in [from, to).
-bool loading_sample_in(const InsertionCurve& curve, std::size_t i, double from_m, double to_m) {
-  return curve.velocity_m_per_s[i] > 0.0 && curve.depth_m[i] >= from_m && curve.depth_m[i] < to_m;
+/// The reference's samples on which layer k's factor is fitted: insertion
+/// (loading) samples before the layer's puncture with the layer pressed. With
+/// state columns (the FEM's curve) "pressed" is the layer's state: the
+/// layer segments would not do there, as they end the cut through the layer
+/// above where the reference's tip force returns to 0, and the FEM's stays
+/// positive after the fat's break (the muscle, pressed from 12.2 mm on the
+/// default trajectory, had no window), and a depth range would take in the
+/// sample before a force drop that shares its depth with the one after it
+/// (the quasi-static 3D reference). Without states: the depth range of the
+/// layer's pressing segment (layer_segments). Either way a sample that shares
+/// its depth with its neighbour (a force drop at one instant: the model's
+/// force at that depth is on either side of its own drop) is left out.
+struct PressingWindow {
+  int state_column = -1;  ///< the layer's state column, -1: none
+  double from_m = kNaN, to_m = kNaN;
+  bool contains(const InsertionCurve& curve, std::size_t i) const {
+    if (!(curve.velocity_m_per_s[i] > 0.0) || !(curve.depth_m[i] < to_m)) return false;
+    if ((i > 0 && curve.depth_m[i - 1] == curve.depth_m[i]) ||
+        (i + 1 < curve.size() && curve.depth_m[i + 1] == curve.depth_m[i]))
+      return false;
+    if (state_column >= 0) return curve.layer_states[static_cast<std::size_t>(state_column)][i] == LayerState::Pressed;
+    return curve.depth_m[i] >= from_m;
+  }
+};
+
+PressingWindow pressing_window(const InsertionCurve& curve, const std::string& layer, const LayerSegments& segment,
+                               double puncture_m) {
+  PressingWindow w;
+  w.to_m = puncture_m;
+  w.state_column = curve.layer_index(layer);
+  if (w.state_column < 0 && segment.has_pressing) w.from_m = segment.pressing_from_m;
+  return w;
 }
 
-Window window_of(const ModelRun& run, const ReferenceData& reference, double from_m, double to_m) {
+Window window_of(const ModelRun& run, const ReferenceData& reference, const PressingWindow& pressed) {
   Window w;
   const InsertionCurve& curve = reference.curve;
   double peak = 0.0;
   for (std::size_t i = 0; i < curve.size(); ++i) {
     if (!(curve.velocity_m_per_s[i] > 0.0)) continue;
     peak = std::max(peak, std::abs(curve.force_N[i]));
-    if (!loading_sample_in(curve, i, from_m, to_m)) continue;
+    if (!pressed.contains(curve, i)) continue;
     double contact = 0.0, shaft = 0.0;
     if (!forces_at_depth(run, curve.depth_m[i], contact, shaft)) continue;
     w.depth_m.push_back(curve.depth_m[i]);
@@ -110,12 +120,12 @@ Window window_of(const ModelRun& run, const ReferenceData& reference, double fro
   return w;
 }
 
-/// The reference's samples of the insertion in [from, to) (before any model
-/// run: a window with fewer than two is not fitted, and its run is saved).
-std::size_t reference_samples_in(const ReferenceData& reference, double from_m, double to_m) {
+/// The reference's samples in the window (before any model run: a window
+/// with fewer than two is not fitted, and its run is saved).
+std::size_t reference_samples_in(const ReferenceData& reference, const PressingWindow& pressed) {
   const InsertionCurve& curve = reference.curve;
   std::size_t n = 0;
-  for (std::size_t i = 0; i < curve.size(); ++i) n += loading_sample_in(curve, i, from_m, to_m);
+  for (std::size_t i = 0; i < curve.size(); ++i) n += pressed.contains(curve, i);
   return n;
 }
 
@@ -229,8 +239,8 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
   // 1. The factors, bottom up: a layer's force depends on the layers below it
   //    (and hardly on the punctured ones above), whose factors are then known.
   for (std::size_t k = depths_m.size(); identify_stiffness && k-- > 0;) {
-    const double from_m = pressing_start_m(reference.curve, scene.layers[k].name, segments[k], depths_m[k]);
-    const std::size_t samples = std::isfinite(from_m) ? reference_samples_in(reference, from_m, depths_m[k]) : 0;
+    const PressingWindow pressed = pressing_window(reference.curve, scene.layers[k].name, segments[k], depths_m[k]);
+    const std::size_t samples = reference_samples_in(reference, pressed);
     if (samples < 2) {  // nothing to fit: the factor stays 1, no run
       result.layers[k].window_samples = samples;
       continue;
@@ -239,7 +249,7 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
     const ModelRun run = run_until(model, trial, mesh, until_s[k]);
     ++result.model_runs;
     const Window window =
-        run.failed() ? Window{} : window_of(run, reference, from_m, depths_m[k]);
+        run.failed() ? Window{} : window_of(run, reference, pressed);
     if (window.depth_m.size() < 2) continue;
     LayerIdentification& layer = result.layers[k];
     layer.stiffness_scale =
