@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <string>
 
@@ -25,10 +26,15 @@ fs::path write_temp(const std::string& name, const std::string& text) {
 
 std::string model_text() { return io::read_text_file(fs::path(PUNCTURE_SOURCE_DIR) / "scenes" / "default.json"); }
 
-std::string error_of(const std::string& name, const std::string& text) {
+/// The error message of reading `text` (written to a file named after
+/// `name`) with `read`; "no error" if it reads.
+std::string error_of(const std::string& name, const std::string& text,
+                     const std::function<void(const fs::path&)>& read = [](const fs::path& p) {
+                       read_validation_cases(p);
+                     }) {
   const fs::path p = write_temp(name, text);
   try {
-    read_validation_cases(p);
+    read(p);
   } catch (const std::invalid_argument& e) {
     fs::remove(p);
     return e.what();
@@ -229,15 +235,7 @@ ValidationCases two_cases() {
 }
 
 std::string reasons_error_of(const std::string& name, const std::string& text) {
-  const fs::path p = write_temp(name, text);
-  try {
-    read_miss_reasons(p, two_cases(), {"skin", "fat", "muscle"});
-  } catch (const std::invalid_argument& e) {
-    fs::remove(p);
-    return e.what();
-  }
-  fs::remove(p);
-  return "no error";
+  return error_of(name, text, [](const fs::path& p) { read_miss_reasons(p, two_cases(), {"skin", "fat", "muscle"}); });
 }
 
 TEST(ValidationCases, MissReasonsAreReadAndCheckedAgainstTheCasesAndTheModelsLayers) {

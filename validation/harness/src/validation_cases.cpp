@@ -22,6 +22,27 @@ using nlohmann::json;
   throw std::invalid_argument(file.string() + ": " + pointer + ": " + what);
 }
 
+/// The JSON object in `file` (`kind` names the file in the errors; `main_key` the key it must have).
+json read_json_object(const std::filesystem::path& file, const std::string& kind, const std::string& main_key) {
+  std::ifstream in(file);
+  if (!in) throw std::invalid_argument(file.string() + ": cannot open the " + kind);
+  json root;
+  try {
+    root = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw std::invalid_argument(file.string() + ": not valid JSON: " + e.what());
+  }
+  if (!root.is_object()) fail(file, "/", "must be an object with \"" + main_key + "\"");
+  return root;
+}
+
+/// Fails on a key of object `o` (at `pointer`) that is not in `allowed`.
+void reject_unknown_keys(const json& o, const std::set<std::string>& allowed, const std::filesystem::path& file,
+                         const std::string& pointer) {
+  for (auto it = o.begin(); it != o.end(); ++it)
+    if (!allowed.count(it.key())) fail(file, pointer + "/" + it.key(), "unknown key");
+}
+
 std::string optional_text(const json& c, const char* key, const std::filesystem::path& file,
                           const std::string& pointer) {
   if (!c.contains(key)) return {};
@@ -31,9 +52,7 @@ std::string optional_text(const json& c, const char* key, const std::filesystem:
 
 ValidationCase read_case(const json& c, const std::filesystem::path& file, const std::string& pointer) {
   if (!c.is_object()) fail(file, pointer, "a case must be an object");
-  for (auto it = c.begin(); it != c.end(); ++it)
-    if (!std::set<std::string>{"name", "overrides", "held_out", "rule", "note"}.count(it.key()))
-      fail(file, pointer + "/" + it.key(), "unknown key");
+  reject_unknown_keys(c, {"name", "overrides", "held_out", "rule", "note"}, file, pointer);
   ValidationCase v;
   if (!c.contains("name") || !c["name"].is_string()) fail(file, pointer + "/name", "missing or not a string");
   v.name = c["name"].get<std::string>();
@@ -98,17 +117,8 @@ std::string fixed(const json& v, int decimals, bool sign = false) {
 }  // namespace
 
 ValidationCases read_validation_cases(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw std::invalid_argument(file.string() + ": cannot open the cases file");
-  json root;
-  try {
-    root = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw std::invalid_argument(file.string() + ": not valid JSON: " + e.what());
-  }
-  if (!root.is_object()) fail(file, "/", "must be an object with \"cases\"");
-  for (auto it = root.begin(); it != root.end(); ++it)
-    if (it.key() != "description" && it.key() != "cases") fail(file, "/" + it.key(), "unknown key");
+  const json root = read_json_object(file, "cases file", "cases");
+  reject_unknown_keys(root, {"description", "cases"}, file, "");
   ValidationCases out;
   if (root.contains("description")) {
     if (!root["description"].is_string()) fail(file, "/description", "must be a string");
@@ -128,17 +138,8 @@ ValidationCases read_validation_cases(const std::filesystem::path& file) {
 
 std::vector<MissReason> read_miss_reasons(const std::filesystem::path& file, const ValidationCases& cases,
                                           const std::vector<std::string>& layer_names) {
-  std::ifstream in(file);
-  if (!in) throw std::invalid_argument(file.string() + ": cannot open the reasons file");
-  json root;
-  try {
-    root = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw std::invalid_argument(file.string() + ": not valid JSON: " + e.what());
-  }
-  if (!root.is_object()) fail(file, "/", "must be an object with \"reasons\"");
-  for (auto it = root.begin(); it != root.end(); ++it)
-    if (it.key() != "description" && it.key() != "model" && it.key() != "reasons") fail(file, "/" + it.key(), "unknown key");
+  const json root = read_json_object(file, "reasons file", "reasons");
+  reject_unknown_keys(root, {"description", "model", "reasons"}, file, "");
   for (const char* key : {"description", "model"})
     if (root.contains(key) && !root[key].is_string()) fail(file, std::string("/") + key, "must be a string");
   if (!root.contains("reasons") || !root["reasons"].is_array()) fail(file, "/reasons", "missing or not an array");
@@ -151,8 +152,7 @@ std::vector<MissReason> read_miss_reasons(const std::filesystem::path& file, con
     const json& r = root["reasons"][i];
     const std::string pointer = "/reasons/" + std::to_string(i);
     if (!r.is_object()) fail(file, pointer, "a reason must be an object with case, layer and why");
-    for (auto it = r.begin(); it != r.end(); ++it)
-      if (it.key() != "case" && it.key() != "layer" && it.key() != "why") fail(file, pointer + "/" + it.key(), "unknown key");
+    reject_unknown_keys(r, {"case", "layer", "why"}, file, pointer);
     for (const char* key : {"case", "layer", "why"})
       if (!r.contains(key) || !r[key].is_string() || r[key].get<std::string>().empty())
         fail(file, pointer + "/" + key, "missing or not a non-empty string");
