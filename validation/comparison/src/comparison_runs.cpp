@@ -209,6 +209,7 @@ Scene ComparisonRunner::identify_model(const std::string& key) {
                                   {"stiffness_identified", id.stiffness_identified},
                                   {"model_runs", id.model_runs},
                                   {"wall_time_s", id.wall_time_s}};
+  if (!id.joint_note.empty()) identification_records_[key]["joint_fit"] = id.joint_note;
   Scene identified = with_identified_parameters(scene_, id);
   identified.name = scene_.name + "_" + key + "_identified";
   identified.description = "The scene of `puncture compare` with model " + key +

@@ -104,7 +104,7 @@ void markdown_model_identification(std::ostringstream& md, const nlohmann::json&
   if (identification.empty()) return;
   md << "## Every model identified against the FEM\n\nEvery model but the real-time one (which `puncture calibrate` "
         "tunes) gets, layer by layer on the calibration trajectory, a factor on its Young's modulus (least squares "
-        "on the force while the FEM presses the layer) and the critical contact force at which it breaks the layer "
+        "on the force while the FEM presses the layer, bottom up, then jointly) and the critical contact force at which it breaks the layer "
         "(its force where the FEM punctures it); one or two partial runs of the full model per layer "
         "(model_identification.hpp). On this trajectory the punctures then agree with the FEM's by construction; "
         "the held-out cases test them.\n\n| model | layer | FEM puncture depth mm | stiffness factor | force RMSE "
@@ -122,6 +122,16 @@ void markdown_model_identification(std::ostringstream& md, const nlohmann::json&
       md << " | " << record["model_runs"].get<int>() << " | " << shown(record["wall_time_s"].get<double>()) << " |\n";
     }
   md << "\n";
+  bool any_joint = false;
+  for (const auto& [model, record] : identification.items())
+    if (record.contains("joint_fit")) {
+      if (!any_joint)
+        md << "Where two or more factors were fitted, they were then fitted jointly on all their windows "
+              "(the factors and the \"after\" column above are the joint fit's):\n\n";
+      any_joint = true;
+      md << "- " << model << ": " << record["joint_fit"].get<std::string>() << "\n";
+    }
+  if (any_joint) md << "\n";
 }
 
 /// comparison.md: one row per identification method (nothing without one).

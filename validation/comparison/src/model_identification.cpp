@@ -198,6 +198,80 @@ double identified_scale(const std::string& model, const Scene& trial, std::size_
   }
 }
 
+/// The joint step: ln s of every fitted layer at once (Levenberg-Marquardt
+/// from the bottom-up factors) on all their windows, from one run to the
+/// deepest fitted layer's puncture (prepare_layer_run of that layer: the
+/// layers above break where the reference breaks them, each window sees the
+/// same forces as in its own run). Keeps the factors when the fit does not
+/// lower the cost. Returns the note for the report.
+std::string joint_refinement(const std::string& model, const Scene& trial, const std::vector<std::size_t>& fitted,
+                             const std::vector<Window>& windows, std::shared_ptr<const comparison::TetMesh> mesh,
+                             double until_s, std::vector<double>& scale, std::vector<double>& rmse_after_N,
+                             int& runs, const IdentificationStepProgress& progress) {
+  std::mutex progress_mutex;
+  int evaluations = 0;
+  const ResidualFunction residuals = [&](const std::vector<double>& x, std::vector<double>& out) {
+    Scene s = trial;
+    for (std::size_t j = 0; j < fitted.size(); ++j) s.comparison.stiffness_scale[fitted[j]] = std::exp(x[j]);
+    const ModelRun run = run_until(model, s, mesh, until_s);
+    out.clear();
+    bool ok = !run.failed();
+    for (std::size_t j = 0; ok && j < fitted.size(); ++j) {
+      std::vector<double> r;
+      ok = window_residuals(run, windows[j], r);
+      out.insert(out.end(), r.begin(), r.end());
+    }
+    if (progress) {
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      std::ostringstream line;
+      line << "joint: run " << ++evaluations << " of the optimiser, factors";
+      for (double v : x) line << " " << std::exp(v);
+      progress(line.str());
+    }
+    return ok;
+  };
+  std::vector<double> x0, lower, upper;
+  for (std::size_t k : fitted) {
+    x0.push_back(std::log(scale[k]));
+    lower.push_back(-std::log(kScaleBound));
+    upper.push_back(std::log(kScaleBound));
+  }
+  LevenbergMarquardtOptions options;
+  options.max_iterations = 6;
+  options.max_evaluations = 4 * static_cast<int>(fitted.size()) + 8;
+  options.fd_step = options.fd_step_min = 0.02;
+  options.cost_tolerance = 1e-3;
+  options.threads = 2;
+  std::vector<double> start_residuals;
+  if (!residuals(x0, start_residuals)) return "joint fit not run: the model cannot run at the bottom-up factors";
+  ++runs;
+  double start_cost = 0.0;
+  for (double r : start_residuals) start_cost += r * r;
+  try {
+    const LevenbergMarquardtResult fit = levenberg_marquardt(residuals, x0, lower, upper, options);
+    runs += fit.evaluations;
+    double cost = 0.0;
+    for (double r : fit.residuals) cost += r * r;
+    std::ostringstream note;
+    note << "joint fit of the factors of";
+    for (std::size_t k : fitted) note << " " << trial.layers[k].name;
+    note << " on all their windows (" << fit.evaluations + 1 << " runs): sum of squared residuals "
+         << start_cost << " -> " << std::min(cost, start_cost);
+    if (!(cost < start_cost)) return note.str() + ", bottom-up factors kept";
+    std::size_t offset = 0;
+    for (std::size_t j = 0; j < fitted.size(); ++j) {
+      scale[fitted[j]] = std::exp(fit.x[j]);
+      const std::vector<double> r(fit.residuals.begin() + static_cast<long>(offset),
+                                  fit.residuals.begin() + static_cast<long>(offset + windows[j].depth_m.size()));
+      rmse_after_N[fitted[j]] = rmse_N(r, windows[j].scale_N);
+      offset += windows[j].depth_m.size();
+    }
+    return note.str();
+  } catch (const std::exception& e) {
+    return std::string("joint fit failed, bottom-up factors kept: ") + e.what();
+  }
+}
+
 /// Layer k unbreakable, the layers above it broken where the reference breaks them.
 void prepare_layer_run(Scene& trial, std::size_t k, const std::vector<double>& depths_m) {
   trial.comparison.prescribed_puncture_depths_m.assign(depths_m.begin(), depths_m.begin() + static_cast<long>(k));
@@ -236,6 +310,8 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
   }
   Scene trial = scene;
   trial.comparison.stiffness_scale.assign(scene.layers.size(), 1.0);
+  std::vector<std::size_t> fitted;  // layers whose factor was fitted, top down
+  std::vector<Window> fitted_windows;
   // 1. The factors, bottom up: a layer's force depends on the layers below it
   //    (and hardly on the punctured ones above), whose factors are then known.
   for (std::size_t k = depths_m.size(); identify_stiffness && k-- > 0;) {
@@ -255,6 +331,26 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
     layer.stiffness_scale =
         identified_scale(model, trial, k, mesh, until_s[k], run, window, layer, result.model_runs, progress);
     trial.comparison.stiffness_scale[k] = layer.stiffness_scale;
+    if (layer.stiffness_note.empty()) {
+      fitted.insert(fitted.begin(), k);
+      fitted_windows.insert(fitted_windows.begin(), window);
+    }
+  }
+  // 1b. The fitted factors jointly: a layer's factor also shapes the force
+  //     while the layers above it are pressed (a volumetric model's skin rests
+  //     on its fat), which the bottom-up pass, each layer on its own window,
+  //     cannot weigh.
+  if (fitted.size() >= 2) {
+    const std::size_t deepest = fitted.back();
+    prepare_layer_run(trial, deepest, depths_m);
+    std::vector<double> rmse_after(scene.layers.size(), kNaN);
+    result.joint_note = joint_refinement(model, trial, fitted, fitted_windows, mesh, until_s[deepest],
+                                         trial.comparison.stiffness_scale, rmse_after, result.model_runs, progress);
+    for (std::size_t k : fitted)
+      if (std::isfinite(rmse_after[k])) {
+        result.layers[k].stiffness_scale = trial.comparison.stiffness_scale[k];
+        result.layers[k].window_rmse_after_N = rmse_after[k];
+      }
   }
   // 2. The critical forces, top down, with the final factors: layer k's force
   //    where the reference breaks it, the layers above broken there too (as

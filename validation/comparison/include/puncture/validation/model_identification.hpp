@@ -33,6 +33,13 @@
 //      runs, two at a time). The proportional factor is exact only when the
 //      pressed layer's response scales with its own modulus alone (one layer
 //      on a rigid base); a layer on other layers needs the iterations.
+//   1b. With two or more factors fitted: Levenberg-Marquardt on all of them
+//      at once, from the bottom-up values, on all their windows, each
+//      evaluation one run to the deepest fitted layer's puncture (the layers
+//      above broken where the reference breaks them). A layer's factor also
+//      shapes the force while the layers above it are pressed (a volumetric
+//      model's skin rests on its fat), which the bottom-up pass cannot weigh;
+//      the factors are kept when the joint fit does not lower the cost.
 //   2. The critical forces, top down, with the final factors: F_k is the
 //      contact force on the step at d_k, so the model, breaking each layer by
 //      its critical force, breaks it where the reference does.
@@ -79,6 +86,7 @@ struct ModelIdentification {
   std::vector<LayerIdentification> layers;
   int model_runs = 0;
   double wall_time_s = 0.0;
+  std::string joint_note;  ///< the joint step's outcome (empty: fewer than two layers fitted)
 };
 
 /// One line per model run and per identified layer (called from one thread at a time).
