@@ -146,6 +146,17 @@ double rmse_N(const std::vector<double>& r, double scale_N) {
   return r.empty() ? kNaN : scale_N * std::sqrt(sum / r.size());
 }
 
+/// The optimiser's settings of every factor fit (ln s, full model runs, two at a time).
+LevenbergMarquardtOptions factor_fit_options(int max_evaluations) {
+  LevenbergMarquardtOptions options;
+  options.max_iterations = 6;
+  options.max_evaluations = max_evaluations;
+  options.fd_step = options.fd_step_min = 0.02;
+  options.cost_tolerance = 1e-3;
+  options.threads = 2;
+  return options;
+}
+
 /// Layer k's factor: the least-squares factor for a force proportional to
 /// the modulus from run A, then Levenberg-Marquardt on ln s_k with the full
 /// model (levenberg_marquardt.hpp). Books the runs and the window's RMSE.
@@ -178,12 +189,7 @@ double identified_scale(const std::string& model, const Scene& trial, std::size_
     }
     return ok;
   };
-  LevenbergMarquardtOptions options;
-  options.max_iterations = 6;
-  options.max_evaluations = 14;
-  options.fd_step = options.fd_step_min = 0.02;
-  options.cost_tolerance = 1e-3;
-  options.threads = 2;
+  const LevenbergMarquardtOptions options = factor_fit_options(14);
   const double bound = std::log(kScaleBound);
   try {
     const LevenbergMarquardtResult fit =
@@ -236,28 +242,16 @@ std::string joint_refinement(const std::string& model, const Scene& trial, const
     lower.push_back(-std::log(kScaleBound));
     upper.push_back(std::log(kScaleBound));
   }
-  LevenbergMarquardtOptions options;
-  options.max_iterations = 6;
-  options.max_evaluations = 4 * static_cast<int>(fitted.size()) + 8;
-  options.fd_step = options.fd_step_min = 0.02;
-  options.cost_tolerance = 1e-3;
-  options.threads = 2;
-  std::vector<double> start_residuals;
-  if (!residuals(x0, start_residuals)) return "joint fit not run: the model cannot run at the bottom-up factors";
-  ++runs;
-  double start_cost = 0.0;
-  for (double r : start_residuals) start_cost += r * r;
+  const LevenbergMarquardtOptions options = factor_fit_options(4 * static_cast<int>(fitted.size()) + 8);
   try {
     const LevenbergMarquardtResult fit = levenberg_marquardt(residuals, x0, lower, upper, options);
     runs += fit.evaluations;
-    double cost = 0.0;
-    for (double r : fit.residuals) cost += r * r;
     std::ostringstream note;
     note << "joint fit of the factors of";
     for (std::size_t k : fitted) note << " " << trial.layers[k].name;
-    note << " on all their windows (" << fit.evaluations + 1 << " runs): sum of squared residuals "
-         << start_cost << " -> " << std::min(cost, start_cost);
-    if (!(cost < start_cost)) return note.str() + ", bottom-up factors kept";
+    note << " on all their windows (" << fit.evaluations << " runs): sum of squared residuals " << fit.initial_cost
+         << " -> " << std::min(fit.cost, fit.initial_cost);
+    if (!(fit.cost < fit.initial_cost)) return note.str() + ", bottom-up factors kept";
     std::size_t offset = 0;
     for (std::size_t j = 0; j < fitted.size(); ++j) {
       scale[fitted[j]] = std::exp(fit.x[j]);
@@ -267,8 +261,8 @@ std::string joint_refinement(const std::string& model, const Scene& trial, const
       offset += windows[j].depth_m.size();
     }
     return note.str();
-  } catch (const std::exception& e) {
-    return std::string("joint fit failed, bottom-up factors kept: ") + e.what();
+  } catch (const std::exception& e) {  // e.g. the model cannot run at the bottom-up factors
+    return std::string("joint fit not run, bottom-up factors kept: ") + e.what();
   }
 }
 
