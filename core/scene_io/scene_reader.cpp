@@ -334,6 +334,7 @@ ComparisonSettings read_comparison(ObjectReader r, const std::string& file) {
     m.reject_unknown_keys();
   }
   c.integrator = r.string("integrator", c.integrator);
+  c.mass_spring_springs = r.string("mass_spring_springs", c.mass_spring_springs);
   c.relative_tolerance = r.number("relative_tolerance", c.relative_tolerance);
   c.absolute_tolerance_m = r.number("absolute_tolerance_mm", c.absolute_tolerance_m / kMm) * kMm;
   c.mass_damping_per_s = r.number("mass_damping_per_s", c.mass_damping_per_s);

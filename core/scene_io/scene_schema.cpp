@@ -168,6 +168,7 @@ std::vector<SceneField> comparison_fields() {
       {"/comparison/mesh/size_far_mm", T::Number, "mm", kOptional, any(), kRealtime, kWritten},
       {"/comparison/mesh/grading", T::Number, "", kOptional, at_least(0), kRealtime, kWritten},
       {"/comparison/integrator", T::String, "", kOptional, any(), kRealtime, kWritten},
+      {"/comparison/mass_spring_springs", T::String, "", kOptional, any(), kRealtime, kWritten},
       {"/comparison/relative_tolerance", T::Number, "", kOptional, within(0, 1, true, true), kRealtime, kWritten},
       {"/comparison/absolute_tolerance_mm", T::Number, "mm", kOptional, above(0), kRealtime, kWritten},
       {"/comparison/mass_damping_per_s", T::Number, "1/s", kOptional, at_least(0), kRealtime, kWritten},

@@ -312,6 +312,9 @@ void validate_comparison(const Scene& s, const std::string& file) {
   if (c.integrator != "implicit" && c.integrator != "explicit")
     throw SceneError(file, "/comparison/integrator",
                      "unknown integrator '" + c.integrator + "' (known: implicit, explicit)");
+  if (c.mass_spring_springs != "linear" && c.mass_spring_springs != "nonlinear")
+    throw SceneError(file, "/comparison/mass_spring_springs",
+                     "unknown spring kind '" + c.mass_spring_springs + "' (known: linear, nonlinear)");
   require(c.relative_tolerance > 0 && c.relative_tolerance < 1, file, "/comparison/relative_tolerance", "in (0, 1)",
           c.relative_tolerance);
   require(c.absolute_tolerance_m > 0, file, "/comparison/absolute_tolerance_mm", "> 0", c.absolute_tolerance_m / kMm);

@@ -171,6 +171,8 @@ json comparison_json(const ComparisonSettings& c) {
     comparison["prescribed_puncture_depths_mm"] = mm;
   }
   if (!c.mass_spring_stiffness_scale.empty()) comparison["mass_spring_stiffness_scale"] = c.mass_spring_stiffness_scale;
+  if (c.mass_spring_springs != "linear")  // the default is not written
+    comparison["mass_spring_springs"] = c.mass_spring_springs;
   return comparison;
 }
 

@@ -357,6 +357,10 @@ struct ComparisonSettings {
   /// Time integration of the volumetric models through SUNDIALS: "implicit"
   /// (CVODE BDF, Newton-Krylov) or "explicit" (ARKODE explicit Runge-Kutta).
   std::string integrator = "implicit";
+  /// Volumetric mass-spring model's springs: "linear" (seed 001's M x'' = -K x - Y x'
+  /// with K constant: each spring linearised about its rest direction) or
+  /// "nonlinear" (geometrically exact springs).
+  std::string mass_spring_springs = "linear";
   double relative_tolerance = 1e-4;       ///< integrator relative tolerance
   double absolute_tolerance_m = 1e-7;     ///< integrator absolute tolerance on positions (velocities: per second)
   double mass_damping_per_s = 20.0;       ///< alpha of the Rayleigh damping Y = alpha M + beta K0 (seed 001: M x'' = -K x - Y x')

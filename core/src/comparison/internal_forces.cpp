@@ -56,9 +56,17 @@ std::vector<std::pair<int, int>> tet_node_pairs(const TetMesh& mesh) { return te
 
 // ---------------------------------------------------------------------------- mass-spring
 
+SpringKind parse_spring_kind(const std::string& name) {
+  if (name == "linear") return SpringKind::Linear;
+  if (name == "nonlinear") return SpringKind::Nonlinear;
+  throw std::invalid_argument("unknown spring kind '" + name + "' (known: linear, nonlinear)");
+}
+
+const char* to_string(SpringKind kind) { return kind == SpringKind::Linear ? "linear" : "nonlinear"; }
+
 MassSpringLaw::MassSpringLaw(const TetMesh& mesh, const std::vector<LayerElasticity>& layers,
-                             std::vector<double> layer_scale)
-    : mesh_(&mesh), layers_(layers), layer_scale_(std::move(layer_scale)), edges_(tet_edges(mesh)) {
+                             std::vector<double> layer_scale, SpringKind kind)
+    : mesh_(&mesh), layers_(layers), layer_scale_(std::move(layer_scale)), edges_(tet_edges(mesh)), kind_(kind) {
   if (layer_scale_.empty()) layer_scale_.assign(layers_.size(), 1.0);
   if (layer_scale_.size() != layers_.size())
     throw std::invalid_argument("MassSpringLaw: " + std::to_string(layer_scale_.size()) + " stiffness scales for " +
@@ -66,8 +74,15 @@ MassSpringLaw::MassSpringLaw(const TetMesh& mesh, const std::vector<LayerElastic
   for (double s : layer_scale_)
     if (!(s > 0.0) || !std::isfinite(s)) throw std::invalid_argument("MassSpringLaw: stiffness scales must be > 0");
   rest_length_.resize(edges_.size());
-  for (std::size_t e = 0; e < edges_.size(); ++e)
-    rest_length_[e] = (mesh.points_m.col(edges_[e].first) - mesh.points_m.col(edges_[e].second)).norm();
+  rest_direction_.resize(edges_.size());
+  for (std::size_t e = 0; e < edges_.size(); ++e) {
+    const Eigen::Vector3d d = mesh.points_m.col(edges_[e].second) - mesh.points_m.col(edges_[e].first);
+    rest_length_[e] = d.norm();
+    if (!(rest_length_[e] > 0.0))
+      throw std::invalid_argument("MassSpringLaw: edge " + std::to_string(edges_[e].first) + "-" +
+                                  std::to_string(edges_[e].second) + " has zero rest length");
+    rest_direction_[e] = d / rest_length_[e];
+  }
   compute_stiffness(std::vector<std::uint8_t>(mesh.tets.size(), 0));
 }
 
@@ -98,6 +113,13 @@ void MassSpringLaw::add_forces(VectorRef x, VectorRef, const double*, MutableVec
     if (k == 0.0) continue;
     const int a = edges_[e].first, b = edges_[e].second;
     const Eigen::Vector3d d = segment(x, b) - segment(x, a);
+    if (kind_ == SpringKind::Linear) {
+      // Stretch along the rest direction: n0 . (d - d0) = n0 . d - l0.
+      const Eigen::Vector3d force = k * (rest_direction_[e].dot(d) - rest_length_[e]) * rest_direction_[e];
+      f.segment<3>(3 * a) += force;
+      f.segment<3>(3 * b) -= force;
+      continue;
+    }
     const double length = d.norm();
     if (!(length > 0.0)) continue;
     const Eigen::Vector3d force = k * (length - rest_length_[e]) / length * d;  // pulls a toward b when stretched
@@ -111,6 +133,14 @@ void MassSpringLaw::add_tangent(VectorRef x, double gamma, NodeBlockMatrix& K) c
     const double k = stiffness_[e];
     if (k == 0.0) continue;
     const int a = edges_[e].first, b = edges_[e].second;
+    if (kind_ == SpringKind::Linear) {
+      const Eigen::Matrix3d block = k * rest_direction_[e] * rest_direction_[e].transpose();
+      K.add_block(a, a, block);
+      K.add_block(b, b, block);
+      K.add_block(a, b, -block);
+      K.add_block(b, a, -block);
+      continue;
+    }
     const Eigen::Vector3d d = segment(x, b) - segment(x, a);
     const double length = d.norm();
     if (!(length > 0.0)) continue;
@@ -133,7 +163,8 @@ void MassSpringLaw::add_tangent(VectorRef x, double gamma, NodeBlockMatrix& K) c
 double MassSpringLaw::energy_J(VectorRef x) const {
   double energy = 0.0;
   for (std::size_t e = 0; e < edges_.size(); ++e) {
-    const double stretch = (segment(x, edges_[e].second) - segment(x, edges_[e].first)).norm() - rest_length_[e];
+    const Eigen::Vector3d d = segment(x, edges_[e].second) - segment(x, edges_[e].first);
+    const double stretch = (kind_ == SpringKind::Linear ? rest_direction_[e].dot(d) : d.norm()) - rest_length_[e];
     energy += 0.5 * stiffness_[e] * stretch * stretch;
   }
   return energy;
@@ -145,7 +176,8 @@ void MassSpringLaw::set_removed(const std::vector<std::uint8_t>& removed) {
 }
 
 std::size_t MassSpringLaw::memory_bytes() const {
-  return bytes_of(edges_) + bytes_of(rest_length_) + bytes_of(stiffness_) + bytes_of(layer_scale_);
+  return bytes_of(edges_) + bytes_of(rest_length_) + bytes_of(rest_direction_) + bytes_of(stiffness_) +
+         bytes_of(layer_scale_);
 }
 
 // ---------------------------------------------------------------------------- linear tensor-mass

@@ -132,10 +132,15 @@ std::unique_ptr<ComparisonModel> make_comparison_model(const std::string& name, 
   const std::string integration = std::string(", ") + to_string(settings.integrator);
   std::ostringstream mesh_text;
   mesh_text << " on " << mesh->node_count() << " nodes / " << mesh->tet_count() << " tetrahedra";
-  if (name == "msm")
+  if (name == "msm") {
+    const SpringKind springs = parse_spring_kind(scene.comparison.mass_spring_springs);
     return std::make_unique<VolumetricNeedleModel>(
-        scene, mesh, std::make_unique<MassSpringLaw>(*mesh, elasticity, scene.comparison.mass_spring_stiffness_scale),
-        settings, "volumetric mass-spring (one spring per edge, Van Gelder stiffness)" + mesh_text.str() + integration);
+        scene, mesh,
+        std::make_unique<MassSpringLaw>(*mesh, elasticity, scene.comparison.mass_spring_stiffness_scale, springs),
+        settings,
+        std::string("volumetric mass-spring (one ") + to_string(springs) +
+            " spring per edge, Van Gelder stiffness)" + mesh_text.str() + integration);
+  }
   if (name == "mass_tensor")
     return std::make_unique<VolumetricNeedleModel>(scene, mesh, std::make_unique<LinearTensorMass>(*mesh, elasticity),
                                                    settings,

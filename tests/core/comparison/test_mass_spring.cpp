@@ -59,9 +59,11 @@ TEST(MassSpring, KuhnLatticeMatchesClosedFormElasticConstants) {
               1e-5 * volume * E * eps * eps);
 }
 
-TEST(MassSpring, ForcesAreEnergyGradientAndTangentIsTheirDerivative) {
+class MassSpringKinds : public ::testing::TestWithParam<SpringKind> {};
+
+TEST_P(MassSpringKinds, ForcesAreEnergyGradientAndTangentIsTheirDerivative) {
   const TetMesh mesh = testing::kuhn_box(2, 1e-3);
-  const MassSpringLaw law(mesh, {{10e3, 0.45, 1000.0}});
+  const MassSpringLaw law(mesh, {{10e3, 0.45, 1000.0}}, {}, GetParam());
   Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(mesh.points_m.data(), mesh.points_m.size());
   for (Eigen::Index i = 0; i < x.size(); ++i) x[i] += 1e-4 * std::sin(1.7 * i);  // stretched springs only matter
   Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size());
@@ -83,6 +85,72 @@ TEST(MassSpring, ForcesAreEnergyGradientAndTangentIsTheirDerivative) {
   law.add_forces(X - 1e-9 * u, X, nullptr, fm, nullptr);
   const Eigen::VectorXd Ku = K.matrix() * u;
   EXPECT_LT((Ku + (fp - fm) / 2e-9).norm(), 1e-5 * Ku.norm());
+}
+
+INSTANTIATE_TEST_SUITE_P(BothSpringKinds, MassSpringKinds,
+                         ::testing::Values(SpringKind::Linear, SpringKind::Nonlinear),
+                         [](const ::testing::TestParamInfo<SpringKind>& info) { return std::string(to_string(info.param)); });
+
+TEST(MassSpring, LinearSpringUnderARigidRotationMatchesItsClosedForm) {
+  // One spring from (0,0,0) to (l0,0,0), its end turned by theta about z: the
+  // exact spring keeps its length (no force); the linearised one measures
+  // n0 . d - l0 = l0 (cos theta - 1) and pulls along n0 = x.
+  TetMesh mesh;
+  mesh.points_m.resize(3, 4);
+  const double l0 = 2e-3;
+  mesh.points_m << 0, l0, 0, 0, 0, 0, 1e-3, 0, 0, 0, 0, 1e-3;
+  mesh.tets = {Eigen::Vector4i(0, 1, 2, 3)};
+  mesh.layer = {0};
+  mesh.needle_column = {0};
+  const MassSpringLaw linear(mesh, {{12e3, 0.45, 1000.0}}, {}, SpringKind::Linear);
+  const MassSpringLaw exact(mesh, {{12e3, 0.45, 1000.0}}, {}, SpringKind::Nonlinear);
+  const double theta = 0.3;
+  Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(mesh.points_m.data(), mesh.points_m.size());
+  x.segment<3>(3) = Eigen::Vector3d(l0 * std::cos(theta), l0 * std::sin(theta), 0.0);
+  // Node 0's force is the 0-1 spring's alone (its springs to nodes 2 and 3 are at rest).
+  const double k = linear.stiffness_N_per_m()[0];  // edges sorted: (0,1) first
+  ASSERT_EQ(linear.edges()[0], std::make_pair(0, 1));
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size());
+  linear.add_forces(x, x, nullptr, f, nullptr);
+  EXPECT_NEAR(f[0], k * l0 * (std::cos(theta) - 1.0), 1e-12 * k * l0);
+  EXPECT_NEAR(f[1], 0.0, 1e-12 * k * l0);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
+  exact.add_forces(x, x, nullptr, g, nullptr);
+  EXPECT_NEAR(g.segment<3>(0).norm(), 0.0, 1e-12 * k * l0);
+}
+
+TEST(MassSpring, LinearSpringsAreExactSpringsToFirstOrder) {
+  // Seed 001's constant K is the exact springs' tangent at rest: the two
+  // forces differ at second order in the displacement.
+  const TetMesh mesh = testing::kuhn_box(2, 1e-3);
+  const MassSpringLaw linear(mesh, {{10e3, 0.45, 1000.0}}, {}, SpringKind::Linear);
+  const MassSpringLaw exact(mesh, {{10e3, 0.45, 1000.0}}, {}, SpringKind::Nonlinear);
+  const Eigen::VectorXd X = Eigen::Map<const Eigen::VectorXd>(mesh.points_m.data(), mesh.points_m.size());
+  Eigen::VectorXd u(X.size());
+  for (Eigen::Index i = 0; i < u.size(); ++i) u[i] = std::sin(0.7 * i + 0.2);
+  auto relative_difference = [&](double eps) {
+    Eigen::VectorXd fl = Eigen::VectorXd::Zero(X.size()), fe = fl;
+    linear.add_forces(X + eps * u, X, nullptr, fl, nullptr);
+    exact.add_forces(X + eps * u, X, nullptr, fe, nullptr);
+    return (fl - fe).norm() / fl.norm();
+  };
+  const double coarse = relative_difference(1e-5), fine = relative_difference(1e-6);
+  EXPECT_GT(coarse, 0.0);
+  EXPECT_NEAR(fine / coarse, 0.1, 0.02);  // first order in eps
+  // And linear: forces add.
+  Eigen::VectorXd v(X.size());
+  for (Eigen::Index i = 0; i < v.size(); ++i) v[i] = std::cos(1.3 * i);
+  Eigen::VectorXd fu = Eigen::VectorXd::Zero(X.size()), fv = fu, fuv = fu;
+  linear.add_forces(X + 2e-4 * u, X, nullptr, fu, nullptr);
+  linear.add_forces(X + 3e-4 * v, X, nullptr, fv, nullptr);
+  linear.add_forces(X + 2e-4 * u + 3e-4 * v, X, nullptr, fuv, nullptr);
+  EXPECT_LT((fuv - fu - fv).norm(), 1e-9 * fuv.norm());
+}
+
+TEST(MassSpring, SpringKindsByName) {
+  EXPECT_EQ(parse_spring_kind("linear"), SpringKind::Linear);
+  EXPECT_EQ(parse_spring_kind("nonlinear"), SpringKind::Nonlinear);
+  EXPECT_THROW(parse_spring_kind("hooke"), std::invalid_argument);
 }
 
 TEST(MassSpring, RemovedTetrahedraTakeTheirStiffnessWithThem) {

@@ -126,6 +126,8 @@ const BadCase kBadCases[] = {
     {"depth_beyond_tissue", [](json& j) { j["insertion"]["target_depth_mm"] = 60.0; }, "/insertion/target_depth_mm"},
     {"oblique_needle", [](json& j) { j["insertion"]["angle_deg"] = 30.0; }, "/insertion/angle_deg"},
     {"unknown_integrator", [](json& j) { j["realtime"]["integrator"] = "rk4"; }, "/realtime/integrator"},
+    {"unknown_spring_kind", [](json& j) { j["comparison"]["mass_spring_springs"] = "hooke"; },
+     "/comparison/mass_spring_springs"},
     {"poisson_half", [](json& j) { j["layers"][2]["material"]["poisson_ratio"] = 0.5; }, "/layers/2/material/poisson_ratio"},
     {"wrong_schema_version", [](json& j) { j["schema_version"] = 7; }, "/schema_version"},
     {"huge_force_mesh", [](json& j) { j["layers"][2]["force_mesh"]["w"] = 40; }, "/layers/2/force_mesh/L_mm"},

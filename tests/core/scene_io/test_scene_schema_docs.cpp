@@ -52,6 +52,7 @@ Scene scene_with_every_block() {
   l.force_law.cutting_rate.viscous_fraction = 0.2;  // written when used
   l.force_law.rupture_release_rate.exponent = 0.3;   // written when used
   s.comparison.mass_spring_stiffness_scale.assign(s.layers.size(), 1.0);
+  s.comparison.mass_spring_springs = "nonlinear";  // written when not the default
   s.comparison.stiffness_scale.assign(s.layers.size(), 1.0);
   s.comparison.prescribed_puncture_depths_m = {1e-3};
   s.comparison.prony_g = {0.2};

@@ -251,7 +251,11 @@ TEST(MassSpringIdentification, RecoversFactorsOfASyntheticReference) {
   // fat); the search starts from 1, 1, 1. A coarse mesh without sliver
   // exudation keeps the test quick and deterministic; thresholds of 0.2 mm
   // keep each layer pressed over several samples.
+  // The exact springs: with seed 001's linear ones (the default) the same
+  // budgets leave the skin factor less determined (annealing reaches 2.5
+  // after 60 runs); the searches, not the spring law, are under test here.
   Scene scene = testing::small_slab_scene();
+  scene.comparison.mass_spring_springs = "nonlinear";
   scene.insertion.target_depth_m = 3.5e-3;
   for (Layer& l : scene.layers) l.force_mesh.deformed_threshold_m = 0.2e-3;
   meshing::TetSlabMeshOptions mesh_options = meshing::tet_slab_mesh_options(scene);
@@ -264,8 +268,9 @@ TEST(MassSpringIdentification, RecoversFactorsOfASyntheticReference) {
   settings.quasi_static = true;
   comparison::VolumetricNeedleModel truth(
       scene, mesh,
-      std::make_unique<comparison::MassSpringLaw>(*mesh, comparison::layer_elasticity(scene), truth_factors), settings,
-      "truth");
+      std::make_unique<comparison::MassSpringLaw>(*mesh, comparison::layer_elasticity(scene), truth_factors,
+                                                  comparison::SpringKind::Nonlinear),
+      settings, "truth");
   ReferenceData reference;
   reference.curve.layer_names = {"skin", "fat", "muscle"};
   reference.curve.layer_states.resize(3);

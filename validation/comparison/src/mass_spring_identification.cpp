@@ -26,7 +26,8 @@ ModelRun quasi_static_run(const Scene& scene, std::shared_ptr<const comparison::
   comparison::VolumetricSettings settings = comparison::volumetric_settings(scene);
   settings.quasi_static = true;
   comparison::VolumetricNeedleModel model(
-      scene, mesh, std::make_unique<comparison::MassSpringLaw>(*mesh, comparison::layer_elasticity(scene), scale),
+      scene, mesh, std::make_unique<comparison::MassSpringLaw>(*mesh, comparison::layer_elasticity(scene), scale,
+                                                 comparison::parse_spring_kind(scene.comparison.mass_spring_springs)),
       settings, "mass-spring, quasi-static");
   ModelRun run;
   run.model = "msm";

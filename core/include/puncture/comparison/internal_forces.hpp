@@ -7,7 +7,13 @@
 // (Y = alpha M) is integrated by volumetric_model.hpp.
 //
 //   MassSpringLaw       conventional volumetric mass-spring model: one spring
-//                       per tetrahedron edge, f = k (|l| - l0) l/|l|. Spring
+//                       per tetrahedron edge. Seed 001's form (SpringKind::
+//                       Linear, the default): M x'' = -K (x - x0) - Y x' with
+//                       K constant, each spring's k n0 n0^T about its rest
+//                       direction n0, f = k (n0 . (u_b - u_a)) n0; or
+//                       geometrically exact springs (SpringKind::Nonlinear),
+//                       f = k (|l| - l0) l/|l|, whose compressed springs buckle
+//                       sideways under the tip. Spring
 //                       stiffness by Van Gelder's rule (A. Van Gelder 1998,
 //                       "Approximate simulation of elastic membranes by
 //                       triangulated spring meshes", J. Graphics Tools 3(2),
@@ -111,11 +117,19 @@ std::vector<std::pair<int, int>> tet_node_pairs(const TetMesh& mesh);
 /// Unique edges (a < b) of the mesh's tetrahedra, sorted.
 std::vector<std::pair<int, int>> tet_edges(const TetMesh& mesh);
 
+/// How a spring's force depends on its end points: linearised about the rest
+/// direction (seed 001's constant K) or geometrically exact.
+enum class SpringKind { Linear, Nonlinear };
+SpringKind parse_spring_kind(const std::string& name);  ///< "linear", "nonlinear"; throws otherwise
+const char* to_string(SpringKind kind);
+
 class MassSpringLaw final : public InternalForceLaw {
  public:
   /// layer_scale: one factor per layer on the Van Gelder stiffness (empty: 1).
-  MassSpringLaw(const TetMesh& mesh, const std::vector<LayerElasticity>& layers, std::vector<double> layer_scale = {});
+  MassSpringLaw(const TetMesh& mesh, const std::vector<LayerElasticity>& layers, std::vector<double> layer_scale = {},
+                SpringKind kind = SpringKind::Linear);
   std::string name() const override { return "msm"; }
+  SpringKind spring_kind() const { return kind_; }
   void add_forces(VectorRef x, VectorRef v, const double* q, MutableVectorRef f,
                   double* qdot) const override;
   void add_tangent(VectorRef x, double gamma, NodeBlockMatrix& K) const override;
@@ -135,7 +149,9 @@ class MassSpringLaw final : public InternalForceLaw {
   std::vector<double> layer_scale_;
   std::vector<std::pair<int, int>> edges_;
   std::vector<double> rest_length_;
+  std::vector<Eigen::Vector3d> rest_direction_;  ///< n0 of each edge, from its first to its second node
   std::vector<double> stiffness_;
+  SpringKind kind_;
 };
 
 class LinearTensorMass final : public InternalForceLaw {
