@@ -45,6 +45,26 @@ TEST(LevenbergMarquardt, RecoversExponentialDecayParameters) {
   EXPECT_GT(res.initial_cost, 1.0);
 }
 
+TEST(LevenbergMarquardt, AcceptsAStartThatIsGoodEnoughWithoutAJacobian) {
+  const auto r = exponential_fit(2.5, 1.3);
+  std::vector<double> r0;
+  r({2.4, 1.3}, r0);
+  double start_cost = 0.0;
+  for (double v : r0) start_cost += v * v;
+  pv::LevenbergMarquardtOptions o;
+  o.accept_start_cost = 1.01 * start_cost;
+  const pv::LevenbergMarquardtResult kept = pv::levenberg_marquardt(r, {2.4, 1.3}, {0.0, 0.0}, {10.0, 10.0}, o);
+  EXPECT_EQ(kept.status, "start_accepted");
+  EXPECT_EQ(kept.evaluations, 1);
+  EXPECT_EQ(kept.x, (std::vector<double>{2.4, 1.3}));
+  EXPECT_DOUBLE_EQ(kept.cost, start_cost);
+  // Just below the start's cost the fit runs and finds the truth.
+  o.accept_start_cost = 0.99 * start_cost;
+  const pv::LevenbergMarquardtResult fitted = pv::levenberg_marquardt(r, {2.4, 1.3}, {0.0, 0.0}, {10.0, 10.0}, o);
+  EXPECT_NE(fitted.status, "start_accepted");
+  EXPECT_NEAR(fitted.x[0], 2.5, 1e-5);
+}
+
 TEST(LevenbergMarquardt, SolvesRosenbrockValley) {
   pv::LevenbergMarquardtOptions o;
   o.max_iterations = 200;

@@ -178,6 +178,10 @@ LevenbergMarquardtResult levenberg_marquardt(const ResidualFunction& r, const st
                                              const std::vector<double>& lower, const std::vector<double>& upper,
                                              const LevenbergMarquardtOptions& o) {
   LevenbergMarquardtResult res = start_point(r, x0, lower, upper);
+  if (o.accept_start_cost >= 0.0 && res.cost <= o.accept_start_cost) {
+    res.status = "start_accepted";
+    return res;
+  }
   const int lanes = thread_count(o.threads, 2) >= 2 ? 2 : 1;
   double lambda = o.initial_lambda;
   double fd_step = o.fd_step;

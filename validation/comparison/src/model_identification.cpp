@@ -153,6 +153,7 @@ LevenbergMarquardtOptions factor_fit_options(int max_evaluations) {
   options.max_evaluations = max_evaluations;
   options.fd_step = options.fd_step_min = 0.02;
   options.cost_tolerance = 1e-3;
+  options.step_tolerance = 1e-3;  // a factor to 0.1 %: finer steps move no table (the runs to confirm them did)
   options.threads = 2;
   return options;
 }
@@ -204,16 +205,26 @@ double identified_scale(const std::string& model, const Scene& trial, std::size_
   }
 }
 
+/// Relative rise of the windows' summed cost, at the bottom-up factors,
+/// over the sum of their own fits below which the joint fit stops at its
+/// start: no window was moved by the other layers' factors, so there is no
+/// coupling for a joint fit to weigh (one run instead of a Jacobian's and
+/// trial steps').
+constexpr double kJointCouplingTolerance = 0.01;
+
 /// The joint step: ln s of every fitted layer at once (Levenberg-Marquardt
 /// from the bottom-up factors) on all their windows, from one run to the
 /// deepest fitted layer's puncture (prepare_layer_run of that layer: the
 /// layers above break where the reference breaks them, each window sees the
-/// same forces as in its own run). Keeps the factors when the fit does not
-/// lower the cost. Returns the note for the report.
+/// same forces as in its own run). own_cost: the sum of the windows' squared
+/// residuals in their own bottom-up fits (the fit stops at its start when the
+/// joint run's cost is within kJointCouplingTolerance of it). Keeps the
+/// factors when the fit does not lower the cost. Returns the note for the report.
 std::string joint_refinement(const std::string& model, const Scene& trial, const std::vector<std::size_t>& fitted,
-                             const std::vector<Window>& windows, std::shared_ptr<const comparison::TetMesh> mesh,
-                             double until_s, std::vector<double>& scale, std::vector<double>& rmse_after_N,
-                             int& runs, const IdentificationStepProgress& progress) {
+                             const std::vector<Window>& windows, double own_cost,
+                             std::shared_ptr<const comparison::TetMesh> mesh, double until_s,
+                             std::vector<double>& scale, std::vector<double>& rmse_after_N, int& runs,
+                             const IdentificationStepProgress& progress) {
   std::mutex progress_mutex;
   int evaluations = 0;
   const ResidualFunction residuals = [&](const std::vector<double>& x, std::vector<double>& out) {
@@ -242,11 +253,20 @@ std::string joint_refinement(const std::string& model, const Scene& trial, const
     lower.push_back(-std::log(kScaleBound));
     upper.push_back(std::log(kScaleBound));
   }
-  const LevenbergMarquardtOptions options = factor_fit_options(4 * static_cast<int>(fitted.size()) + 8);
+  LevenbergMarquardtOptions options = factor_fit_options(4 * static_cast<int>(fitted.size()) + 8);
+  options.accept_start_cost = (1.0 + kJointCouplingTolerance) * own_cost;
   try {
     const LevenbergMarquardtResult fit = levenberg_marquardt(residuals, x0, lower, upper, options);
     runs += fit.evaluations;
     std::ostringstream note;
+    if (fit.status == "start_accepted") {
+      note << "joint fit of the factors of";
+      for (std::size_t k : fitted) note << " " << trial.layers[k].name;
+      note << " not needed: at the bottom-up factors their windows cost " << fit.initial_cost << " together, "
+           << own_cost << " in their own fits (within " << 100.0 * kJointCouplingTolerance
+           << " %: no window is moved by the other layers' factors; 1 run)";
+      return note.str();
+    }
     note << "joint fit of the factors of";
     for (std::size_t k : fitted) note << " " << trial.layers[k].name;
     note << " on all their windows (" << fit.evaluations << " runs): sum of squared residuals " << fit.initial_cost
@@ -338,7 +358,12 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
     const std::size_t deepest = fitted.back();
     prepare_layer_run(trial, deepest, depths_m);
     std::vector<double> rmse_after(scene.layers.size(), kNaN);
-    result.joint_note = joint_refinement(model, trial, fitted, fitted_windows, mesh, until_s[deepest],
+    double own_cost = 0.0;  // in the optimiser's units: sum of (residual / window scale)^2
+    for (std::size_t j = 0; j < fitted.size(); ++j) {
+      const double rmse = result.layers[fitted[j]].window_rmse_after_N / fitted_windows[j].scale_N;
+      own_cost += static_cast<double>(fitted_windows[j].depth_m.size()) * rmse * rmse;
+    }
+    result.joint_note = joint_refinement(model, trial, fitted, fitted_windows, own_cost, mesh, until_s[deepest],
                                          trial.comparison.stiffness_scale, rmse_after, result.model_runs, progress);
     for (std::size_t k : fitted)
       if (std::isfinite(rmse_after[k])) {

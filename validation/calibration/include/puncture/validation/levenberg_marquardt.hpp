@@ -52,6 +52,10 @@ struct LevenbergMarquardtOptions {
   double cost_tolerance = 1e-4;    ///< relative decrease of an accepted step counted as stalling
   double step_tolerance = 1e-6;    ///< max |dx| below which the iteration stops
   int threads = 0;                 ///< 0: std::thread::hardware_concurrency()
+  /// When >= 0 and the cost at x0 is at most this, x0 is returned after its
+  /// one evaluation (status "start_accepted"): a caller that knows what cost
+  /// is good enough saves the Jacobian's evaluations.
+  double accept_start_cost = -1.0;
 };
 
 struct LevenbergMarquardtResult {
