@@ -173,6 +173,53 @@ TEST(VolumetricModels, LaggedPreconditionerGivesTheSameForces) {
   }
 }
 
+/// A law seen as a general one (is_linear() false): the model takes its
+/// contact force from the sweep over every element.
+class GeneralView final : public InternalForceLaw {
+ public:
+  explicit GeneralView(std::unique_ptr<InternalForceLaw> law) : law_(std::move(law)) {}
+  std::string name() const override { return law_->name(); }
+  void add_forces(VectorRef x, VectorRef v, const double* q, MutableVectorRef f, double* qdot) const override {
+    law_->add_forces(x, v, q, f, qdot);
+  }
+  void add_tangent(VectorRef x, double gamma, NodeBlockMatrix& K) const override { law_->add_tangent(x, gamma, K); }
+  double energy_J(VectorRef x) const override { return law_->energy_J(x); }
+  void set_removed(const std::vector<std::uint8_t>& removed) override { law_->set_removed(removed); }
+  std::size_t memory_bytes() const override { return law_->memory_bytes(); }
+
+ private:
+  std::unique_ptr<InternalForceLaw> law_;
+};
+
+TEST(VolumetricModels, ALinearLawsContactForceFromColumnsOfK0IsTheElementSweeps) {
+  // The linear laws' contact force comes from the contact nodes' columns of
+  // the rest tangent; the sweep over every element must give the same
+  // force at every step, through the skin's and the fat's punctures (which
+  // remove tetrahedra and so change K0).
+  Scene scene = testing::small_slab_scene();
+  scene.insertion.target_depth_m = 4e-3;
+  const auto mesh = mesh_of(scene);
+  for (const char* law : {"mass_tensor", "msm"}) {
+    SCOPED_TRACE(law);
+    auto columns = make_comparison_model(law, scene, mesh);
+    std::unique_ptr<InternalForceLaw> force_law;
+    if (std::string(law) == "msm")
+      force_law = std::make_unique<MassSpringLaw>(*mesh, layer_elasticity(scene), std::vector<double>{});
+    else
+      force_law = std::make_unique<LinearTensorMass>(*mesh, layer_elasticity(scene));
+    ASSERT_TRUE(force_law->is_linear());
+    VolumetricNeedleModel sweep(scene, mesh, std::make_unique<GeneralView>(std::move(force_law)),
+                                volumetric_settings(scene), "element sweep");
+    const RunRecord a = run(*columns, scene), b = run(sweep, scene);
+    ASSERT_EQ(a.force_N.size(), b.force_N.size());
+    ASSERT_GT(b.max_abs_force_N, 1e-3);
+    for (std::size_t i = 0; i < a.force_N.size(); ++i)
+      ASSERT_NEAR(a.force_N[i], b.force_N[i], 1e-9 * b.max_abs_force_N) << "step " << i;
+    EXPECT_EQ(a.states.back(), b.states.back());
+    EXPECT_EQ(a.states.back()[0], LayerState::Punctured);
+  }
+}
+
 TEST(VolumetricModels, ApproachBeforeContactIsTheRestState) {
   // Nothing is integrated before the first contact: starting 0.5 mm above
   // the skin must give the same forces, shifted in time, as starting on it.

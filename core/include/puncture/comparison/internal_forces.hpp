@@ -89,6 +89,9 @@ class InternalForceLaw {
   /// True if add_tangent is the exact derivative of add_forces (not for the
   /// visco-elastic law), so a Jacobian-vector product may use it.
   virtual bool tangent_is_exact() const { return true; }
+  /// True if the forces are f = -K0 (x - X) with K0 the tangent at rest
+  /// (constant), so a few nodes' forces are a few columns of K0.
+  virtual bool is_linear() const { return false; }
   /// Elastic energy (J) at x (the long-term part for the visco-elastic law).
   virtual double energy_J(VectorRef x) const = 0;
   /// Tetrahedra flagged 1 no longer contribute.
@@ -130,6 +133,7 @@ class MassSpringLaw final : public InternalForceLaw {
                 SpringKind kind = SpringKind::Linear);
   std::string name() const override { return "msm"; }
   SpringKind spring_kind() const { return kind_; }
+  bool is_linear() const override { return kind_ == SpringKind::Linear; }
   void add_forces(VectorRef x, VectorRef v, const double* q, MutableVectorRef f,
                   double* qdot) const override;
   void add_tangent(VectorRef x, double gamma, NodeBlockMatrix& K) const override;
@@ -158,6 +162,7 @@ class LinearTensorMass final : public InternalForceLaw {
  public:
   LinearTensorMass(const TetMesh& mesh, const std::vector<LayerElasticity>& layers);
   std::string name() const override { return "mass_tensor"; }
+  bool is_linear() const override { return true; }
   void add_forces(VectorRef x, VectorRef v, const double* q, MutableVectorRef f,
                   double* qdot) const override;
   void add_tangent(VectorRef x, double gamma, NodeBlockMatrix& K) const override;

@@ -213,7 +213,7 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
 
   // Preconditioner data (implicit).
   NodeBlockMatrix tangent_;            ///< K at the last setup
-  NodeBlockMatrix rest_tangent_;       ///< K0 (for the stiffness-proportional damping)
+  NodeBlockMatrix rest_tangent_;       ///< K0 (for the stiffness-proportional damping, and a linear law's forces)
   Eigen::SparseMatrix<double> system_; ///< (1 + gamma alpha) M + (gamma^2 + gamma beta) K, eliminated
   /// A factorisation is used for gammas within this factor of its own.
   static constexpr double kFactorReuse = 10.0;
