@@ -212,3 +212,45 @@ TEST(EvaluateResidualsParallel, UsesSeveralThreadsWhenAsked) {
   }
   EXPECT_EQ(most.load(), 2);
 }
+
+TEST(LevenbergMarquardt, EvaluatesTheStartAndItsFirstJacobianTogetherWithTheSameResult) {
+  // With two threads the start and the first Jacobian's difference point of a
+  // one-parameter fit run at once, and that Jacobian is finite_difference_jacobian's.
+  std::atomic<int> concurrent{0}, most{0}, calls{0};
+  const auto line = exponential_fit(2.5, 1.3);
+  const pv::ResidualFunction r = [&](const std::vector<double>& x, std::vector<double>& out) {
+    const int now = ++concurrent;
+    int seen = most.load();
+    while (now > seen && !most.compare_exchange_weak(seen, now)) {
+    }
+    if (++calls <= 2) std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the first batch overlaps
+    --concurrent;
+    return line({x[0], 1.3}, out);
+  };
+  pv::LevenbergMarquardtOptions o;
+  o.threads = 1;
+  const pv::LevenbergMarquardtResult serial = pv::levenberg_marquardt(r, {1.0}, {0.0}, {10.0}, o);
+  EXPECT_EQ(most.load(), 1);
+  calls = 0;
+  o.threads = 2;
+  const pv::LevenbergMarquardtResult together = pv::levenberg_marquardt(r, {1.0}, {0.0}, {10.0}, o);
+  EXPECT_EQ(most.load(), 2);
+  EXPECT_NEAR(together.x[0], 2.5, 1e-6);
+  EXPECT_NEAR(serial.x[0], 2.5, 1e-6);
+  // One thread tries one lambda per iteration, two threads two: compare the
+  // first Jacobian instead, which both compute at the start.
+  pv::LevenbergMarquardtOptions first = o;
+  first.max_iterations = 0;
+  const pv::LevenbergMarquardtResult a = pv::levenberg_marquardt(r, {1.0}, {0.0}, {10.0}, first);
+  first.threads = 1;
+  const pv::LevenbergMarquardtResult b = pv::levenberg_marquardt(r, {1.0}, {0.0}, {10.0}, first);
+  EXPECT_EQ(a.evaluations, 2);
+  EXPECT_EQ(a.jacobian.rows(), static_cast<Eigen::Index>(exponential_times().size()));
+  EXPECT_TRUE(a.jacobian_at_x);
+  EXPECT_EQ(a.cost, b.cost);
+  std::vector<double> r0;
+  line({1.0, 1.3}, r0);
+  std::vector<double> lower{0.0}, upper{10.0};
+  const Eigen::MatrixXd J = pv::finite_difference_jacobian(r, {1.0}, r0, lower, upper, o.fd_step, 1, nullptr);
+  EXPECT_EQ((a.jacobian - J).norm(), 0.0);
+}

@@ -100,45 +100,78 @@ void evaluate_residuals_parallel(const ResidualFunction& r, const std::vector<st
   for (std::thread& t : pool) t.join();
 }
 
-Eigen::MatrixXd finite_difference_jacobian(const ResidualFunction& r, const std::vector<double>& x,
-                                           const std::vector<double>& r0, const std::vector<double>& lower,
-                                           const std::vector<double>& upper, double h, int threads, int* evaluations) {
+namespace {
+
+/// The difference points x + step_j e_j of a forward-difference Jacobian
+/// (backward where x + h > upper, towards the farther bound in a box narrower than h).
+std::vector<std::vector<double>> difference_points(const std::vector<double>& x, const std::vector<double>& lower,
+                                                   const std::vector<double>& upper, double h,
+                                                   std::vector<double>& step) {
   std::vector<std::vector<double>> points(x.size(), x);
-  std::vector<double> step(x.size(), h);
+  step.assign(x.size(), h);
   for (std::size_t j = 0; j < x.size(); ++j) {
     if (x[j] + h > upper[j]) step[j] = x[j] - h >= lower[j] ? -h : (upper[j] - x[j] >= x[j] - lower[j] ? upper[j] - x[j] : lower[j] - x[j]);
     if (step[j] == 0.0) step[j] = h;  // an empty box (lower = upper): r is tried just outside it
     points[j][j] += step[j];
   }
-  std::vector<std::vector<double>> rs;
-  std::vector<char> ok;
-  evaluate_residuals_parallel(r, points, rs, ok, threads);
-  if (evaluations) *evaluations += static_cast<int>(points.size());
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(r0.size()), static_cast<Eigen::Index>(x.size()));
-  for (std::size_t j = 0; j < x.size(); ++j) {
+  return points;
+}
+
+/// The Jacobian from the residuals at the difference points (a failed column is zero).
+Eigen::MatrixXd jacobian_from(const std::vector<std::vector<double>>& rs, const std::vector<char>& ok,
+                              const std::vector<double>& r0, const std::vector<double>& step) {
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(r0.size()), static_cast<Eigen::Index>(step.size()));
+  for (std::size_t j = 0; j < step.size(); ++j) {
     if (!ok[j] || rs[j].size() != r0.size()) continue;
     J.col(static_cast<Eigen::Index>(j)) = (as_vector(rs[j]) - as_vector(r0)) / step[j];
   }
   return J;
 }
 
+}  // namespace
+
+Eigen::MatrixXd finite_difference_jacobian(const ResidualFunction& r, const std::vector<double>& x,
+                                           const std::vector<double>& r0, const std::vector<double>& lower,
+                                           const std::vector<double>& upper, double h, int threads, int* evaluations) {
+  std::vector<double> step;
+  const std::vector<std::vector<double>> points = difference_points(x, lower, upper, h, step);
+  std::vector<std::vector<double>> rs;
+  std::vector<char> ok;
+  evaluate_residuals_parallel(r, points, rs, ok, threads);
+  if (evaluations) *evaluations += static_cast<int>(points.size());
+  return jacobian_from(rs, ok, r0, step);
+}
+
 namespace {
 
+/// The start: r at x0 (clamped into the box). With `with_jacobian` the
+/// difference points of the first Jacobian (step h) are evaluated together
+/// with it on `threads` threads (they do not need r(x0)), so a fit that will
+/// need that Jacobian anyway does not wait for the start alone; the Jacobian
+/// is the same as finite_difference_jacobian's.
 LevenbergMarquardtResult start_point(const ResidualFunction& r, const std::vector<double>& x0,
-                                     const std::vector<double>& lower, const std::vector<double>& upper) {
+                                     const std::vector<double>& lower, const std::vector<double>& upper,
+                                     bool with_jacobian, double h, int threads) {
   check_problem(x0, lower, upper);
   LevenbergMarquardtResult res;
   res.x = x0;
   for (std::size_t j = 0; j < x0.size(); ++j) res.x[j] = std::clamp(x0[j], lower[j], upper[j]);
-  bool ok = false;
-  try {
-    ok = r(res.x, res.residuals);
-  } catch (const std::exception&) {
-    ok = false;
+  std::vector<std::vector<double>> points{res.x};
+  std::vector<double> step;
+  if (with_jacobian) {
+    const std::vector<std::vector<double>> columns = difference_points(res.x, lower, upper, h, step);
+    points.insert(points.end(), columns.begin(), columns.end());
   }
-  res.evaluations = 1;
-  if (!ok || res.residuals.empty()) throw std::invalid_argument("levenberg_marquardt: the residuals cannot be evaluated at x0");
+  std::vector<std::vector<double>> rs;
+  std::vector<char> ok;
+  evaluate_residuals_parallel(r, points, rs, ok, threads);
+  res.evaluations = static_cast<int>(points.size());
+  res.residuals = rs[0];
+  if (!ok[0] || res.residuals.empty()) throw std::invalid_argument("levenberg_marquardt: the residuals cannot be evaluated at x0");
   res.cost = res.initial_cost = sum_sq(res.residuals);
+  if (with_jacobian)
+    res.jacobian = jacobian_from(std::vector<std::vector<double>>(rs.begin() + 1, rs.end()),
+                                 std::vector<char>(ok.begin() + 1, ok.end()), res.residuals, step);
   return res;
 }
 
@@ -177,7 +210,12 @@ Trial try_steps(const ResidualFunction& r, LevenbergMarquardtResult& res, const 
 LevenbergMarquardtResult levenberg_marquardt(const ResidualFunction& r, const std::vector<double>& x0,
                                              const std::vector<double>& lower, const std::vector<double>& upper,
                                              const LevenbergMarquardtOptions& o) {
-  LevenbergMarquardtResult res = start_point(r, x0, lower, upper);
+  // The first Jacobian's columns beside the start when there is a thread
+  // for them and no chance the start alone ends the fit.
+  const bool jacobian_with_start = o.accept_start_cost < 0.0 && thread_count(o.threads, 2) >= 2 &&
+                                   1 + static_cast<int>(x0.size()) <= o.max_evaluations;
+  LevenbergMarquardtResult res = start_point(r, x0, lower, upper, jacobian_with_start, o.fd_step,
+                                             jacobian_with_start ? o.threads : 1);
   if (o.accept_start_cost >= 0.0 && res.cost <= o.accept_start_cost) {
     res.status = "start_accepted";
     return res;
@@ -188,7 +226,7 @@ LevenbergMarquardtResult levenberg_marquardt(const ResidualFunction& r, const st
   int stalls = 0;
   // A stall with a coarse difference step may be the Jacobian's error across
   // a kink: refine the step and go on from the same point.
-  bool need_jacobian = true;
+  bool need_jacobian = !jacobian_with_start;
   double cycle_start_cost = res.cost;
   auto refine = [&](const char* why) {
     if (fd_step / 10.0 < 0.999 * o.fd_step_min) {

@@ -126,8 +126,9 @@ void markdown_model_identification(std::ostringstream& md, const nlohmann::json&
   for (const auto& [model, record] : identification.items())
     if (record.contains("joint_fit")) {
       if (!any_joint)
-        md << "Where two or more factors were fitted, they were then fitted jointly on all their windows "
-              "(the factors and the \"after\" column above are the joint fit's):\n\n";
+        md << "Where two or more factors were fitted, the joint fit on all their windows after the bottom-up pass "
+              "(where it ran, the factors and the \"after\" column above are its result; it stops after one run "
+              "when no window moved with the other layers' factors):\n\n";
       any_joint = true;
       md << "- " << model << ": " << record["joint_fit"].get<std::string>() << "\n";
     }

@@ -14,7 +14,9 @@
 //
 // Method (Nielsen's damping, Marquardt's scaling): at x, J by forward
 // differences of step fd_step in x (backward where x + h leaves the box),
-// the columns evaluated concurrently on `threads` threads. A step solves
+// the columns evaluated concurrently on `threads` threads (the first
+// Jacobian's together with the start when there are two or more threads and
+// accept_start_cost is not set). A step solves
 // (J^T J + lambda D) dx = -J^T r, D = diag(J^T J) with a floor, over the free
 // parameters: those not at a bound with the gradient pushing them out (an
 // active set); the trial point is projected into the box. With two or more
