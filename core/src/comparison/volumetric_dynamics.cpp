@@ -34,7 +34,7 @@ void VolumetricNeedleModel::drop_factors() {
 }
 
 void VolumetricNeedleModel::compute_rest_tangent() {
-  if (settings_.stiffness_damping_s <= 0.0 && !law_->is_linear()) return;
+  if (rest_tangent_.node_count() == 0) return;  // not needed (constructor)
   rest_tangent_.set_zero();
   law_->add_tangent(rest_, 0.0, rest_tangent_);
 }

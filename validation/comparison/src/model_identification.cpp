@@ -259,16 +259,14 @@ std::string joint_refinement(const std::string& model, const Scene& trial, const
     const LevenbergMarquardtResult fit = levenberg_marquardt(residuals, x0, lower, upper, options);
     runs += fit.evaluations;
     std::ostringstream note;
+    note << "joint fit of the factors of";
+    for (std::size_t k : fitted) note << " " << trial.layers[k].name;
     if (fit.status == "start_accepted") {
-      note << "joint fit of the factors of";
-      for (std::size_t k : fitted) note << " " << trial.layers[k].name;
       note << " not needed: at the bottom-up factors their windows cost " << fit.initial_cost << " together, "
            << own_cost << " in their own fits (within " << 100.0 * kJointCouplingTolerance
            << " %: no window is moved by the other layers' factors; 1 run)";
       return note.str();
     }
-    note << "joint fit of the factors of";
-    for (std::size_t k : fitted) note << " " << trial.layers[k].name;
     note << " on all their windows (" << fit.evaluations << " runs): sum of squared residuals " << fit.initial_cost
          << " -> " << std::min(fit.cost, fit.initial_cost);
     if (!(fit.cost < fit.initial_cost)) return note.str() + ", bottom-up factors kept";

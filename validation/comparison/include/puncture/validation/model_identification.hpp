@@ -39,7 +39,10 @@
 //      above broken where the reference breaks them). A layer's factor also
 //      shapes the force while the layers above it are pressed (a volumetric
 //      model's skin rests on its fat), which the bottom-up pass cannot weigh;
-//      the factors are kept when the joint fit does not lower the cost.
+//      the factors are kept when the joint fit does not lower the cost. It
+//      stops after its first run when the windows there cost within 1 % of
+//      their own bottom-up fits together (no window moved with the other
+//      layers' factors: the BEM's and SHF's never do).
 //   2. The critical forces, top down, with the final factors: F_k is the
 //      contact force on the step at d_k, so the model, breaking each layer by
 //      its critical force, breaks it where the reference does.
