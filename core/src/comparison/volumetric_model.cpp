@@ -552,6 +552,10 @@ VolumeFrame VolumetricNeedleModel::volume_frame() const {
   return frame;
 }
 
+ElementInversion VolumetricNeedleModel::element_inversion() const {
+  return measure_element_inversion(*mesh_, y_.head(3 * nodes_), removed_);
+}
+
 std::string VolumetricNeedleModel::integrator_report() const {
   if (settings_.quasi_static) {
     std::ostringstream out;

@@ -232,6 +232,11 @@ TEST(VolumetricModels, ApproachBeforeContactIsTheRestState) {
   const auto mesh = mesh_of(on_skin);
   auto a = make_comparison_model("mass_tensor", on_skin, mesh);
   auto b = make_comparison_model("mass_tensor", above, mesh);
+  // At rest no tetrahedron is inverted and every volume ratio is 1.
+  const ElementInversion rest = a->element_inversion();
+  EXPECT_EQ(rest.elements, mesh->tet_count());
+  EXPECT_EQ(rest.inverted, 0);
+  EXPECT_DOUBLE_EQ(rest.min_volume_ratio, 1.0);
   const RunRecord ra = run(*a, on_skin, on_skin.insertion.target_depth_m / on_skin.insertion.speed_m_per_s);
   const RunRecord rb = run(*b, above, (above.insertion.start_height_m + above.insertion.target_depth_m) / above.insertion.speed_m_per_s);
   const std::size_t shift = rb.force_N.size() - ra.force_N.size();

@@ -55,6 +55,7 @@ HeldOutRow run_model_on_case(const ComparisonCase& c, const CaseSetup& setup, co
   ModelRunOptions run_options;
   run_options.profile_depths_m = setup.reference.profile_depths_m;
   run_options.profile_radii_m = setup.reference.profile_radii_m;
+  run_options.measure_inversion = true;
   ModelRun run = run_comparison_model(*model, model_scene, run_options);
   run.model = key;
   HeldOutRow row;
@@ -127,7 +128,8 @@ std::string heldout_csv(const Scene& scene, const std::vector<HeldOutRow>& rows)
   csv << "case,held_out,model,force_rmse_relative,peak_force_error_relative,puncture_depth_error_mm,"
          "puncture_layers_disagreeing";
   for (const Layer& l : scene.layers) csv << ',' << l.name << "_puncture_mm," << l.name << "_fem_puncture_mm";
-  csv << ",deflection_rmse_relative,step_time_mean_ms,step_time_p99_ms,memory_MB,completed_fraction,failure\n";
+  csv << ",deflection_rmse_relative,step_time_mean_ms,step_time_p99_ms,memory_MB,completed_fraction,"
+         "inverted_share_max,first_inversion_depth_mm,min_volume_ratio,failure\n";
   for (const HeldOutRow& r : rows) {
     const ModelMetrics& m = r.metrics;
     csv << r.case_name << ',' << (r.held_out ? "true" : "false") << ',' << m.model << ',' << fmt(m.force_rmse_relative)
@@ -137,7 +139,8 @@ std::string heldout_csv(const Scene& scene, const std::vector<HeldOutRow>& rows)
       csv << ',' << fmt(p.model_depth_m / kMm) << ',' << fmt(p.reference_depth_m / kMm);
     csv << ',' << fmt(m.deflection_rmse_relative) << ',' << fmt(m.step_time_mean_s * 1e3) << ','
         << fmt(m.step_time_p99_s * 1e3) << ',' << fmt(m.memory_bytes / 1e6) << ',' << fmt(m.completed_fraction)
-        << ",\"" << r.failure << "\"\n";
+        << ',' << fmt(m.inverted_share_max) << ',' << fmt(m.first_inversion_depth_m / kMm) << ','
+        << fmt(m.min_volume_ratio) << ",\"" << r.failure << "\"\n";
   }
   return csv.str();
 }

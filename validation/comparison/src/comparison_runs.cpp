@@ -112,6 +112,7 @@ ModelRunOptions ComparisonRunner::run_options(const std::string& key, const comp
   ModelRunOptions o;
   o.profile_depths_m = reference_.profile_depths_m;
   o.profile_radii_m = reference_.profile_radii_m;
+  o.measure_inversion = true;
   const double x_offset = 1.25 * scene_.sample.diameter_m * (static_cast<int>(runs_.size()) + 1);
   if (options_.write_vtk && frame_interval_s_ > 0.0) {
     o.frame_interval_s = frame_interval_s_;

@@ -40,10 +40,22 @@ void markdown_header(std::ostringstream& md, const ComparisonContent& c) {
        << " tetrahedra; " << comparison::describe(c.mesh.report.quality) << ".\n\n";
 }
 
+/// The inverted-tetrahedra cell: "n/a" without a tetrahedral mesh, "0 (J >=
+/// 0.31)" when none inverted, else "4.4 % (3.0; J >= -1.7)" (with_depth) or
+/// "4.4 % (J >= -1.7)".
+std::string inversion_cell(const ModelMetrics& m, bool with_depth) {
+  if (!std::isfinite(m.inverted_share_max)) return "n/a";
+  const std::string j = "J >= " + shown(m.min_volume_ratio, 2);
+  if (m.inverted_share_max == 0.0) return "0 (" + j + ")";
+  return shown(100.0 * m.inverted_share_max, 2) + " % (" +
+         (with_depth ? shown(m.first_inversion_depth_m / kMm, 3) + "; " : std::string()) + j + ")";
+}
+
 /// comparison.md: one row per model, then the ranking.
 void markdown_metrics(std::ostringstream& md, const ComparisonContent& c) {
   md << "| model | dofs | memory MB | force RMSE / FEM peak | peak force error | puncture depth error mm | "
-        "skin deflection RMSE / max | step mean ms | step p99 ms |\n|---|---|---|---|---|---|---|---|---|\n";
+        "skin deflection RMSE / max | inverted tetrahedra, most (first at depth mm) | step mean ms | step p99 ms |\n"
+        "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const ModelMetrics& m : c.rows.metrics)
     md << "| " << m.model << " | " << m.dofs << " | " << shown(m.memory_bytes / 1e6) << " | "
        << shown(m.force_rmse_relative) << " | " << shown(m.peak_force_error_relative) << " | "
@@ -51,9 +63,13 @@ void markdown_metrics(std::ostringstream& md, const ComparisonContent& c) {
        << (m.puncture_layers_disagreeing
                ? " (" + std::to_string(m.puncture_layers_disagreeing) + " layer(s) broken by one only)"
                : "")
-       << " | " << shown(m.deflection_rmse_relative) << " | " << shown(m.step_time_mean_s * 1e3) << " | "
-       << shown(m.step_time_p99_s * 1e3) << " |\n";
-  md << "\nTimes per step are over the steps with the tip in the tissue; the FEM's is its wall time per load step.\n\n";
+       << " | " << shown(m.deflection_rmse_relative) << " | " << inversion_cell(m, true) << " | "
+       << shown(m.step_time_mean_s * 1e3) << " | " << shown(m.step_time_p99_s * 1e3) << " |\n";
+  md << "\nTimes per step are over the steps with the tip in the tissue; the FEM's is its wall time per load step. "
+        "Inverted tetrahedra: the largest share of the volumetric models' remaining tetrahedra with J = V / V0 <= 0 "
+        "(turned inside out; sampled every " << kInversionSampleSteps << " haptic steps), the needle depth where the "
+        "first appeared and the smallest J; no elastic body passes through such a state, and the FEM's Newton "
+        "rejects one (n/a: no tetrahedral mesh).\n\n";
   if (c.heldout.empty()) {
     md << "## Ranking (seed paper Sec. 3.3)\n\n" << ranking_markdown(c.grade, c.weights) << "\n";
   } else {
@@ -72,9 +88,9 @@ void markdown_heldout(std::ostringstream& md, const ComparisonContent& c) {
         "table above).\n\n"
         "| case | held out | model | force RMSE / FEM peak | peak force error | puncture depth error mm | ";
   for (const Layer& l : c.scene.layers) md << l.name << " puncture mm (FEM) | ";
-  md << "skin deflection RMSE / max | step p99 ms |\n|---|---|---|---|---|---|";
+  md << "skin deflection RMSE / max | inverted tetrahedra, most | step p99 ms |\n|---|---|---|---|---|---|";
   for (std::size_t k = 0; k < c.scene.layers.size(); ++k) md << "---|";
-  md << "---|---|\n";
+  md << "---|---|---|\n";
   for (const HeldOutRow& r : c.heldout) {
     const ModelMetrics& m = r.metrics;
     md << "| " << r.case_name << " | " << (r.held_out ? "yes" : "no") << " | " << m.model << " | "
@@ -82,7 +98,8 @@ void markdown_heldout(std::ostringstream& md, const ComparisonContent& c) {
        << shown(m.puncture_depth_error_m / kMm) << " | ";
     for (const LayerPunctureComparison& p : m.punctures)
       md << shown(p.model_depth_m / kMm, 4) << " (" << shown(p.reference_depth_m / kMm, 4) << ") | ";
-    md << shown(m.deflection_rmse_relative) << " | " << shown(m.step_time_p99_s * 1e3) << " |\n";
+    md << shown(m.deflection_rmse_relative) << " | " << inversion_cell(m, false) << " | "
+       << shown(m.step_time_p99_s * 1e3) << " |\n";
   }
   md << "\n## Ranking on the held-out cases (seed paper Sec. 3.3)\n\nPer model the mean over the held-out cases of "
         "the force RMSE, |peak force error|, puncture depth error (every layer of every case) and deflection RMSE, "
@@ -217,7 +234,7 @@ std::string comparison_csv(const Scene& scene, const ComparisonRows& rows) {
   for (const Layer& l : scene.layers) csv << ',' << l.name << "_puncture_mm";
   csv << ",deflection_rmse_mm,deflection_rmse_relative,deflection_depths,withdrawal_force_rmse_N,"
          "step_time_mean_ms,step_time_p99_ms,step_time_max_ms,build_s,run_s,completed_fraction,recovered_steps,"
-         "description\n";
+         "inverted_share_max,first_inversion_depth_mm,min_volume_ratio,description\n";
   for (std::size_t i = 0; i < rows.metrics.size(); ++i) {
     const ModelMetrics& m = rows.metrics[i];
     const ModelRun* run = rows.runs[i];
@@ -230,7 +247,9 @@ std::string comparison_csv(const Scene& scene, const ComparisonRows& rows) {
         << ',' << fmt(m.withdrawal_force_rmse_N) << ',' << fmt(m.step_time_mean_s * 1e3) << ','
         << fmt(m.step_time_p99_s * 1e3) << ',' << fmt(m.step_time_max_s * 1e3) << ','
         << (run ? fmt(run->build_wall_time_s) : "nan") << ',' << (run ? fmt(run->run_wall_time_s) : "nan") << ','
-        << fmt(m.completed_fraction) << ',' << (run ? std::to_string(run->recovered_steps) : "0") << ",\""
+        << fmt(m.completed_fraction) << ',' << (run ? std::to_string(run->recovered_steps) : "0") << ','
+        << fmt(m.inverted_share_max) << ',' << fmt(m.first_inversion_depth_m / kMm) << ',' << fmt(m.min_volume_ratio)
+        << ",\""
         << rows.descriptions[i] << "\"\n";
   }
   return csv.str();
@@ -338,6 +357,14 @@ nlohmann::json summary_json(const ComparisonContent& c) {
   nlohmann::json integrators = nlohmann::json::object();
   for (const auto& run : c.runs) {
     integrators[run->model] = {{"description", run->description}, {"integrator", run->integrator_report}};
+    if (run->inverted_elements_max >= 0)
+      integrators[run->model]["inverted_tetrahedra"] = {
+          {"most", run->inverted_elements_max},
+          {"share_at_most", run->inverted_share_max},
+          {"first_at_depth_mm", std::isfinite(run->first_inversion_depth_m) ? nlohmann::json(run->first_inversion_depth_m / kMm)
+                                                                             : nlohmann::json(nullptr)},
+          {"min_volume_ratio", run->min_volume_ratio},
+          {"sampled_every_steps", kInversionSampleSteps}};
     if (run->failed()) integrators[run->model]["failure"] = run->failure;
   }
   summary["models"] = integrators;

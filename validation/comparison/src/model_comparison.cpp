@@ -115,6 +115,22 @@ class ShaftForcesOfModel {
 
 }  // namespace
 
+namespace {
+
+/// One sample of the deformed mesh's inverted tetrahedra into the run's worst case.
+void record_inversion(const comparison::ElementInversion& sample, double depth_m, ModelRun& run) {
+  if (sample.elements == 0) return;  // no tetrahedral mesh
+  if (run.inverted_elements_max < 0 || sample.inverted > run.inverted_elements_max) {
+    run.inverted_elements_max = sample.inverted;
+    run.inverted_share_max = sample.inverted_share();
+  }
+  if (sample.inverted > 0 && !std::isfinite(run.first_inversion_depth_m)) run.first_inversion_depth_m = depth_m;
+  if (std::isnan(run.min_volume_ratio) || sample.min_volume_ratio < run.min_volume_ratio)
+    run.min_volume_ratio = sample.min_volume_ratio;
+}
+
+}  // namespace
+
 ModelRun run_comparison_model(comparison::ComparisonModel& model, const Scene& scene, const ModelRunOptions& options) {
   ModelRun run;
   run.model = model.name();
@@ -161,6 +177,8 @@ ModelRun run_comparison_model(comparison::ComparisonModel& model, const Scene& s
       run.skin_profiles.push_back(snapshot);
       ++next_profile;
     }
+    if (options.measure_inversion && (i % kInversionSampleSteps == 0 || i + 1 == n_steps))
+      record_inversion(model.element_inversion(), needle.depth_m(), run);
     if (options.on_frame && options.frame_interval_s > 0.0 && t + 0.5 * dt >= next_frame * options.frame_interval_s) {
       options.on_frame(model, t, next_frame);
       ++next_frame;
@@ -345,6 +363,11 @@ ModelMetrics metrics_against_reference(const Scene& scene, const ModelRun& run, 
   m.completed_fraction = total_steps ? static_cast<double>(run.steps()) / static_cast<double>(total_steps) : 0.0;
   m.memory_bytes = static_cast<double>(run.size.memory_bytes);
   m.dofs = run.size.dofs;
+  if (run.inverted_elements_max >= 0) {
+    m.inverted_share_max = run.inverted_share_max;
+    m.first_inversion_depth_m = run.first_inversion_depth_m;
+    m.min_volume_ratio = run.min_volume_ratio;
+  }
   if (run.steps() < 2) return m;
   const InsertionCurve curve = curve_from_model_run(scene, run, reference.has_shaft_forces);
   add_force_metrics(curve, reference, m);

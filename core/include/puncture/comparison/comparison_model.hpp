@@ -27,6 +27,7 @@
 
 #include <Eigen/Core>
 
+#include "puncture/comparison/element_inversion.hpp"
 #include "puncture/comparison/internal_forces.hpp"
 #include "puncture/needle.hpp"
 #include "puncture/puncture_force.hpp"
@@ -72,6 +73,9 @@ class ComparisonModel {
   /// Volumetric models: the deformed tetrahedral mesh.
   virtual bool has_volume() const { return false; }
   virtual VolumeFrame volume_frame() const { return {}; }
+  /// Volumetric models: the inverted tetrahedra of the deformed mesh now
+  /// (element_inversion.hpp); the others: elements == 0.
+  virtual ElementInversion element_inversion() const { return {}; }
   /// Integrator statistics and notes for the report ("" if none).
   virtual std::string integrator_report() const { return ""; }
   /// Steps on which the integrator had to recover (error test or convergence failures).

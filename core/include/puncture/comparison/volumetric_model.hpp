@@ -134,6 +134,7 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   ModelSize model_size() const override;
   bool has_volume() const override { return true; }
   VolumeFrame volume_frame() const override;
+  ElementInversion element_inversion() const override;
   std::string integrator_report() const override;
   long recovered_steps() const override;
 

@@ -54,6 +54,13 @@ struct ModelRun {
   std::string integrator_report;
   double build_wall_time_s = 0.0;
   double run_wall_time_s = 0.0;
+  /// Volumetric models with ModelRunOptions::measure_inversion: the deformed
+  /// mesh's worst moment (element_inversion.hpp), sampled every
+  /// kInversionSampleSteps haptic steps and at the last one.
+  long inverted_elements_max = -1;  ///< -1: not measured (no tetrahedral mesh, or not asked)
+  double inverted_share_max = std::numeric_limits<double>::quiet_NaN();  ///< of the remaining tetrahedra, at that sample
+  double first_inversion_depth_m = std::numeric_limits<double>::quiet_NaN();  ///< needle depth of the first inverted sample (NaN: none)
+  double min_volume_ratio = std::numeric_limits<double>::quiet_NaN();       ///< smallest J = V / V0 sampled
   std::string failure;  ///< empty when the run completed
 
   bool failed() const { return !failure.empty(); }
@@ -75,7 +82,13 @@ struct ModelRunOptions {
   RunProgress on_progress;
   /// Stop after this time (s; <= 0: the whole trajectory).
   double end_time_s = -1.0;
+  /// Sample the volumetric models' inverted tetrahedra (ModelRun; one sweep
+  /// over the mesh per sample; the identification's partial runs skip it).
+  bool measure_inversion = false;
 };
+
+/// Haptic steps between two samples of a run's inverted tetrahedra (10 ms at 1 kHz).
+inline constexpr long kInversionSampleSteps = 10;
 
 ModelRun run_comparison_model(comparison::ComparisonModel& model, const Scene& scene,
                               const ModelRunOptions& options = {});
@@ -116,6 +129,10 @@ struct ModelMetrics {
   double completed_fraction = 0.0;  ///< steps completed / trajectory steps (1 unless the model failed)
   double memory_bytes = std::numeric_limits<double>::quiet_NaN();  ///< the model's own data (ModelSize)
   long dofs = 0;
+  /// Deformed-mesh validity (ModelRun; NaN: no tetrahedral mesh or not measured).
+  double inverted_share_max = std::numeric_limits<double>::quiet_NaN();
+  double first_inversion_depth_m = std::numeric_limits<double>::quiet_NaN();
+  double min_volume_ratio = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Reference side of the comparison: the FEM curve and its surface profiles
