@@ -12,17 +12,22 @@
 # held-out metrics. One FEM run per case when not cached (out/.fem_cache,
 # about 2 min each on 2 cores).
 #   bash scripts/results_comparison.sh          (RANKS=2; MODELS=all: every model)
+# The StVK tensor-mass model on the same slab and cases (about an hour on 2
+# cores; results/comparison/README.md says why):
+#   MODELS=realtime,shf,bem,nonlinear_mass_tensor,fem OUT=results/comparison/default_scene_stvk \
+#     bash scripts/results_comparison.sh
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/results_env.sh"
-out=results/comparison/default_scene
+out="${OUT:-results/comparison/default_scene}"
 source scripts/results_folder.sh
 start=$(date +%s)
 # Two volumetric models are left out here by default, for their cost on this
 # slab's extruded mesh (4560 vertices; measured on 2 cores): the StVK
-# tensor-mass model, whose identification runs take about 2 minutes each (the
-# linear one's 13 s) and whose run of the calibration trajectory had done 10 %
-# of it after 6 minutes (2026-12-04); the visco-elastic one, dearer per step
-# than StVK (small slab: 49.8 against 19.8 ms). The mass-spring model (seed
+# tensor-mass model, whose identification runs take 1-2 minutes each (the
+# linear one's 25 take 192 s in all: StVK has no stiffness against the collapse of the fat's
+# tetrahedra under the dimpled skin, which the linear laws pass through
+# inverted); the visco-elastic one, dearer per step than StVK (small slab:
+# 49.8 against 19.8 ms). The mass-spring model (seed
 # 001's linear springs) and the linear tensor-mass model stand for the
 # volumetric family here; the small-slab comparison (results/comparison) has
 # them all. MODELS=all puts them back (or name the models, comma separated).
