@@ -278,4 +278,28 @@ TEST(ModelIdentification, TheJointFitStopsAtItsStartWhereTheWindowsAreUncoupled)
   for (const validation::LayerIdentification& l : stiffening.layers) EXPECT_TRUE(l.identified) << l.layer;
 }
 
+TEST(ModelIdentification, AFactorStoppedByTheSearchsBoundIsMarked) {
+  // Within a factor 1.1 of 1000 or of 1/1000, and nowhere else.
+  EXPECT_TRUE(validation::near_stiffness_scale_bound(973.2));
+  EXPECT_TRUE(validation::near_stiffness_scale_bound(910.0));
+  EXPECT_FALSE(validation::near_stiffness_scale_bound(909.0));
+  EXPECT_TRUE(validation::near_stiffness_scale_bound(1.05e-3));
+  EXPECT_FALSE(validation::near_stiffness_scale_bound(1.2e-3));
+  EXPECT_FALSE(validation::near_stiffness_scale_bound(1.0));
+  EXPECT_FALSE(validation::near_stiffness_scale_bound(0.0));
+  // A reference whose muscle is 3000 times the scene's: the fit ends at the
+  // bound and says so; the skin's and fat's factors (2 and 0.5) are not marked.
+  const Reference reference = reference_of({2.0, 0.5, 3000.0}, {4e-3, 3e-3, 5e-3});
+  const validation::ModelIdentification id =
+      validation::identify_comparison_model("bem", default_scene(), nullptr, reference.data, true);
+  ASSERT_EQ(id.layers.size(), 3u);
+  ASSERT_TRUE(id.layers[2].identified) << id.layers[2].note;
+  EXPECT_NEAR(id.layers[2].stiffness_scale, validation::kStiffnessScaleBound, 1e-6 * validation::kStiffnessScaleBound);
+  EXPECT_TRUE(id.layers[2].stiffness_scale_near_bound());
+  for (std::size_t k = 0; k < 2; ++k) {
+    ASSERT_TRUE(id.layers[k].identified) << id.layers[k].note;
+    EXPECT_FALSE(id.layers[k].stiffness_scale_near_bound()) << id.layers[k].layer << " x " << id.layers[k].stiffness_scale;
+  }
+}
+
 }  // namespace

@@ -198,6 +198,8 @@ Scene ComparisonRunner::identify_model(const std::string& key) {
     if (std::isfinite(l.reference_depth_m)) j["reference_depth_mm"] = l.reference_depth_m / kMm;
     if (l.identified) {
       j["stiffness_scale"] = l.stiffness_scale;
+      if (l.stiffness_scale_near_bound())  // the bound it is near
+        j["stiffness_scale_near_bound"] = l.stiffness_scale > 1.0 ? kStiffnessScaleBound : 1.0 / kStiffnessScaleBound;
       j["critical_force_N"] = l.critical_force_N;
       j["window_samples"] = l.window_samples;
       if (std::isfinite(l.window_rmse_before_N)) j["window_rmse_before_N"] = l.window_rmse_before_N;

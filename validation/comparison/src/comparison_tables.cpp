@@ -132,7 +132,12 @@ void markdown_model_identification(std::ostringstream& md, const nlohmann::json&
       md << "| " << model << " | " << layer["layer"].get<std::string>() << " | "
          << shown(layer.value("reference_depth_mm", kNaN), 4) << " | ";
       if (layer.value("identified", false))
-        md << shown(layer["stiffness_scale"].get<double>(), 4) << " | " << window_rmse_cell(layer) << " | "
+        md << shown(layer["stiffness_scale"].get<double>(), 4)
+           << (layer.contains("stiffness_scale_near_bound")
+                   ? " (near the search's bound " + shown(layer["stiffness_scale_near_bound"].get<double>(), 4) +
+                         ": the factor absorbs what the model lacks)"
+                   : std::string())
+           << " | " << window_rmse_cell(layer) << " | "
            << shown(layer["critical_force_N"].get<double>(), 4);
       else
         md << "- | - | not identified: " << layer.value("note", std::string());

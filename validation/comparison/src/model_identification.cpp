@@ -19,7 +19,7 @@ namespace puncture::validation {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kScaleBound = 1000.0;
+constexpr double kScaleBound = kStiffnessScaleBound;
 
 /// Time (s) of the first haptic step at which the scripted tip reaches depth_m; < 0 if never.
 double first_step_at_depth(const Scene& scene, double depth_m) {
@@ -291,6 +291,10 @@ void prepare_layer_run(Scene& trial, std::size_t k, const std::vector<double>& d
 }
 
 }  // namespace
+
+bool near_stiffness_scale_bound(double scale) {
+  return scale > 0.0 && std::abs(std::log(scale)) >= std::log(kStiffnessScaleBound) - std::log(1.1);
+}
 
 ModelIdentification identify_comparison_model(const std::string& model, const Scene& scene,
                                               std::shared_ptr<const comparison::TetMesh> mesh,

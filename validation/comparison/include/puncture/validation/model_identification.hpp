@@ -68,6 +68,14 @@
 
 namespace puncture::validation {
 
+/// The stiffness factors s_k are searched in [1 / kStiffnessScaleBound,
+/// kStiffnessScaleBound] (on ln s).
+inline constexpr double kStiffnessScaleBound = 1000.0;
+/// True when s lies within a factor 1.1 of either bound: the fit was stopped
+/// by the bound, or nearly, so the factor absorbs what the model lacks rather
+/// than measuring a modulus (the report says so beside it).
+bool near_stiffness_scale_bound(double scale);
+
 struct LayerIdentification {
   std::string layer;
   bool identified = false;
@@ -81,6 +89,7 @@ struct LayerIdentification {
   double window_rmse_after_N = std::numeric_limits<double>::quiet_NaN();
   std::string note;                   ///< why not identified (empty when identified)
   std::string stiffness_note;         ///< why the factor was kept at 1 (empty when fitted)
+  bool stiffness_scale_near_bound() const { return near_stiffness_scale_bound(stiffness_scale); }
 };
 
 struct ModelIdentification {
