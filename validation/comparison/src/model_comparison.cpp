@@ -113,10 +113,6 @@ class ShaftForcesOfModel {
   std::size_t punctured_before_ = 0;
 };
 
-}  // namespace
-
-namespace {
-
 /// One sample of the deformed mesh's inverted tetrahedra into the run's worst case.
 void record_inversion(const comparison::ElementInversion& sample, double depth_m, ModelRun& run) {
   if (sample.elements == 0) return;  // no tetrahedral mesh
