@@ -25,9 +25,8 @@ class ScriptedInversionModel final : public comparison::ComparisonModel {
   explicit ScriptedInversionModel(bool has_mesh) : has_mesh_(has_mesh) {}
   std::string name() const override { return "scripted"; }
   std::string description() const override { return "scripted inversion"; }
-  double step(const NeedleState& needle) override {
+  double step(const NeedleState&) override {
     ++steps_;
-    last_depth_m_ = needle.depth_m();
     return 0.0;
   }
   LayerState layer_state(std::size_t) const override { return LayerState::Untouched; }
@@ -52,7 +51,6 @@ class ScriptedInversionModel final : public comparison::ComparisonModel {
  private:
   bool has_mesh_;
   long steps_ = 0;
-  double last_depth_m_ = 0.0;
 };
 
 Scene scene() { return load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json"); }

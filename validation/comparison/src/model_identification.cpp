@@ -19,7 +19,6 @@ namespace puncture::validation {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kScaleBound = kStiffnessScaleBound;
 
 /// Time (s) of the first haptic step at which the scripted tip reaches depth_m; < 0 if never.
 double first_step_at_depth(const Scene& scene, double depth_m) {
@@ -174,7 +173,7 @@ double identified_scale(const std::string& model, const Scene& trial, std::size_
     const double c = r[i] * w.scale_N + w.target_N[i];
     cc += c * c, cf += c * w.target_N[i];
   }
-  const double proportional = cc > 0.0 && cf > 0.0 ? std::clamp(cf / cc, 1.0 / kScaleBound, kScaleBound) : 1.0;
+  const double proportional = cc > 0.0 && cf > 0.0 ? std::clamp(cf / cc, 1.0 / kStiffnessScaleBound, kStiffnessScaleBound) : 1.0;
   std::mutex progress_mutex;
   int evaluations = 0;
   const ResidualFunction residuals = [&](const std::vector<double>& x, std::vector<double>& out) {
@@ -191,7 +190,7 @@ double identified_scale(const std::string& model, const Scene& trial, std::size_
     return ok;
   };
   const LevenbergMarquardtOptions options = factor_fit_options(14);
-  const double bound = std::log(kScaleBound);
+  const double bound = std::log(kStiffnessScaleBound);
   try {
     const LevenbergMarquardtResult fit =
         levenberg_marquardt(residuals, {std::log(proportional)}, {-bound}, {bound}, options);
@@ -250,8 +249,8 @@ std::string joint_refinement(const std::string& model, const Scene& trial, const
   std::vector<double> x0, lower, upper;
   for (std::size_t k : fitted) {
     x0.push_back(std::log(scale[k]));
-    lower.push_back(-std::log(kScaleBound));
-    upper.push_back(std::log(kScaleBound));
+    lower.push_back(-std::log(kStiffnessScaleBound));
+    upper.push_back(std::log(kStiffnessScaleBound));
   }
   LevenbergMarquardtOptions options = factor_fit_options(4 * static_cast<int>(fitted.size()) + 8);
   options.accept_start_cost = (1.0 + kJointCouplingTolerance) * own_cost;
