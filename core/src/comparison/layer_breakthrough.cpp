@@ -2,6 +2,7 @@
 // model's layer; see layer_breakthrough.hpp.
 #include "puncture/comparison/layer_breakthrough.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "puncture/breakthrough_rate.hpp"
@@ -50,6 +51,11 @@ bool LayerBreakthroughRule::broken(double force_N, const std::vector<double>& ri
       return work_J_ >= criterion_.critical_energy_J * rate_factor();
   }
   return false;
+}
+
+double LayerBreakthroughRule::load_at_break_N(double force_N) const {
+  if (prescribed_depth_m_ > 0.0 || criterion_.kind != BreakthroughCriterion::Kind::CriticalForce) return force_N;
+  return std::min(force_N, criterion_.critical_force_N * rate_factor());
 }
 
 }  // namespace puncture::comparison

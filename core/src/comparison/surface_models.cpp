@@ -68,7 +68,7 @@ double LinearSurfaceModel::step(const NeedleState& needle) {
     }
     if (needle.axial_velocity_m_per_s < 0.0 || !layer.breakthrough.broken(force, deflection)) return force;
     layer.state = LayerState::Punctured;
-    layer.break_force_N = force;
+    layer.break_force_N = layer.breakthrough.load_at_break_N(force);
     layer.indentation_m = 0.0;
     activation_depth_m_ = depth;
     ++active_;

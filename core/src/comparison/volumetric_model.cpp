@@ -178,54 +178,79 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
   // surface that recovers behind the retreating tip would otherwise be put
   // back onto it, be released again in tension on the next step, and so on
   // (a contact chatter that restarted the integrator at every haptic step).
-  while (active_ < layers_.size() && !withdrawing) {
-    LayerRuntime& layer = layers_[active_];
-    bool started_now = false;
-    for (int a : layer.candidates) {
-      if (dof_[static_cast<std::size_t>(a)] != Dof::Free) continue;
-      if (y_[3 * a + 2] < z_tip) continue;  // the tip has not reached this node
-      if (!layer.contact_started) {
-        started_now = true;
-        layer.baseline_m = layer.ring_probe.deflection_m(y_, mesh_->points_m);
-        layer.contact_started = true;
-        layer.state = LayerState::Pressed;
-        layer.breakthrough.start(-z_tip, time_);
+  // A layer whose surface the relaxation below presses onto the tip beyond
+  // its critical force breaks on this step, and the contacts are updated
+  // again for the layer under it (a chain of breaks).
+  for (bool again = true; again;) {
+    again = false;
+    while (active_ < layers_.size() && !withdrawing) {
+      LayerRuntime& layer = layers_[active_];
+      bool started_now = false;
+      for (int a : layer.candidates) {
+        if (dof_[static_cast<std::size_t>(a)] != Dof::Free) continue;
+        if (y_[3 * a + 2] < z_tip) continue;  // the tip has not reached this node
+        if (!layer.contact_started) {
+          started_now = true;
+          layer.baseline_m = layer.ring_probe.deflection_m(y_, mesh_->points_m);
+          layer.contact_started = true;
+          layer.state = LayerState::Pressed;
+          layer.breakthrough.start(-z_tip, time_);
+        }
+        snap = std::max(snap, y_[3 * a + 2] - z_tip);
+        y_[3 * a + 2] = z_tip;
+        y_.segment<3>(3 * nodes_ + 3 * a) = Eigen::Vector3d(0.0, 0.0, velocity_z);
+        dof_[static_cast<std::size_t>(a)] = Dof::Contact;
+        changed = true;
       }
-      snap = std::max(snap, y_[3 * a + 2] - z_tip);
-      y_[3 * a + 2] = z_tip;
-      y_.segment<3>(3 * nodes_ + 3 * a) = Eigen::Vector3d(0.0, 0.0, velocity_z);
-      dof_[static_cast<std::size_t>(a)] = Dof::Contact;
+      // Layers break only while the needle advances (the loop's condition),
+      // and not on the step their contact starts: a surface put onto the tip
+      // from above is brought to equilibrium below first (its force before
+      // that is the snap's) and checked there (break_after_relaxation).
+      if (!layer.contact_started || started_now) break;
+      std::vector<double> deflection;
+      if (layer.breakthrough.needs_deflection()) {
+        deflection = layer.ring_probe.deflection_m(y_, mesh_->points_m);
+        for (std::size_t i = 0; i < deflection.size(); ++i) deflection[i] -= layer.baseline_m[i];
+      }
+      const double force = layer.breakthrough.needs_force() ? contact_force_N() : 0.0;
+      layer.breakthrough.advance(-z_tip, force, time_);
+      if (!layer.breakthrough.broken(force, deflection)) {
+        if (layer.breakthrough.needs_force()) checked_force_N_ = force;  // the step's contact force, if nothing moves now
+        break;
+      }
+      layer.break_force_N = layer.breakthrough.needs_force() ? layer.breakthrough.load_at_break_N(force) : contact_force_N();
+      puncture_active_layer();
       changed = true;
     }
-    // Layers break only while the needle advances (the loop's condition),
-    // and not on the step their contact starts: a surface put onto the tip
-    // from above is brought to equilibrium below first (its force before
-    // that is the snap's).
-    if (!layer.contact_started || started_now) break;
-    std::vector<double> deflection;
-    if (layer.breakthrough.needs_deflection()) {
-      deflection = layer.ring_probe.deflection_m(y_, mesh_->points_m);
-      for (std::size_t i = 0; i < deflection.size(); ++i) deflection[i] -= layer.baseline_m[i];
+    // A node put onto the tip from far above it (the next layer's surface after
+    // a puncture lies below the tip) is an impulsive deformation; like the FEM
+    // reference, find the equilibrium with the new contact set at once.
+    if (changed) static_factor_valid_ = false;
+    if (snap > snap_relax_threshold_m_ && !settings_.quasi_static) {
+      const bool relaxed = relax_to_equilibrium();
+      checked_force_N_ = std::numeric_limits<double>::quiet_NaN();
+      snap = 0.0;
+      again = relaxed && break_after_relaxation(z_tip);
+      changed = changed || again;
     }
-    const double force = layer.breakthrough.needs_force() ? contact_force_N() : 0.0;
-    layer.breakthrough.advance(-z_tip, force, time_);
-    if (!layer.breakthrough.broken(force, deflection)) {
-      if (layer.breakthrough.needs_force()) checked_force_N_ = force;  // the step's contact force, if nothing moves now
-      break;
-    }
-    layer.break_force_N = layer.breakthrough.needs_force() ? force : contact_force_N();
-    puncture_active_layer();
-    changed = true;
-  }
-  // A node put onto the tip from far above it (the next layer's surface after
-  // a puncture lies below the tip) is an impulsive deformation; like the FEM
-  // reference, find the equilibrium with the new contact set at once.
-  if (changed) static_factor_valid_ = false;
-  if (snap > snap_relax_threshold_m_ && !settings_.quasi_static) {
-    relax_to_equilibrium();
-    checked_force_N_ = std::numeric_limits<double>::quiet_NaN();
   }
   return changed;
+}
+
+bool VolumetricNeedleModel::break_after_relaxation(double z_tip) {
+  if (active_ >= layers_.size()) return false;
+  LayerRuntime& layer = layers_[active_];
+  if (!layer.contact_started || !layer.breakthrough.needs_force()) return false;
+  const double force = contact_force_N();
+  layer.breakthrough.advance(-z_tip, force, time_);  // the tip has not moved: no work is booked
+  if (!layer.breakthrough.broken(force)) {
+    checked_force_N_ = force;
+    return false;
+  }
+  layer.break_force_N = layer.breakthrough.load_at_break_N(force);
+  puncture_active_layer();
+  static_factor_valid_ = false;
+  return true;
 }
 
 bool VolumetricNeedleModel::factorise_static_tangent(const Eigen::VectorXd& state) {
@@ -253,7 +278,7 @@ bool VolumetricNeedleModel::factorise_static_tangent(const Eigen::VectorXd& stat
   return static_factor_valid_;
 }
 
-void VolumetricNeedleModel::relax_to_equilibrium() {
+bool VolumetricNeedleModel::relax_to_equilibrium() {
   const int n3 = 3 * nodes_;
   Eigen::VectorXd state = y_;
   state.segment(n3, n3).setZero();  // quasi-static: no damping forces
@@ -282,7 +307,7 @@ void VolumetricNeedleModel::relax_to_equilibrium() {
   int slow = 0;
   for (int iteration = 0; iteration < 40 && norm > target && slow < 3; ++iteration) {
     if (!static_factor_valid_) {
-      if (!factorise_static_tangent(state)) return;  // leave the state to the dynamics
+      if (!factorise_static_tangent(state)) return false;  // leave the state to the dynamics
       fresh = true;
     }
     const Eigen::VectorXd step =  // K dx = f (f = -dW/dx)
@@ -317,6 +342,7 @@ void VolumetricNeedleModel::relax_to_equilibrium() {
       state.segment<3>(n3 + 3 * a) = y_.segment<3>(n3 + 3 * a);  // contact nodes keep the needle's velocity
   y_ = state;
   ++relaxations_;
+  return true;
 }
 
 void VolumetricNeedleModel::puncture_active_layer() {

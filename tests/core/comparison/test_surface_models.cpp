@@ -241,6 +241,44 @@ TEST(BoundaryElementModel, TheCriticalForceScalesWithThePressingSpeedAsTheRealTi
   }
 }
 
+TEST(BoundaryElementModel, ALayerCarriesNoMoreThanItsCriticalForceAtTheBreak) {
+  // The needle jumps from the surface to 6 mm in one step (0.6 s at 10 mm/s,
+  // the rate law's reference speed): the contact force S 6 mm is 1.5 F_c
+  // there, but the layer broke when the force crossed F_c between the steps,
+  // so the load it carried at the break (the start of its rupture release) is
+  // F_c; at half the reference speed with n = 0.5 it is F_c sqrt(1/2). Under
+  // the energy rule the load at the break is the force on the step.
+  Scene scene = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json");
+  const double S = BoundaryElementModel(scene).stiffness_N_per_m(0);
+  const double critical = S * 4e-3;
+  BreakthroughCriterion& b = scene.layers[0].force_law.breakthrough;
+  b.kind = BreakthroughCriterion::Kind::CriticalForce;
+  b.critical_force_N = critical;
+  b.rate_exponent = 0.5;
+  b.reference_speed_m_per_s = 0.01;
+  auto jump = [](LinearSurfaceModel& model, double depth_m, double duration_s) {
+    NeedleState needle;
+    needle.axial_velocity_m_per_s = depth_m / duration_s;
+    model.step(needle);
+    needle.tip_position_m.z() = -depth_m;
+    needle.time_s = duration_s;
+    return model.step(needle);
+  };
+  for (const double duration_s : {0.6, 1.2}) {
+    BoundaryElementModel bem(scene);
+    jump(bem, 6e-3, duration_s);
+    ASSERT_EQ(bem.layer_state(0), LayerState::Punctured) << duration_s;
+    const double v = 6e-3 / duration_s;
+    EXPECT_NEAR(bem.break_force_N(0), critical * std::sqrt(v / 0.01), 1e-12 * critical) << duration_s;
+  }
+  scene.layers[0].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalEnergy;
+  scene.layers[0].force_law.breakthrough.critical_energy_J = 0.5 * S * 4e-3 * 4e-3;
+  BoundaryElementModel bem(scene);
+  jump(bem, 6e-3, 0.6);
+  ASSERT_EQ(bem.layer_state(0), LayerState::Punctured);
+  EXPECT_NEAR(bem.break_force_N(0), S * 6e-3, 1e-12 * S * 6e-3);
+}
+
 TEST(BoundaryElementModel, BreaksAtTheLayersCriticalWork) {
   // The work of F = S z from contact to z is S z^2 / 2 (the trapezoidal rule
   // is exact for a linear force): the skin breaks at z = sqrt(2 W_c / S).

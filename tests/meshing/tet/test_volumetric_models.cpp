@@ -10,6 +10,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "puncture/comparison/model_factory.hpp"
 #include "puncture/comparison/surface_models.hpp"
@@ -249,6 +250,49 @@ TEST(VolumetricModels, ApproachBeforeContactIsTheRestState) {
   // force of the nodes put onto the moving tip.
   for (std::size_t i = 1; i < ra.force_N.size(); ++i)
     EXPECT_NEAR(rb.force_N[i + shift], ra.force_N[i], 0.01 * scale) << "step " << i;
+}
+
+TEST(VolumetricModels, ASurfacePressedOntoTheTipPastItsCriticalForceBreaksOnThatStep) {
+  // The needle jumps from above the skin to 2 mm deep in one step: the skin's
+  // surface is put onto the tip and relaxed to equilibrium, where it carries
+  // F_eq (measured with a critical force it never reaches). With a critical
+  // force below F_eq the skin breaks on that same step and carried F_c at the
+  // break (the force crossed F_c on the way; the layer holds no more); above
+  // F_eq it is still pressed.
+  Scene scene = testing::small_slab_scene();
+  BreakthroughCriterion& rule = scene.layers[0].force_law.breakthrough;
+  rule.kind = BreakthroughCriterion::Kind::CriticalForce;
+  rule.rate_exponent = 0.0;
+  const auto mesh = mesh_of(scene);
+  auto jump = [&](double critical_N) {
+    rule.critical_force_N = critical_N;
+    auto model = make_comparison_model("mass_tensor", scene, mesh);
+    NeedleState needle;
+    needle.axial_velocity_m_per_s = 0.01;
+    needle.tip_position_m.z() = 0.1e-3;
+    model->step(needle);
+    needle.tip_position_m.z() = -2e-3;
+    needle.time_s = 0.21;
+    const double force = model->step(needle);
+    EXPECT_TRUE(std::isfinite(force));
+    return std::make_pair(std::move(model), force);
+  };
+  const auto [held, equilibrium_N] = jump(1e3);
+  ASSERT_EQ(held->layer_state(0), LayerState::Pressed);
+  ASSERT_GT(equilibrium_N, 1e-3);
+  {
+    const auto [model, force] = jump(0.5 * equilibrium_N);
+    EXPECT_EQ(model->layer_state(0), LayerState::Punctured);
+    EXPECT_DOUBLE_EQ(model->break_force_N(0), 0.5 * equilibrium_N);
+    // Nothing touches the tip then: the fat's surface under the broken skin lies below it.
+    EXPECT_NE(model->layer_state(1), LayerState::Punctured);
+    EXPECT_EQ(force, 0.0);
+  }
+  {
+    const auto [model, force] = jump(2.0 * equilibrium_N);
+    EXPECT_EQ(model->layer_state(0), LayerState::Pressed);
+    EXPECT_DOUBLE_EQ(force, equilibrium_N);
+  }
 }
 
 TEST(VolumetricModels, PersistentIntegrationFailureStopsWithAMessageAfterOneRestart) {

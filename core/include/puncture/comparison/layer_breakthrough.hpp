@@ -15,6 +15,12 @@
 // The critical force or energy scales with the layer's mean pressing speed
 // as the real-time model's does (breakthrough_rate.hpp): the tip's advance
 // since the contact started over the time since.
+// The load the layer carried when it broke (the start of its rupture release,
+// cutting.hpp) is the contact force at the break, but under the critical-force
+// rule no more than the critical force: a model that finds the force above it
+// on a step (a surface pressed onto the tip at once, after the layer above
+// broke) crossed it between steps, where the layer broke; the layer cannot
+// carry more than its strength.
 // A depth prescribed for the layer (ComparisonSettings::
 // prescribed_puncture_depths_m) overrides the rule: the layer breaks when the
 // tip reaches it. Checked only while the needle advances (as the force mesh's
@@ -54,6 +60,10 @@ class LayerBreakthroughRule {
   /// Whether the layer breaks with this contact force (N) and, for Rings,
   /// ring deflections (m).
   bool broken(double force_N, const std::vector<double>& ring_deflection_m = {}) const;
+  /// The load (N) the layer carried at its break with this contact force (N):
+  /// the force, capped at the critical force at the pressing speed so far
+  /// under the critical-force rule (not when a prescribed depth decides).
+  double load_at_break_N(double force_N) const;
 
  private:
   BreakthroughCriterion criterion_;  ///< the layer's rule: kind, critical values, rate law

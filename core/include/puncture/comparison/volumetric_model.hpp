@@ -172,10 +172,15 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   void drop_factors();
   void compute_forces(const Eigen::VectorXd& y, Eigen::VectorXd& f) const;
   bool update_contacts(double z_tip_m, double velocity_z_m_per_s, bool withdrawing);
+  /// After a relaxation to equilibrium with the tip at z_tip_m: the needle's
+  /// layer, if its rule reads the contact force, is checked on this state and
+  /// broken when the force reaches its critical one. True when it broke.
+  bool break_after_relaxation(double z_tip_m);
   void puncture_active_layer();
   /// Static equilibrium of the free nodes with the current contact set
   /// (modified Newton on the law's tangent); free velocities set to zero.
-  void relax_to_equilibrium();
+  /// False when the tangent could not be factorised (the state is left to the dynamics).
+  bool relax_to_equilibrium();
   /// The law's exact tangent at `state` with the prescribed dofs eliminated,
   /// factorised for relax_to_equilibrium; false if the factorisation failed.
   bool factorise_static_tangent(const Eigen::VectorXd& state);
