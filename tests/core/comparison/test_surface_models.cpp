@@ -201,16 +201,32 @@ FirstPuncture first_puncture(LinearSurfaceModel& model, const Scene& scene, std:
   return p;
 }
 
+/// The default scene whose skin breaks by the critical-force rule at the
+/// BEM's force at 4 mm, F_c = S 4 mm (S: the BEM's skin stiffness, N/m),
+/// scaled by (v / 10 mm/s)^rate_exponent.
+struct CriticalForceSkin {
+  Scene scene;
+  double stiffness_N_per_m = 0.0;
+  double critical_N = 0.0;
+};
+CriticalForceSkin critical_force_skin(double rate_exponent) {
+  CriticalForceSkin c{load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json")};
+  c.stiffness_N_per_m = BoundaryElementModel(c.scene).stiffness_N_per_m(0);
+  c.critical_N = c.stiffness_N_per_m * 4e-3;
+  BreakthroughCriterion& b = c.scene.layers[0].force_law.breakthrough;
+  b.kind = BreakthroughCriterion::Kind::CriticalForce;
+  b.critical_force_N = c.critical_N;
+  b.rate_exponent = rate_exponent;
+  b.reference_speed_m_per_s = 0.01;
+  return c;
+}
+
 TEST(BoundaryElementModel, BreaksAtTheLayersCriticalForce) {
   // Linear layer: F = S (depth - contact); with a critical force F_c the skin
   // breaks on the first step with S (depth - 0) >= F_c, i.e. at
   // depth = F_c / S (+ at most one step of needle travel, 10 um). F_c: the
   // force at 4 mm of the BEM's stiffness (checked against Sneddon above).
-  Scene scene = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json");
-  const double S = BoundaryElementModel(scene).stiffness_N_per_m(0);
-  const double critical = S * 4e-3;
-  scene.layers[0].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
-  scene.layers[0].force_law.breakthrough.critical_force_N = critical;
+  const auto [scene, S, critical] = critical_force_skin(0.0);
   BoundaryElementModel bem(scene);
   const FirstPuncture p = first_puncture(bem, scene, 0);
   ASSERT_GT(p.depth_m, 0.0);
@@ -222,14 +238,7 @@ TEST(BoundaryElementModel, BreaksAtTheLayersCriticalForce) {
 TEST(BoundaryElementModel, TheCriticalForceScalesWithThePressingSpeedAsTheRealTimeModels) {
   // The rate law of breakthrough_rate.hpp, n = 0.5 about 10 mm/s: at 2.5 and
   // 10 mm/s the skin breaks at depth F_c s / S, s = sqrt(v / 10 mm/s).
-  Scene scene = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json");
-  const double S = BoundaryElementModel(scene).stiffness_N_per_m(0);
-  const double critical = S * 4e-3;
-  BreakthroughCriterion& b = scene.layers[0].force_law.breakthrough;
-  b.kind = BreakthroughCriterion::Kind::CriticalForce;
-  b.critical_force_N = critical;
-  b.rate_exponent = 0.5;
-  b.reference_speed_m_per_s = 0.01;
+  const auto [scene, S, critical] = critical_force_skin(0.5);
   for (double v : {0.0025, 0.01}) {
     Scene at_speed = scene;
     at_speed.insertion.speed_m_per_s = v;
@@ -248,14 +257,7 @@ TEST(BoundaryElementModel, ALayerCarriesNoMoreThanItsCriticalForceAtTheBreak) {
   // so the load it carried at the break (the start of its rupture release) is
   // F_c; at half the reference speed with n = 0.5 it is F_c sqrt(1/2). Under
   // the energy rule the load at the break is the force on the step.
-  Scene scene = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json");
-  const double S = BoundaryElementModel(scene).stiffness_N_per_m(0);
-  const double critical = S * 4e-3;
-  BreakthroughCriterion& b = scene.layers[0].force_law.breakthrough;
-  b.kind = BreakthroughCriterion::Kind::CriticalForce;
-  b.critical_force_N = critical;
-  b.rate_exponent = 0.5;
-  b.reference_speed_m_per_s = 0.01;
+  auto [scene, S, critical] = critical_force_skin(0.5);
   auto jump = [](LinearSurfaceModel& model, double depth_m, double duration_s) {
     NeedleState needle;
     needle.axial_velocity_m_per_s = depth_m / duration_s;
