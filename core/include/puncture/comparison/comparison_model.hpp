@@ -64,9 +64,11 @@ class ComparisonModel {
   /// step where its deflection is still 0 and its state Untouched.
   virtual bool layer_touched(std::size_t layer) const { return layer_state(layer) != LayerState::Untouched; }
   /// The load (N) the layer carried at its break, where its rupture release
-  /// starts (cutting.hpp): the contact force it broke under, no more than its
-  /// critical force under the critical-force rule (LayerBreakthroughRule::
-  /// load_at_break_N); NaN while it is not punctured.
+  /// starts (cutting.hpp): the contact force it broke under; the SHF, BEM
+  /// and volumetric models cap it at the critical force under the
+  /// critical-force rule (LayerBreakthroughRule::load_at_break_N), the
+  /// real-time model gives its puncture event's surface force. NaN while the
+  /// layer is not punctured.
   virtual double break_force_N(std::size_t layer) const = 0;
   /// Deflection (m, > 0 into the tissue, i.e. -u_z) of the layer's top surface
   /// at the radii r (m) from the needle axis, mean over the azimuth.
