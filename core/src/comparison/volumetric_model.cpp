@@ -218,8 +218,7 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
         if (layer.breakthrough.needs_force()) checked_force_N_ = force;  // the step's contact force, if nothing moves now
         break;
       }
-      layer.break_force_N = layer.breakthrough.needs_force() ? layer.breakthrough.load_at_break_N(force) : contact_force_N();
-      puncture_active_layer();
+      puncture_active_layer(layer.breakthrough.needs_force() ? layer.breakthrough.load_at_break_N(force) : contact_force_N());
       changed = true;
     }
     // A node put onto the tip from far above it (the next layer's surface after
@@ -230,8 +229,7 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
       const bool relaxed = relax_to_equilibrium();
       checked_force_N_ = std::numeric_limits<double>::quiet_NaN();
       snap = 0.0;
-      again = relaxed && break_after_relaxation(z_tip);
-      changed = changed || again;
+      again = relaxed && break_after_relaxation(z_tip);  // (changed is already set: a node joined the contact)
     }
   }
   return changed;
@@ -247,9 +245,7 @@ bool VolumetricNeedleModel::break_after_relaxation(double z_tip) {
     checked_force_N_ = force;
     return false;
   }
-  layer.break_force_N = layer.breakthrough.load_at_break_N(force);
-  puncture_active_layer();
-  static_factor_valid_ = false;
+  puncture_active_layer(layer.breakthrough.load_at_break_N(force));
   return true;
 }
 
@@ -345,8 +341,9 @@ bool VolumetricNeedleModel::relax_to_equilibrium() {
   return true;
 }
 
-void VolumetricNeedleModel::puncture_active_layer() {
+void VolumetricNeedleModel::puncture_active_layer(double load_at_break_N) {
   const int k = static_cast<int>(active_);
+  layers_[active_].break_force_N = load_at_break_N;
   for (std::size_t t = 0; t < mesh_->tets.size(); ++t)
     if (mesh_->layer[t] == k && mesh_->needle_column[t]) removed_[t] = 1;
   law_->set_removed(removed_);

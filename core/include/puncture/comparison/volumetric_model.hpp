@@ -176,7 +176,8 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   /// layer, if its rule reads the contact force, is checked on this state and
   /// broken when the force reaches its critical one. True when it broke.
   bool break_after_relaxation(double z_tip_m);
-  void puncture_active_layer();
+  /// Breaks the needle's layer, which carried load_at_break_N (N) at the break.
+  void puncture_active_layer(double load_at_break_N);
   /// Static equilibrium of the free nodes with the current contact set
   /// (modified Newton on the law's tangent); free velocities set to zero.
   /// False when the tangent could not be factorised (the state is left to the dynamics).
