@@ -91,25 +91,39 @@ std::vector<double> radial_lines(double r_c, double a, double R_s, double h_tip,
   return R;
 }
 
-/// Axial lines, layer by layer (Z decreasing from 0; see the header's layout).
+/// Element sizes through layer i along the needle path: h_tip at its top,
+/// growing by 1.2 up to min(path size, thickness / min_elements_per_layer).
+/// A property of the layer alone, so the path's lines above any depth are the
+/// same whatever the target depth.
+std::vector<double> path_sizes(const Scene& scene, std::size_t i, double h_tip) {
+  const FemMeshSettings& ms = scene.fem.mesh;
+  const double t = scene.layers[i].thickness_m;
+  const double largest = std::min(ms.path_element_size_mm * 1e-3, t / ms.min_elements_per_layer);
+  return growing_sizes(t, std::min(h_tip, largest), 1.2, largest);
+}
+
+/// Axial lines, layer by layer (Z decreasing from 0; see the header's layout):
+/// each layer's path sizes down to the path depth D_p (a line of that
+/// pattern), then sizes graded toward the base.
 std::vector<double> axial_lines(const Scene& scene, double D_p, double h_tip) {
   const FemMeshSettings& ms = scene.fem.mesh;
   std::vector<double> Z{0.0};
-  const double path_size = ms.path_element_size_mm * 1e-3;
   double below_path_size = h_tip;
   for (std::size_t i = 0; i < scene.layers.size(); ++i) {
     const double top = scene.layer_top_depth_m(i), t = scene.layers[i].thickness_m, bottom = top + t;
-    const double largest = std::min(path_size, t / ms.min_elements_per_layer);
     std::vector<double> sizes;
-    if (top < D_p) {
-      const double path_part = std::min(bottom, D_p) - top;
-      sizes = growing_sizes(path_part, std::min(h_tip, largest), 1.2, largest);
-      const double below_part = bottom - std::min(bottom, D_p);
+    if (top < D_p - 1e-12) {
+      double depth = top;
+      for (double s : path_sizes(scene, i, h_tip)) {
+        if (depth >= D_p - 1e-12) break;
+        sizes.push_back(s);
+        depth += s;
+      }
+      const double below_part = bottom - depth;
       if (below_part > 1e-12) {
-        // The crack line ends inside this layer: a line at the path depth,
-        // sizes graded below it; both parts keep the layer's minimum count.
-        const int n_min_below =
-            std::max(1, ms.min_elements_per_layer - static_cast<int>(sizes.size()));
+        // The crack line ends inside this layer: sizes graded below its end;
+        // both parts keep the layer's minimum count.
+        const int n_min_below = std::max(1, ms.min_elements_per_layer - static_cast<int>(sizes.size()));
         const auto below = graded_divisions(below_part, sizes.back(), ms.radial_growth, n_min_below);
         sizes.insert(sizes.end(), below.begin(), below.end());
       }
@@ -233,7 +247,20 @@ double crack_path_depth(const Scene& scene) {
   const double a = scene.needle.radius_m;
   const double H = scene.total_thickness_m();
   const double h_tip = a / std::max(2, scene.fem.mesh.elements_per_needle_radius);
-  return std::min(scene.insertion.target_depth_m + std::max(2e-3, 4.0 * a), H - h_tip);
+  const double wanted = std::min(scene.insertion.target_depth_m + std::max(2e-3, 4.0 * a), H - h_tip);
+  // The first line of the path's pattern at or below the wanted depth (and
+  // above the base), so the lines above it do not depend on the target.
+  double deepest = 0.0;
+  for (std::size_t i = 0; i < scene.layers.size(); ++i) {
+    double depth = scene.layer_top_depth_m(i);
+    for (double s : path_sizes(scene, i, h_tip)) {
+      depth += s;
+      if (depth > H - 0.5 * h_tip) return deepest > 0.0 ? deepest : wanted;
+      if (depth >= wanted - 1e-12) return depth;
+      deepest = depth;
+    }
+  }
+  return deepest > 0.0 ? deepest : wanted;
 }
 
 AxisymmetricSlabMesh build_axisymmetric_slab_mesh(const Scene& scene, int refinement) {

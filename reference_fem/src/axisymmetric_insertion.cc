@@ -47,6 +47,27 @@ using axisymmetric_insertion::LayerLaws;
 using axisymmetric_insertion::TrajectoryPoint;
 
 constexpr double kPi = 3.14159265358979323846;
+/// The share of the needle's opening within which a layer's cohesive law
+/// must be able to separate its faces fully (separable_strength_Pa).
+constexpr double kSeparableOpeningShare = 0.9;
+
+/// The cohesive strength (Pa) with which the needle can separate a crack's
+/// faces: the scene's sigma_c, raised to 2 G_c / (0.9 x the needle's opening)
+/// where the law's full separation 2 G_c / sigma_c would exceed that. The
+/// needle's opening is the largest separation it imposes on the crack: the
+/// ring's radial opening from r_c to the shaft times the law's opening scale
+/// (2a for a bevel: the slit's faces spread over its width; a - r_lumen for a
+/// hollow tip). A law that needs more than the needle opens would leave its
+/// faces holding on to the shaft behind the tip with a residual traction: a
+/// crack the needle has passed but never separated (no puncture recorded
+/// while the force shows one) and a grip that multiplies the shaft friction.
+/// The raised strength keeps G_c, so the work to cut a unit area and the
+/// steady cutting force G_c x 2a are the scene's.
+double separable_strength_Pa(const LayerCrack& crack, double radial_opening_m) {
+  const double opening = crack.opening_scale * radial_opening_m;
+  if (!(opening > 0.0)) return crack.law.strength_Pa;  // a flat punch shears its crack open without bound
+  return std::max(crack.law.strength_Pa, 2.0 * crack.law.toughness_J_per_m2 / (kSeparableOpeningShare * opening));
+}
 
 /// The scene's trajectory as the list of step end points: the approach to the
 /// surface in one step, insertion in steps of load_step, the dwell in steps
@@ -120,6 +141,7 @@ LayerLaws layer_laws(const Scene& scene, double crack_radius_m) {
         c.area_scale = 2.0 * a / (2.0 * kPi * crack_radius_m);
         c.opening_scale = 2.0 * a / (a - crack_radius_m);
       }
+      c.law.strength_Pa = separable_strength_Pa(c, a - crack_radius_m);
     } else {
       c.kind = LayerCrack::Kind::TiedUntilBroken;
     }
@@ -171,6 +193,18 @@ int checked_element_degree(const Scene& scene, const FemRunOptions& options) {
 namespace axisymmetric_insertion {
 
 constexpr double kMinStepFraction = 1.0 / 256.0;
+/// A step cut to this fraction of the planned one that still fails plain
+/// Newton is continued (pseudo-transient continuation) before it is cut again.
+constexpr double kContinuationFraction = 1.0 / 64.0;
+/// A Newton stall is accepted below this share of the run's largest needle
+/// force so far (the needle force is then exact to about that share): the
+/// kinks of contact, friction and damage where Newton cycles at millinewtons.
+constexpr double kStallAcceptanceOfPeak = 1e-3;
+/// A crack point is open (cut) at this damage.
+constexpr double kCutDamage = 0.999;
+/// Consistency of the records (check_intact_friction, check_force_drops).
+constexpr double kIntactFrictionN = 0.1, kIntactFrictionShare = 0.25;
+constexpr double kDropN = 0.2, kDropShare = 0.15, kDropWindow_m = 1.5e-3, kStateWindow_m = 1.0e-3;
 
 AxisymmetricInsertionRun::AxisymmetricInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm,
                                                    FemRunSummary& summary)
@@ -223,6 +257,17 @@ void AxisymmetricInsertionRun::describe_model(MPI_Comm comm) {
                                 std::to_string(degree_) + "; at least " + format_double(needed, 2) +
                                 " are needed for the needle force to be within 3 % of its converged value "
                                 "(results/fem_axisymmetric_convergence.md)");
+  for (std::size_t i = 0; i < n_layers_; ++i) {
+    const PunctureCriterion& p = scene_.layers[i].puncture;
+    const double strength = laws_.cracks[i].law.strength_Pa;
+    if (p.kind == PunctureCriterion::Kind::FractureEnergy && strength > p.cohesive_strength_Pa * (1.0 + 1e-12))
+      summary_.warnings.push_back(
+          "layer '" + scene_.layers[i].name + "': cohesive strength raised from " +
+          format_double(p.cohesive_strength_Pa * 1e-3, 4) + " to " + format_double(strength * 1e-3, 4) +
+          " kPa (G_c kept): with the scene's, 2 G_c / sigma_c = " +
+          format_double(2e3 * p.toughness_J_per_m2 / p.cohesive_strength_Pa, 3) +
+          " mm exceeds what the needle can open, and the crack it passes would never separate");
+  }
   for (std::size_t i = 0; i < n_layers_; ++i)
     if (mesh_.elements_through_layer[i] < 4)
       summary_.warnings.push_back("mesh: layer '" + scene_.layers[i].name + "' has only " +
@@ -255,9 +300,10 @@ void AxisymmetricInsertionRun::walk_trajectory() {
       if (!step) continue;  // the step was cut: try again with half of it
       detect_punctures();
       record_step(phase, *step);
+      check_intact_friction();
     }
   }
-  add_energy_totals();
+  check_force_drops();
 }
 
 // Moves the tip one (sub-)step toward plan point k and solves; a failed solve
@@ -272,11 +318,12 @@ std::optional<StepAdvance> AxisymmetricInsertionRun::advance_needle(std::size_t 
   const double d1 = from.depth_m + s * (goal.depth_m - from.depth_m);
   place_needle(d1);
   solver_.set_time_step(t1 - t0);
+  solver_.set_stall_acceptance_floor(kStallAcceptanceOfPeak * summary_.peak_force_N);
   const double advance = d1 - d0;
   const double predictor = (last_advance_ != 0.0 && advance * last_advance_ > 0.0) ? advance / last_advance_ : 0.0;
   const double dissipated_before = solver_.cohesive_dissipation_J();
   const dealii::Timer solve_timer;
-  const AxisymmetricNewtonReport report = solver_.solve_step(predictor);
+  const AxisymmetricNewtonReport report = solver_.solve_step(predictor, fraction_ <= kContinuationFraction);
   summary_.solve_time_s += solve_timer.wall_time();
   summary_.newton_iterations += report.iterations;
   records_.newton_log << "step " << step_index_ << "  " << goal.phase << "  depth " << d1 * 1e3 << " mm  t " << t1
@@ -289,6 +336,7 @@ std::optional<StepAdvance> AxisymmetricInsertionRun::advance_needle(std::size_t 
   ++step_index_;
   ++summary_.load_steps;
   if (report.accepted_at_stall) ++summary_.steps_accepted_at_stall;
+  if (report.continuation_steps > 0) ++summary_.steps_continued;
   time_ = t1;
   depth_ = d1;
   last_advance_ = advance;
@@ -408,11 +456,59 @@ int AxisymmetricInsertionRun::pressed_layer() const {
   return -1;
 }
 
-// Layer i is punctured once its crack is fully open a little below its top.
+// Layer i is punctured once its crack is fully open (damage >= kCutDamage)
+// a little below its top: min(t/4, a), so that the crack has run into the
+// layer, not only opened the edge of its surface.
 bool AxisymmetricInsertionRun::crack_through_top(std::size_t i) const {
   const double top = scene_.layer_top_depth_m(i);
   const double margin = std::min(0.25 * scene_.layers[i].thickness_m, a_);
-  return solver_.crack_front_depth_m(static_cast<int>(i)) >= top + margin - 1e-12;
+  return solver_.crack_front_depth_m(static_cast<int>(i), kCutDamage) >= top + margin - 1e-12;
+}
+
+// The records must not contradict the forces: the shaft meets tissue only
+// through a cut, so a friction force (beyond what the rounded shoulder picks
+// up at the top of a crack, kIntactFriction*) while no layer is punctured
+// means a cut the states missed. Stops the run (the outputs say "failed").
+void AxisymmetricInsertionRun::check_intact_friction() const {
+  if (std::find(states_.begin(), states_.end(), LayerState::Punctured) != states_.end()) return;
+  const Row& r = rows_.back();
+  if (std::abs(r.friction_N) <= std::max(kIntactFrictionN, kIntactFrictionShare * std::abs(r.force_N))) return;
+  std::ostringstream m;
+  m << "inconsistent puncture records at tip depth " << depth_ * 1e3 << " mm (" << r.phase << "): shaft friction "
+    << r.friction_N << " N of a needle force " << r.force_N
+    << " N while no layer is punctured (the shaft meets tissue only through a cut)";
+  throw std::runtime_error(m.str());
+}
+
+// A large fall of the force during insertion (from a local maximum, by more
+// than kDropN and kDropShare of it within kDropWindow) is a puncture: some
+// layer must change state within kStateWindow of it. Stops the run otherwise.
+void AxisymmetricInsertionRun::check_force_drops() const {
+  std::vector<std::size_t> ins;
+  for (std::size_t k = 0; k < rows_.size(); ++k)
+    if (rows_[k].phase == "insertion") ins.push_back(k);
+  std::vector<double> changes;
+  for (std::size_t k = 1; k < rows_.size(); ++k)
+    if (rows_[k].states != rows_[k - 1].states) changes.push_back(rows_[k].depth_m);
+  for (std::size_t n = 0; n < ins.size(); ++n) {
+    const Row& a = rows_[ins[n]];
+    const bool peak = (n == 0 || a.force_N >= rows_[ins[n - 1]].force_N) &&
+                      (n + 1 == ins.size() || a.force_N > rows_[ins[n + 1]].force_N);
+    if (!peak) continue;
+    const double limit = std::max(kDropN, kDropShare * a.force_N);
+    for (std::size_t m = n + 1; m < ins.size() && rows_[ins[m]].depth_m - a.depth_m <= kDropWindow_m; ++m) {
+      const Row& b = rows_[ins[m]];
+      if (a.force_N - b.force_N <= limit) continue;
+      const bool explained = std::any_of(changes.begin(), changes.end(), [&](double d) {
+        return d >= a.depth_m - kStateWindow_m && d <= b.depth_m + kStateWindow_m;
+      });
+      if (explained) break;
+      std::ostringstream msg;
+      msg << "inconsistent puncture records: the force falls from " << a.force_N << " N at " << a.depth_m * 1e3
+          << " mm to " << b.force_N << " N at " << b.depth_m * 1e3 << " mm and no layer changes state near it";
+      throw std::runtime_error(msg.str());
+    }
+  }
 }
 
 }  // namespace axisymmetric_insertion
@@ -484,7 +580,12 @@ FemRunSummary run_axisymmetric_insertion(const Scene& scene, const FemRunOptions
     try {
       widen_cpu_affinity();
       axisymmetric_insertion::AxisymmetricInsertionRun run(scene, options, comm, summary);  // mesh and solver
-      run.walk_trajectory();  // per step: advance, detect punctures, record
+      try {
+        run.walk_trajectory();  // per step: advance, detect punctures, record
+      } catch (const std::exception& e) {
+        run.write_outputs(e.what());  // the rows so far, "status": "failed" and why
+        throw;
+      }
       run.write_outputs();
     } catch (const std::exception& e) {
       error = e.what();

@@ -43,6 +43,9 @@ void AxisymmetricInsertionRun::record(const std::string& phase, double velocity,
   summary_.cutting_force_N.push_back(cutting_N);
   summary_.friction_force_N.push_back(friction);
   summary_.phase.push_back(phase);
+  std::vector<std::string> states;
+  for (const LayerState st : states_) states.push_back(to_string(st));
+  summary_.layer_states.push_back(std::move(states));
   if (total > summary_.peak_force_N) {
     summary_.peak_force_N = total;
     summary_.peak_force_depth_m = depth_;
@@ -76,14 +79,15 @@ void AxisymmetricInsertionRun::write_frame(double time) {
   summary_.files_written.push_back(name.str());
 }
 
-// Writes the outputs (wall time first, so the summary reports it).
-void AxisymmetricInsertionRun::write_outputs() {
+// Writes the outputs (energies and wall time first, so the summary reports them).
+void AxisymmetricInsertionRun::write_outputs(const std::string& failure) {
+  add_energy_totals();
   summary_.wall_time_s = wall_timer_.wall_time();
   if (!options_.write_files) return;
   insertion::write_text_outputs(out_dir_, force_depth_csv(), records_);
   write_pvd();
   insertion::list_text_outputs(summary_.files_written);
-  io::write_file_atomically(out_dir_ / "fem_summary.json", summary_json().dump(2) + "\n");
+  io::write_file_atomically(out_dir_ / "fem_summary.json", summary_json(failure).dump(2) + "\n");
 }
 
 // fem_force_depth.csv: one line per recorded row.
@@ -120,9 +124,10 @@ void AxisymmetricInsertionRun::write_pvd() const {
 
 // fem_summary.json: the model, the peak, the energies, the counts, the
 // timings, the punctures and the files.
-nlohmann::json AxisymmetricInsertionRun::summary_json() const {
-  nlohmann::json j = insertion::common_summary_json("ok", scene_.name, summary_, degree_, refinement_,
-                                                    scene_.fem.load_step_m, /*with_stretch=*/false);
+nlohmann::json AxisymmetricInsertionRun::summary_json(const std::string& failure) const {
+  nlohmann::json j = insertion::common_summary_json(failure.empty() ? "ok" : "failed", scene_.name, summary_, degree_,
+                                                    refinement_, scene_.fem.load_step_m, /*with_stretch=*/false);
+  if (!failure.empty()) j["error"] = failure;
   j.update({{"geometry", "axisymmetric"},
             {"assembly_threads", summary_.assembly_threads},
             {"n_ranks_used", 1},
@@ -132,7 +137,8 @@ nlohmann::json AxisymmetricInsertionRun::summary_json() const {
             {"cohesive_dissipation_J", summary_.cohesive_dissipation_J},
             {"stabilization_dissipation_J", summary_.stabilization_dissipation_J},
             {"needle_work_insertion_J", summary_.needle_work_J},
-            {"steps_accepted_at_stall", summary_.steps_accepted_at_stall}});
+            {"steps_accepted_at_stall", summary_.steps_accepted_at_stall},
+            {"steps_continued", summary_.steps_continued}});
   return j;
 }
 

@@ -73,8 +73,10 @@ class AxisymmetricInsertionRun {
   AxisymmetricInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm, FemRunSummary& summary);
   /// Walks the needle along the whole trajectory, step by step.
   void walk_trajectory();
-  /// Writes the CSV files, the Newton log, the PVD collection and the summary.
-  void write_outputs();
+  /// Writes the CSV files, the Newton log, the PVD collection and the summary
+  /// ("status": "ok", or "failed" with `failure` as its "error" and the rows
+  /// recorded before it).
+  void write_outputs(const std::string& failure = "");
 
  private:
   std::optional<StepAdvance> advance_needle(std::size_t k);
@@ -85,6 +87,8 @@ class AxisymmetricInsertionRun {
   void open_crack(std::size_t i);
   void record_puncture(std::size_t i, double force_after_N);
   void record_step(const std::string& phase, const StepAdvance& step);
+  void check_intact_friction() const;
+  void check_force_drops() const;
   void record(const std::string& phase, double velocity, double cutting_N);
   void add_energy_totals();
   void describe_model(MPI_Comm comm);
@@ -95,7 +99,7 @@ class AxisymmetricInsertionRun {
   void write_frame(double time);
   std::string force_depth_csv() const;
   void write_pvd() const;
-  nlohmann::json summary_json() const;
+  nlohmann::json summary_json(const std::string& failure) const;
   void log(const std::string& s) const {
     if (options_.verbose) std::cout << s << std::endl;
   }

@@ -37,6 +37,12 @@ namespace puncture::fem {
 using namespace dealii;
 using namespace axisymmetric_cell;
 
+namespace {
+/// The predictor is kept unless its free residual exceeds this factor times
+/// the residual without it.
+constexpr double kPredictorResidualFactor = 10.0;
+}  // namespace
+
 /// What the phases of one solve_step share.
 struct AxisymmetricSolver::Step {
   AxisymmetricNewtonReport report;
@@ -49,7 +55,8 @@ struct AxisymmetricSolver::Step {
   Vector<double> du, trial;               ///< Newton direction; the line search's state
   double max_free = 0.0;                  ///< largest free residual of the step so far (N)
   int contact_changes = 0;                ///< changes of the punch contact set so far
-  std::vector<double> history;            ///< free residual per iteration (stall detection)
+  std::vector<double> history;            ///< free residual per iteration of one Newton solve (stall detection)
+  bool strict = false;                    ///< converged to the Newton tolerance (not only at a stall)
 };
 
 /// One Newton iterate (the state solution_).
@@ -62,31 +69,47 @@ struct AxisymmetricSolver::Iterate {
   std::ostringstream line;  ///< the iterate's line of the Newton log
 };
 
-AxisymmetricNewtonReport AxisymmetricSolver::solve_step(double predictor_scale) {
+AxisymmetricNewtonReport AxisymmetricSolver::solve_step(double predictor_scale, bool continue_if_stuck) {
   Step step;
   start_step(step, predictor_scale);
+  Failure why = newton(step, settings_.max_newton_iterations);
+  if (why && continue_if_stuck && settings_.continuation_steps > 0) why = continue_step(step, *why);
+  return why ? fail_step(step, *why) : accept_step(step);
+}
+
+AxisymmetricSolver::Failure AxisymmetricSolver::newton(Step& step, int max_iterations) {
+  step.history.clear();
+  step.max_free = 0.0;
+  step.contact_changes = 0;
   for (int it = 0;; ++it) {
     Iterate x;
-    if (const Failure why = evaluate_iterate(step, it, x)) return fail_step(step, *why);
+    if (const Failure why = evaluate_iterate(step, it, x)) return why;
     if (x.converged) {
       // Flat punch: release nodes pulled by the face (tensile reaction) and
       // take in the nodes it reaches; if the contact set changed, go on.
       const bool released = release_pulled_punch_nodes(step.released_in_step, x.scale);
       const bool joined = update_punch_contact(step.released_in_step);
-      if (!released && !joined) return accept_step(step, x, it);
-      if (++step.contact_changes > 50) return fail_step(step, "flat punch contact set does not settle");
+      if (!released && !joined) {
+        step.strict = x.strict;
+        step.report.iterations += it;
+        step.report.table.push_back(x.line.str() +
+                                    (x.strict ? "  converged" : "  converged (stalled below the acceptance tolerance)"));
+        if (settings_.verbose) std::cout << "      " << step.report.table.back() << std::endl;
+        return std::nullopt;
+      }
+      if (++step.contact_changes > 50) return "flat punch contact set does not settle";
       x.line << "  (punch contact set changed)";
       step.report.table.push_back(x.line.str());
       continue;
     }
-    if (const Failure why = give_up_reason(it, x)) {
+    if (const Failure why = give_up_reason(it, x, max_iterations)) {
       step.report.table.push_back(x.line.str());
-      step.report.iterations = it;
-      return fail_step(step, *why);
+      step.report.iterations += it;
+      return why;
     }
-    if (const Failure why = newton_direction(step, x)) return fail_step(step, *why);
+    if (const Failure why = newton_direction(step, x)) return why;
     double alpha = 0.0;
-    if (const Failure why = line_search(step, x, alpha)) return fail_step(step, *why);
+    if (const Failure why = line_search(step, x, alpha)) return why;
     x.line << "  alpha " << std::defaultfloat << alpha << "  t_assemble " << std::setprecision(3) << x.assemble_s
            << " s  t_solve " << x.solve_s << " s";
     step.report.table.push_back(x.line.str());
@@ -95,14 +118,66 @@ AxisymmetricNewtonReport AxisymmetricSolver::solve_step(double predictor_scale) 
   }
 }
 
+// Pseudo-transient continuation (Kelley & Keyes 1998; Coffey, Kelley & Keyes
+// 2003) of a step plain Newton could not solve: from the step's start, a
+// sequence of pseudo-time steps at the same needle position, each the step's
+// equations plus a viscous stress ratio 2 mu_0 sym(H - H_k) on the change
+// from the previous pseudo-step's state H_k. A large ratio makes each
+// pseudo-step an easy, nearly linear solve (the tissue may only creep toward
+// equilibrium); the ratio falls by continuation_decrease after each converged
+// pseudo-step and rises by continuation_increase (the pseudo-step undone)
+// after a failed one. Once it is below continuation_final_ratio the viscous
+// stress is negligible and plain Newton finishes the step from there: the
+// accepted state solves the step's own equations, continuation only finds it.
+AxisymmetricSolver::Failure AxisymmetricSolver::continue_step(Step& step, const std::string& plain_failure) {
+  std::ostringstream head;
+  head << "  -> " << plain_failure << "; pseudo-transient continuation";
+  step.report.table.push_back(head.str());
+  restore_step_start(step);
+  double ratio = settings_.continuation_initial_ratio;
+  int failures = 0;
+  for (int k = 0; k < settings_.continuation_steps && ratio >= settings_.continuation_final_ratio; ++k) {
+    continuation_reference_ = solution_;
+    continuation_ratio_ = ratio;
+    const Failure why = newton(step, settings_.continuation_max_iterations);
+    std::ostringstream line;
+    line << "  pseudo-step " << k << "  ratio " << std::scientific << std::setprecision(2) << ratio << "  "
+         << (why ? "failed: " + *why : std::string("converged"));
+    step.report.table.push_back(line.str());
+    if (settings_.verbose) std::cout << "      " << line.str() << std::endl;
+    if (why) {
+      solution_ = continuation_reference_;
+      if (++failures > settings_.continuation_max_failures) break;
+      ratio *= settings_.continuation_increase;
+    } else {
+      ratio /= settings_.continuation_decrease;
+    }
+  }
+  continuation_ratio_ = 0.0;
+  ++step.report.continuation_steps;
+  if (ratio >= settings_.continuation_final_ratio)
+    return plain_failure + "; pseudo-transient continuation did not reach the step's equilibrium either";
+  step.report.table.push_back("  plain Newton from the continued state");
+  if (const Failure why = newton(step, settings_.max_newton_iterations))
+    return plain_failure + "; after pseudo-transient continuation: " + *why;
+  return std::nullopt;
+}
+
 void AxisymmetricSolver::start_step(Step& step, double predictor_scale) {
   step.u_start = solution_;
   step_start_ = step.u_start;
   step.punch_contact_start = punch_contact_;
   step.punch_hold_start = punch_lateral_hold_;
   if (predictor_scale > 0.0 && last_increment_.linfty_norm() > 0.0) {
-    solution_.add(predictor_scale, last_increment_);
-    if (!assemble(solution_, false)) solution_ = step.u_start;
+    // The extrapolated start only where it is admissible and not far worse
+    // than the last state (through a snap the last increment points the
+    // wrong way, and its residual would inflate the step's force scale, the
+    // convergence test). Not only where it is better: along a withdrawal
+    // the extrapolated sliding is the better start although its first
+    // residual is often larger.
+    Vector<double> predicted = solution_;
+    predicted.add(predictor_scale, last_increment_);
+    if (free_residual_at(predicted) < kPredictorResidualFactor * free_residual_at(solution_)) solution_ = predicted;
   }
   step.released_in_step.assign(contact_nodes_.size(), 0);
   update_punch_contact(step.released_in_step);
@@ -133,10 +208,19 @@ AxisymmetricSolver::Failure AxisymmetricSolver::evaluate_iterate(Step& step, int
   x.stalled = check_stall(step.history, x.free);
   const bool gap_closed = x.gap <= 1e-12 * std::max(1e-3, punch_radius_m_);
   x.strict = x.free <= settings_.newton_tolerance * x.scale || x.free <= settings_.absolute_residual_floor_N;
-  const bool loose = x.stalled && x.free <= settings_.stall_acceptance_tolerance * x.scale;
+  const bool loose = x.stalled && x.free <= std::max(settings_.stall_acceptance_tolerance * x.scale,
+                                                     stall_acceptance_floor_N_);
   x.converged = gap_closed && (x.strict || loose);
   write_iterate_line(it, x);
   return std::nullopt;
+}
+
+double AxisymmetricSolver::free_residual_at(const Vector<double>& u) {
+  if (!assemble(u, false)) return std::numeric_limits<double>::infinity();
+  AffineConstraints<double> c;
+  make_constraints(u, c);
+  const double r = free_residual_norm(c);
+  return std::isfinite(r) ? r : std::numeric_limits<double>::infinity();
 }
 
 bool AxisymmetricSolver::check_stall(std::vector<double>& history, double free) const {
@@ -205,8 +289,8 @@ bool AxisymmetricSolver::update_punch_contact(const std::vector<char>& released_
   return changed;
 }
 
-AxisymmetricSolver::Failure AxisymmetricSolver::give_up_reason(int it, const Iterate& x) const {
-  if (it >= settings_.max_newton_iterations) return "no convergence in " + std::to_string(it) + " Newton iterations";
+AxisymmetricSolver::Failure AxisymmetricSolver::give_up_reason(int it, const Iterate& x, int max_iterations) const {
+  if (it >= max_iterations) return "no convergence in " + std::to_string(it) + " Newton iterations";
   if (!x.stalled) return std::nullopt;
   std::ostringstream why;
   why << "Newton stalls: |R_free| " << std::scientific << std::setprecision(3) << x.free << " N did not fall by "
@@ -259,14 +343,10 @@ AxisymmetricSolver::Failure AxisymmetricSolver::line_search(Step& step, const It
   return std::nullopt;
 }
 
-AxisymmetricNewtonReport AxisymmetricSolver::accept_step(Step& step, const Iterate& x, int it) {
+AxisymmetricNewtonReport AxisymmetricSolver::accept_step(Step& step) {
   AxisymmetricNewtonReport& report = step.report;
-  report.accepted_at_stall = !x.strict;
-  report.table.push_back(x.line.str() +
-                         (x.strict ? "  converged" : "  converged (stalled below the acceptance tolerance)"));
-  if (settings_.verbose) std::cout << "      " << report.table.back() << std::endl;
+  report.accepted_at_stall = !step.strict;
   report.converged = true;
-  report.iterations = it;
   last_increment_ = solution_;
   last_increment_ -= step.u_start;
   commit();
@@ -274,12 +354,18 @@ AxisymmetricNewtonReport AxisymmetricSolver::accept_step(Step& step, const Itera
   return report;
 }
 
-AxisymmetricNewtonReport AxisymmetricSolver::fail_step(Step& step, const std::string& why) {
+void AxisymmetricSolver::restore_step_start(Step& step) {
+  continuation_ratio_ = 0.0;
   solution_ = step.u_start;
   punch_contact_ = step.punch_contact_start;
   punch_lateral_hold_ = step.punch_hold_start;
+  step.released_in_step.assign(contact_nodes_.size(), 0);
   cohesive_trial_ = cohesive_committed_;
   friction_trial_ = friction_committed_;
+}
+
+AxisymmetricNewtonReport AxisymmetricSolver::fail_step(Step& step, const std::string& why) {
+  restore_step_start(step);
   assemble(solution_, true);
   step.report.converged = false;
   step.report.failure = why;

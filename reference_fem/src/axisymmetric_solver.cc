@@ -18,7 +18,6 @@
 #include <deal.II/numerics/vector_tools.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
 #include <iomanip>
 #include <exception>
@@ -190,6 +189,10 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
   // initial shear modulus.
   const bool stabilize = settings_.stabilization_time_s > 0.0 && dt_s_ > 0.0 && step_start_.size() == u.size();
   const double stab_ratio = stabilize ? settings_.stabilization_time_s / dt_s_ : 0.0;
+  // Pseudo-transient continuation (continue_step): ratio 2 mu_0 sym(H - H_k)
+  // on the change from the last pseudo-step's state (not physical energy).
+  const bool continuing = continuation_ratio_ > 0.0 && continuation_reference_.size() == u.size();
+  std::vector<Tensor<2, 3>> Hk(continuing ? nq : 0);
 
   for (std::size_t k = begin; k < end; ++k) {
     const auto& cell = cells_[k];
@@ -204,11 +207,15 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
     Ke = 0.0;
     Re = 0.0;
     B = 0.0;
-    double two_mu_v = 0.0;
+    double two_mu_v = 0.0, two_mu_c = 0.0;
+    const LayerMaterial& m = material_of(cell);
     if (stabilize) {
       gradients.compute(fev, step_start_, H0);
-      const LayerMaterial& m = material_of(cell);
       two_mu_v = stab_ratio * m.youngs_modulus_Pa() / (1.0 + m.poisson_ratio());
+    }
+    if (continuing) {
+      gradients.compute(fev, continuation_reference_, Hk);
+      two_mu_c = continuation_ratio_ * m.youngs_modulus_Pa() / (1.0 + m.poisson_ratio());
     }
     for (unsigned q = 0; q < nq; ++q) {
       const double R = fev.quadrature_point(q)[0];
@@ -219,6 +226,7 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
       }
       if (stabilize)
         out.stabilization_J += add_stabilization(two_mu_v, H[q] - H0[q], gradN, st.dV[q], with_matrix, Ke, Re);
+      if (continuing) add_stabilization(two_mu_c, H[q] - Hk[q], gradN, st.dV[q], with_matrix, Ke, Re);
       if (!with_matrix) continue;
       const Tensor<2, 3> S_full(st.S[q]);
       const Tensor<2, 3> F_inv_T = transpose(invert(st.F[q]));

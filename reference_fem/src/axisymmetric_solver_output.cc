@@ -29,9 +29,13 @@ using axisymmetric_cell::evaluate_cell;
 
 double AxisymmetricSolver::crack_front_depth_m(int layer, double damage_threshold) const {
   double depth = -1.0;
-  for (std::size_t k = 0; k < cohesive_points_.size(); ++k)
-    if (cohesive_points_[k].layer == layer && cohesive_committed_[k].damage >= damage_threshold)
-      depth = std::max(depth, -cohesive_points_[k].Z);
+  for (std::size_t k = 0; k < cohesive_points_.size(); ++k) {
+    if (cohesive_points_[k].layer != layer) continue;
+    // The damage the separation reached calls for (without the viscous lag).
+    const CohesiveHistory& h = cohesive_committed_[k];
+    const double damage = std::max(h.damage, bilinear_damage(cracks_[layer].law, h.max_separation_m));
+    if (damage >= damage_threshold) depth = std::max(depth, -cohesive_points_[k].Z);
+  }
   return depth;
 }
 

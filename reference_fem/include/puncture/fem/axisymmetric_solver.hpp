@@ -54,6 +54,7 @@
 #include <deal.II/lac/vector.h>
 
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -109,6 +110,20 @@ struct AxisymmetricSettings {
   /// tissue that has stiffened far beyond mu_0) and grows when a step is cut,
   /// so a cut step converges. Its dissipated energy is reported.
   double stabilization_time_s = 1e-4;
+  /// Pseudo-transient continuation of a step plain Newton cannot solve
+  /// (solve_step; 0 pseudo-steps: off, the step fails at once): a viscous
+  /// stress ratio x 2 mu_0 sym(H - H_k) on each pseudo-step's change, the
+  /// ratio from initial down by `decrease` per converged pseudo-step, up by
+  /// `increase` per failed one (at most max_failures), until below final,
+  /// where plain Newton finishes the step. A pseudo-step gets at most
+  /// continuation_max_iterations iterations.
+  int continuation_steps = 60;
+  int continuation_max_iterations = 15;  ///< per pseudo-step (a harder one raises the ratio)
+  double continuation_initial_ratio = 1.0;
+  double continuation_final_ratio = 1e-4;
+  double continuation_decrease = 4.0;
+  double continuation_increase = 8.0;
+  int continuation_max_failures = 8;
   bool verbose = false;
 };
 
@@ -138,6 +153,8 @@ struct AxisymmetricNewtonReport {
   /// Converged to stall_acceptance_tolerance only (Newton stalled below it).
   bool accepted_at_stall = false;
   int iterations = 0;
+  /// 1 when plain Newton failed and pseudo-transient continuation took over.
+  int continuation_steps = 0;
   double residual_N = 0.0;
   double force_scale_N = 0.0;
   std::string failure;
@@ -182,12 +199,21 @@ class AxisymmetricSolver {
   /// Time step of the coming solve (s), for the cohesive viscosity and the
   /// viscoelastic layers.
   void set_time_step(double dt_s) { dt_s_ = dt_s; }
+  /// A stalled Newton solve whose free residual is below this force (N) is
+  /// accepted as well (as below stall_acceptance_tolerance x the step's
+  /// force scale): the insertion sets it to 1e-3 x the largest needle force
+  /// of the run so far, so that the steps where the needle force is
+  /// millinewtons (the end of a withdrawal) are held to the run's scale.
+  void set_stall_acceptance_floor(double force_N) { stall_acceptance_floor_N_ = force_N; }
 
   // --- solving ----------------------------------------------------------------
   /// Newton solve of the current step from u + predictor_scale x (last
   /// increment) when admissible. Commits the histories on success; restores
   /// the last converged state on failure.
-  AxisymmetricNewtonReport solve_step(double predictor_scale = 0.0);
+  /// With `continue_if_stuck`, a step plain Newton cannot solve is handed to
+  /// pseudo-transient continuation before it fails (the insertion does so
+  /// once cutting the load step has not helped).
+  AxisymmetricNewtonReport solve_step(double predictor_scale = 0.0, bool continue_if_stuck = true);
 
   struct Snapshot {
     dealii::Vector<double> solution, last_increment;
@@ -212,8 +238,10 @@ class AxisymmetricSolver {
   double cohesive_dissipation_J() const { return dissipated_J_; }
   /// Energy dissipated by the viscous stabilisation so far (J).
   double stabilization_dissipation_J() const { return stabilization_J_; }
-  /// Deepest crack point (depth below the surface, m) whose damage >= threshold
-  /// in the given layer (-1: none).
+  /// Deepest crack point (depth below the surface, m) of the given layer whose
+  /// damage >= threshold (-1: none): the rate-independent damage its largest
+  /// separation so far calls for (bilinear_damage), which the viscously
+  /// regularised damage follows with a delay of the cohesive viscosity.
   double crack_front_depth_m(int layer, double damage_threshold = 0.999) const;
   /// Largest damage of the crack points of a layer.
   double max_damage(int layer) const;
@@ -280,6 +308,8 @@ class AxisymmetricSolver {
   void start_step(Step& step, double predictor_scale);
   /// Assembles at solution_: the free residual, the force scale, stall and convergence tests.
   Failure evaluate_iterate(Step& step, int it, Iterate& x);
+  /// The free residual (N) at u (infinity where u is inverted or non-finite).
+  double free_residual_at(const dealii::Vector<double>& u);
   /// Appends the free residual to the step's history; true if Newton stalls.
   bool check_stall(std::vector<double>& history, double free) const;
   /// The iterate's line of the Newton log (residual, scale, force, contact and crack counts).
@@ -289,13 +319,20 @@ class AxisymmetricSolver {
   /// Flat punch: the top nodes within its radius that the face has reached join; true if any.
   bool update_punch_contact(const std::vector<char>& released_in_step);
   /// Too many iterations or a stall: why the step is given up (nullopt: go on).
-  Failure give_up_reason(int it, const Iterate& x) const;
+  Failure give_up_reason(int it, const Iterate& x, int max_iterations) const;
   /// Newton direction: K du = -R with the increment constraints condensed in.
   Failure newton_direction(Step& step, Iterate& x);
   /// Backtracking line search along du from solution_: the step length alpha and step.trial.
   Failure line_search(Step& step, const Iterate& x, double& alpha);
-  /// A converged step: its log line, the last increment, the histories committed.
-  AxisymmetricNewtonReport accept_step(Step& step, const Iterate& x, int it);
+  /// At most max_iterations Newton iterations from solution_ to convergence
+  /// (nullopt) or to why they fail.
+  Failure newton(Step& step, int max_iterations);
+  /// Pseudo-transient continuation from the step's start after plain Newton failed.
+  Failure continue_step(Step& step, const std::string& plain_failure);
+  /// The state at the start of the step (solution, punch contact, trial histories).
+  void restore_step_start(Step& step);
+  /// A converged step: the last increment, the histories committed.
+  AxisymmetricNewtonReport accept_step(Step& step);
   /// A failed step: the state at its start restored, the reason reported.
   AxisymmetricNewtonReport fail_step(Step& step, const std::string& why);
 
@@ -368,6 +405,11 @@ class AxisymmetricSolver {
   double dissipated_J_ = 0.0, dissipated_trial_J_ = 0.0;
   double stabilization_J_ = 0.0, stabilization_trial_J_ = 0.0;
   dealii::Vector<double> step_start_;  ///< u at the start of the step (viscous stabilisation)
+  /// Pseudo-transient continuation: the viscous ratio (0: off) and the state
+  /// of the last pseudo-step it acts on.
+  double continuation_ratio_ = 0.0;
+  double stall_acceptance_floor_N_ = 0.0;
+  dealii::Vector<double> continuation_reference_;
 
   // needle
   bool cutting_ = true;

@@ -106,6 +106,9 @@ struct FemRunSummary {
   /// tolerance (AxisymmetricSettings::stall_acceptance_tolerance) rather than
   /// at the Newton tolerance.
   int steps_accepted_at_stall = 0;
+  /// Steps plain Newton could not solve and pseudo-transient continuation did
+  /// (axisymmetric reference).
+  int steps_continued = 0;
   int bisections = 0;         ///< steps undone to locate a puncture depth
   int spring_back_stages = 0; ///< solves of the spring-back homotopies
   int newton_iterations = 0;  ///< total
@@ -124,6 +127,8 @@ struct FemRunSummary {
   /// advance), tip (the rest: pressing and spreading the tissue).
   std::vector<double> tip_force_N, cutting_force_N, friction_force_N;
   std::vector<std::string> phase;  ///< per row: approach|insertion|dwell|withdrawal
+  /// Per row, each layer's state: untouched|pressed|punctured (axisymmetric geometry).
+  std::vector<std::vector<std::string>> layer_states;
   std::string geometry = "3d";
   double cohesive_dissipation_J = 0.0;  ///< energy dissipated by the crack (J)
   /// Energy dissipated by the numerical (Kelvin-Voigt) stabilisation (J); to

@@ -1,0 +1,194 @@
+#!/usr/bin/env python3
+"""fem_robustness_study.py: the FEM reference on scenes drawn at random.
+
+Draws COUNT scenes with a seeded generator (scripts/fem_robustness.py: each
+layer's thickness, modulus, stiffening, Prony terms, toughness, cohesive
+strength and friction, speed 1-20 mm/s, target depth over the whole slab,
+hold 0-10 s, bevel and blunt tips), runs `puncture fem` on each, JOBS scenes
+side by side (one assembly thread each), checks every run's outputs with
+fem_robustness.check_run (independently of the solver's own flags) and writes
+OUT/README.md (the page), OUT/runs.csv (one row per scene) and OUT/scenes/
+(every drawn scene, so any row can be run again by hand).
+
+  python3 scripts/fem_robustness_study.py [--count 60] [--seed 48] [--jobs 2]
+          [--family full|small] [--out results/fem_robustness] [--build build]
+  # one scene only (a cluster task; OUT/runs/<name>/ and OUT/results/<name>.json):
+  python3 scripts/fem_robustness_study.py --only 17 --out DIR
+  # the page from the per-scene results already in OUT (after the tasks):
+  python3 scripts/fem_robustness_study.py --collect --out DIR
+
+Exit status: 0 when every scene converged with consistent records, 1 otherwise.
+"""
+import argparse
+import concurrent.futures
+import json
+import os
+import random
+import shutil
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fem_robustness as fr  # noqa: E402
+import provenance  # noqa: E402
+import results_io  # noqa: E402
+
+
+def scenes_of(count, seed, family):
+    rng = random.Random(seed)
+    return [fr.draw_scene(rng, family, i) for i in range(count)]
+
+
+def run_one(scene, out, binary, threads):
+    """Runs the FEM on one scene; returns (and writes) its result record."""
+    name = scene["name"]
+    scene_path = os.path.join(out, "scenes", name + ".json")
+    run_dir = os.path.join(out, "runs", name)
+    shutil.rmtree(run_dir, ignore_errors=True)
+    env = dict(os.environ, PUNCTURE_FEM_THREADS=str(threads))
+    t0 = time.monotonic()
+    p = subprocess.run([binary, "fem", scene_path, "-o", run_dir, "--no-vtu", "-q"], env=env,
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    wall = time.monotonic() - t0
+    rec = {"scene": name, "exit": p.returncode, "wall_s": round(wall, 1), "error": "", "problems": [],
+           "tip": scene["needle"]["tip"], "target_mm": scene["insertion"]["target_depth_mm"],
+           "speed_mm_per_s": scene["insertion"]["speed_mm_per_s"], "hold_s": scene["insertion"]["dwell_s"],
+           "thickness_mm": [l["thickness_mm"] for l in scene["layers"]]}
+    if p.returncode != 0:
+        lines = [l for l in p.stderr.splitlines() if l.strip() and not l.startswith("warning")]
+        rec["error"] = lines[-1] if lines else f"exit {p.returncode}"
+    else:
+        with open(os.path.join(run_dir, "fem_summary.json")) as f:
+            s = json.load(f)
+        rec.update({"load_steps": s.get("load_steps"), "step_cuts": s.get("step_cuts"),
+                    "accepted_at_stall": s.get("steps_accepted_at_stall"),
+                    "newton_iterations": s.get("newton_iterations"), "status": s.get("status"),
+                    "punctures": [(e["name"], round(e["depth_mm"], 3), round(e["force_N"], 4))
+                                  for e in s.get("punctures", [])]})
+        rec["problems"] = fr.check_run(run_dir)
+    results_io.write_text(os.path.join(out, "results", name + ".json"), json.dumps(rec, indent=1))
+    return rec
+
+
+def median(v):
+    v = sorted(v)
+    n = len(v)
+    return float("nan") if n == 0 else (v[n // 2] if n % 2 else 0.5 * (v[n // 2 - 1] + v[n // 2]))
+
+
+def page(records, args, command):
+    ok = [r for r in records if r["exit"] == 0 and not r["problems"]]
+    failed = [r for r in records if r["exit"] != 0]
+    wrong = [r for r in records if r["exit"] == 0 and r["problems"]]
+    walls = [r["wall_s"] for r in records if r["exit"] == 0]
+    cuts = [r.get("step_cuts") or 0 for r in records if r["exit"] == 0]
+    lines = [
+        "# FEM reference on scenes drawn at random",
+        "",
+        f"Made by `{command}` on {provenance.machine()}, {provenance.utc_now()} UTC, git {provenance.git_revision()}.",
+        f"Scenes: {len(records)} drawn with seed {args.seed}, family `{args.family}` "
+        "(scripts/fem_robustness.py: the ranges are `RANGES` there), "
+        f"{args.jobs} run(s) side by side with one assembly thread each.",
+        "",
+        "| outcome | scenes |",
+        "|---|---|",
+        f"| converged, records consistent | {len(ok)} of {len(records)} |",
+        f"| converged, records contradict the forces | {len(wrong)} |",
+        f"| stopped with an error | {len(failed)} |",
+        "",
+        f"Wall time per run: median {median(walls):.0f} s, max {max(walls) if walls else float('nan'):.0f} s. "
+        f"Load-step cuts: {sum(cuts)} in all, at most {max(cuts) if cuts else 0} in one run, "
+        f"{sum(1 for c in cuts if c)} run(s) with any.",
+        "",
+        "Checks, from each run's fem_force_depth.csv and fem_summary.json alone (thresholds `CHECKS`):",
+        f"shaft friction above {fr.CHECKS['intact_friction_N']} N and {fr.CHECKS['intact_friction_share']:.0%} "
+        "of the force while no layer is punctured; a force drop during insertion of more than "
+        f"{fr.CHECKS['drop_N']} N and {fr.CHECKS['drop_share']:.0%} within {fr.CHECKS['drop_window_mm']} mm "
+        f"with no layer changing state within {fr.CHECKS['state_window_mm']} mm; a layer punctured before "
+        "the one above it or a state going back; the summary's punctures not those of the state columns.",
+        "",
+    ]
+    if failed or wrong:
+        lines += ["## Failures", "", "| scene | what | |", "|---|---|---|"]
+        for r in failed:
+            lines.append(f"| {r['scene']} | error | {r['error']} |")
+        for r in wrong:
+            lines.append(f"| {r['scene']} | inconsistent | {'; '.join(r['problems'])} |")
+        lines.append("")
+    lines += ["## Every scene", "",
+              "Scene files in `scenes/`; `puncture fem scenes/<scene>.json` runs one again.", "",
+              "| scene | tip | skin / fat / muscle mm | speed mm/s | target mm | hold s | wall s | steps | cuts | punctures (layer mm N) | outcome |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in records:
+        th = " / ".join(f"{t:g}" for t in r["thickness_mm"])
+        pun = "; ".join(f"{n} {d:g} {f:.3g}" for n, d, f in r.get("punctures", []))
+        outcome = "error" if r["exit"] else ("inconsistent" if r["problems"] else "ok")
+        lines.append(f"| {r['scene']} | {r['tip']} | {th} | {r['speed_mm_per_s']:g} | {r['target_mm']:g} | "
+                     f"{r['hold_s']:g} | {r['wall_s']:.0f} | {r.get('load_steps', '')} | {r.get('step_cuts', '')} | "
+                     f"{pun} | {outcome} |")
+    lines += ["", "## On a cluster", "",
+              "Each scene is one task: draw the scenes once (`--count N --collect` writes nothing but the page; "
+              "`--only I` draws and runs scene I), e.g. a Slurm array:", "", "```bash",
+              "#SBATCH --array=0-59 --cpus-per-task=1",
+              "python3 scripts/fem_robustness_study.py --count 60 --seed 48 --only $SLURM_ARRAY_TASK_ID --out $OUT",
+              "# after the array:",
+              "python3 scripts/fem_robustness_study.py --count 60 --seed 48 --collect --out $OUT", "```", ""]
+    return "\n".join(lines)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--count", type=int, default=60)
+    ap.add_argument("--seed", type=int, default=48)
+    ap.add_argument("--family", choices=["full", "small"], default="full")
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--out", default=os.path.join(fr.ROOT, "results", "fem_robustness"))
+    ap.add_argument("--build", default=os.environ.get("PUNCTURE_BUILD_DIR", os.path.join(fr.ROOT, "build")))
+    ap.add_argument("--only", type=int, default=-1, help="run scene ONLY alone (a cluster task)")
+    ap.add_argument("--collect", action="store_true", help="write the page from the results in OUT")
+    args = ap.parse_args()
+    binary = os.path.join(args.build, "apps", "puncture")
+    command = "python3 scripts/fem_robustness_study.py " + " ".join(sys.argv[1:])
+    scenes = scenes_of(args.count, args.seed, args.family)
+    for d in ("scenes", "runs", "results"):
+        os.makedirs(os.path.join(args.out, d), exist_ok=True)
+    for s in scenes:
+        fr.write_scene(s, os.path.join(args.out, "scenes", s["name"] + ".json"))
+    if args.collect:
+        records = []
+        for s in scenes:
+            path = os.path.join(args.out, "results", s["name"] + ".json")
+            if not os.path.exists(path):
+                sys.exit(f"fem_robustness_study: no result for {s['name']} in {args.out}/results")
+            with open(path) as f:
+                records.append(json.load(f))
+    elif args.only >= 0:
+        if args.only >= len(scenes):
+            sys.exit(f"fem_robustness_study: --only {args.only}: there are {len(scenes)} scenes")
+        rec = run_one(scenes[args.only], args.out, binary, threads=1)
+        print(json.dumps(rec))
+        return 0 if rec["exit"] == 0 and not rec["problems"] else 1
+    else:
+        if not os.access(binary, os.X_OK):
+            sys.exit(f"fem_robustness_study: {binary} not built (bash scripts/build.sh)")
+        threads = 1 if args.jobs > 1 else max(1, os.cpu_count() or 1)
+        records = [None] * len(scenes)
+        t0 = time.monotonic()
+        with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+            futures = {pool.submit(run_one, s, args.out, binary, threads): i for i, s in enumerate(scenes)}
+            for n, f in enumerate(concurrent.futures.as_completed(futures), 1):
+                i = futures[f]
+                r = records[i] = f.result()
+                outcome = "error: " + r["error"] if r["exit"] else ("; ".join(r["problems"]) or "ok")
+                print(f"[{n}/{len(scenes)}, {time.monotonic() - t0:.0f} s] {r['scene']}: {r['wall_s']:.0f} s, "
+                      f"{outcome}", flush=True)
+    results_io.write_text(os.path.join(args.out, "README.md"), page(records, args, command))
+    good = all(r["exit"] == 0 and not r["problems"] for r in records)
+    print(f"fem_robustness_study: {sum(1 for r in records if r['exit'] == 0 and not r['problems'])} of "
+          f"{len(records)} converged with consistent records; page {args.out}/README.md")
+    return 0 if good else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
