@@ -108,6 +108,9 @@ def draw_scene(rng, family="full", index=0):
     if family == "small":
         s["sample"]["diameter_mm"] = 20.0
         ins["start_height_mm"] = 0.5
+        for layer in s["layers"]:  # the real-time force mesh must fit in the sample (scene check)
+            fm = layer["force_mesh"]
+            fm["L_mm"] = min(fm["L_mm"], round(0.45 * s["sample"]["diameter_mm"] / (fm["w"] - 1), 3))
     if rng.random() < BLUNT_SHARE:
         blunt(s, rng)
     return s

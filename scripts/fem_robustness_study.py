@@ -7,8 +7,9 @@ strength and friction, speed 1-20 mm/s, target depth over the whole slab,
 hold 0-10 s, bevel and blunt tips), runs `puncture fem` on each, JOBS scenes
 side by side (one assembly thread each), checks every run's outputs with
 fem_robustness.check_run (independently of the solver's own flags) and writes
-OUT/README.md (the page), OUT/runs.csv (one row per scene) and OUT/scenes/
-(every drawn scene, so any row can be run again by hand).
+OUT/README.md (the page), OUT/runs.csv (one row per scene), OUT/scenes/ (every
+drawn scene, so any row can be run again by hand), OUT/results/ (each scene's
+record) and OUT/runs/ (each run's outputs; not committed).
 
   python3 scripts/fem_robustness_study.py [--count 60] [--seed 48] [--jobs 2]
           [--family full|small] [--out results/fem_robustness] [--build build]
@@ -62,7 +63,7 @@ def run_one(scene, out, binary, threads):
         with open(os.path.join(run_dir, "fem_summary.json")) as f:
             s = json.load(f)
         rec.update({"load_steps": s.get("load_steps"), "step_cuts": s.get("step_cuts"),
-                    "accepted_at_stall": s.get("steps_accepted_at_stall"),
+                    "accepted_at_stall": s.get("steps_accepted_at_stall"), "continued": s.get("steps_continued"),
                     "newton_iterations": s.get("newton_iterations"), "status": s.get("status"),
                     "punctures": [(e["name"], round(e["depth_mm"], 3), round(e["force_N"], 4))
                                   for e in s.get("punctures", [])]})
@@ -128,13 +129,29 @@ def page(records, args, command):
                      f"{r['hold_s']:g} | {r['wall_s']:.0f} | {r.get('load_steps', '')} | {r.get('step_cuts', '')} | "
                      f"{pun} | {outcome} |")
     lines += ["", "## On a cluster", "",
-              "Each scene is one task: draw the scenes once (`--count N --collect` writes nothing but the page; "
-              "`--only I` draws and runs scene I), e.g. a Slurm array:", "", "```bash",
+              "Each scene is one task (`--only I` draws the scenes and runs scene I alone, writing "
+              "`results/<scene>.json`); `--collect` then writes this page from those files. A Slurm array:",
+              "", "```bash",
               "#SBATCH --array=0-59 --cpus-per-task=1",
               "python3 scripts/fem_robustness_study.py --count 60 --seed 48 --only $SLURM_ARRAY_TASK_ID --out $OUT",
               "# after the array:",
               "python3 scripts/fem_robustness_study.py --count 60 --seed 48 --collect --out $OUT", "```", ""]
     return "\n".join(lines)
+
+
+def runs_csv(records):
+    head = ("scene,tip,skin_mm,fat_mm,muscle_mm,speed_mm_per_s,target_mm,hold_s,exit,wall_s,load_steps,step_cuts,"
+            "steps_continued,steps_accepted_at_stall,punctures,outcome")
+    out = [head]
+    for r in records:
+        pun = " ".join(f"{n}@{d:g}mm/{f:.4g}N" for n, d, f in r.get("punctures", []))
+        outcome = ("error: " + r["error"]) if r["exit"] else ("; ".join(r["problems"]) or "ok")
+        cells = [r["scene"], r["tip"]] + [f"{t:g}" for t in r["thickness_mm"]] + [
+            f"{r['speed_mm_per_s']:g}", f"{r['target_mm']:g}", f"{r['hold_s']:g}", str(r["exit"]), f"{r['wall_s']:.1f}",
+            str(r.get("load_steps", "")), str(r.get("step_cuts", "")), str(r.get("continued", "")),
+            str(r.get("accepted_at_stall", "")), pun, '"' + outcome.replace('"', "'") + '"']
+        out.append(",".join(cells))
+    return "\n".join(out) + "\n"
 
 
 def main():
@@ -184,6 +201,7 @@ def main():
                 print(f"[{n}/{len(scenes)}, {time.monotonic() - t0:.0f} s] {r['scene']}: {r['wall_s']:.0f} s, "
                       f"{outcome}", flush=True)
     results_io.write_text(os.path.join(args.out, "README.md"), page(records, args, command))
+    results_io.write_text(os.path.join(args.out, "runs.csv"), runs_csv(records))
     good = all(r["exit"] == 0 and not r["problems"] for r in records)
     print(f"fem_robustness_study: {sum(1 for r in records if r['exit'] == 0 and not r['problems'])} of "
           f"{len(records)} converged with consistent records; page {args.out}/README.md")
