@@ -41,6 +41,9 @@ namespace {
 /// The predictor is kept unless its free residual exceeds this factor times
 /// the residual without it.
 constexpr double kPredictorResidualFactor = 10.0;
+/// A line search that finds no decrease takes its least bad step, unless that
+/// raises the residual beyond this factor (the Newton solve fails instead).
+constexpr double kUphillLimit = 10.0;
 }  // namespace
 
 /// What the phases of one solve_step share.
@@ -319,6 +322,13 @@ AxisymmetricSolver::Failure AxisymmetricSolver::newton_direction(Step& step, Ite
   x.solve_s = section_wall_seconds(timer_, "linear solve") - solve_before_s;
   step.constraints.distribute(step.du);
   if (!std::isfinite(step.du.l2_norm())) return "non-finite Newton update";
+  // Trust region on the displacement: no node moves more than
+  // max_newton_displacement tip elements in one iteration, unless a
+  // prescribed value asks for it (a node held only by a vanishing contact
+  // stiffness would otherwise be thrown across the mesh by the full step).
+  const double limit = settings_.max_newton_displacement * mesh_.tip_element_size_m;
+  const double largest = step.du.linfty_norm();
+  if (limit > 0.0 && largest > limit && x.gap <= 0.0) step.du *= limit / largest;
   return std::nullopt;
 }
 
@@ -337,7 +347,10 @@ AxisymmetricSolver::Failure AxisymmetricSolver::line_search(Step& step, const It
   alpha = search.alpha;
   if (search.accepted) return std::nullopt;
   if (alpha < 0.0) return "line search: every trial state is inverted or non-finite";
-  // No decrease found: the least bad admissible step.
+  // No decrease found: the least bad admissible step, unless it would throw
+  // the iterate far from where it is (a near-singular direction at a kink).
+  if (search.free_N > kUphillLimit * x.free)
+    return "line search: every trial step multiplies the residual by more than " + std::to_string(int(kUphillLimit));
   step.trial = solution_;
   step.trial.add(alpha, step.du);
   return std::nullopt;

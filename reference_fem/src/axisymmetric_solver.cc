@@ -372,7 +372,8 @@ void AxisymmetricSolver::add_needle_contact(const Vector<double>& u, bool with_m
     } else {
       c = outer_contact(needle_, x, settings_.edge_rounding * mesh_.tip_element_size_m);
       resp = nodal_contact(c, x, edge, friction_committed_[i], friction_[nd.layer], penalty,
-                           settings_.friction_penalty * penalty_[i]);
+                           settings_.friction_penalty * penalty_[i],
+                           settings_.friction_min_slip * mesh_.tip_element_size_m);
     }
     friction_trial_[i] = resp.history;
     if (!resp.history.in_contact) continue;

@@ -11,7 +11,8 @@
 //   trial state.
 // Out: LineSearchResult: accepted (then alpha and halvings are that trial's);
 //   otherwise alpha is the admissible trial with the smallest residual (the
-//   caller makes it the trial state again) or -1 if no trial was admissible.
+//   caller makes it the trial state again) or -1 if no trial was admissible;
+//   free_N is the returned trial's residual.
 #pragma once
 
 #include <cmath>
@@ -24,6 +25,7 @@ struct LineSearchResult {
   double alpha = -1.0;
   int halvings = 0;
   bool accepted = false;
+  double free_N = std::numeric_limits<double>::infinity();  ///< the returned trial's free residual
 };
 
 template <class TryStep>
@@ -35,10 +37,11 @@ LineSearchResult backtracking_line_search(double free_N, bool accept_any, double
   for (int h = 0; h <= max_halvings; ++h, alpha *= 0.5) {
     const std::optional<double> trial_free = try_step(alpha, h);
     if (!trial_free || !std::isfinite(*trial_free)) continue;
-    if (accept_any || *trial_free < (1.0 - 1e-4 * alpha) * free_N || *trial_free <= floor_N) return {alpha, h, true};
+    if (accept_any || *trial_free < (1.0 - 1e-4 * alpha) * free_N || *trial_free <= floor_N)
+      return {alpha, h, true, *trial_free};
     if (*trial_free < best_free) {
       best_free = *trial_free;
-      best = {alpha, h, false};
+      best = {alpha, h, false, best_free};
     }
   }
   return best;

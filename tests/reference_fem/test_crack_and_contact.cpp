@@ -247,26 +247,53 @@ TEST(NeedleContact, ForceDerivativeMatchesFiniteDifferences) {
   const Vec2 flank_node{n.edge_radius_m + 0.1e-3 * std::sin(b) - 10e-6 * std::cos(b),
                         n.z_tip_m + 0.1e-3 * std::cos(b) + 10e-6 * std::sin(b)};
   const Vec2 shaft_node{n.shaft_radius_m - 10e-6, n.shoulder_z() + 1e-3};
-  for (const Vec2& x : {flank_node, shaft_node})
-    for (double slip : {1e-6, 30e-6}) {  // stick, slide
-      FrictionHistory h = sticking;
-      const ContactPoint c0 = outer_contact(n, x);
-      h.anchor = {x[0] - edge[0] - slip * c0.tangent[0], x[1] - edge[1] - slip * c0.tangent[1]};
-      const NodalContactResponse r = nodal_contact(c0, x, edge, h, mu, pen, k_t);
-      const double step = 1e-10;
-      for (int j = 0; j < 2; ++j) {
-        Vec2 xp = x, xm = x;
-        xp[j] += step;
-        xm[j] -= step;
-        const auto rp = nodal_contact(outer_contact(n, xp), xp, edge, h, mu, pen, k_t);
-        const auto rm = nodal_contact(outer_contact(n, xm), xm, edge, h, mu, pen, k_t);
-        for (int i = 0; i < 2; ++i) {
-          const double fd = ((rp.normal_force[i] + rp.friction_force[i]) - (rm.normal_force[i] + rm.friction_force[i])) /
-                            (2 * step);
-          EXPECT_NEAR(r.dforce_dx[i][j], fd, 1e-4 * k_n) << "i " << i << " j " << j << " slip " << slip;
+  // min_slip 0: the slip length is mu N / k_t (about 3 um here); 20 um: the floor holds.
+  for (double min_slip : {0.0, 20e-6})
+    for (const Vec2& x : {flank_node, shaft_node})
+      for (double slip : {1e-6, 30e-6}) {  // stick, slide
+        FrictionHistory h = sticking;
+        const ContactPoint c0 = outer_contact(n, x);
+        h.anchor = {x[0] - edge[0] - slip * c0.tangent[0], x[1] - edge[1] - slip * c0.tangent[1]};
+        const NodalContactResponse r = nodal_contact(c0, x, edge, h, mu, pen, k_t, min_slip);
+        const double step = 1e-10;
+        for (int j = 0; j < 2; ++j) {
+          Vec2 xp = x, xm = x;
+          xp[j] += step;
+          xm[j] -= step;
+          const auto rp = nodal_contact(outer_contact(n, xp), xp, edge, h, mu, pen, k_t, min_slip);
+          const auto rm = nodal_contact(outer_contact(n, xm), xm, edge, h, mu, pen, k_t, min_slip);
+          for (int i = 0; i < 2; ++i) {
+            const double fd =
+                ((rp.normal_force[i] + rp.friction_force[i]) - (rm.normal_force[i] + rm.friction_force[i])) / (2 * step);
+            EXPECT_NEAR(r.dforce_dx[i][j], fd, 1e-4 * k_n)
+                << "i " << i << " j " << j << " slip " << slip << " min_slip " << min_slip;
+          }
         }
       }
-    }
+}
+
+TEST(NeedleContact, FrictionBuildsUpOverAtLeastTheMinimumSlipWhateverThePressure) {
+  // Lightly pressed (N = 1e-4 N): mu N / k_t is 6 nm; with a floor of 1 um the
+  // friction is -mu N tanh(xi / 1 um) and a node slips over the floor's length.
+  const RigidNeedle n = bevel_needle();
+  const FrictionCoefficients mu{0.2, 0.3};
+  const double k_n = 1e4, k_t = 5e3;
+  const ContactPenalty pen{k_n, 0.0};
+  const Vec2 x{n.shaft_radius_m - 1e-8, n.shoulder_z() + 1e-3};  // 10 nm into the shaft: N = 1e-4 N
+  const Vec2 edge{n.edge_radius_m, n.z_tip_m};
+  const ContactPoint c = outer_contact(n, x);
+  FrictionHistory h;
+  h.in_contact = true;
+  const double N = pen.force(c.penetration_m);
+  ASSERT_NEAR(N, 1e-4, 1e-9);
+  for (double xi : {0.2e-6, 1e-6, 3e-6}) {
+    h.anchor = {x[0] - edge[0] - xi * c.tangent[0], x[1] - edge[1] - xi * c.tangent[1]};
+    const Vec2 f = nodal_contact(c, x, edge, h, mu, pen, k_t, 1e-6).friction_force;
+    EXPECT_NEAR(f[0] * c.tangent[0] + f[1] * c.tangent[1], -mu.static_ * N * std::tanh(xi / 1e-6), 1e-12) << xi;
+    // Without the floor the same slips are full sliding already.
+    const Vec2 g = nodal_contact(c, x, edge, h, mu, pen, k_t, 0.0).friction_force;
+    EXPECT_NEAR(g[0] * c.tangent[0] + g[1] * c.tangent[1], -mu.static_ * N, 1e-9 * N) << xi;
+  }
 }
 
 TEST(NeedleContact, FrictionFadesSmoothlyRoundTheShoulderAndItsDerivativeMatchesFiniteDifferences) {

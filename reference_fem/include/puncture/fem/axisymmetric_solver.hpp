@@ -77,6 +77,10 @@ struct AxisymmetricSettings {
   double newton_tolerance = 1e-6;
   double absolute_residual_floor_N = 1e-10;
   int max_line_search_halvings = 6;
+  /// Trust region of a Newton iteration: the largest nodal displacement of
+  /// its direction, in tip element sizes (the direction is scaled down to
+  /// it; 0: no limit).
+  double max_newton_displacement = 0.5;
   /// Stall detection: a step whose best free residual has not fallen below
   /// stall_factor x its best before the last stall_window iterations is given
   /// up (and cut by the driver) instead of cycling up to max_newton_iterations
@@ -95,6 +99,9 @@ struct AxisymmetricSettings {
   unsigned int assembly_threads = 1;
   double contact_penalty = 1e2;   ///< k_n / (diagonal of the bulk tangent at the node)
   double friction_penalty = 0.5;  ///< k_t / k_n
+  /// The least elastic slip over which the shaft friction builds up to mu N,
+  /// in tip element sizes (k_t is capped at mu N / that; nodal_contact).
+  double friction_min_slip = 0.005;
   double contact_rounding = 0.02; ///< eps of the C1 penalty, in tip element sizes
   double edge_rounding = 0.25;    ///< shoulder rounding radius and inner-wall ramp height, in tip element sizes
   /// Hold the crack line at r <= r_c below the edge too (the ring crack stands

@@ -224,10 +224,16 @@ inline NodalContactResponse core_wall_contact(const RigidNeedle& needle, const V
 inline constexpr double kCommittedSlipRatio = 2.0;
 
 /// Penalty contact and friction of an outer-side node touching the face c.
-/// edge = (r_c, z_tip): position of the cutting edge; k_t: tangential penalty (N/m).
+/// edge = (r_c, z_tip): position of the cutting edge; k_t: tangential penalty (N/m);
+/// min_slip_m: the elastic slip over which the friction builds up to mu N is
+/// at least this (m): k_t is capped at mu N / min_slip_m. Without the floor,
+/// the slip range mu N / k_t (a few times mu x the penetration) shrinks to
+/// nanometres where the contact pressure is small, the friction becomes a
+/// step at that scale, and Newton cannot tell a sticking node from a sliding
+/// one (it cycles, or its steps go uphill at any length it can try).
 inline NodalContactResponse nodal_contact(const ContactPoint& c, const Vec2& x, const Vec2& edge,
                                           const FrictionHistory& committed, const FrictionCoefficients& mu,
-                                          const ContactPenalty& penalty, double k_t) {
+                                          const ContactPenalty& penalty, double k_t, double min_slip_m = 0.0) {
   NodalContactResponse out;
   if (!(c.penetration_m > 0.0)) return out;  // no contact: friction history reset
   const double N = penalty.force(c.penetration_m), dN = penalty.stiffness(c.penetration_m);
@@ -265,11 +271,15 @@ inline NodalContactResponse nodal_contact(const ContactPoint& c, const Vec2& x, 
   const double mu_now = committed.sliding ? mu.dynamic : mu.static_;
   const double cap = mu_now * N;
   if (!(cap > 0.0)) return out;
-  const double u = k_t * xi / cap;
+  // The slip length of the regularisation: cap / k_t, at least min_slip_m
+  // (then u = xi / min_slip_m no longer depends on N).
+  const bool floored = min_slip_m > 0.0 && cap < k_t * min_slip_m;
+  const double slip_length = floored ? min_slip_m : cap / k_t;
+  const double u = xi / slip_length;
   const double th = std::tanh(u), sech2 = 1.0 - th * th;
   const double f = -cap * th;
-  const double df_dxi = -k_t * sech2;
-  const double df_dN = -mu_now * (th - u * sech2);
+  const double df_dxi = -cap / slip_length * sech2;
+  const double df_dN = floored ? -mu_now * th : -mu_now * (th - u * sech2);
   // d xi / dx = t + slip . dt/dx; d N / dx = dN (-n) (the penetration falls
   // along n); the force w f t also turns with t on the shoulder.
   const double w = c.friction_weight;
@@ -282,7 +292,7 @@ inline NodalContactResponse nodal_contact(const ContactPoint& c, const Vec2& x, 
                              w * f * dt[i][j];
     }
   }
-  const double xi_max = kCommittedSlipRatio * cap / k_t;
+  const double xi_max = kCommittedSlipRatio * slip_length;
   if (std::abs(xi) > xi_max) {
     out.history.sliding = true;
     const double xi_e = xi > 0.0 ? xi_max : -xi_max;
