@@ -47,4 +47,13 @@ inline meshing::SlabMeshOptions coarse_mesh() {
   return m;
 }
 
+/// Run options of a test: nothing printed, no files written.
+inline FemRunOptions quiet() {
+  FemRunOptions o;
+  o.verbose = false;
+  o.write_files = false;
+  o.write_vtu = false;
+  return o;
+}
+
 }  // namespace puncture::fem::testing

@@ -15,10 +15,13 @@
 #include <filesystem>
 #include <puncture/fem/needle_insertion.hpp>
 #include <puncture/scene_io.hpp>
+
+#include "fem_test_scenes.hpp"
 #include <string>
 
 using namespace puncture;
 using namespace puncture::fem;
+using puncture::fem::testing::quiet;
 
 namespace {
 
@@ -36,14 +39,6 @@ Scene small_default_scene() {
   s.fem.mesh.elements_per_needle_radius = 4;
   s.fem.mesh.path_element_size_mm = 0.4;
   return s;
-}
-
-FemRunOptions quiet() {
-  FemRunOptions o;
-  o.verbose = false;
-  o.write_files = false;
-  o.write_vtu = false;
-  return o;
 }
 
 }  // namespace

@@ -26,21 +26,16 @@
 #include <puncture/fem/needle_insertion.hpp>
 #include <puncture/scene_io.hpp>
 
+#include "fem_test_scenes.hpp"
+
 using namespace puncture;
 using namespace puncture::fem;
+using puncture::fem::testing::quiet;
 
 namespace {
 
 Scene scene_file(const std::string& name) {
   return load_scene(std::filesystem::path(PUNCTURE_SOURCE_DIR) / "tests" / "reference_fem" / "scenes" / (name + ".json"));
-}
-
-FemRunOptions quiet() {
-  FemRunOptions o;
-  o.verbose = false;
-  o.write_files = false;
-  o.write_vtu = false;
-  return o;
 }
 
 bool any_punctured(const std::vector<std::string>& states) {
