@@ -201,7 +201,7 @@ def check_run(out_dir, layer_names=None):
 
 
 def write_scene(scene, path):
-    tmp = path + ".part"
+    tmp = f"{path}.{os.getpid()}.part"  # one per process: tasks of a study run side by side
     with open(tmp, "w") as f:
         json.dump(scene, f, indent=1)
     os.replace(tmp, path)
