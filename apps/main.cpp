@@ -98,12 +98,54 @@ CLI::App* add_validate(CLI::App& app, CommandLine& c) {
   return validate_cmd;
 }
 
+/// How a raw rig recording is read (validation/harness recording.hpp): its
+/// format file and the fields that override it.
+void add_recording_options(CLI::App* cmd, puncture::validation::ReferenceRecordingOptions& r) {
+  namespace pv = puncture::validation;
+  const auto field = [&r](std::string& into) {
+    return [&r, &into](const std::string& v) {
+      into = v;
+      r.overrides.source = "the command line";
+    };
+  };
+  cmd->add_option("--recording-format", r.format_file,
+                  "Raw rig recording: its format (JSON: time, position, force columns, units, into_tissue, sign; "
+                  "validation/README.md); default: <reference stem>.json beside it, if present")
+      ->check(CLI::ExistingFile);
+  cmd->add_option_function<std::string>("--time-column", field(r.overrides.time.name), "Raw recording: the time column");
+  cmd->add_option_function<std::string>("--time-unit", field(r.overrides.time.unit), "Raw recording: s, ms or us "
+                                        "(default: the column name's _<unit> suffix)");
+  cmd->add_option_function<std::string>("--position-column", field(r.overrides.position.name),
+                                        "Raw recording: the stage position column");
+  cmd->add_option_function<std::string>("--position-unit", field(r.overrides.position.unit), "Raw recording: m, mm or um");
+  cmd->add_option_function<std::string>("--force-column", field(r.overrides.force.name), "Raw recording: the force column");
+  cmd->add_option_function<std::string>("--force-unit", field(r.overrides.force.unit), "Raw recording: N or mN");
+  cmd->add_option_function<std::string>(
+         "--stage-direction",
+         [&r](const std::string& d) {
+           r.overrides.into_tissue = d == "increasing" ? pv::StageDirection::Increasing : pv::StageDirection::Decreasing;
+           r.overrides.source = "the command line";
+         },
+         "Raw recording: increasing or decreasing (the stage position as the needle goes into the tissue)")
+      ->check(CLI::IsMember({"increasing", "decreasing"}));
+  cmd->add_option_function<int>(
+         "--force-sign",
+         [&r](int sign) {
+           r.overrides.force_sign = sign;
+           r.overrides.source = "the command line";
+         },
+         "Raw recording: 1 or -1 (the sign of the file's force while the tissue resists the insertion)")
+      ->check(CLI::IsMember({1, -1}));
+}
+
 CLI::App* add_calibrate(CLI::App& app, CommandLine& c) {
   CLI::App* calibrate_cmd = app.add_subcommand("calibrate", "Tune the force law per layer (K, breakthrough, cutting, friction, stiffening; optionally w, L, k_s, d); write a preset");
   add_scene_options(calibrate_cmd, c, "Output directory; default: out/<scene name>_calibration", true);
   calibrate_cmd->add_option("--reference", c.reference,
-                            "Measured insertion curve (CSV with depth_mm and force_N at least; see "
-                            "validation/README.md); default: the scene's FEM reference (cached)");
+                            "Measured insertion curve (CSV with depth_mm and force_N at least, or a raw rig "
+                            "recording with its format: --recording-format; see validation/README.md); default: "
+                            "the scene's FEM reference (cached)");
+  add_recording_options(calibrate_cmd, c.calibrate.recording);
   calibrate_cmd->add_option("--method", c.calibrate.method,
                             "levenberg_marquardt (default), nelder_mead, bobyqa or simulated_annealing")
       ->check(CLI::IsMember({"levenberg_marquardt", "nelder_mead", "bobyqa", "simulated_annealing"}));

@@ -2,8 +2,9 @@
 // against a reference insertion curve (the scene's FEM reference, cached, or a
 // measured curve) and writes a tuned preset with its provenance, the curves of
 // the reference and of the model before and after (calibration_curves.csv),
-// their plot (calibration_force_depth.png, scripts/plot_calibration.py) and
-// calibration_summary.md.
+// their plot (calibration_force_depth.png, scripts/plot_calibration.py), for a
+// measured reference what was detected on it (reference_detection.png,
+// scripts/plot_reference_detection.py) and calibration_summary.md.
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -19,6 +20,7 @@
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/calibration.hpp"
 #include "puncture/validation/metrics.hpp"
+#include "puncture/validation/recording.hpp"
 #include "puncture/validation/fem_comparison.hpp"
 #include "puncture/validation/fem_reference_curve.hpp"
 #include "puncture/validation/surface_identification.hpp"
@@ -29,12 +31,29 @@
 namespace puncture::apps {
 namespace {
 
+/// The raw-recording options as given (empty for a curve in the reader's schema).
+std::string recording_options_text(const validation::ReferenceRecordingOptions& r) {
+  std::ostringstream c;
+  const validation::RecordingFormat& o = r.overrides;
+  if (!r.format_file.empty()) c << " --recording-format " << r.format_file.string();
+  const std::pair<const char*, const std::string*> texts[] = {
+      {"--time-column", &o.time.name},         {"--time-unit", &o.time.unit}, {"--position-column", &o.position.name},
+      {"--position-unit", &o.position.unit}, {"--force-column", &o.force.name}, {"--force-unit", &o.force.unit}};
+  for (const auto& [flag, value] : texts)
+    if (!value->empty()) c << ' ' << flag << ' ' << *value;
+  if (o.into_tissue != validation::StageDirection::Unset)
+    c << " --stage-direction " << (o.into_tissue == validation::StageDirection::Increasing ? "increasing" : "decreasing");
+  if (o.force_sign != 0) c << " --force-sign " << o.force_sign;
+  return c.str();
+}
+
 /// The command line that reproduces this calibration, every setting spelled out.
 std::string command_line(const CalibrateOptions& options, const std::filesystem::path& scene_path,
                          const std::filesystem::path& dir, const std::string& name, const std::string& integrator) {
   std::ostringstream c;
   c << "puncture calibrate " << scene_path.string();
   if (!options.reference.empty()) c << " --reference " << options.reference.string();
+  c << recording_options_text(options.recording);
   if (options.reference_depth_offset_mm != 0.0) c << " --reference-depth-offset " << options.reference_depth_offset_mm;
   c << " -o " << dir.string() << " --name " << name << " --method " << options.method;
   for (std::size_t i = 0; i < options.also_tune.size(); ++i) c << (i ? "," : " --also-tune ") << options.also_tune[i];
@@ -63,6 +82,9 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
 bool load_references(const CalibrateOptions& options, const Scene& scene, std::ostream& out,
                      std::vector<validation::ReferenceCurve>& references, std::filesystem::path& fem_dir) {
   if (options.reference.empty()) {
+    if (!options.recording.format_file.empty() || !options.recording.overrides.empty())
+      throw UsageError("--recording-format and the --time-column ... options describe a raw --reference recording: "
+                       "give --reference");
     validation::FemReferenceOptions fem;
     if (!options.cache_dir.empty()) fem.cache_dir = options.cache_dir;
     fem.verbose = !options.quiet;
@@ -85,8 +107,13 @@ bool load_references(const CalibrateOptions& options, const Scene& scene, std::o
   if (!options.fem_speeds_mm_per_s.empty()) throw UsageError("--fem-speeds takes the scene's FEM reference, not --reference");
   if (options.surface_fit) throw UsageError("--surface-fit needs the scene's FEM reference (its surface profiles), not --reference");
   validation::ReferenceCurve reference;
-  reference.curve = validation::read_insertion_curve(options.reference);
+  reference.curve = validation::read_reference_recording(options.reference, options.recording);
   reference.kind = "measured";
+  const auto& meta = reference.curve.metadata;
+  if (meta.count("recording_format"))
+    out << "[calibrate] raw recording " << options.reference.string() << " (format: " << meta.at("recording_format")
+        << "): contact at " << meta.at("contact_time_s") << " s, tare " << meta.at("tare_N") << " N, noise "
+        << meta.at("noise_N") << " N, insertion at " << meta.at("speed_mm_per_s") << " mm/s\n";
   if (!std::isfinite(options.reference_depth_offset_mm))
     throw UsageError("--reference-depth-offset must be a finite number (mm)");
   if (options.reference_depth_offset_mm != 0.0) {
@@ -215,6 +242,24 @@ Scene scene_on_slab(const std::filesystem::path& scene_path, const std::vector<d
   }
 }
 
+/// The summary's section on every reference when there are several (the term
+/// tables compare the model with the first; the objective sums them all).
+std::string every_reference_markdown(const std::vector<validation::ReferenceCurve>& references,
+                                     const validation::CalibrationResult& result) {
+  std::ostringstream refs;
+  refs << "\n## Every reference\n\nThe term tables above compare the model with the first reference; the "
+          "calibration's objective is the sum over all of them:\n\n| reference | speed (mm/s) | objective before | "
+          "after |\n|---|---|---|---|\n";
+  for (std::size_t r = 0; r < references.size(); ++r) {
+    const auto speed = references[r].curve.metadata.find("speed_mm_per_s");
+    refs << "| " << references[r].kind << " (" << references[r].curve.source << ") | "
+         << (speed != references[r].curve.metadata.end() ? speed->second : std::string("the scene's")) << " | "
+         << std::setprecision(4) << result.trajectory_before[r].objective << " | " << result.trajectory_after[r].objective
+         << " |\n";
+  }
+  return refs.str();
+}
+
 }  // namespace
 
 int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stream, std::ostream& err) {
@@ -262,21 +307,7 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
                                (options.threads > 0 ? std::to_string(options.threads) : std::string("every")) +
                                " thread(s)";
     std::string md = validation::calibration_summary_markdown(result, scene, reference, provenance, method, calibration_s, name);
-    if (references.size() > 1) {
-      // The tables above are of the first reference; the objective sums every reference's.
-      std::ostringstream refs;
-      refs << "\n## Every reference\n\nThe term tables above compare the model with the first reference; the "
-              "calibration's objective is the sum over all of them:\n\n| reference | speed (mm/s) | objective before | "
-              "after |\n|---|---|---|---|\n";
-      for (std::size_t r = 0; r < references.size(); ++r) {
-        const auto speed = references[r].curve.metadata.find("speed_mm_per_s");
-        refs << "| " << references[r].kind << " (" << references[r].curve.source << ") | "
-             << (speed != references[r].curve.metadata.end() ? speed->second : std::string("the scene's")) << " | "
-             << std::setprecision(4) << result.trajectory_before[r].objective << " | " << result.trajectory_after[r].objective
-             << " |\n";
-      }
-      md += refs.str();
-    }
+    if (references.size() > 1) md += every_reference_markdown(references, result);
     if (options.surface_fit)
       md += "\n## Force meshes identified from the FEM's surface (--surface-fit)\n\nBefore the stages below, each "
             "layer with FEM surface profiles taken while its surface follows the tip had K, k_s, k_a and z_v "
@@ -287,6 +318,8 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
             "-> after, over the FEM's largest force and deflection of those samples; per sample and ring in "
             "surface_identification.csv.\n\n" +
             validation::surface_identification_markdown(surfaces);
+    // A measured reference: what was detected on it (contact, phases, drops), to check before trusting the fit.
+    if (!options.reference.empty()) validation::run_plot_script("plot_reference_detection.py", dir, out, err);
     for (const std::string& p : validation::run_plot_script("plot_calibration.py", dir, out, err))
       md += "\n![" + p + "](" + p + ")\n";
     io::OutputSession md_session(dir);

@@ -41,6 +41,7 @@
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/metrics.hpp"
+#include "puncture/validation/recording.hpp"
 #include "puncture/io/atomic_file.hpp"
 #include "puncture/validation/fem_comparison.hpp"
 #include "puncture/validation/sweep.hpp"

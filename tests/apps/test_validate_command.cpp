@@ -17,6 +17,7 @@
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/metrics.hpp"
+#include "puncture/validation/recording.hpp"
 
 namespace fs = std::filesystem;
 

@@ -15,6 +15,7 @@
 #include "puncture/validation/force_noise.hpp"
 #include "puncture/validation/puncture_events.hpp"
 #include "puncture/validation/reference_checks.hpp"
+#include "puncture/validation/recording.hpp"
 
 namespace pv = puncture::validation;
 namespace fs = std::filesystem;
@@ -105,7 +106,12 @@ TEST(NoisyDrops, OkamuraLiverCurveHasTheDropsOneSees) {
   // Plotted, the curve is flat (noise) to about 9.5 mm, rises to 1.37 N and
   // falls to 0.15-0.4 N at 19.1 mm (the capsule), then shows clear falls at
   // 29.9 mm (1.7 -> 0.7 N), 32.75 mm (1.96 -> 1.0 N), 35.25 mm (1.55 ->
-  // 1.34 N) and 36.7 mm (2.3 -> 1.3 N), and relaxes flat beyond 38 mm.
+  // 1.34 N) and 36.7 mm (2.3 -> 1.3 N), a small one at 37.16 mm (1.52 ->
+  // 1.34 N, 12.6 sigma, after a rise of 0.22 N from 1.30 N), and relaxes
+  // flat beyond 38 mm. (Until issue 49 the fall at 37.16 mm was not counted:
+  // the force rises more steeply after it than before, which the old rule,
+  // a stiff rise giving way to a softer course, rejected; a drop followed by
+  // a stiffer course now counts, as several drops in one layer do.)
   const pv::InsertionCurve c = shared_curve("okamura2004_liver_depth_force.csv");
   const std::vector<pv::ForceDrop> drops = pv::detect_force_drops(c);
   std::vector<double> clear;
@@ -114,9 +120,11 @@ TEST(NoisyDrops, OkamuraLiverCurveHasTheDropsOneSees) {
     EXPECT_LT(d.depth_m, 38e-3) << "a drop in the flat tail at " << d.depth_m * 1e3 << " mm";
     if (!d.marginal) clear.push_back(d.depth_m * 1e3);
   }
-  const double seen[][2] = {{19.0, 19.35}, {29.8, 30.15}, {32.6, 32.9}, {35.1, 35.4}, {36.5, 36.85}};
-  ASSERT_EQ(clear.size(), 5u);
-  for (std::size_t k = 0; k < 5; ++k) {
+  const double seen[][2] = {{19.0, 19.35}, {29.8, 30.15}, {32.6, 32.9}, {35.1, 35.4}, {36.5, 36.85}, {37.0, 37.3}};
+  std::string found;
+  for (double d : clear) found += std::to_string(d) + " mm ";
+  ASSERT_EQ(clear.size(), 6u) << found;
+  for (std::size_t k = 0; k < 6; ++k) {
     EXPECT_GE(clear[k], seen[k][0]) << k;
     EXPECT_LE(clear[k], seen[k][1]) << k;
   }

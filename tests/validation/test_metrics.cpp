@@ -9,6 +9,7 @@
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/metrics.hpp"
+#include "puncture/validation/recording.hpp"
 #include "puncture/validation/puncture_events.hpp"
 
 namespace pv = puncture::validation;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "puncture/validation/metrics.hpp"
+#include "puncture/validation/recording.hpp"
 
 namespace puncture::validation {
 namespace {

@@ -4,6 +4,7 @@
 #include "puncture/model/realtime_model.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/puncture_force_shares.hpp"
+#include "puncture/validation/recording.hpp"
 
 namespace pv = puncture::validation;
 

@@ -18,6 +18,7 @@
 #include "puncture/validation/calibration.hpp"
 #include "puncture/validation/puncture_events.hpp"
 #include "puncture/validation/trajectory_objective.hpp"
+#include "puncture/validation/recording.hpp"
 
 namespace pv = puncture::validation;
 using puncture::Scene;

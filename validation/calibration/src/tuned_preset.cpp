@@ -99,8 +99,13 @@ nlohmann::json events_json(const ReferenceEvents& ev, const std::vector<std::str
   }
   j["punctures"] = p;
   nlohmann::json drops = nlohmann::json::array();
-  for (const ForceDrop& d : ev.drops) drops.push_back({{"depth_mm", d.depth_m / kMm}, {"peak_force_N", d.peak_force_N}, {"drop_N", d.drop_N}});
+  for (const ForceDrop& d : ev.drops)
+    drops.push_back({{"depth_mm", d.depth_m / kMm}, {"peak_force_N", d.peak_force_N}, {"drop_N", d.drop_N},
+                     {"marginal", d.marginal}});
   j["force_drops"] = drops;
+  j["noise_N"] = ev.noise_N;
+  j["contact_onset_mm"] = ev.has_contact_onset ? nlohmann::json(ev.contact_onset_m / kMm) : nlohmann::json(nullptr);
+  j["doubts"] = ev.doubts;
   return j;
 }
 

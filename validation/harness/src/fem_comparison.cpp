@@ -16,6 +16,7 @@
 #include "puncture/io/csv_reader.hpp"
 #include "puncture/io/csv_writer.hpp"
 #include "puncture/validation/number_format.hpp"
+#include "puncture/validation/recording.hpp"
 
 namespace puncture::validation {
 

@@ -1,4 +1,5 @@
 #include "puncture/validation/fem_reference_curve.hpp"
+#include "puncture/validation/recording.hpp"
 
 #include <cmath>
 #include <sstream>

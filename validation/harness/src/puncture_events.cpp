@@ -126,6 +126,9 @@ ReferenceEvents reference_events(const InsertionCurve& reference, const std::vec
         ev.contact_onset_m = reference.depth_m[i];
         break;
       }
+  } else if (std::isfinite(reference.known_contact_depth_m)) {
+    ev.has_contact_onset = true;  // a raw recording's contact fit (recording.hpp)
+    ev.contact_onset_m = reference.known_contact_depth_m;
   } else {
     ev.has_contact_onset = contact_onset_from_force(reference, phase, ev.noise_N, o, ev.contact_onset_m);
   }

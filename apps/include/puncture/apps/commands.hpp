@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "puncture/validation/calibration.hpp"
+#include "puncture/validation/recording.hpp"
 
 namespace puncture::apps {
 
@@ -74,6 +75,10 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
 struct CalibrateOptions {
   std::filesystem::path scene;
   std::filesystem::path reference;    ///< measured curve CSV; empty: FEM reference of the scene (cached)
+  /// How to read a raw rig recording (recording.hpp): a format file
+  /// (--recording-format; empty: the sidecar <reference stem>.json if present)
+  /// and the command line's fields over it (--time-column, ...).
+  validation::ReferenceRecordingOptions recording;
   std::filesystem::path output_dir;   ///< empty: out/<scene name>_calibration
   std::filesystem::path cache_dir;    ///< empty: out/.fem_cache
   std::string method = "levenberg_marquardt"; ///< levenberg_marquardt, nelder_mead, bobyqa, simulated_annealing

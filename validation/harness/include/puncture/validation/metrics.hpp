@@ -2,7 +2,9 @@
 // curve lies from a reference curve.
 //
 // InsertionCurve: one sample per row, SI units inside. Read from a CSV file
-// with one reader for the real-time model's realtime_curve.csv, the FEM's
+// (recording.hpp: read_insertion_curve; a raw rig recording of time, stage
+// position and force is converted by read_reference_recording) with one
+// reader for the real-time model's realtime_curve.csv, the FEM's
 // fem_force_depth.csv and a MEASURED insertion curve:
 //   * optional metadata lines at the top, "# key: value" (e.g.
 //     "# needle_gauge: 18", "# speed_mm_per_s: 10", "# source: ..."),
@@ -96,6 +98,10 @@ struct InsertionCurve {
   bool has_time = true;       ///< false: time_s is the sample number
   bool has_velocity = true;   ///< false: velocity_m_per_s is inferred from the phase
   bool phase_from_column = false;
+  /// Depth (m) where the tip met the tissue when the reader knows it (a raw
+  /// recording's contact fit, recording.hpp: 0); NaN otherwise (the contact
+  /// onset is then found from the states or the force, puncture_events.hpp).
+  double known_contact_depth_m = std::numeric_limits<double>::quiet_NaN();
 
   std::size_t size() const { return time_s.size(); }
   bool has_layer_states() const { return !layer_names.empty(); }
@@ -106,8 +112,8 @@ struct InsertionCurve {
   bool metadata_number(const std::string& key, double& value) const;
 };
 
-InsertionCurve read_insertion_curve(const std::filesystem::path& path);
-InsertionCurve parse_insertion_curve(const std::string& text, const std::string& source_name);
+// read_insertion_curve / parse_insertion_curve (the schema above) and the
+// raw rig recordings: recording.hpp.
 /// The curve of a real-time run (total force, per-layer states).
 /// include_damping = false: the force is the total minus every layer's damping
 /// force d h v (what a quasi-static, frictionless reference can be compared

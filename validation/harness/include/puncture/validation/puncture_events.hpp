@@ -11,38 +11,42 @@
 //     detect_force_drops, force_drops.cpp). The force's noise sigma is
 //     estimated from the curve itself (force_noise.hpp; ~0 on a finely
 //     sampled model or FEM curve, where the rules below reduce to the
-//     noiseless ones). A drop is a local maximum F_p of the insertion force
-//     after which the force falls by at least max(min_drop_fraction F_p,
+//     noiseless ones). A drop starts at an insertion sample F_p (a local
+//     maximum, or a sample of a plateau that sags into the fall) after which
+//     the force falls by at least max(min_drop_fraction F_p,
 //     min_drop_of_peak x the curve's peak, min_drop_sigmas sigma) by the next
 //     sample or before the tip has advanced window_m beyond it (and before it
 //     rises above F_p again; the next sample counts however coarse the
 //     sampling), with F_p itself at least min_peak_sigmas sigma (noise near
-//     zero force is no drop), and at which a stiff rise gives way to a softer
-//     course: the force's slope over slope_window_m before the maximum, or,
-//     when the force stayed within a band of F_p (noise_band_sigmas sigma, or
-//     plateau_fraction of the drop) over a plateau of at most max_plateau_m
-//     that it rose into from below, the steeper of that and the slope of the
-//     rise before the plateau, plus slope_margin_sigmas standard errors of
-//     the two slopes (0 without noise), exceeds the slope over
-//     slope_window_m after the drop (least-squares lines). A puncture ends
-//     the pressing of a layer and leaves cutting and friction; a cut that
-//     ends on an unloaded layer below (a model without layer interaction)
-//     also drops the force, but from a plateau it entered from above (the
-//     previous puncture) onto a new rise. The drop's depth is that of the
-//     first sample after the fall's start (the last sample before the lowest
-//     one still within the noise band of F_p; without noise the maximum
-//     itself, as a state column would mark it), its force F_p (on a noisy
-//     curve biased up by about a sigma). Candidates whose maximum lies inside
-//     the previous drop's fall, or closer than window_m, are one drop (the
-//     larger wins): a drop spread over many samples counts once. A drop below
-//     clear_drop_sigmas sigma is marginal.
+//     zero force is no drop), and which the force rose into from below: F_p
+//     exceeds the lowest force since the previous drop's lowest sample (or
+//     the start of the insertion) by at least min_rise_of_drop x the drop and
+//     noise_band_sigmas sigma. A puncture ends the pressing of a layer, whatever comes after it
+//     (a softer cut, or a stiffer layer pressed next) and whatever the
+//     maximum's plateau does (flat or sagging); a cut that ends on an
+//     unloaded layer below (a model without layer interaction) also drops the
+//     force, but from a plateau it entered from above (the previous
+//     puncture), which the rise rule rejects. The fall starts at the knee
+//     between the maximum and the lowest sample of the fall: of the samples
+//     still above the fall's middle, the one farthest above the straight
+//     line from the maximum to the lowest sample (the maximum itself when the force falls at once; the end of a sag or
+//     plateau before a steep fall). The drop's depth is that of the first
+//     sample after the fall's start (without noise and with a one-sample
+//     fall, the sample after the maximum, as a state column would mark it),
+//     its force F_p (on a noisy curve biased up by about a sigma).
+//     Candidates whose maximum lies inside the previous drop's fall, or
+//     closer than window_m, are one drop (the larger wins): a drop spread
+//     over many samples counts once, several drops in one layer (a liver's
+//     vessels) each count. A drop below clear_drop_sigmas sigma is marginal.
 //     The k-th drop is layer k's puncture. ReferenceEvents::doubts lists why
 //     that assignment is a guess (reference_checks.hpp, detection_doubts):
 //     a marginal drop; more clear drops than layers (the largest are kept);
 //     fewer drops than the layers whose undeformed bottom the curve's
 //     deepest sample passes. Calibration stops on any doubt and asks for
 //     the puncture depths.
-//   Contact onset (no states): the first insertion sample whose force
+//   Contact onset (no states): where the reader knows it
+//   (InsertionCurve::known_contact_depth_m: a raw recording's contact fit),
+//   else the first insertion sample whose force
 //   exceeds max(onset_fraction x the peak, noise_band_sigmas sigma) and stays
 //   above it over the next onset_hold_m of depth (at least the next sample).
 //
@@ -77,21 +81,18 @@ struct PunctureDetectionOptions {
   double min_drop_fraction = 0.1;  ///< a drop is at least this fraction of the force at its maximum
   double min_drop_of_peak = 0.02;  ///< and at least this fraction of the curve's peak force
   double window_m = 0.25e-3;       ///< the drop happens within this much further insertion (m)
-  double slope_window_m = 0.3e-3;  ///< depth range of the slopes before the maximum and after the drop (m)
   double onset_fraction = 0.01;    ///< contact onset: first force above this fraction of the peak (no states)
   double onset_hold_m = 0.1e-3;    ///< ... that stays above it over this much further depth (m)
   double min_drop_sigmas = 8.0;    ///< a drop is at least this many noise deviations
   double clear_drop_sigmas = 12.0; ///< a drop below this many noise deviations is marginal
   double min_peak_sigmas = 10.0;   ///< the force at the maximum is at least this many noise deviations
-  double noise_band_sigmas = 3.0;  ///< force within this many deviations of F_p is at its level (plateau, fall start)
-  double plateau_fraction = 0.05;  ///< ... or within this fraction of the drop (a plateau without noise)
-  double max_plateau_m = 2e-3;     ///< longest plateau before a drop that counts (m)
-  double slope_margin_sigmas = 3.0;  ///< slope comparison margin in standard errors of the slopes
+  double noise_band_sigmas = 3.0;  ///< force within this many deviations is at one level (rise, contact)
+  double min_rise_of_drop = 0.5;   ///< the rise into the maximum is at least this fraction of the drop
 };
 
 struct ForceDrop {
-  std::size_t index = 0;    ///< curve sample of the maximum
-  double depth_m = 0.0;     ///< depth of the first sample after the maximum
+  std::size_t index = 0;    ///< curve sample of F_p (the maximum, or a sample of a sagging plateau)
+  double depth_m = 0.0;     ///< depth of the first sample after the fall's start (its knee; see the header)
   double peak_force_N = 0.0;
   double drop_N = 0.0;
   double noise_sigmas = 0.0;  ///< drop_N / the curve's noise sigma (infinity without noise)
