@@ -127,48 +127,38 @@ AxisymmetricSolver::Failure AxisymmetricSolver::newton(Step& step, int max_itera
 // equations plus a viscous stress ratio 2 mu_0 sym(H - H_k) on the change
 // from the previous pseudo-step's state H_k. A large ratio makes each
 // pseudo-step an easy, nearly linear solve (the tissue may only creep toward
-// equilibrium). After a converged pseudo-step the ratio follows the step's
-// own residual there (switched evolution relaxation: times its ratio to the
-// last one, at most continuation_decrease smaller, never larger), so it falls
-// as fast as the state nears equilibrium and holds while the tissue still
-// creeps; a failed pseudo-step is undone and the ratio rises by
-// continuation_increase. Once the ratio is below continuation_final_ratio, or
-// the step's residual is already small enough for plain Newton's tests, plain
-// Newton finishes the step from there: the accepted state solves the step's
-// own equations, continuation only finds it.
+// equilibrium); the ratio falls by continuation_decrease after each converged
+// pseudo-step and rises by continuation_increase (the pseudo-step undone)
+// after a failed one. Once it is below continuation_final_ratio the viscous
+// stress is negligible and plain Newton finishes the step from there: the
+// accepted state solves the step's own equations, continuation only finds it.
 AxisymmetricSolver::Failure AxisymmetricSolver::continue_step(Step& step, const std::string& plain_failure) {
   std::ostringstream head;
   head << "  -> " << plain_failure << "; pseudo-transient continuation";
   step.report.table.push_back(head.str());
   restore_step_start(step);
   double ratio = settings_.continuation_initial_ratio;
-  double last_residual = free_residual_at(solution_);
   int failures = 0;
-  bool near = false;
-  for (int k = 0; k < settings_.continuation_steps && ratio >= settings_.continuation_final_ratio && !near; ++k) {
+  for (int k = 0; k < settings_.continuation_steps && ratio >= settings_.continuation_final_ratio; ++k) {
     continuation_reference_ = solution_;
     continuation_ratio_ = ratio;
     const Failure why = newton(step, settings_.continuation_max_iterations);
-    continuation_ratio_ = 0.0;
     std::ostringstream line;
-    line << "  pseudo-step " << k << "  ratio " << std::scientific << std::setprecision(2) << ratio << "  ";
-    if (why) {
-      line << "failed: " << *why;
-      solution_ = continuation_reference_;
-      ratio *= settings_.continuation_increase;
-      if (++failures > settings_.continuation_max_failures) k = settings_.continuation_steps;
-    } else {
-      const double residual = free_residual_at(solution_);  // the step's own equations
-      line << "converged, residual of the step " << residual << " N";
-      ratio *= std::clamp(residual / last_residual, 1.0 / settings_.continuation_decrease, 1.0);
-      last_residual = residual;
-      near = residual <= std::max(stall_acceptance_floor_N_, settings_.absolute_residual_floor_N);
-    }
+    line << "  pseudo-step " << k << "  ratio " << std::scientific << std::setprecision(2) << ratio << "  "
+         << (why ? "failed: " + *why : std::string("converged"));
     step.report.table.push_back(line.str());
     if (settings_.verbose) std::cout << "      " << line.str() << std::endl;
+    if (why) {
+      solution_ = continuation_reference_;
+      if (++failures > settings_.continuation_max_failures) break;
+      ratio *= settings_.continuation_increase;
+    } else {
+      ratio /= settings_.continuation_decrease;
+    }
   }
+  continuation_ratio_ = 0.0;
   ++step.report.continuation_steps;
-  if (ratio >= settings_.continuation_final_ratio && !near)
+  if (ratio >= settings_.continuation_final_ratio)
     return plain_failure + "; pseudo-transient continuation did not reach the step's equilibrium either";
   step.report.table.push_back("  plain Newton from the continued state");
   if (const Failure why = newton(step, settings_.max_newton_iterations))

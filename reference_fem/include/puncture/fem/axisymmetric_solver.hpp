@@ -120,11 +120,11 @@ struct AxisymmetricSettings {
   /// Pseudo-transient continuation of a step plain Newton cannot solve
   /// (solve_step; 0 pseudo-steps: off, the step fails at once): a viscous
   /// stress ratio x 2 mu_0 sym(H - H_k) on each pseudo-step's change, the
-  /// ratio from initial down with the step's residual (by at most `decrease`
-  /// per converged pseudo-step), up by `increase` per failed one (at most
-  /// max_failures), until below final, where plain Newton finishes the step.
-  /// A pseudo-step gets at most continuation_max_iterations iterations.
-  int continuation_steps = 80;
+  /// ratio from initial down by `decrease` per converged pseudo-step, up by
+  /// `increase` per failed one (at most max_failures), until below final,
+  /// where plain Newton finishes the step. A pseudo-step gets at most
+  /// continuation_max_iterations iterations.
+  int continuation_steps = 60;
   int continuation_max_iterations = 15;  ///< per pseudo-step (a harder one raises the ratio)
   double continuation_initial_ratio = 1.0;
   double continuation_final_ratio = 1e-4;
