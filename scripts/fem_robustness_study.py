@@ -78,6 +78,20 @@ def median(v):
     return float("nan") if n == 0 else (v[n // 2] if n % 2 else 0.5 * (v[n // 2 - 1] + v[n // 2]))
 
 
+def force_parts(out, scene):
+    """(peak |force|, largest |tip part|, largest |cutting part|) of a run's
+    curve in OUT/runs/<scene>/, or None when the run left no curve."""
+    path = os.path.join(out, "runs", scene, "fem_force_depth.csv")
+    if not os.path.exists(path):
+        return None
+    rows = fr.read_force_depth(path)
+    if not rows or "tip_force_N" not in rows[0]:
+        return None
+    def biggest(key):
+        return max(abs(float(r[key])) for r in rows)
+    return biggest("force_N"), biggest("tip_force_N"), biggest("cutting_force_N")
+
+
 def page(records, args, command):
     ok = [r for r in records if r["exit"] == 0 and not r["problems"]]
     failed = [r for r in records if r["exit"] != 0]
@@ -116,6 +130,18 @@ def page(records, args, command):
             lines.append(f"| {r['scene']} | error | {r['error']} |")
         for r in wrong:
             lines.append(f"| {r['scene']} | inconsistent | {'; '.join(r['problems'])} |")
+        lines.append("")
+    parts = [(r["scene"],) + fp for r in records if (fp := force_parts(args.out, r["scene"]))]
+    swings = [q for q in parts if max(q[2], q[3]) > 2.0 * q[1]]
+    if parts:
+        lines += ["## The force's parts (not among the checks above)", "",
+                  f"In {len(swings)} of {len(parts)} runs with a curve, the tip part (`tip_force_N`) or the "
+                  "cutting part (`cutting_force_N`) exceeds twice the run's peak needle force at some row: the two "
+                  "swing to large values of opposite sign whose sum is the needle force (the total is the "
+                  "equilibrium's; the split between the flank's and the core wall's contact is not physical there). "
+                  "Calibration terms that read the parts are not to be trusted on such scenes.", "",
+                  "| scene | peak force N | largest tip part N | largest cutting part N |", "|---|---|---|---|"]
+        lines += [f"| {q[0]} | {q[1]:.3g} | {q[2]:.3g} | {q[3]:.3g} |" for q in swings]
         lines.append("")
     lines += ["## Every scene", "",
               "Scene files in `scenes/`; `puncture fem scenes/<scene>.json` runs one again.", "",
