@@ -16,22 +16,6 @@ namespace {
 
 constexpr double kMm = 1e-3;
 
-std::string read_file_bytes(const std::filesystem::path& path) {
-  try {
-    return io::read_text_file(path);
-  } catch (const std::runtime_error& e) {
-    throw CurveFormatError(path.string(), 0, "", e.what());
-  }
-}
-
-io::CsvDocument parse_document(const std::string& text, const std::string& source_name) {
-  try {
-    return io::parse_csv(text, source_name);
-  } catch (const io::CsvFormatError& e) {
-    throw CurveFormatError(e.source(), e.line(), e.column(), e.reason());
-  }
-}
-
 bool parse_state(const std::string& text, LayerState& state) {
   if (text == "untouched") state = LayerState::Untouched;
   else if (text == "pressed") state = LayerState::Pressed;
@@ -152,7 +136,7 @@ void velocity_from_phases(InsertionCurve& curve) {
 InsertionCurve parse_insertion_curve(const std::string& text, const std::string& source_name) {
   InsertionCurve curve;
   curve.source = source_name;
-  const io::CsvDocument doc = parse_document(text, source_name);
+  const io::CsvDocument doc = parse_curve_csv(text, source_name);
   curve.metadata = doc.metadata_map();
   const CurveColumns columns = curve_columns(doc, source_name, curve);
   curve.has_time = columns.time >= 0;
@@ -167,10 +151,26 @@ InsertionCurve parse_insertion_curve(const std::string& text, const std::string&
 }
 
 InsertionCurve read_insertion_curve(const std::filesystem::path& path) {
-  const std::string bytes = read_file_bytes(path);
+  const std::string bytes = read_curve_file_bytes(path);
   InsertionCurve c = parse_insertion_curve(bytes, path.string());
   c.content_hash = io::fnv1a64_hex(bytes);
   return c;
+}
+
+std::string read_curve_file_bytes(const std::filesystem::path& path) {
+  try {
+    return io::read_text_file(path);
+  } catch (const std::runtime_error& e) {
+    throw CurveFormatError(path.string(), 0, "", e.what());
+  }
+}
+
+io::CsvDocument parse_curve_csv(const std::string& text, const std::string& source_name) {
+  try {
+    return io::parse_csv(text, source_name);
+  } catch (const io::CsvFormatError& e) {
+    throw CurveFormatError(e.source(), e.line(), e.column(), e.reason());
+  }
 }
 
 }  // namespace puncture::validation

@@ -11,29 +11,13 @@
 #include "puncture/io/csv_reader.hpp"
 #include "puncture/io/csv_writer.hpp"
 #include "puncture/validation/puncture_events.hpp"
+#include "puncture/validation/recording.hpp"
 
 namespace puncture::validation {
 
 namespace {
 
 constexpr double kMm = 1e-3;
-
-// The surface-profile reader's file and CSV errors as CurveFormatError (as curve_reader.cpp does).
-std::string read_file_bytes(const std::filesystem::path& path) {
-  try {
-    return io::read_text_file(path);
-  } catch (const std::runtime_error& e) {
-    throw CurveFormatError(path.string(), 0, "", e.what());
-  }
-}
-
-io::CsvDocument parse_document(const std::string& text, const std::string& source_name) {
-  try {
-    return io::parse_csv(text, source_name);
-  } catch (const io::CsvFormatError& e) {
-    throw CurveFormatError(e.source(), e.line(), e.column(), e.reason());
-  }
-}
 
 std::string describe_time(const InsertionCurve& c, std::size_t i) {
   std::ostringstream s;
@@ -294,7 +278,7 @@ DeflectionProfileError deflection_profile_error(const std::vector<double>& ring_
 }
 
 std::vector<RadialProfile> parse_surface_profiles(const std::string& text, const std::string& source_name) {
-  const io::CsvDocument doc = parse_document(text, source_name);
+  const io::CsvDocument doc = parse_curve_csv(text, source_name);
   const std::size_t c_step = doc.require_column("step"), c_depth = doc.require_column("depth_mm"),
                     c_r = doc.require_column("r_mm"), c_uz = doc.require_column("uz_mm");
   std::vector<RadialProfile> out;
@@ -326,7 +310,7 @@ std::vector<RadialProfile> parse_surface_profiles(const std::string& text, const
 }
 
 std::vector<RadialProfile> read_surface_profiles(const std::filesystem::path& path) {
-  return parse_surface_profiles(read_file_bytes(path), path.string());
+  return parse_surface_profiles(read_curve_file_bytes(path), path.string());
 }
 
 const RadialProfile& profile_nearest_depth(const std::vector<RadialProfile>& profiles, double depth_m) {

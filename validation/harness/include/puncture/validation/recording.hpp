@@ -76,6 +76,11 @@ namespace puncture::validation {
 
 InsertionCurve read_insertion_curve(const std::filesystem::path& path);
 InsertionCurve parse_insertion_curve(const std::string& text, const std::string& source_name);
+/// A curve file's bytes, and its text parsed as CSV; either problem as a
+/// CurveFormatError naming the file (and line and column). Shared by the
+/// curve and surface-profile readers.
+std::string read_curve_file_bytes(const std::filesystem::path& path);
+io::CsvDocument parse_curve_csv(const std::string& text, const std::string& source_name);
 
 /// A raw recording or its format that cannot be read (bad input): the message
 /// starts with the file and names the field or column.
