@@ -17,7 +17,10 @@ check_run(out_dir) -> list of str
     (the shaft meets tissue only through a cut); (2) a large force drop during
     insertion with no layer changing state near it; (3) a layer punctured
     before the one above it, or a state going back; (4) the summary's
-    punctures not those of the state columns. Empty: consistent.
+    punctures not those of the state columns; (5) where the curve has the
+    force's parts, a cutting part below zero or above the force beyond
+    friction (the parts must split the total, not swing past it). Empty:
+    consistent.
 
 The thresholds (CHECKS) are in N and mm and stated on the results page.
 """
@@ -51,6 +54,8 @@ CHECKS = {
     # (2) a drop of the force over at most drop_window_mm of insertion, above
     # both, with no state change within state_window_mm of it
     "drop_N": 0.2, "drop_share": 0.15, "drop_window_mm": 1.5, "state_window_mm": 1.0,
+    # (5) the parts within the total, to this tolerance (the CSV's rounding)
+    "parts_tolerance_N": 1e-6,
 }
 
 
@@ -192,6 +197,15 @@ def check_run(out_dir, layer_names=None):
                 problems.append(f"{layer_names[i]} punctured at {depth[k]:.3g} mm before a layer above it")
         if len(problems) > 4:
             break
+    # (5) the cutting part within [0, force - friction].
+    if rows and "cutting_force_N" in rows[0]:
+        tol = c["parts_tolerance_N"]
+        for k, r in enumerate(rows):
+            cut = float(r["cutting_force_N"])
+            if cut < -tol or cut > max(0.0, force[k] - friction[k]) + tol:
+                problems.append(f"cutting part {cut:.3g} N at {depth[k]:.3g} mm ({phase[k]}) outside "
+                                f"[0, force - friction = {force[k] - friction[k]:.3g} N]")
+                break
     # (4) the summary's punctures are the state columns'.
     punctured = [layer_names[i] for i in range(len(layer_names)) if states[-1][i] == 2]
     listed = [p["name"] for p in summary.get("punctures", [])]

@@ -65,6 +65,9 @@ def run_one(scene, out, binary, threads):
         rec.update({"load_steps": s.get("load_steps"), "step_cuts": s.get("step_cuts"),
                     "accepted_at_stall": s.get("steps_accepted_at_stall"), "continued": s.get("steps_continued"),
                     "newton_iterations": s.get("newton_iterations"), "status": s.get("status"),
+                    "last_resort": s.get("steps_accepted_last_resort", 0),
+                    "largest_residual_share": (s.get("largest_accepted_residual_N", 0.0) /
+                                               max(s.get("peak_force_N") or 0.0, 1e-300)),
                     "punctures": [(e["name"], round(e["depth_mm"], 3), round(e["force_N"], 4))
                                   for e in s.get("punctures", [])]})
         rec["problems"] = fr.check_run(run_dir)
@@ -78,18 +81,19 @@ def median(v):
     return float("nan") if n == 0 else (v[n // 2] if n % 2 else 0.5 * (v[n // 2 - 1] + v[n // 2]))
 
 
-def force_parts(out, scene):
-    """(peak |force|, largest |tip part|, largest |cutting part|) of a run's
-    curve in OUT/runs/<scene>/, or None when the run left no curve."""
-    path = os.path.join(out, "runs", scene, "fem_force_depth.csv")
+def released_share(out, scene):
+    """The share of a run's crack dissipation that came from energy the
+    tissue had stored (crack_energy_released_J / cohesive_dissipation_J of
+    OUT/runs/<scene>/fem_summary.json), or None."""
+    path = os.path.join(out, "runs", scene, "fem_summary.json")
     if not os.path.exists(path):
         return None
-    rows = fr.read_force_depth(path)
-    if not rows or "tip_force_N" not in rows[0]:
+    with open(path) as f:
+        s = json.load(f)
+    total = s.get("cohesive_dissipation_J") or 0.0
+    if "crack_energy_released_J" not in s or total <= 0.0:
         return None
-    def biggest(key):
-        return max(abs(float(r[key])) for r in rows)
-    return biggest("force_N"), biggest("tip_force_N"), biggest("cutting_force_N")
+    return s["crack_energy_released_J"] / total
 
 
 def page(records, args, command):
@@ -114,14 +118,19 @@ def page(records, args, command):
         "",
         f"Wall time per run: median {median(walls):.0f} s, max {max(walls) if walls else float('nan'):.0f} s. "
         f"Load-step cuts: {sum(cuts)} in all, at most {max(cuts) if cuts else 0} in one run, "
-        f"{sum(1 for c in cuts if c)} run(s) with any.",
+        f"{sum(1 for c in cuts if c)} run(s) with any. "
+        f"Steps accepted by the last resort (a stall below 0.5 % of the peak force at 1/256 of the load step, "
+        f"reference_fem/README.md): {sum(r.get('last_resort') or 0 for r in records)} in "
+        f"{sum(1 for r in records if r.get('last_resort'))} run(s); the largest residual any accepted step left: "
+        f"{100 * max([r.get('largest_residual_share') or 0.0 for r in records] + [0.0]):.2g} % of its run's peak force.",
         "",
         "Checks, from each run's fem_force_depth.csv and fem_summary.json alone (thresholds `CHECKS`):",
         f"shaft friction above {fr.CHECKS['intact_friction_N']} N and {fr.CHECKS['intact_friction_share']:.0%} "
         "of the force while no layer is punctured; a force drop during insertion of more than "
         f"{fr.CHECKS['drop_N']} N and {fr.CHECKS['drop_share']:.0%} within {fr.CHECKS['drop_window_mm']} mm "
         f"with no layer changing state within {fr.CHECKS['state_window_mm']} mm; a layer punctured before "
-        "the one above it or a state going back; the summary's punctures not those of the state columns.",
+        "the one above it or a state going back; the summary's punctures not those of the state columns; "
+        "a cutting part below zero or above the force beyond friction.",
         "",
     ]
     if failed or wrong:
@@ -131,18 +140,13 @@ def page(records, args, command):
         for r in wrong:
             lines.append(f"| {r['scene']} | inconsistent | {'; '.join(r['problems'])} |")
         lines.append("")
-    parts = [(r["scene"],) + fp for r in records if (fp := force_parts(args.out, r["scene"]))]
-    swings = [q for q in parts if max(q[2], q[3]) > 2.0 * q[1]]
-    if parts:
-        lines += ["## The force's parts (not among the checks above)", "",
-                  f"In {len(swings)} of {len(parts)} runs with a curve, the tip part (`tip_force_N`) or the "
-                  "cutting part (`cutting_force_N`) exceeds twice the run's peak needle force at some row: the two "
-                  "swing to large values of opposite sign whose sum is the needle force (the total is the "
-                  "equilibrium's; the split between the flank's and the core wall's contact is not physical there). "
-                  "Calibration terms that read the parts are not to be trusted on such scenes.", "",
-                  "| scene | peak force N | largest tip part N | largest cutting part N |", "|---|---|---|---|"]
-        lines += [f"| {q[0]} | {q[1]:.3g} | {q[2]:.3g} | {q[3]:.3g} |" for q in swings]
-        lines.append("")
+    shares = [q for r in records if (q := released_share(args.out, r["scene"])) is not None]
+    if shares:
+        lines += ["## The cutting part and crack runs", "",
+                  "The cutting part of the force is the crack's dissipation per unit advance, at most the force "
+                  "beyond friction (reference_fem/README.md); what a crack run dissipates beyond that is energy "
+                  "the tissue had stored (`crack_energy_released_J`). Its share of the crack's dissipation: "
+                  f"median {100 * median(shares):.0f} %, max {100 * max(shares):.0f} % over {len(shares)} runs.", ""]
     lines += ["## Every scene", "",
               "Scene files in `scenes/`; `puncture fem scenes/<scene>.json` runs one again.", "",
               "| scene | tip | skin / fat / muscle mm | speed mm/s | target mm | hold s | wall s | steps | cuts | punctures (layer mm N) | outcome |",

@@ -29,6 +29,7 @@
 #endif
 
 #include <puncture/fem/axisymmetric_solver.hpp>
+#include <puncture/fem/cpu_affinity.hpp>
 #include <puncture/fem/field_output.hpp>
 #include <puncture/fem/needle_insertion.hpp>
 #include <puncture/io/pvd.hpp>
@@ -151,20 +152,6 @@ LayerLaws layer_laws(const Scene& scene, double crack_radius_m) {
   return laws;
 }
 
-/// Rank 0 solves while the other ranks sleep (share_outcome): let its
-/// assembly threads use every online core even where mpirun bound the rank to
-/// one (OpenMPI binds each rank to a core by default). Best effort: where the
-/// system refuses, the binding stays and the threads share that core.
-void widen_cpu_affinity() {
-#ifdef __linux__
-  const long n = ::sysconf(_SC_NPROCESSORS_ONLN);
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  for (long c = 0; c < n && c < CPU_SETSIZE; ++c) CPU_SET(static_cast<int>(c), &set);
-  (void)::sched_setaffinity(0, sizeof set, &set);
-#endif
-}
-
 /// Newton settings of the axisymmetric solver from the scene.
 AxisymmetricSettings solver_settings(const Scene& scene, int degree) {
   AxisymmetricSettings settings;
@@ -200,11 +187,16 @@ constexpr double kContinuationFraction = 1.0 / 64.0;
 /// force so far (the needle force is then exact to about that share): the
 /// kinks of contact, friction and damage where Newton cycles at millinewtons.
 constexpr double kStallAcceptanceOfPeak = 1e-3;
+/// The last resort before a run stops: a step at 1/256 of the planned one
+/// that neither Newton nor continuation brings below the floor above is solved
+/// once more accepting a stall below this share of the peak (half the 1 %
+/// the reference is held to). Where Coulomb friction holds a node on the
+/// crack line between stick and slip (withdrawal through the skin) Newton
+/// cycles at a few millinewtons; each such step is counted
+/// (steps_accepted_last_resort) and its residual reported.
+constexpr double kLastResortStallOfPeak = 5e-3;
 /// A crack point is open (cut) at this damage.
 constexpr double kCutDamage = 0.999;
-/// Consistency of the records (check_intact_friction, check_force_drops).
-constexpr double kIntactFrictionN = 0.1, kIntactFrictionShare = 0.25;
-constexpr double kDropN = 0.2, kDropShare = 0.15, kDropWindow_m = 1.5e-3, kStateWindow_m = 1.0e-3;
 
 AxisymmetricInsertionRun::AxisymmetricInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm,
                                                    FemRunSummary& summary)
@@ -318,7 +310,8 @@ std::optional<StepAdvance> AxisymmetricInsertionRun::advance_needle(std::size_t 
   const double d1 = from.depth_m + s * (goal.depth_m - from.depth_m);
   place_needle(d1);
   solver_.set_time_step(t1 - t0);
-  solver_.set_stall_acceptance_floor(kStallAcceptanceOfPeak * summary_.peak_force_N);
+  solver_.set_stall_acceptance_floor((last_resort_ ? kLastResortStallOfPeak : kStallAcceptanceOfPeak) *
+                                     summary_.peak_force_N);
   const double advance = d1 - d0;
   const double predictor = (last_advance_ != 0.0 && advance * last_advance_ > 0.0) ? advance / last_advance_ : 0.0;
   const double dissipated_before = solver_.cohesive_dissipation_J();
@@ -335,15 +328,19 @@ std::optional<StepAdvance> AxisymmetricInsertionRun::advance_needle(std::size_t 
   }
   ++step_index_;
   ++summary_.load_steps;
-  if (report.accepted_at_stall) ++summary_.steps_accepted_at_stall;
+  if (report.accepted_at_stall) {
+    ++summary_.steps_accepted_at_stall;
+    summary_.largest_accepted_residual_N = std::max(summary_.largest_accepted_residual_N, report.residual_N);
+  }
+  if (last_resort_) ++summary_.steps_accepted_last_resort;
+  last_resort_ = false;
   if (report.continuation_steps > 0) ++summary_.steps_continued;
   time_ = t1;
   depth_ = d1;
   last_advance_ = advance;
   fraction_ = std::min(1.0, 2.0 * fraction_);
-  const double dissipated = solver_.cohesive_dissipation_J();
-  const double cutting_N = advance > 0.0 ? (dissipated - dissipated_before) / advance : 0.0;
-  return StepAdvance{t0, advance, cutting_N, report.iterations};
+  return StepAdvance{t0, advance, cutting_force_N(advance, solver_.cohesive_dissipation_J() - dissipated_before),
+                     report.iterations};
 }
 
 // A failed step: halve it (stop with an error below 1/256 of the planned
@@ -353,10 +350,17 @@ void AxisymmetricInsertionRun::cut_step(const AxisymmetricNewtonReport& report, 
   ++summary_.step_cuts;
   records_.newton_log << "  -> " << report.failure << "; step cut\n";
   fraction_ *= 0.5;
+  if (fraction_ < kMinStepFraction && !last_resort_) {
+    last_resort_ = true;
+    fraction_ = kMinStepFraction;
+    records_.newton_log << "  -> last resort: the step again, accepting a stall below "
+                        << kLastResortStallOfPeak * summary_.peak_force_N << " N\n";
+  }
   if (fraction_ < kMinStepFraction) {
     std::ostringstream m;
-    m << "no convergence at tip depth " << d1 * 1e3 << " mm (" << phase << ") even with 1/256 of the load step: "
-      << report.failure;
+    m << "no convergence at tip depth " << d1 * 1e3 << " mm (" << phase
+      << ") even with 1/256 of the load step and a stall accepted below " << 100.0 * kLastResortStallOfPeak
+      << " % of the peak force: " << report.failure;
     throw std::runtime_error(m.str());
   }
   place_needle(d0);
@@ -465,52 +469,6 @@ bool AxisymmetricInsertionRun::crack_through_top(std::size_t i) const {
   return solver_.crack_front_depth_m(static_cast<int>(i), kCutDamage) >= top + margin - 1e-12;
 }
 
-// The records must not contradict the forces: the shaft meets tissue only
-// through a cut, so a friction force (beyond what the rounded shoulder picks
-// up at the top of a crack, kIntactFriction*) while no layer is punctured
-// means a cut the states missed. Stops the run (the outputs say "failed").
-void AxisymmetricInsertionRun::check_intact_friction() const {
-  if (std::find(states_.begin(), states_.end(), LayerState::Punctured) != states_.end()) return;
-  const Row& r = rows_.back();
-  if (std::abs(r.friction_N) <= std::max(kIntactFrictionN, kIntactFrictionShare * std::abs(r.force_N))) return;
-  std::ostringstream m;
-  m << "inconsistent puncture records at tip depth " << depth_ * 1e3 << " mm (" << r.phase << "): shaft friction "
-    << r.friction_N << " N of a needle force " << r.force_N
-    << " N while no layer is punctured (the shaft meets tissue only through a cut)";
-  throw std::runtime_error(m.str());
-}
-
-// A large fall of the force during insertion (from a local maximum, by more
-// than kDropN and kDropShare of it within kDropWindow) is a puncture: some
-// layer must change state within kStateWindow of it. Stops the run otherwise.
-void AxisymmetricInsertionRun::check_force_drops() const {
-  std::vector<std::size_t> ins;
-  for (std::size_t k = 0; k < rows_.size(); ++k)
-    if (rows_[k].phase == "insertion") ins.push_back(k);
-  std::vector<double> changes;
-  for (std::size_t k = 1; k < rows_.size(); ++k)
-    if (rows_[k].states != rows_[k - 1].states) changes.push_back(rows_[k].depth_m);
-  for (std::size_t n = 0; n < ins.size(); ++n) {
-    const Row& a = rows_[ins[n]];
-    const bool peak = (n == 0 || a.force_N >= rows_[ins[n - 1]].force_N) &&
-                      (n + 1 == ins.size() || a.force_N > rows_[ins[n + 1]].force_N);
-    if (!peak) continue;
-    const double limit = std::max(kDropN, kDropShare * a.force_N);
-    for (std::size_t m = n + 1; m < ins.size() && rows_[ins[m]].depth_m - a.depth_m <= kDropWindow_m; ++m) {
-      const Row& b = rows_[ins[m]];
-      if (a.force_N - b.force_N <= limit) continue;
-      const bool explained = std::any_of(changes.begin(), changes.end(), [&](double d) {
-        return d >= a.depth_m - kStateWindow_m && d <= b.depth_m + kStateWindow_m;
-      });
-      if (explained) break;
-      std::ostringstream msg;
-      msg << "inconsistent puncture records: the force falls from " << a.force_N << " N at " << a.depth_m * 1e3
-          << " mm to " << b.force_N << " N at " << b.depth_m * 1e3 << " mm and no layer changes state near it";
-      throw std::runtime_error(msg.str());
-    }
-  }
-}
-
 }  // namespace axisymmetric_insertion
 
 namespace {
@@ -595,6 +553,16 @@ FemRunSummary run_axisymmetric_insertion(const Scene& scene, const FemRunOptions
   share_outcome(comm, error, summary);
   if (!error.empty()) throw std::runtime_error(error);
   return summary;
+}
+
+void widen_cpu_affinity() {
+#ifdef __linux__
+  const long n = ::sysconf(_SC_NPROCESSORS_ONLN);
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (long c = 0; c < n && c < CPU_SETSIZE; ++c) CPU_SET(static_cast<int>(c), &set);
+  (void)::sched_setaffinity(0, sizeof set, &set);
+#endif
 }
 
 }  // namespace puncture::fem

@@ -1,9 +1,16 @@
 // axisymmetric_insertion_output.cc: what the axisymmetric insertion run records (each
-// step's row, energies, the layers' top profiles, frames) and writes (CSV files, PVD, the
+// step's row and its force's parts, energies, the layers' top profiles, frames), the
+// checks that the records agree with the forces, and what it writes (CSV files, PVD, the
 // summary JSON); the algorithm is in axisymmetric_insertion.cc.
 #include "axisymmetric_insertion_run.hpp"
 
 namespace puncture::fem::axisymmetric_insertion {
+
+namespace {
+/// Consistency of the records (check_intact_friction, check_force_drops).
+constexpr double kIntactFrictionN = 0.1, kIntactFrictionShare = 0.25;
+constexpr double kDropN = 0.2, kDropShare = 0.15, kDropWindow_m = 1.5e-3, kStateWindow_m = 1.0e-3;
+}  // namespace
 
 // Records a converged step: its row, every other step the pressed layer's
 // surface, a frame every frame_every steps, progress every 10 steps.
@@ -21,6 +28,69 @@ void AxisymmetricInsertionRun::record_step(const std::string& phase, const StepA
       << depth_ * 1e3 << " mm  force " << std::setprecision(4) << rows_.back().force_N << " N (friction "
       << rows_.back().friction_N << " N)  newton " << step.newton_iterations;
     log(m.str());
+  }
+}
+
+// The cutting part of the needle force over a step that advanced the tip by
+// advance_m and dissipated crack_J in the cohesive layer: the crack's
+// dissipation per unit advance, but no more than the needle's force beyond
+// friction at the step's end. In a crack run (the cut jumps ahead at a
+// puncture) the crack dissipates energy the tissue had stored, which the
+// needle paid for as tip work in earlier steps; that excess is counted in
+// crack_energy_released_J, so the cutting part never exceeds the needle force
+// and the tip part is never pushed below zero by it.
+double AxisymmetricInsertionRun::cutting_force_N(double advance_m, double crack_J) {
+  if (advance_m <= 0.0) return 0.0;
+  const NeedleForce f = solver_.needle_force();
+  const double beyond_friction_N = f.nodes_in_contact > 0 ? std::max(0.0, f.total_N - f.friction_N) : 0.0;
+  const double cutting_N = std::clamp(crack_J / advance_m, 0.0, beyond_friction_N);
+  summary_.crack_energy_released_J += std::max(0.0, crack_J - cutting_N * advance_m);
+  return cutting_N;
+}
+
+// The records must not contradict the forces: the shaft meets tissue only
+// through a cut, so a friction force (beyond what the rounded shoulder picks
+// up at the top of a crack, kIntactFriction*) while no layer is punctured
+// means a cut the states missed. Stops the run (the outputs say "failed").
+void AxisymmetricInsertionRun::check_intact_friction() const {
+  if (std::find(states_.begin(), states_.end(), LayerState::Punctured) != states_.end()) return;
+  const Row& r = rows_.back();
+  if (std::abs(r.friction_N) <= std::max(kIntactFrictionN, kIntactFrictionShare * std::abs(r.force_N))) return;
+  std::ostringstream m;
+  m << "inconsistent puncture records at tip depth " << depth_ * 1e3 << " mm (" << r.phase << "): shaft friction "
+    << r.friction_N << " N of a needle force " << r.force_N
+    << " N while no layer is punctured (the shaft meets tissue only through a cut)";
+  throw std::runtime_error(m.str());
+}
+
+// A large fall of the force during insertion (from a local maximum, by more
+// than kDropN and kDropShare of it within kDropWindow) is a puncture: some
+// layer must change state within kStateWindow of it. Stops the run otherwise.
+void AxisymmetricInsertionRun::check_force_drops() const {
+  std::vector<std::size_t> ins;
+  for (std::size_t k = 0; k < rows_.size(); ++k)
+    if (rows_[k].phase == "insertion") ins.push_back(k);
+  std::vector<double> changes;
+  for (std::size_t k = 1; k < rows_.size(); ++k)
+    if (rows_[k].states != rows_[k - 1].states) changes.push_back(rows_[k].depth_m);
+  for (std::size_t n = 0; n < ins.size(); ++n) {
+    const Row& a = rows_[ins[n]];
+    const bool peak = (n == 0 || a.force_N >= rows_[ins[n - 1]].force_N) &&
+                      (n + 1 == ins.size() || a.force_N > rows_[ins[n + 1]].force_N);
+    if (!peak) continue;
+    const double limit = std::max(kDropN, kDropShare * a.force_N);
+    for (std::size_t m = n + 1; m < ins.size() && rows_[ins[m]].depth_m - a.depth_m <= kDropWindow_m; ++m) {
+      const Row& b = rows_[ins[m]];
+      if (a.force_N - b.force_N <= limit) continue;
+      const bool explained = std::any_of(changes.begin(), changes.end(), [&](double d) {
+        return d >= a.depth_m - kStateWindow_m && d <= b.depth_m + kStateWindow_m;
+      });
+      if (explained) break;
+      std::ostringstream msg;
+      msg << "inconsistent puncture records: the force falls from " << a.force_N << " N at " << a.depth_m * 1e3
+          << " mm to " << b.force_N << " N at " << b.depth_m * 1e3 << " mm and no layer changes state near it";
+      throw std::runtime_error(msg.str());
+    }
   }
 }
 
@@ -135,9 +205,12 @@ nlohmann::json AxisymmetricInsertionRun::summary_json(const std::string& failure
             {"crack_radius_mm", mesh_.crack_radius_m * 1e3},
             {"elements_through_layer", mesh_.elements_through_layer},
             {"cohesive_dissipation_J", summary_.cohesive_dissipation_J},
+            {"crack_energy_released_J", summary_.crack_energy_released_J},
             {"stabilization_dissipation_J", summary_.stabilization_dissipation_J},
             {"needle_work_insertion_J", summary_.needle_work_J},
             {"steps_accepted_at_stall", summary_.steps_accepted_at_stall},
+            {"steps_accepted_last_resort", summary_.steps_accepted_last_resort},
+            {"largest_accepted_residual_N", summary_.largest_accepted_residual_N},
             {"steps_continued", summary_.steps_continued}});
   return j;
 }

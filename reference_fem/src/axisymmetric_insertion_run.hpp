@@ -90,6 +90,7 @@ class AxisymmetricInsertionRun {
   void check_intact_friction() const;
   void check_force_drops() const;
   void record(const std::string& phase, double velocity, double cutting_N);
+  double cutting_force_N(double advance_m, double crack_J);
   void add_energy_totals();
   void describe_model(MPI_Comm comm);
   void place_needle(double depth);
@@ -132,6 +133,7 @@ class AxisymmetricInsertionRun {
   // State of the walk.
   double depth_, time_ = 0.0;
   double fraction_ = 1.0;  // of the planned step, grows back after cuts
+  bool last_resort_ = false;  // the step is retried at 1/256 with the larger stall floor
   int step_index_ = 0;
   double last_advance_ = 0.0;  // depth change of the last converged step (for the predictor)
 };

@@ -102,6 +102,17 @@ TEST(AxisymmetricInsertion, SmallDefaultSlabPuncturesInOrderWithFrictionThatReve
   ASSERT_GT(r.needle_work_J, 0.0);
   EXPECT_LT(r.stabilization_dissipation_J, 0.02 * r.needle_work_J);
   EXPECT_GT(r.cohesive_dissipation_J, 0.0);
+  // The crack's dissipation is the cutting part's work over the advancing
+  // steps plus what crack runs released (stored energy, not needle force),
+  // plus what it dissipates while the needle holds or withdraws: so the
+  // first two sum to at most the whole.
+  double cutting_work_J = 0.0;
+  for (std::size_t k = 1; k < r.force_N.size(); ++k)
+    if (r.depth_m[k] > r.depth_m[k - 1]) cutting_work_J += r.cutting_force_N[k] * (r.depth_m[k] - r.depth_m[k - 1]);
+  EXPECT_GT(cutting_work_J, 0.0);
+  EXPECT_GE(r.crack_energy_released_J, 0.0);
+  EXPECT_LE(cutting_work_J + r.crack_energy_released_J, r.cohesive_dissipation_J * (1.0 + 1e-9));
+  EXPECT_LE(r.crack_energy_released_J, r.cohesive_dissipation_J);
 }
 
 TEST(AxisymmetricInsertion, WithoutFrictionTheWithdrawalForceIsNeverNegative) {

@@ -27,9 +27,8 @@
 
 #ifdef PUNCTURE_HAVE_FEM
 #include <deal.II/base/mpi.h>
-#include <sched.h>
-#include <unistd.h>
 
+#include "puncture/fem/cpu_affinity.hpp"
 #include "puncture/fem/needle_insertion.hpp"
 #endif
 
@@ -98,23 +97,6 @@ std::unique_ptr<dealii::Utilities::MPI::MPI_InitFinalize>& mpi_session() {
   return session;
 }
 
-/// mpirun binds every rank to one core (OpenMPI's default for two ranks or
-/// fewer). Rank 0 does all of a command's work after the FEM references, with
-/// two threads where it can (the optimisers, the held-out runs), while the
-/// other ranks wait asleep: let it use every online core. Best effort: where
-/// the system refuses, the binding stays. (The FEM solver widens its own
-/// affinity the same way when it solves; a run whose references all come from
-/// the cache would otherwise stay on one core.)
-void widen_cpu_affinity() {
-#ifdef __linux__
-  const long n = ::sysconf(_SC_NPROCESSORS_ONLN);
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  for (long c = 0; c < n && c < CPU_SETSIZE; ++c) CPU_SET(static_cast<int>(c), &set);
-  (void)::sched_setaffinity(0, sizeof set, &set);
-#endif
-}
-
 /// The ranks other than 0 have only helped with the FEM references; they
 /// wait here, asleep (a test every 20 ms), until rank 0 has done the rest of
 /// the command and releases them. Left to MPI_Finalize, OpenMPI's wait polls
@@ -157,7 +139,9 @@ void ensure_mpi() {
   mpi_session() = std::make_unique<dealii::Utilities::MPI::MPI_InitFinalize>(argc, argv, 1);
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  if (rank == 0) widen_cpu_affinity();
+  // Rank 0 does the command's work after the FEM references (the optimisers,
+  // the held-out runs) while the other ranks sleep.
+  if (rank == 0) puncture::fem::widen_cpu_affinity();
 #endif
 }
 

@@ -106,6 +106,10 @@ struct FemRunSummary {
   /// tolerance (AxisymmetricSettings::stall_acceptance_tolerance) rather than
   /// at the Newton tolerance.
   int steps_accepted_at_stall = 0;
+  /// Steps accepted only by the last resort (a stall below 0.5 % of the peak
+  /// force at 1/256 of the load step; axisymmetric reference).
+  int steps_accepted_last_resort = 0;
+  double largest_accepted_residual_N = 0.0;  ///< largest |R_free| of a step accepted at a stall (N)
   /// Steps plain Newton could not solve and pseudo-transient continuation did
   /// (axisymmetric reference).
   int steps_continued = 0;
@@ -124,13 +128,19 @@ struct FemRunSummary {
   std::vector<double> time_s, depth_m, force_N;  ///< the rows of the force-depth CSV
   /// Parts of force_N per row (axisymmetric geometry; 0 in 3D): friction on
   /// the shaft and flank, cutting (cohesive energy dissipated per unit tip
-  /// advance), tip (the rest: pressing and spreading the tissue).
+  /// advance, at most force_N - friction: see crack_energy_released_J), tip
+  /// (the rest: pressing and spreading the tissue).
   std::vector<double> tip_force_N, cutting_force_N, friction_force_N;
   std::vector<std::string> phase;  ///< per row: approach|insertion|dwell|withdrawal
   /// Per row, each layer's state: untouched|pressed|punctured (axisymmetric geometry).
   std::vector<std::vector<std::string>> layer_states;
   std::string geometry = "3d";
   double cohesive_dissipation_J = 0.0;  ///< energy dissipated by the crack (J)
+  /// The part of the crack's dissipation in insertion steps that exceeded the
+  /// needle's work beyond friction in the step (J): energy stored in the
+  /// tissue and released by a crack run (the cut jumping ahead at a
+  /// puncture), not counted in the cutting part.
+  double crack_energy_released_J = 0.0;
   /// Energy dissipated by the numerical (Kelvin-Voigt) stabilisation (J); to
   /// be compared with the needle's work, of which it should be a small share.
   double stabilization_dissipation_J = 0.0;
