@@ -25,10 +25,13 @@ check_run(out_dir) -> list of str
 The thresholds (CHECKS) are in N and mm and stated on the results page.
 """
 import copy
-import csv
 import json
 import math
 import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import results_io  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 
@@ -136,9 +139,7 @@ def blunt(s, rng):
 
 
 def read_force_depth(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
-    return rows
+    return results_io.read_csv_rows(path)
 
 
 def check_run(out_dir, layer_names=None):

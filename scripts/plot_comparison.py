@@ -10,28 +10,17 @@ Out: DIR/force_depth.png       force against depth of every model and the FEM
      DIR/skin_deflection.png   skin surface deflection against the distance from
                                the needle, every model and the FEM, at one depth
 """
-import csv
 import math
 import os
 import sys
 
-import matplotlib
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from results_io import number as num, pareto_front, read_csv_rows as read_rows, save_figure  # noqa: E402
+
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-
-def read_rows(path):
-    with open(path, newline="") as f:
-        lines = [l for l in f if not l.startswith("#")]
-    return list(csv.DictReader(lines))
-
-
-def num(text):
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return math.nan
 
 
 def phases(rows):
@@ -71,7 +60,7 @@ def plot_force_depth(d, models):
     zoom.set_ylim(-0.2 * fem_peak, 3.0 * fem_peak)
     ax.legend(fontsize=7, ncol=2)
     fig.tight_layout()
-    fig.savefig(os.path.join(d, "force_depth.png"), dpi=120)
+    save_figure(fig, os.path.join(d, "force_depth.png"), dpi=120)
     plt.close(fig)
 
 
@@ -86,10 +75,7 @@ def plot_pareto(d, rows):
     for t, e, m in pts:
         ax.plot(t, max(e, 1e-4), "o")
         ax.annotate(m, (t, max(e, 1e-4)), fontsize=7, xytext=(4, 3), textcoords="offset points")
-    front = []
-    for t, e, m in sorted(pts):
-        if not front or e < front[-1][1]:
-            front.append((t, e))
+    front = pareto_front(pts)
     if front:
         ax.step([p[0] for p in front], [max(p[1], 1e-4) for p in front], where="post", color="grey", lw=0.8,
                 label="Pareto front")
@@ -102,7 +88,7 @@ def plot_pareto(d, rows):
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(os.path.join(d, "pareto.png"), dpi=120)
+    save_figure(fig, os.path.join(d, "pareto.png"), dpi=120)
     plt.close(fig)
 
 
@@ -132,7 +118,7 @@ def plot_deflection(d):
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, ncol=2)
     fig.tight_layout()
-    fig.savefig(os.path.join(d, "skin_deflection.png"), dpi=120)
+    save_figure(fig, os.path.join(d, "skin_deflection.png"), dpi=120)
     plt.close(fig)
 
 

@@ -8,20 +8,21 @@ and FEM_DIR/fem_force_depth.csv if given. The note (e.g. command, machine,
 date) is printed under the plot so the figure says how it was made.
 """
 import argparse
-import csv
 import json
 import os
+import sys
 
-import matplotlib
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from results_io import read_csv_rows  # noqa: E402
+
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
 def read_csv(path):
-    with open(path, newline="") as f:
-        # Skip the provenance lines ("# key: value") before the header.
-        rows = list(csv.DictReader(l for l in f if not l.startswith("#")))
+    rows = read_csv_rows(path)
     if not rows:
         raise SystemExit(f"{path}: no rows")
     return rows

@@ -8,31 +8,24 @@ Out: DIR/pareto.png: force RMSE against the finest FEM versus time per step
      99th percentile; FEM: per load step), log axes, one marker series per
      knob, the non-dominated points joined.
 """
-import csv
 import math
 import os
 import sys
 
-import matplotlib
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from results_io import number as num, pareto_front, read_csv_rows as read_rows, save_figure  # noqa: E402
+
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-
-def num(text):
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return math.nan
 
 
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: plot_sweep.py SWEEP_DIR")
     d = sys.argv[1]
-    with open(os.path.join(d, "accuracy_cost.csv"), newline="") as f:
-        # Skip the provenance lines ("# key: value") before the header.
-        rows = [r for r in csv.DictReader(l for l in f if not l.startswith("#")) if r["status"] == "ok"]
+    rows = [r for r in read_rows(os.path.join(d, "accuracy_cost.csv")) if r["status"] == "ok"]
     points = []
     for r in rows:
         t, e = num(r["time_per_step_s"]), num(r["force_rmse_N"])
@@ -55,11 +48,7 @@ def main():
                 ax.plot([t, p99], [e, e], color=sc.get_facecolor()[0], lw=0.8, alpha=0.6)
         for t, e, r in sel:
             ax.annotate(r["value"], (t, e), fontsize=7, xytext=(3, 3), textcoords="offset points")
-    front, best = [], math.inf
-    for t, e, _ in sorted(points, key=lambda p: p[0]):
-        if e < best:
-            front.append((t, e))
-            best = e
+    front = pareto_front(points)
     if len(front) > 1:
         ax.plot([p[0] for p in front], [p[1] for p in front], "k--", lw=0.8, label="Pareto front")
     ax.set_xscale("log")
@@ -70,7 +59,7 @@ def main():
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(os.path.join(d, "pareto.png"), dpi=120)
+    save_figure(fig, os.path.join(d, "pareto.png"), dpi=120)
     plt.close(fig)
 
 

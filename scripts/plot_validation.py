@@ -8,28 +8,17 @@ Out: DIR/force_depth.png        force against depth, both models (insertion and 
                                  before and after breakthrough, both models
      DIR/layer_errors.png        per-layer force RMSE, puncture depth and force errors
 """
-import csv
 import math
 import os
 import sys
 
-import matplotlib
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from results_io import number as num, read_csv_rows as read_rows, save_figure  # noqa: E402
+
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-
-def read_rows(path):
-    with open(path, newline="") as f:
-        lines = [l for l in f if not l.startswith("#")]
-    return list(csv.DictReader(lines))
-
-
-def num(text):
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return math.nan
 
 
 def insertion(rows):
@@ -68,7 +57,7 @@ def plot_force_depth(d):
     ax.grid(alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    fig.savefig(os.path.join(d, "force_depth.png"), dpi=120)
+    save_figure(fig, os.path.join(d, "force_depth.png"), dpi=120)
     plt.close(fig)
 
 
@@ -96,7 +85,7 @@ def plot_profiles(d):
             if ax.lines:
                 ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(os.path.join(d, "deflection_profiles.png"), dpi=110)
+    save_figure(fig, os.path.join(d, "deflection_profiles.png"), dpi=110)
     plt.close(fig)
 
 
@@ -119,7 +108,7 @@ def plot_layer_errors(d):
         ax.grid(axis="y", alpha=0.3)
     fig.suptitle("Per-layer errors (real-time minus FEM)")
     fig.tight_layout()
-    fig.savefig(os.path.join(d, "layer_errors.png"), dpi=110)
+    save_figure(fig, os.path.join(d, "layer_errors.png"), dpi=110)
     plt.close(fig)
 
 

@@ -3,7 +3,15 @@ never finds a half-written one (write to a temporary name, then rename).
 
 write_text(path, text): the text file at path.
 save_figure(fig, path, dpi=120): a matplotlib figure as the PNG at path.
+And how it reads the project's CSV outputs:
+read_csv_rows(path): the rows (dicts by column name) of a CSV whose
+    provenance lines ("# key: value") come before the header.
+number(text): the float in a CSV cell, NaN where it is empty or not a number.
+pareto_front(points): of (cost, error, ...) tuples, the (cost, error) pairs no
+    other point beats in both, cheapest first (the accuracy-cost plots).
 """
+import csv
+import math
 import os
 
 
@@ -18,3 +26,23 @@ def save_figure(fig, path, dpi=120):
     tmp = path + ".part.png"
     fig.savefig(tmp, dpi=dpi)
     os.replace(tmp, path)
+
+
+def read_csv_rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(line for line in f if not line.startswith("#")))
+
+
+def number(text):
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def pareto_front(points):
+    front = []
+    for p in sorted(points, key=lambda q: (q[0], q[1])):
+        if not front or p[1] < front[-1][1]:
+            front.append((p[0], p[1]))
+    return front
