@@ -15,7 +15,9 @@
 
 namespace {
 std::atomic<bool> counting{false};
+thread_local bool thread_counting = false;
 std::atomic<long> allocations{0};
+inline bool counts() { return thread_counting || counting.load(std::memory_order_relaxed); }
 }  // namespace
 
 #ifdef PUNCTURE_ASAN
@@ -26,7 +28,7 @@ extern "C" int __sanitizer_install_malloc_and_free_hooks(void (*malloc_hook)(con
 
 namespace {
 void on_malloc(const volatile void*, std::size_t) {
-  if (counting.load(std::memory_order_relaxed)) ++allocations;
+  if (counts()) ++allocations;
 }
 void on_free(const volatile void*) {}
 const bool hooks_installed = [] {
@@ -48,15 +50,15 @@ void* __libc_realloc(void*, std::size_t);
 void __libc_free(void*);
 
 void* malloc(std::size_t n) {
-  if (counting.load(std::memory_order_relaxed)) ++allocations;
+  if (counts()) ++allocations;
   return __libc_malloc(n);
 }
 void* calloc(std::size_t n, std::size_t m) {
-  if (counting.load(std::memory_order_relaxed)) ++allocations;
+  if (counts()) ++allocations;
   return __libc_calloc(n, m);
 }
 void* realloc(void* p, std::size_t n) {
-  if (counting.load(std::memory_order_relaxed)) ++allocations;
+  if (counts()) ++allocations;
   return __libc_realloc(p, n);
 }
 void free(void* p) { __libc_free(p); }
@@ -65,7 +67,7 @@ void free(void* p) { __libc_free(p); }
 // operator new goes to __libc_malloc directly, so an allocation by new is
 // counted once.
 void* operator new(std::size_t n) {
-  if (counting.load(std::memory_order_relaxed)) ++allocations;
+  if (counts()) ++allocations;
   if (void* p = __libc_malloc(n ? n : 1)) return p;
   throw std::bad_alloc();
 }
@@ -92,5 +94,9 @@ long stop_counting_allocations() {
   counting = false;
   return allocations.load();
 }
+
+void count_this_threads_allocations(bool on) { thread_counting = on; }
+void reset_allocation_count() { allocations = 0; }
+long allocation_count() { return allocations.load(); }
 
 }  // namespace puncture::test

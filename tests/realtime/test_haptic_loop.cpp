@@ -21,57 +21,38 @@
 #include "puncture/realtime/pointer_device.hpp"
 #include "puncture/realtime/scripted_device.hpp"
 #include "puncture/realtime/udp_device.hpp"
+#include "../core/allocation_counter.hpp"
 #include "realtime_test_scenes.hpp"
-
-// Allocation counters: only allocations made by a thread that set `counting` count.
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void __libc_free(void*);
-}
-namespace {
-thread_local bool counting = false;
-std::atomic<long> allocations{0};
-}  // namespace
-extern "C" {
-void* malloc(std::size_t n) {
-  if (counting) ++allocations;
-  return __libc_malloc(n);
-}
-void* calloc(std::size_t n, std::size_t m) {
-  if (counting) ++allocations;
-  return __libc_calloc(n, m);
-}
-void* realloc(void* p, std::size_t n) {
-  if (counting) ++allocations;
-  return __libc_realloc(p, n);
-}
-void free(void* p) { __libc_free(p); }
-}
-void* operator new(std::size_t n) {
-  if (counting) ++allocations;
-  if (void* p = __libc_malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { __libc_free(p); }
-void operator delete[](void* p) noexcept { __libc_free(p); }
-void operator delete(void* p, std::size_t) noexcept { __libc_free(p); }
-void operator delete[](void* p, std::size_t) noexcept { __libc_free(p); }
 
 namespace puncture::realtime {
 namespace {
 
 namespace fs = std::filesystem;
 
-TEST(HapticLoop, CountersSeeAnAllocation) {
-  counting = true;
-  auto* v = new std::vector<int>(10);
-  counting = false;
+TEST(HapticLoop, CountersSeeThisThreadsAllocationsOnly) {
+  using namespace puncture::test;
+  // Another thread allocating while this one counts is not counted.
+  std::atomic<bool> go{false}, done{false};
+  std::thread other([&] {
+    while (!go.load()) std::this_thread::yield();
+    int* volatile p = new int(1);
+    delete p;
+    done = true;
+  });
+  reset_allocation_count();
+  count_this_threads_allocations(true);
+  go = true;
+  while (!done.load()) std::this_thread::yield();
+  count_this_threads_allocations(false);
+  other.join();
+  EXPECT_EQ(allocation_count(), 0);
+  // This thread's own allocation is.
+  count_this_threads_allocations(true);
+  std::vector<int>* volatile v = new std::vector<int>(10);
+  count_this_threads_allocations(false);
   delete v;
-  EXPECT_GE(allocations.load(), 2);  // the instrument works
-  allocations = 0;
+  EXPECT_GE(allocation_count(), 1);  // the instrument works
+  reset_allocation_count();
 }
 
 /// One whole scripted cycle, a fresh-tissue swap and the next insertion with a
@@ -97,11 +78,11 @@ void expect_no_allocation_in_the_haptic_path(const std::string& text, const std:
   while (models.models_built() < 2) std::this_thread::sleep_for(std::chrono::milliseconds(5));
 
   std::int64_t n = 0;
-  allocations = 0;
-  counting = true;
+  puncture::test::reset_allocation_count();
+  puncture::test::count_this_threads_allocations(true);
   for (; n < 1400; ++n) loop.step(n, n * dt);  // one whole cycle, a swap, and the next insertion
-  counting = false;
-  EXPECT_EQ(allocations.load(), 0);
+  puncture::test::count_this_threads_allocations(false);
+  EXPECT_EQ(puncture::test::allocation_count(), 0);
   EXPECT_EQ(loop.counters().fresh_tissues, 1);
   EXPECT_EQ(loop.counters().held_ticks, 0);
   EXPECT_EQ(loop.counters().snapshots, 1400);
@@ -145,7 +126,7 @@ TEST(HapticLoop, NoAllocationWithTheUdpAndMouseDevices) {
   for (HapticDevice* device : {static_cast<HapticDevice*>(&udp), static_cast<HapticDevice*>(&mouse)}) {
     HapticLoop loop(scene, models, *device, ForceGuard(scene.haptics, dt), HapticLoopOptions{}, HapticLoopSinks{});
     mouse.set_target(Eigen::Vector3d(0.0, 0.0, -0.003));  // the view thread's part (allocation-free too)
-    allocations = 0;
+    puncture::test::reset_allocation_count();
     for (std::int64_t n = 0; n < 600; ++n) {
       udp::PoseMessage m;
       m.sequence = static_cast<std::uint32_t>(n + 1);
@@ -153,11 +134,11 @@ TEST(HapticLoop, NoAllocationWithTheUdpAndMouseDevices) {
       std::uint8_t b[udp::kPoseSize];
       udp::encode(m, b);
       ::sendto(fd, b, sizeof b, 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
-      counting = true;
+      puncture::test::count_this_threads_allocations(true);
       loop.step(n, n * dt);
-      counting = false;
+      puncture::test::count_this_threads_allocations(false);
     }
-    EXPECT_EQ(allocations.load(), 0) << device->name();
+    EXPECT_EQ(puncture::test::allocation_count(), 0) << device->name();
     EXPECT_GT(loop.counters().model_ticks, 0);
   }
   ::close(fd);
