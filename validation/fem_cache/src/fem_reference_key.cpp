@@ -1,11 +1,14 @@
 // fem_reference_key.cpp: see fem_reference_key.hpp.
 #include "puncture/validation/fem_reference_key.hpp"
 
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 
 #include "puncture/io/content_hash.hpp"
 #include "puncture/io/provenance.hpp"
 #include "puncture/scene_io.hpp"
+#include "puncture/scene_schema.hpp"
 
 namespace puncture::validation {
 
@@ -43,25 +46,30 @@ void erase_pattern(json& node, const std::vector<std::string>& pattern, std::siz
 }  // namespace
 
 const std::vector<std::string>& realtime_only_fields() {
-  // Everything else in the canonical scene JSON is read by the FEM or may
-  // be: a field absent from this list is part of the key.
-  static const std::vector<std::string> fields{
-      "/name",                        // labels only (the cached summary names the scene that made it)
-      "/description",
-      "/layers/*/density_kg_per_m3",  // the FEM is quasi-static
-      "/layers/*/force_mesh",         // K, w, L, surface stiffness, threshold, node damping
-      "/layers/*/damping_d_N_s_per_m2",
-      "/layers/*/resumption_time_s",
-      "/layers/*/force_law",          // breakthrough, stiffening, cutting, friction of the real-time law
-      "/layers/*/material/source",    // provenance text
-      "/layers/*/material/viscoelastic/source",
-      "/layers/*/puncture/source",
-      "/layers/*/shaft_friction/source",
-      "/realtime",
-      "/effects",
-      "/haptics",
-      "/comparison",                  // the comparison models' tetrahedral mesh and integrator
-  };
+  // From the schema's `fem` column: each field the FEM does not read, widened
+  // to the largest block above it that holds no field the FEM reads.
+  static const std::vector<std::string> fields = [] {
+    const std::vector<SceneField>& schema = scene_schema();
+    auto all_realtime_only_under = [&](const std::string& block) {
+      return std::none_of(schema.begin(), schema.end(), [&](const SceneField& f) {
+        return f.fem && f.path.compare(0, block.size() + 1, block + "/") == 0;
+      });
+    };
+    std::vector<std::string> out;
+    for (const SceneField& f : schema) {
+      if (f.fem || !f.written) continue;
+      std::string subtree = f.path;
+      for (std::size_t cut = f.path.find('/', 1); cut != std::string::npos; cut = f.path.find('/', cut + 1)) {
+        const std::string block = f.path.substr(0, cut);
+        if (block.back() != '*' && all_realtime_only_under(block)) {
+          subtree = block;
+          break;
+        }
+      }
+      if (std::find(out.begin(), out.end(), subtree) == out.end()) out.push_back(subtree);
+    }
+    return out;
+  }();
   return fields;
 }
 

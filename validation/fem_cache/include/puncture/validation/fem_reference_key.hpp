@@ -7,8 +7,8 @@
 // options (refinement / degree overrides applied to the scene's fem block, the
 // 3D hex mesh options), the program version, a digest of the FEM and mesh
 // sources and the key format. So a field that is added to the scene enters the
-// key unless someone declares it real-time-only in realtime_only_fields()
-// (which a test checks against the `fem` column of scene_schema.hpp); a
+// key unless scene_schema.hpp's `fem` column says the FEM does not read it
+// (realtime_only_fields() is derived from that column); a
 // test (tests/validation/test_fem_reference_key.cpp) perturbs every leaf of
 // the default scene and runs the FEM with every real-time-only field changed
 // to show that those fields leave the FEM's result as it was.
@@ -40,7 +40,10 @@ struct FemKeyOptions {
 };
 
 /// JSON pointers (RFC 6901, "*" for any array index) of the canonical scene's
-/// fields that only the real-time model reads. Each removes the whole subtree.
+/// fields that only the real-time model reads, derived from scene_schema()'s
+/// `fem` column: each such field, or the largest block above it that holds no
+/// field the FEM reads (e.g. "/realtime", "/layers/*/force_mesh"). Each
+/// removes the whole subtree.
 const std::vector<std::string>& realtime_only_fields();
 
 /// True when `pointer` (e.g. "/layers/0/force_mesh/w") lies inside one of
