@@ -28,6 +28,7 @@
 #include "puncture/io/provenance.hpp"
 #include "puncture/io/provenance_json.hpp"
 #include "puncture/model/realtime_model.hpp"
+#include "puncture/realtime/device_registry.hpp"
 #include "puncture/realtime/force_guard.hpp"
 #include "puncture/realtime/haptic_loop.hpp"
 #include "puncture/realtime/model_supplier.hpp"
@@ -35,7 +36,6 @@
 #include "puncture/realtime/realtime_clock.hpp"
 #include "puncture/realtime/recording.hpp"
 #include "puncture/realtime/replay.hpp"
-#include "puncture/realtime/scripted_device.hpp"
 #include "puncture/realtime/session_report.hpp"
 #include "puncture/realtime/session_statistics.hpp"
 #include "puncture/realtime/udp_device.hpp"
@@ -229,27 +229,19 @@ struct DeviceChoice {
 };
 
 DeviceChoice make_device(const Options& o, const SessionScene& s, double dt) {
+  DeviceSetup setup;
+  setup.scene = &s.scene;
+  setup.tick_period_s = dt;
+  setup.repeat = !o.no_repeat;
+  setup.recording = s.recording ? &*s.recording : nullptr;
+  setup.udp.bind_address = o.udp_bind;
+  setup.udp.port = static_cast<std::uint16_t>(o.udp_port);
+  setup.udp.timeout_s = o.udp_timeout_s;
   DeviceChoice d;
-  if (o.device == "mouse") {
-    auto p = std::make_unique<PointerDevice>(s.scene, dt);
-    d.pointer = p.get();
-    d.device = std::move(p);
-  } else if (o.device == "scripted") {
-    d.device = std::make_unique<ScriptedDevice>(s.scene.insertion, dt, !o.no_repeat);
-  } else if (o.device == "replay") {
-    d.device = std::make_unique<ReplayDevice>(*s.recording);
-  } else if (o.device == "udp") {
-    UdpDeviceOptions u;
-    u.bind_address = o.udp_bind;
-    u.port = static_cast<std::uint16_t>(o.udp_port);
-    u.timeout_s = o.udp_timeout_s;
-    auto p = std::make_unique<UdpDevice>(u);
-    d.udp = p.get();
-    if (!o.quiet) std::cout << "[app] udp device listening on " << o.udp_bind << ":" << p->port() << "\n";
-    d.device = std::move(p);
-  } else {
-    throw std::runtime_error("unknown device '" + o.device + "'");
-  }
+  d.device = realtime::make_device(o.device, setup);
+  d.pointer = dynamic_cast<PointerDevice*>(d.device.get());
+  d.udp = dynamic_cast<UdpDevice*>(d.device.get());
+  if (d.udp && !o.quiet) std::cout << "[app] udp device listening on " << o.udp_bind << ":" << d.udp->port() << "\n";
   return d;
 }
 
@@ -518,8 +510,9 @@ int main(int argc, char** argv) {
   CLI::App app{"puncture-app: real-time needle puncture (1 kHz haptic thread, 60 Hz VTK view)"};
   app.add_option("scene", o.scene, "Scene or tuned preset (JSON); default: scenes/default.json "
                                    "(a replay uses the recorded scene)");
-  app.add_option("--device", o.device, "mouse (default), scripted, replay or udp")
-      ->check(CLI::IsMember({"mouse", "scripted", "replay", "udp"}));
+  std::string devices_help = "The needle device (realtime/README.md, devices):";
+  for (const DeviceEntry& e : registered_devices()) devices_help += "\n  " + e.name + ": " + e.description;
+  app.add_option("--device", o.device, devices_help + "\ndefault: mouse")->check(CLI::IsMember(device_names()));
   app.add_option("--recording", o.recording, "Recorded session to replay (--device replay), --verify or --export-csv");
   app.add_option("--record", o.record, "Record the session (every haptic tick) to this file");
   app.add_flag("--offscreen", o.offscreen, "Render without a window (under Xvfb in CI); needs --duration");
