@@ -8,6 +8,7 @@ import pytest
 
 import puncture
 from conftest import run_program
+from synthetic_fem import seed_fem_reference
 
 
 @pytest.fixture()
@@ -52,3 +53,26 @@ def test_validate_with_a_missing_cases_file_gives_the_command_lines_message(shor
     assert done.returncode == 2
     assert done.stderr.strip().splitlines()[-1] == "error: " + str(raised.value)
     assert not (tmp_path / "report").exists() and not (tmp_path / "cache").exists()
+
+
+def test_validate_against_the_models_own_curve_equals_the_command_line(short_scene, program, tmp_path):
+    """The FEM reference seeded with the model's own run: the pressing force RMSE is 0 and every
+    puncture depth within one stored sample; the report's metrics are the command line's."""
+    seed_fem_reference(short_scene, tmp_path / "cache")
+    result = puncture.validate(short_scene, cache_dir=tmp_path / "cache", output_dir=tmp_path / "report")
+    layers = result["validation_metrics"]["layers"]
+    assert [m["layer"] for m in layers] == ["skin", "fat", "muscle"]
+    for m in layers[:2]:  # punctured in the 8 mm insertion
+        assert m["realtime_punctured"] and m["fem_punctured"]
+        assert m["pressing_force_rmse_relative"] == 0.0
+        assert abs(m["puncture_depth_error_mm"]) <= 0.1  # 10 ticks at 10 mm/s
+    np.testing.assert_array_equal(result["layer_metrics"]["pressing_force_rmse_N"][:2], [0.0, 0.0])
+    assert sorted(result["files"]) == sorted(str(p.relative_to(tmp_path / "report"))
+                                             for p in (tmp_path / "report").rglob("*") if p.is_file())
+    np.testing.assert_array_equal(result["realtime_curve"]["force_N"][::10][:50],
+                                  puncture.Simulator(short_scene).run().force_N[::10][:50])
+    scene_path = tmp_path / "default_short.json"
+    short_scene.save(scene_path)
+    run_program(program, "validate", scene_path, "-o", tmp_path / "cli", "--cache", tmp_path / "cache", "--no-vtk", "-q")
+    cli = json.loads((tmp_path / "cli" / "validation_metrics.json").read_text())
+    assert cli["layers"] == layers and cli["acceptance"] == result["validation_metrics"]["acceptance"]
