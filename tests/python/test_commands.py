@@ -76,3 +76,21 @@ def test_validate_against_the_models_own_curve_equals_the_command_line(short_sce
     run_program(program, "validate", scene_path, "-o", tmp_path / "cli", "--cache", tmp_path / "cache", "--no-vtk", "-q")
     cli = json.loads((tmp_path / "cli" / "validation_metrics.json").read_text())
     assert cli["layers"] == layers and cli["acceptance"] == result["validation_metrics"]["acceptance"]
+
+
+def test_fem_computes_a_missing_reference_into_the_cache_or_says_why_not(short_scene, tmp_path):
+    """With the FEM built: a 1.5 mm press computed in this process (a few seconds), then read from the
+    cache; without it: the command line's RunError, nothing cached."""
+    scene = short_scene.updated({"insertion/target_depth_mm": 1.5, "insertion/dwell_s": 0.0})
+    if not puncture.HAVE_FEM:
+        with pytest.raises(puncture.RunError, match="this build has no FEM"):
+            puncture.fem(scene, cache_dir=tmp_path / "cache")
+        assert not (tmp_path / "cache").exists()
+        return
+    first = puncture.fem(scene, cache_dir=tmp_path / "cache")
+    force = first["fem_force_depth"]["force_N"]
+    assert not first["from_cache"] and first["fem_summary"].get("status") != "failed"
+    assert np.all(np.isfinite(force)) and force.max() > 0.0
+    again = puncture.fem(scene, cache_dir=tmp_path / "cache")
+    assert again["from_cache"] and again["dir"] == first["dir"]
+    np.testing.assert_array_equal(again["fem_force_depth"]["force_N"], force)

@@ -32,6 +32,8 @@ def test_get_and_set_a_field_by_json_path(default_scene):
     assert scene.get("/layers/0/thickness_mm") == pytest.approx(1.2)
     assert default_scene.get("layers/0/thickness_mm") == pytest.approx(0.8)  # copy() is a copy
     assert scene.layer_names == ["skin", "fat", "muscle"]
+    scene["layers/2/thickness_mm"] = 30.0  # the same as set() and get()
+    assert scene["layers/2/thickness_mm"] == 30.0
 
 
 def test_updated_sets_several_fields_at_once(default_scene):

@@ -173,6 +173,14 @@ void bind_run_result(py::module_& m) {
         return names;
       })
       .def("__len__", [](const RunResult& r) { return py::len(r.arrays["time_s"]); })
+      .def("__repr__",
+           [](const RunResult& r) {
+             std::string layers;
+             for (const std::string& l : r.layer_names) layers += (layers.empty() ? "" : ", ") + l;
+             return "<puncture.RunResult " + std::to_string(py::len(r.arrays["time_s"])) + " ticks of " +
+                    std::to_string(r.time_step_s) + " s; layers " + layers + "; " + std::to_string(py::len(r.events)) +
+                    " punctures>";
+           })
       .def_readonly("events", &RunResult::events)
       .def_readonly("layer_names", &RunResult::layer_names)
       .def_readonly("time_step_s", &RunResult::time_step_s)

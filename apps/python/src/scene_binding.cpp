@@ -62,6 +62,11 @@ SceneHandle with_changes(const SceneHandle& s, const py::dict& changes) {
   return from_document(document, s.source);
 }
 
+/// Sets one field; the scene is unchanged when the result is not a valid scene.
+void set_path(SceneHandle& s, const std::string& path, const py::object& value) {
+  s = with_changes(s, py::dict(py::arg(path.c_str()) = value));
+}
+
 py::object get_field(const SceneHandle& s, const std::string& path) {
   const nlohmann::json document = s.document();
   const auto pointer = json_path_pointer(path, s.source);
@@ -105,9 +110,14 @@ void bind_scene(py::module_& m) {
       .def("get", &get_field, py::arg("path"), "The field at a JSON path, e.g. 'layers/0/thickness_mm' (KeyError if absent).")
       .def(
           "set",
-          [](SceneHandle& s, const std::string& path, const py::object& value) { s = with_changes(s, py::dict(py::arg(path.c_str()) = value)); },
+          &set_path,
           py::arg("path"), py::arg("value"),
           "Sets the field at a JSON path; the scene is validated and left unchanged on error (puncture.SceneError).")
+      .def("__getitem__", &get_field, py::arg("path"), "scene['layers/0/thickness_mm']: get(path)")
+      .def(
+          "__setitem__",
+          &set_path,
+          py::arg("path"), py::arg("value"), "scene['layers/0/thickness_mm'] = 2.0: set(path, value)")
       .def("updated", &with_changes, py::arg("changes"),
            "A new scene with every {path: value} of `changes` set, validated once (for fields that must change together).")
       .def("copy", [](const SceneHandle& s) { return s; })
