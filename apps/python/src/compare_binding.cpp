@@ -62,8 +62,10 @@ void bind_compare(py::module_& m) {
         py::arg("scene_parameters") = false, py::arg("critical_forces_only") = false, py::arg("cases") = py::none(),
         py::arg("frames") = 0, py::arg("write_vtk") = false,
         "`puncture compare` on the scene: the comparison models of both papers and the real-time model against the "
-        "FEM reference (cached), graded. Returns the files by stem (comparison, ranking, comparison_summary, "
-        "comparison_md ...), 'warnings', 'output_dir'; options as the command's (models empty: all).");
+        "FEM reference (cached), graded. Returns the files by stem (comparison and ranking as arrays, "
+        "comparison_summary, 'comparison.md' as text: a stem two files share keeps the file name), 'files', "
+        "'warnings', 'output_dir'; options as the command's (models empty: all; frames 0 and write_vtk False: no "
+        "ParaView series). Runs for minutes with every model.");
 }
 
 }  // namespace puncture::python

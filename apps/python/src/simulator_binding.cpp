@@ -19,8 +19,7 @@ namespace puncture::python {
 
 namespace {
 
-constexpr double kMPerMm = 1e-3;
-/// One millimetre in metres: values in mm are metres / kMm, as `puncture run` writes them.
+/// One millimetre in metres: mm = metres / kMm as `puncture run` writes them, metres = mm * kMm.
 constexpr double kMm = 1e-3;
 
 std::size_t layer_of(const SimulatorHandle& s, const py::object& layer) {
@@ -37,7 +36,7 @@ std::size_t layer_of(const SimulatorHandle& s, const py::object& layer) {
   return static_cast<std::size_t>(k);
 }
 
-std::optional<double> mm_to_m(std::optional<double> mm) { return mm ? std::optional<double>(*mm * kMPerMm) : std::nullopt; }
+std::optional<double> mm_to_m(std::optional<double> mm) { return mm ? std::optional<double>(*mm * kMm) : std::nullopt; }
 
 /// 3 x N positions (m) as an (N, 3) array in mm.
 py::array_t<double> points_mm(const Eigen::Matrix3Xd& p) {
@@ -120,7 +119,7 @@ void bind_simulator(py::module_& m) {
       .def(
           "tick",
           [](SimulatorHandle& s, double depth_mm, std::optional<double> velocity_mm_per_s, std::optional<double> time_s) {
-            return s.tick_depth(depth_mm * kMPerMm, mm_to_m(velocity_mm_per_s), time_s);
+            return s.tick_depth(depth_mm * kMm, mm_to_m(velocity_mm_per_s), time_s);
           },
           py::arg("depth_mm"), py::arg("velocity_mm_per_s") = py::none(), py::arg("time_s") = py::none(),
           "One haptic tick, the tip on the insertion axis at depth_mm below the undeformed skin. "
@@ -129,7 +128,7 @@ void bind_simulator(py::module_& m) {
       .def(
           "tick_pose",
           [](SimulatorHandle& s, const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& direction, double velocity_mm_per_s,
-             std::optional<double> time_s) { return s.tick_pose(tip_mm * kMPerMm, direction, velocity_mm_per_s * kMPerMm, time_s); },
+             std::optional<double> time_s) { return s.tick_pose(tip_mm * kMm, direction, velocity_mm_per_s * kMm, time_s); },
           py::arg("tip_position_mm"), py::arg("direction"), py::arg("velocity_mm_per_s"), py::arg("time_s") = py::none(),
           "One haptic tick with the needle's pose: tip position (mm, scene frame, skin surface at z = 0, tissue below), "
           "unit insertion direction, speed along it (> 0 inserting).")
