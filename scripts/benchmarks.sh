@@ -24,8 +24,9 @@ fi
 
 if (( ! report_only )); then
   if [[ ! -f "$build/CMakeCache.txt" ]]; then
+    # No Python module: its libraries would be compiled position-independent.
     cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPUNCTURE_WITH_FEM=OFF -DPUNCTURE_WITH_VTK=OFF \
-      -DPUNCTURE_BUILD_TESTS=ON -DPUNCTURE_BUILD_BENCHMARKS=ON
+      -DPUNCTURE_BUILD_TESTS=ON -DPUNCTURE_BUILD_BENCHMARKS=ON -DPUNCTURE_WITH_PYTHON=OFF
   fi
   build_type="$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "$build/CMakeCache.txt")"
   if [[ "$build_type" != "Release" ]]; then

@@ -18,6 +18,7 @@ PACKAGES=(
   libnlopt-cxx-dev libnlopt-dev libgsl-dev   # calibration
   openmpi-bin libopenmpi-dev        # MPI runs of the FEM
   python3 python3-matplotlib python3-numpy   # plots in results/
+  pybind11-dev python3-dev python3-pytest    # the Python module (apps/python) and its tests
   xvfb                              # offscreen rendering in CI
   clang libclang-rt-14-dev          # libFuzzer target of the scene reader (tests/fuzz/)
 )

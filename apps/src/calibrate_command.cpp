@@ -279,11 +279,12 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
     std::vector<validation::SurfaceIdentificationResult> surfaces;
     if (options.surface_fit) surfaces = fit_surfaces(fem_dir, scene, calibration, options.threads, out);
     validation::CalibrationProgressCallback progress;
-    if (!options.quiet)
+    if (!options.quiet || options.progress)
       progress = [&](const validation::CalibrationProgress& p) {
-        if (p.evaluations % 25 == 0)
+        if (!options.quiet && p.evaluations % 25 == 0)
           out << "[calibrate] " << p.stage << ": " << p.evaluations << " model runs, best objective "
               << p.best_objective << '\n' << std::flush;
+        if (options.progress) options.progress(p);
       };
     const auto t_start = std::chrono::steady_clock::now();
     const validation::CalibrationResult result = validation::calibrate(scene, references, calibration, progress);

@@ -169,6 +169,27 @@ TEST(Calibration, SequentialStagesRecoverTheFatBelowTheSkin) {
             truth.layers[2].force_mesh.virtual_stiffness_N_per_m);
 }
 
+TEST(Calibration, AProgressCallbackThatThrowsStopsItAndItsExceptionComesOut) {
+  // The Python module's Ctrl-C and progress callback (apps/python): the
+  // callback throws once; no model run follows and calibrate() rethrows it.
+  struct Stop {};
+  const Scene truth = truth_scene();
+  const pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);
+  Scene start = truth;
+  start.layers[0].force_mesh.virtual_stiffness_N_per_m *= 1.3;
+  start.layers[1].force_mesh.virtual_stiffness_N_per_m *= 1.25;
+  pv::CalibrationOptions options;
+  options.layers = {"skin", "fat"};
+  options.threads = 2;
+  int calls = 0;
+  EXPECT_THROW(pv::calibrate(start, ref, options,
+                             [&](const pv::CalibrationProgress&) {
+                               if (++calls == 3) throw Stop{};
+                             }),
+               Stop);
+  EXPECT_EQ(calls, 3);  // never called again once it threw
+}
+
 TEST(Calibration, DampingIsTunedOnlyWithRateInformation) {
   const Scene truth = truth_scene();
   pv::InsertionCurve ref = pv::simulate_insertion_curve(truth);

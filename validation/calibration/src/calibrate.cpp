@@ -36,6 +36,7 @@ struct Calibration {
   std::vector<LayerIdentifiability> identifiable;  ///< per layer, merged over the references
   SurfaceCache cache;
   int total_evaluations = 0;
+  CalibrationStop stop;  ///< the progress callback threw (calibration.hpp)
   std::vector<Parameter> parameters;  ///< every tuned parameter; bounds fixed once, from the scene's values
   std::vector<bool> moved_inside;
 
@@ -45,7 +46,7 @@ struct Calibration {
 
   StageInputs inputs(const CalibrationResult& result) {
     return StageInputs{&references, &result.reference_events, &geometry, &options, &cache, &progress,
-                       &total_evaluations};
+                       &total_evaluations, &stop};
   }
   Parameter parameter(std::size_t k, ParamKind kind) {
     for (const Parameter& p : parameters)
@@ -604,9 +605,14 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
   const int passes = options.passes > 0 ? options.passes
                                         : (scene.effects.layer_interaction && c.layers.size() > 1 ? 2 : 1);
   for (int pass = 0; pass < passes; ++pass)
-    for (std::size_t k : c.layers) current = run_layer_stage(c, result, current, k, pass, passes);
+    for (std::size_t k : c.layers) {
+      current = run_layer_stage(c, result, current, k, pass, passes);
+      c.stop.rethrow_if_requested();
+    }
   if (result.damping_tuned) current = run_rate_stage(c, result, current);
+  c.stop.rethrow_if_requested();
   current = run_joint_stage(c, result, current);
+  c.stop.rethrow_if_requested();
 
   result.tuned_scene = current;
   report_identifiability(c, result);

@@ -68,6 +68,7 @@ double StageObjective::value_of(const Scene& s) const {
 }
 
 double StageObjective::evaluate(const double* x) {
+  if (stopped()) return kFailedObjective;
   double f = kFailedObjective;
   try {
     f = value_of(scene_at(x));
@@ -87,8 +88,14 @@ void StageObjective::record(const double* x, double f) {
     best_ = f;
     best_x_ = candidate;
   }
-  if (in_.progress && *in_.progress)
-    (*in_.progress)(CalibrationProgress{in_.total_evaluations ? *in_.total_evaluations : evaluations_, best_, f, name_});
+  if (in_.progress && *in_.progress && !stopped()) {
+    try {
+      (*in_.progress)(CalibrationProgress{in_.total_evaluations ? *in_.total_evaluations : evaluations_, best_, f, name_});
+    } catch (...) {
+      if (!in_.stop) throw;
+      in_.stop->capture(std::current_exception());
+    }
+  }
 }
 
 void StageObjective::offer(const std::vector<double>& x, double f) {
@@ -104,6 +111,7 @@ bool StageObjective::better(double f, const std::vector<double>& x) const {
 }
 
 bool StageObjective::set_layout(const std::vector<double>& x) {
+  if (stopped()) return false;
   std::vector<TrajectoryComparison> cs;
   try {
     cs = compare(scene_at(x.data()));
@@ -120,6 +128,7 @@ bool StageObjective::set_layout(const std::vector<double>& x) {
 
 bool StageObjective::residuals_at(const std::vector<double>& x, std::vector<double>& r) {
   r.clear();
+  if (stopped()) return false;
   std::vector<TrajectoryComparison> cs;
   double total = 0.0;
   try {

@@ -14,6 +14,8 @@
 // under a lock.
 #pragma once
 
+#include <atomic>
+#include <exception>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -25,6 +27,26 @@
 
 namespace puncture::validation::calibration_detail {
 
+/// A calibration stopped by its progress callback (calibration.hpp): the
+/// callback's exception, kept for calibrate() to rethrow.
+class CalibrationStop {
+ public:
+  bool requested() const { return requested_; }
+  void capture(std::exception_ptr error) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!error_) error_ = std::move(error);
+    requested_ = true;
+  }
+  void rethrow_if_requested() const {
+    if (requested_) std::rethrow_exception(error_);
+  }
+
+ private:
+  std::atomic<bool> requested_{false};
+  mutable std::mutex mutex_;
+  std::exception_ptr error_;
+};
+
 struct StageInputs {
   const std::vector<ReferenceCurve>* references = nullptr;
   const std::vector<ReferenceEvents>* events = nullptr;
@@ -33,6 +55,7 @@ struct StageInputs {
   const SurfaceCache* cache = nullptr;
   const CalibrationProgressCallback* progress = nullptr;
   int* total_evaluations = nullptr;
+  CalibrationStop* stop = nullptr;  ///< set when the progress callback threw
 };
 
 class StageObjective {
@@ -50,6 +73,8 @@ class StageObjective {
   double turn_depth_m = std::numeric_limits<double>::infinity();
 
   const std::string& name() const { return name_; }
+  /// The calibration was stopped by its progress callback: evaluations fail at once.
+  bool stopped() const { return in_.stop && in_.stop->requested(); }
   const StageInputs& inputs() const { return in_; }
   Scene scene_at(const double* x) const;
   /// Every reference's comparison of the model run of `s`.

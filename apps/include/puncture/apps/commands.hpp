@@ -130,6 +130,10 @@ struct CalibrateOptions {
   /// the scene's own. For the family of a slab rule (slab-rule below).
   std::vector<double> layer_thickness_mm;
   bool quiet = false;
+  /// Called after every model run besides the printed progress (the Python
+  /// module's progress callback); may throw to stop the calibration
+  /// (calibration.hpp), which then writes nothing and fails with the message.
+  validation::CalibrationProgressCallback progress;
 };
 
 /// `puncture calibrate`: tunes the force-law parameters against a reference

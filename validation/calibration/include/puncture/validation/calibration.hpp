@@ -222,6 +222,11 @@ struct CalibrationProgress {
   double last_objective = 0.0;
   std::string stage;                ///< e.g. "skin (w = 8)" or "damping"
 };
+/// Called after every model run (from the optimiser's threads, one call at a
+/// time). It may throw to stop the calibration (a user's Ctrl-C, a script's
+/// abort): the exception is kept, every later model run of the calibration is
+/// skipped (counted as failed, no model run), and calibrate() rethrows it
+/// after the current stage instead of returning.
 using CalibrationProgressCallback = std::function<void(const CalibrationProgress&)>;
 
 /// The tunable parameters of one layer, SI.
