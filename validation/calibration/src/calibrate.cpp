@@ -399,7 +399,9 @@ bool tunes_release_rate(const Calibration& c, std::size_t k) {
 }
 
 /// The rate stage: d of every calibrated layer, the rate exponent n of every
-/// breakthrough threshold that has one (breakthrough_rate.hpp), the viscous
+/// breakthrough threshold that has one (breakthrough_rate.hpp) with the
+/// threshold's level at v_ref when the layer stage tuned it (fitted there to
+/// every speed at the start n, a compromise n alone cannot undo), the viscous
 /// fraction b of every cutting force the references cut and the rate exponent
 /// m of every rupture release length in use (cutting.hpp), on the
 /// whole trajectory of references at two or more speeds; every other
@@ -411,7 +413,12 @@ Scene run_rate_stage(Calibration& c, CalibrationResult& result, const Scene& cur
   std::vector<Parameter> ds;
   for (std::size_t k : c.layers) {
     ds.push_back(c.parameter(k, ParamKind::Damping));
-    if (has_breakthrough_rate(c.scene, k)) ds.push_back(c.parameter(k, ParamKind::BreakthroughRate));
+    if (has_breakthrough_rate(c.scene, k)) {
+      ds.push_back(c.parameter(k, ParamKind::BreakthroughRate));
+      // With n its level F_c,ref (or G,ref): the layer stage fitted it to every speed at the start n.
+      for (const Parameter& p : std::vector<Parameter>(c.parameters))
+        if (p.layer == k && (p.kind == ParamKind::CriticalForce || p.kind == ParamKind::CriticalEnergy)) ds.push_back(p);
+    }
     if (tunes_cutting_rate(c, k)) {
       ds.push_back(c.parameter(k, ParamKind::CuttingRate));
       CuttingRate& rate = current.layers[k].force_law.cutting_rate;
@@ -600,7 +607,12 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
                        n_tuned + (result.damping_tuned ? c.layers.size() : 0), n_requested);
 
   result.critical_force_note = critical_force_start_note(c, scene);
-  Scene current = scene;
+  std::vector<bool> level_tuned(scene.layers.size(), false);
+  for (std::size_t k : c.layers)
+    level_tuned[k] = options.parameters.deformed_threshold && withheld_reason(c, result, k, ParamKind::CriticalForce).empty();
+  Scene current = result.damping_tuned ? rate_exponent_start(scene, c.layers, level_tuned, references,
+                                                             result.reference_events, result.warnings)
+                                       : scene;
   const int passes = options.passes > 0 ? options.passes
                                         : (scene.effects.layer_interaction && c.layers.size() > 1 ? 2 : 1);
   for (int pass = 0; pass < passes; ++pass)
