@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "model_runs.hpp"
 #include "puncture/stiffening.hpp"
@@ -240,6 +241,25 @@ Scene rate_exponent_start(const Scene& scene, const std::vector<std::size_t>& la
                     " punctures (then tuned with its critical force)");
   }
   return s;
+}
+
+std::string critical_force_start_note(const Scene& scene, const std::vector<std::size_t>& layers,
+                                      const CalibrationOptions& options) {
+  if (!options.scaled_start) return {};
+  std::ostringstream note;
+  for (std::size_t k : layers) {
+    const std::vector<ParamKind> kinds = layer_kinds(scene, k, options.parameters, nullptr);
+    if (std::find(kinds.begin(), kinds.end(), ParamKind::CriticalForce) == kinds.end()) continue;
+    const Layer& l = scene.layers[k];
+    note << (note.tellp() > 0 ? "; " : "") << l.name << ": ";
+    if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy && l.puncture.toughness_J_per_m2 > 0.0)
+      note << "G_c x 2a = " << l.puncture.toughness_J_per_m2 << " J/m^2 x " << 2e3 * scene.needle.radius_m
+           << " mm = " << l.puncture.toughness_J_per_m2 * 2.0 * scene.needle.radius_m
+           << " N (the layer's fracture toughness)";
+    else
+      note << "the reference's puncture force less the model's other terms there (no fracture toughness)";
+  }
+  return note.str();
 }
 
 }  // namespace puncture::validation::calibration_detail

@@ -29,6 +29,10 @@ Scene scaled_start(const Scene& candidate, std::size_t k, const ReferenceCurve& 
                    const std::vector<LayerGeometry>& layers, const CalibrationOptions& options, const SurfaceCache& cache,
                    const std::vector<Parameter>& parameters);
 
+/// The critical-force starts of the scaled start, in words (empty without scaled_start).
+std::string critical_force_start_note(const Scene& scene, const std::vector<std::size_t>& layers,
+                                      const CalibrationOptions& options);
+
 /// The start of the breakthrough rate exponent n of each layer in `layers`
 /// whose critical force is tuned (`level_tuned`), from the references'
 /// punctures of it at two or more speeds: the slope of ln F against ln v
