@@ -2,7 +2,7 @@
 //   puncture run       [SCENE] [-o DIR]   real-time SHF + MSM model
 //   puncture fem       [SCENE] [-o DIR]   deal.II FEM reference (mpirun-able)
 //   puncture validate  [SCENE] [-o DIR]   both models on the same insertion, metrics, report
-//   puncture calibrate [SCENE] [--reference CSV] [-o DIR]   tuned preset
+//   puncture calibrate [SCENE] [--reference CSV ...] [--held-out CSV ...] [-o DIR]   tuned preset
 //   puncture sweep     [SCENE] [-o DIR]   accuracy versus time of every fidelity knob
 //   puncture grade SCORES.csv [-o DIR]    comprehensive weighted grading (paper Sec. 3.3)
 //   puncture slab-rule PRESET... [-o DIR] each layer's parameters from its thickness or depth, fitted on a family of slabs
@@ -33,7 +33,7 @@ std::string default_text(double value) {
 /// What the command line sets: the options of every subcommand and the
 /// values they share (scene, output, FEM cache).
 struct CommandLine {
-  std::string scene, output, cache, reference, scores;
+  std::string scene, output, cache, scores;
   RunOptions run;
   FemOptions fem;
   ValidateOptions validate;
@@ -141,10 +141,19 @@ void add_recording_options(CLI::App* cmd, puncture::validation::ReferenceRecordi
 CLI::App* add_calibrate(CLI::App& app, CommandLine& c) {
   CLI::App* calibrate_cmd = app.add_subcommand("calibrate", "Tune the force law per layer (K, breakthrough, cutting, friction, stiffening; optionally w, L, k_s, d); write a preset");
   add_scene_options(calibrate_cmd, c, "Output directory; default: out/<scene name>_calibration", true);
-  calibrate_cmd->add_option("--reference", c.reference,
+  calibrate_cmd->add_option("--reference", c.calibrate.references,
                             "Measured insertion curve (CSV with depth_mm and force_N at least, or a raw rig "
-                            "recording with its format: --recording-format; see validation/README.md); default: "
-                            "the scene's FEM reference (cached)");
+                            "recording with its format: --recording-format or its sidecar; see validation/README.md); "
+                            "repeat it for repeats and other speeds of the same tissue, calibrated together, each at "
+                            "its own speed (two or more speeds identify d and the rate laws); default: the scene's FEM "
+                            "reference (cached)")
+      ->expected(1)
+      ->take_all();
+  calibrate_cmd->add_option("--held-out", c.calibrate.held_out,
+                            "Recording of the same tissue left out of the fit (repeatable): judged with the tuned "
+                            "model in the same report and counted in the scatter of repeats")
+      ->expected(1)
+      ->take_all();
   add_recording_options(calibrate_cmd, c.calibrate.recording);
   calibrate_cmd->add_option("--method", c.calibrate.method,
                             "levenberg_marquardt (default), nelder_mead, bobyqa or simulated_annealing")
@@ -281,7 +290,6 @@ int dispatch(const Subcommands& sub, CommandLine& c) {
   }
   if (*sub.calibrate) {
     c.calibrate.scene = c.scene, c.calibrate.output_dir = c.output, c.calibrate.cache_dir = c.cache;
-    c.calibrate.reference = c.reference;
     return calibrate_command(c.calibrate, std::cout, std::cerr);
   }
   if (*sub.sweep) {

@@ -4,8 +4,13 @@
 #   bash scripts/calibration_speed.sh [output dir]     (default results/calibration_speed)
 #
 # Cases: the default slab (scenes/default_force_law.json against its cached
-# FEM reference, the command of scripts/results_validation.sh) and the liver
-# scene against the measured Okamura 2004 curve (../shared/data). Rows: the
+# FEM reference, the command of scripts/results_validation.sh), the liver
+# scene against the measured Okamura 2004 curve (../shared/data) and the
+# skin-on-muscle phantom against the shared rig-like raw recording (issue 49:
+# no hand-entered depth). CASES="rig" (any of default, liver, rig) remakes
+# only those cases' rows: every row is kept in rows.tsv beside the README,
+# with the machine, date, revision and load average it was made at, and the
+# README is written from all of them. Rows: the
 # derivative-free Nelder-Mead with whole model runs on one thread (the
 # calibration as it was, with this build's cheaper model runs), with runs that
 # turn past each stage's depths, then Levenberg-Marquardt on one thread and
@@ -30,8 +35,13 @@ trap 'rm -rf "$work"' EXIT
 default_args=(scenes/default_force_law.json --integrator implicit --force-weight 4 --depth-weight 1)
 liver_args=(scenes/liver_okamura.json --reference "$shared/okamura2004_liver_depth_force.csv"
             --reference-depth-offset 9.5 --puncture-depths 9.65,9.66)
+rig_args=(scenes/skin_on_muscle_phantom.json --reference "$shared/rig_like_recording.csv"
+          --recording-format validation/cases/rig_like_recording_format.json)
+cases=" ${CASES:-default liver rig} "
 # The FEM reference of the default slab, computed once if not cached (not timed).
-"$build/apps/puncture" calibrate "${default_args[@]}" -o "$work/warmup" -q >/dev/null
+if [[ "$cases" == *" default "* ]]; then
+  "$build/apps/puncture" calibrate "${default_args[@]}" -o "$work/warmup" -q >/dev/null
+fi
 
 rows="$work/rows.tsv"
 : > "$rows"
@@ -40,6 +50,9 @@ count=0
 run() {
   local case="$1" label="$2" gain="$3" n="$4" bin="$5"
   shift 5
+  [[ "$cases" == *" $case "* ]] || return 0
+  local load
+  load=$(cut -d' ' -f1 /proc/loadavg)
   local times=() i=0 summary=""
   for ((i = 1; i <= n; ++i)); do
     count=$((count + 1))
@@ -61,7 +74,8 @@ run() {
   objective=$(grep -o 'Objective [0-9.e+-]* -> [0-9.e+-]*' "$summary" | head -1 | awk '{print $4}')
   local exact
   exact=$(python3 -c "import json,sys; print('%.6f' % json.load(open(sys.argv[1]))['objective_after'])" "$(dirname "$summary")/run.provenance.json")
-  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$case" "$label" "$gain" "$median" "$all" "$runs" "$exact" "$n" >> "$rows"
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$case" "$label" "$gain" "$median" "$all" "$runs" "$exact" "$n" \
+    "$load-$(cut -d' ' -f1 /proc/loadavg)" "$(date -u +%Y-%m-%dT%H:%M:%SZ)" >> "$rows"
   mkdir -p "$out/summaries"
   cp "$summary" "$out/summaries/${case}_$(echo "$label" | tr -c 'A-Za-z0-9' '_' | sed 's/_*$//').md"
 }
@@ -83,30 +97,52 @@ run liver "Nelder-Mead, whole runs, 1 thread" "-" 1 \
   "$build/apps/puncture" "${liver_args[@]}" --method nelder_mead --stage-turn-margin 0 --threads 1
 run liver "Levenberg-Marquardt, 2 threads (default)" "all of the above" "$repeats" \
   "$build/apps/puncture" "${liver_args[@]}"
+run rig "Levenberg-Marquardt, 2 threads (default)" "-" "$repeats" \
+  "$build/apps/puncture" "${rig_args[@]}"
 
-python3 - "$rows" "$out/README.md" "$repeats" <<'EOF'
-import subprocess, sys, datetime, platform, os
-rows = [l.rstrip('\n').split('\t') for l in open(sys.argv[1]) if l.strip()]
+python3 - "$rows" "$out" <<'EOF'
+import subprocess, sys, platform, os
+new_rows = [l.rstrip('\n').split('\t') for l in open(sys.argv[1]) if l.strip()]
+out = sys.argv[2]
 git = subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], capture_output=True, text=True).stdout.strip()
 dirty = subprocess.run(['git', 'status', '--porcelain', '--untracked-files=no'], capture_output=True, text=True).stdout.strip()
 cpu = next((l.split(':', 1)[1].strip() for l in open('/proc/cpuinfo') if l.startswith('model name')), platform.processor())
+machine = f"{platform.node()} ({cpu}, {os.cpu_count()} cores)"
+# rows.tsv: case, label, gain, median, runs, model runs, objective, n, load before-after, date, machine, git
+store = os.path.join(out, 'rows.tsv')
+kept = [l.rstrip('\n').split('\t') for l in open(store) if l.strip()] if os.path.exists(store) else []
+remade = {r[0] for r in new_rows}
+rows = [r for r in kept if r[0] not in remade] + [r + [machine, f"{git}{'-dirty' if dirty else ''}"] for r in new_rows]
+with open(store + '.tmp', 'w') as f:
+    f.write(''.join('\t'.join(r) + '\n' for r in rows))
+os.replace(store + '.tmp', store)
 lines = ["# Calibration speed", "",
-         f"Made by `bash scripts/calibration_speed.sh` on {platform.node()} ({cpu}, {os.cpu_count()} cores), "
-         f"{datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%dT%H:%M:%SZ')}, git {git}{'-dirty' if dirty else ''}. "
-         f"Wall time of the whole `puncture calibrate` process (reference already cached; report and plot included). "
-         f"Levenberg-Marquardt rows: median of {sys.argv[3]} runs; Nelder-Mead rows: one run each. "
-         "The objective is the one the calibration minimises (calibration_summary.md, sum of weight x value^2 over every term); "
-         "on one thread Levenberg-Marquardt tries one step per iteration instead of two, so its path and optimum differ. "
-         "Each configuration's last calibration summary is in summaries/.", ""]
-for case, title in (("default", "Default slab against its FEM reference (scenes/default_force_law.json, 3 layers, 15 tuned parameters)"),
-                    ("liver", "Liver against the measured Okamura 2004 curve (scenes/liver_okamura.json, 2 layers, 11 tuned parameters)")):
+         "Made by `bash scripts/calibration_speed.sh` (`CASES=...` remakes some cases; every row is kept in rows.tsv). "
+         "Wall time of the whole `puncture calibrate` process (reference already cached; report and plots included); "
+         "each table says the machine, date and revision of its runs and the load average (1 min) before the first "
+         "and after the last run of each row: a load above the core count means the machine was shared and the times "
+         "are longer than on an idle one. Levenberg-Marquardt rows: the median of the runs listed; Nelder-Mead rows: "
+         "one run each. The objective is the one the calibration minimises (calibration_summary.md, sum of weight x "
+         "value^2 over every term); on one thread Levenberg-Marquardt tries one step per iteration instead of two, so "
+         "its path and optimum differ. Each configuration's last calibration summary is in summaries/.", ""]
+titles = (("default", "Default slab against its FEM reference (scenes/default_force_law.json, 3 layers, 15 tuned parameters)"),
+          ("liver", "Liver against the measured Okamura 2004 curve (scenes/liver_okamura.json, 2 layers, 11 tuned parameters)"),
+          ("rig", "Skin-on-muscle phantom against the shared rig-like raw recording (scenes/skin_on_muscle_phantom.json, "
+                  "../shared/data/rig_like_recording.csv read raw, its puncture detected; 2 layers, 11 tuned parameters)"))
+for case, title in titles:
     sel = [r for r in rows if r[0] == case]
-    if not sel: continue
-    lines += [f"## {title}", "", "| configuration | gain from | wall time (s, median) | runs (s) | model runs | objective after |",
+    if not sel:
+        continue
+    made = sorted({f"{r[10]}, {r[9][:10]}, git {r[11]}" for r in sel})
+    loads = ', '.join(r[8] if r[8] != '?' else 'not recorded' for r in sel)
+    lines += [f"## {title}", "", f"Made on {'; '.join(made)}; load average before-after each row: {loads}.", "",
+              "| configuration | gain from | wall time (s, median) | runs (s) | model runs | objective after |",
               "|---|---|---|---|---|---|"]
     for r in sel:
         lines.append(f"| {r[1]} | {r[2]} | {float(r[3]):.1f} | {r[4]} | {r[5]} | {r[6]} |")
     lines.append("")
-open(sys.argv[2], 'w').write('\n'.join(lines))
+with open(os.path.join(out, 'README.md.tmp'), 'w') as f:
+    f.write('\n'.join(lines))
+os.replace(os.path.join(out, 'README.md.tmp'), os.path.join(out, 'README.md'))
 EOF
 echo "[calibration_speed] $out/README.md"

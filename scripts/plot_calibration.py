@@ -2,11 +2,18 @@
 """Plot of a `puncture calibrate` folder (matplotlib; run with /usr/bin/python3).
 
 In:  DIR/calibration_curves.csv  (curve,time_s,depth_mm,force_N[,phase]; curve =
-     fem or measured (the reference), before, after; a "# made by: ..." first line)
+     fem or measured (the reference), before, after, the further references' and
+     held-out recordings' series with "@<speed>mm_per_s[#n]" (held_out@..., before@...,
+     after@...); a "# made by: ..." first line)
 Out: DIR/calibration_force_depth.png  force against depth: the reference and the
      real-time model before and after calibration; insertion solid, withdrawal
      dashed (dwell at the deepest point joins them). The axes hold every curve
      (nothing clipped).
+     Several recordings: one colour per recording (reference thick and pale, held out
+     dashed-dotted, the calibrated model thin), the models before omitted but for the first.
+     With DIR/repeat_scatter.csv (several recordings): DIR/repeat_scatter.png, per
+     speed with two or more recordings the band of their insertion forces (min to max),
+     their mean and the calibrated model.
      With DIR/surface_identification.csv (calibrate --surface-fit):
      DIR/surface_identification.png, per identified layer the FEM's surface
      deflection (lines) and the identified force mesh's ring deflections
@@ -38,18 +45,37 @@ def main(folder):
         part[0].append(float(row["depth_mm"]))
         part[1].append(float(row["force_N"]))
     fig, ax = plt.subplots(figsize=(8.5, 5))
-    style = {"before": dict(color="tab:gray", lw=1.2, label="real-time, before calibration"),
-             "after": dict(color="tab:blue", lw=1.6, label="real-time, calibrated")}
+    suffixes = []
+    for name in curves:
+        suffix = name[name.index("@"):] if "@" in name else ""
+        if suffix not in suffixes:
+            suffixes.append(suffix)
+    colours = plt.cm.tab10.colors
     all_f, all_d = [], []
     for name, parts in curves.items():
-        s = style.get(name, dict(color="black", lw=2.2, alpha=0.7, label=f"reference ({name})"))
+        base, suffix = (name.split("@", 1) + [""])[:2]
+        suffix = "@" + suffix if suffix else ""
+        i = suffixes.index(suffix)
+        several = len(suffixes) > 1
+        if base == "before" and several and i > 0:
+            continue
+        tag = f" {suffix[1:].replace('mm_per_s', ' mm/s')}" if suffix else ""
+        if base == "before":
+            s = dict(color="tab:gray", lw=1.2, label="real-time, before calibration")
+        elif base == "after":
+            s = dict(color=colours[i % 10] if several else "tab:blue", lw=1.6, label="real-time, calibrated" + tag)
+        else:
+            s = dict(color=colours[i % 10] if several else "black", lw=2.2, alpha=0.4 if several else 0.7,
+                     label=f"{'held out' if base == 'held_out' else 'reference (' + base + ')'}{tag}")
         for phase, (d, f) in parts.items():
             kw = dict(s)
             if phase == "withdrawal":
                 kw["ls"] = "--"
                 kw["label"] = None
-            elif name == "before":
+            elif base == "before":
                 kw["ls"] = ":"
+            elif base == "held_out":
+                kw["ls"] = "-."
             ax.plot(d, f, **kw)
             all_f += f
             all_d += d
@@ -68,6 +94,38 @@ def main(folder):
         fig.text(0.01, 0.005, note, fontsize=6, color="0.4")
     fig.tight_layout(rect=(0, 0.03, 1, 1))
     results_io.save_figure(fig, os.path.join(folder, "calibration_force_depth.png"), dpi=130)
+
+
+def plot_repeat_scatter(folder):
+    path = os.path.join(folder, "repeat_scatter.csv")
+    if not os.path.exists(path):
+        return
+    with open(path, newline="") as f:
+        lines = f.readlines()
+    note = lines[0][1:].strip() if lines and lines[0].startswith("#") else ""
+    groups = {}
+    for row in csv.DictReader(l for l in lines if not l.startswith("#")):
+        g = groups.setdefault(row["group"], {"speed": float(row["speed_mm_per_s"]), "d": [], "lo": [], "hi": [],
+                                              "mean": [], "model": []})
+        for key, col in (("d", "depth_mm"), ("lo", "band_min_N"), ("hi", "band_max_N"), ("mean", "mean_N"),
+                         ("model", "model_N")):
+            g[key].append(float(row[col]))
+    if not groups:
+        return
+    fig, axes = plt.subplots(1, len(groups), figsize=(6 * len(groups), 4.5), squeeze=False)
+    for ax, g in zip(axes[0], groups.values()):
+        ax.fill_between(g["d"], g["lo"], g["hi"], color="tab:orange", alpha=0.3, label="repeats: min to max")
+        ax.plot(g["d"], g["mean"], color="tab:orange", lw=1.2, label="repeats: mean")
+        ax.plot(g["d"], g["model"], color="tab:blue", lw=1.6, label="real-time, calibrated")
+        ax.set_title(f"{g['speed']:.3g} mm/s: the scatter of the repeats")
+        ax.set_xlabel("needle depth from contact (mm)")
+        ax.set_ylabel("insertion force (N)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    if note:
+        fig.text(0.01, 0.005, note, fontsize=6, color="0.4")
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    results_io.save_figure(fig, os.path.join(folder, "repeat_scatter.png"), dpi=120)
 
 
 def plot_surface_identification(folder):
@@ -121,4 +179,5 @@ if __name__ == "__main__":
     if len(sys.argv) != 2:
         sys.exit("usage: plot_calibration.py DIR")
     main(sys.argv[1])
+    plot_repeat_scatter(sys.argv[1])
     plot_surface_identification(sys.argv[1])

@@ -5,6 +5,7 @@
 // their plot (calibration_force_depth.png, scripts/plot_calibration.py), for a
 // measured reference what was detected on it (reference_detection.png,
 // scripts/plot_reference_detection.py) and calibration_summary.md.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -21,6 +22,7 @@
 #include "puncture/validation/calibration.hpp"
 #include "puncture/validation/metrics.hpp"
 #include "puncture/validation/recording.hpp"
+#include "puncture/validation/recording_scatter.hpp"
 #include "puncture/validation/fem_comparison.hpp"
 #include "puncture/validation/fem_reference_curve.hpp"
 #include "puncture/validation/surface_identification.hpp"
@@ -52,7 +54,8 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
                          const std::filesystem::path& dir, const std::string& name, const std::string& integrator) {
   std::ostringstream c;
   c << "puncture calibrate " << scene_path.string();
-  if (!options.reference.empty()) c << " --reference " << options.reference.string();
+  for (const std::filesystem::path& r : options.references) c << " --reference " << r.string();
+  for (const std::filesystem::path& h : options.held_out) c << " --held-out " << h.string();
   c << recording_options_text(options.recording);
   if (options.reference_depth_offset_mm != 0.0) c << " --reference-depth-offset " << options.reference_depth_offset_mm;
   c << " -o " << dir.string() << " --name " << name << " --method " << options.method;
@@ -76,67 +79,107 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
   return c.str();
 }
 
-/// The references: the scene's FEM reference (cached) and, with
-/// --fem-speeds, the FEM references of the scene at those speeds; or the
-/// measured curve. False on the MPI ranks that only help with the FEM.
-bool load_references(const CalibrateOptions& options, const Scene& scene, std::ostream& out,
-                     std::vector<validation::ReferenceCurve>& references, std::filesystem::path& fem_dir) {
-  if (options.reference.empty()) {
-    if (!options.recording.format_file.empty() || !options.recording.overrides.empty())
-      throw UsageError("--recording-format and the --time-column ... options describe a raw --reference recording: "
-                       "give --reference");
-    validation::FemReferenceOptions fem;
-    if (!options.cache_dir.empty()) fem.cache_dir = options.cache_dir;
-    fem.verbose = !options.quiet;
-    std::vector<Scene> scenes{scene};
-    for (double v : options.fem_speeds_mm_per_s) {
-      if (!(v > 0.0) || !std::isfinite(v)) throw UsageError("--fem-speeds: speeds must be finite and > 0 (mm/s)");
-      if (std::abs(v * 1e-3 - scene.insertion.speed_m_per_s) <= 1e-9) continue;  // the scene's own reference
-      scenes.push_back(validation::scene_at_insertion_speed(scene, v * 1e-3));
-    }
-    for (const Scene& s : scenes) {
-      const validation::FemReference ref = validation::obtain_fem_reference(s, fem, out);
-      if (!validation::is_mpi_root()) continue;
-      out << "[calibrate] FEM reference " << ref.hash << " at " << s.insertion.speed_m_per_s * 1e3 << " mm/s"
-          << (ref.from_cache ? " (from cache)" : " (computed)") << '\n';
-      if (references.empty()) fem_dir = ref.dir;
-      references.push_back({validation::fem_insertion_curve(s, ref.dir / "fem_force_depth.csv"), "fem"});
-    }
-    return validation::is_mpi_root();
-  }
-  if (!options.fem_speeds_mm_per_s.empty()) throw UsageError("--fem-speeds takes the scene's FEM reference, not --reference");
-  if (options.surface_fit) throw UsageError("--surface-fit needs the scene's FEM reference (its surface profiles), not --reference");
+/// A measured reference (a curve, or a raw recording read with its format):
+/// the depth offset applied; marked rate dependent unless its metadata says
+/// otherwise (a bench recording is the tissue at its speed: with recordings at
+/// two or more speeds d and the rate laws are tuned).
+validation::ReferenceCurve read_measured(const std::filesystem::path& path, const CalibrateOptions& options,
+                                         std::ostream& out) {
   validation::ReferenceCurve reference;
-  reference.curve = validation::read_reference_recording(options.reference, options.recording);
+  reference.curve = validation::read_reference_recording(path, options.recording);
   reference.kind = "measured";
-  const auto& meta = reference.curve.metadata;
+  auto& meta = reference.curve.metadata;
   if (meta.count("recording_format"))
-    out << "[calibrate] raw recording " << options.reference.string() << " (format: " << meta.at("recording_format")
+    out << "[calibrate] raw recording " << path.string() << " (format: " << meta.at("recording_format")
         << "): contact at " << meta.at("contact_time_s") << " s, tare " << meta.at("tare_N") << " N, noise "
         << meta.at("noise_N") << " N, insertion at " << meta.at("speed_mm_per_s") << " mm/s\n";
-  if (!std::isfinite(options.reference_depth_offset_mm))
-    throw UsageError("--reference-depth-offset must be a finite number (mm)");
+  if (!meta.count("rate_dependent") && !meta.count("quasi_static")) meta["rate_dependent"] = "true";
   if (options.reference_depth_offset_mm != 0.0) {
     for (double& d : reference.curve.depth_m) d -= options.reference_depth_offset_mm * 1e-3;
-    reference.curve.metadata["depth_offset_mm"] = std::to_string(options.reference_depth_offset_mm);
+    meta["depth_offset_mm"] = std::to_string(options.reference_depth_offset_mm);
   }
-  references.push_back(reference);
+  validation::insertion_phase(reference.curve);  // bad input before any model run (names the file)
+  return reference;
+}
+
+/// The scene's FEM reference (cached) and, with --fem-speeds, the FEM
+/// references of the scene at those speeds. False on the MPI ranks that only help with the FEM.
+bool load_fem_references(const CalibrateOptions& options, const Scene& scene, std::ostream& out,
+                         std::vector<validation::ReferenceCurve>& references, std::filesystem::path& fem_dir) {
+  if (options.held_out.empty() && (!options.recording.format_file.empty() || !options.recording.overrides.empty()))
+    throw UsageError("--recording-format and the --time-column ... options describe a raw --reference recording: "
+                     "give --reference");
+  validation::FemReferenceOptions fem;
+  if (!options.cache_dir.empty()) fem.cache_dir = options.cache_dir;
+  fem.verbose = !options.quiet;
+  std::vector<Scene> scenes{scene};
+  for (double v : options.fem_speeds_mm_per_s) {
+    if (!(v > 0.0) || !std::isfinite(v)) throw UsageError("--fem-speeds: speeds must be finite and > 0 (mm/s)");
+    if (std::abs(v * 1e-3 - scene.insertion.speed_m_per_s) <= 1e-9) continue;  // the scene's own reference
+    scenes.push_back(validation::scene_at_insertion_speed(scene, v * 1e-3));
+  }
+  for (const Scene& s : scenes) {
+    const validation::FemReference ref = validation::obtain_fem_reference(s, fem, out);
+    if (!validation::is_mpi_root()) continue;
+    out << "[calibrate] FEM reference " << ref.hash << " at " << s.insertion.speed_m_per_s * 1e3 << " mm/s"
+        << (ref.from_cache ? " (from cache)" : " (computed)") << '\n';
+    if (references.empty()) fem_dir = ref.dir;
+    references.push_back({validation::fem_insertion_curve(s, ref.dir / "fem_force_depth.csv"), "fem"});
+  }
+  return validation::is_mpi_root();
+}
+
+/// The references (the FEM's, or every --reference) and the --held-out
+/// recordings. With more than one recording each must carry its speed.
+bool load_references(const CalibrateOptions& options, const Scene& scene, std::ostream& out,
+                     std::vector<validation::ReferenceCurve>& references,
+                     std::vector<validation::ReferenceCurve>& held_out, std::filesystem::path& fem_dir) {
+  if (!std::isfinite(options.reference_depth_offset_mm))
+    throw UsageError("--reference-depth-offset must be a finite number (mm)");
+  for (const std::filesystem::path& h : options.held_out)
+    for (const std::filesystem::path& r : options.references)
+      if (std::filesystem::weakly_canonical(h) == std::filesystem::weakly_canonical(r))
+        throw UsageError("--held-out " + h.string() + " is also a --reference: a recording is fitted or held out");
+  if (options.references.empty()) {
+    if (!load_fem_references(options, scene, out, references, fem_dir)) return false;
+  } else {
+    if (!options.fem_speeds_mm_per_s.empty()) throw UsageError("--fem-speeds takes the scene's FEM reference, not --reference");
+    if (options.surface_fit) throw UsageError("--surface-fit needs the scene's FEM reference (its surface profiles), not --reference");
+    for (const std::filesystem::path& path : options.references) references.push_back(read_measured(path, options, out));
+  }
+  for (const std::filesystem::path& path : options.held_out) held_out.push_back(read_measured(path, options, out));
+  const std::size_t measured = options.references.size() + held_out.size();
+  double speed = 0.0;
+  if (measured > 1)
+    for (const auto* list : {&references, &held_out})
+      for (const validation::ReferenceCurve& r : *list)
+        if (r.kind == "measured" && !r.curve.metadata_number("speed_mm_per_s", speed))
+          throw UsageError(r.curve.source + ": no insertion speed: with several recordings each needs its own (a raw "
+                           "recording's stage gives it; a curve needs a '# speed_mm_per_s: V' line)");
   return true;
 }
 
-/// The curves the report plots: per reference, the reference and the model
-/// before and after; the first reference's series keep their plain names
-/// (reference kind, "before", "after"), the others carry "@<speed>mm_per_s".
+/// The curves the report plots: per recording (fitted, then held out), the
+/// recording and the model before and after on its trajectory; the first
+/// reference's series keep their plain names (reference kind, "before",
+/// "after"), the others carry "@<speed>mm_per_s" (and "#<n>" for a repeat of a
+/// speed already named); a held-out recording's series is "held_out@...".
 std::vector<std::pair<std::string, const validation::InsertionCurve*>> curve_list(
-    const std::vector<validation::ReferenceCurve>& references, const validation::CalibrationResult& result) {
+    const std::vector<validation::JudgedRecording>& recordings) {
   std::vector<std::pair<std::string, const validation::InsertionCurve*>> curves;
-  for (std::size_t r = 0; r < references.size(); ++r) {
+  std::vector<std::string> used;
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    const validation::JudgedRecording& j = recordings[r];
     std::string suffix;
-    const auto speed = references[r].curve.metadata.find("speed_mm_per_s");
-    if (r > 0) suffix = "@" + (speed != references[r].curve.metadata.end() ? speed->second : std::to_string(r)) + "mm_per_s";
-    curves.push_back({references[r].kind + suffix, &references[r].curve});
-    curves.push_back({"before" + suffix, &result.model_before[r]});
-    curves.push_back({"after" + suffix, &result.model_after[r]});
+    if (r > 0) {
+      const auto speed = j.reference.curve.metadata.find("speed_mm_per_s");
+      suffix = "@" + (speed != j.reference.curve.metadata.end() ? speed->second : std::to_string(r)) + "mm_per_s";
+      if (std::find(used.begin(), used.end(), suffix) != used.end()) suffix += "#" + std::to_string(r + 1);
+    }
+    used.push_back(suffix);
+    curves.push_back({(j.held_out ? std::string("held_out") : j.reference.kind) + suffix, &j.reference.curve});
+    curves.push_back({"before" + suffix, &j.model_before});
+    curves.push_back({"after" + suffix, &j.model_after});
   }
   return curves;
 }
@@ -242,22 +285,66 @@ Scene scene_on_slab(const std::filesystem::path& scene_path, const std::vector<d
   }
 }
 
-/// The summary's section on every reference when there are several (the term
-/// tables compare the model with the first; the objective sums them all).
-std::string every_reference_markdown(const std::vector<validation::ReferenceCurve>& references,
-                                     const validation::CalibrationResult& result) {
-  std::ostringstream refs;
-  refs << "\n## Every reference\n\nThe term tables above compare the model with the first reference; the "
-          "calibration's objective is the sum over all of them:\n\n| reference | speed (mm/s) | objective before | "
-          "after |\n|---|---|---|---|\n";
-  for (std::size_t r = 0; r < references.size(); ++r) {
-    const auto speed = references[r].curve.metadata.find("speed_mm_per_s");
-    refs << "| " << references[r].kind << " (" << references[r].curve.source << ") | "
-         << (speed != references[r].curve.metadata.end() ? speed->second : std::string("the scene's")) << " | "
-         << std::setprecision(4) << result.trajectory_before[r].objective << " | " << result.trajectory_after[r].objective
-         << " |\n";
-  }
-  return refs.str();
+/// The surface fit's section of the summary.
+std::string surface_fit_markdown(const std::vector<validation::SurfaceIdentificationResult>& surfaces) {
+  return "\n## Force meshes identified from the FEM's surface (--surface-fit)\n\nBefore the stages below, each "
+         "layer with FEM surface profiles taken while its surface follows the tip had K, k_s, k_a and z_v "
+         "identified from the FEM's tip force and deflection profile together (quasi-static mesh; "
+         "validation/calibration/include/puncture/validation/surface_identification.hpp); those layers carry "
+         "no tip stiffening (the mesh stiffens itself, so Eq. 5 carries the pressing force) and K and the "
+         "stiffening were kept by the stages. Values +- relative standard error (Gauss-Newton); RMSEs before "
+         "-> after, over the FEM's largest force and deflection of those samples; per sample and ring in "
+         "surface_identification.csv.\n\n" +
+         validation::surface_identification_markdown(surfaces);
+}
+
+/// What calibrate_command reports on.
+struct Calibrated {
+  Scene scene;
+  std::vector<validation::ReferenceCurve> references, held_out;
+  validation::CalibrationOptions calibration;
+  std::vector<validation::SurfaceIdentificationResult> surfaces;
+  validation::CalibrationResult result;
+  double seconds = 0.0;
+  std::vector<validation::JudgedRecording> recordings;  ///< fitted, then held out
+  std::vector<validation::RepeatGroup> groups;          ///< the scatter of repeats (several recordings)
+  bool scatter = false;                                 ///< two or more measured recordings
+};
+
+/// Writes the preset, the curves and the summary into dir (the summary after the plots).
+void write_report(const CalibrateOptions& options, const std::filesystem::path& scene_path,
+                  const std::filesystem::path& dir, const std::string& name, const Calibrated& c, std::ostream& out,
+                  std::ostream& err) {
+  io::OutputSession session(dir);
+  const io::Provenance provenance =
+      io::make_provenance(command_line(options, scene_path, dir, name, c.calibration.integrator));
+  std::vector<validation::CalibratedValue> surface_values;
+  for (const validation::SurfaceIdentificationResult& r : c.surfaces)
+    for (const validation::SurfaceParameterStatus& st : validation::surface_parameter_statuses(r))
+      surface_values.push_back({r.layer, st.pointer, st.status, st.reason, "surface fit", st.relative_standard_error});
+  validation::write_tuned_preset(session, name, c.result, c.references, c.calibration, surface_values);
+  // The model curves the objective compared, before and after, for the report.
+  session.write_text("calibration_curves.csv", validation::calibration_curves_csv(curve_list(c.recordings), provenance));
+  if (c.scatter) session.write_text("repeat_scatter.csv", validation::repeat_scatter_csv(c.groups, provenance));
+  if (options.surface_fit)
+    session.write_text("surface_identification.csv",
+                       io::provenance_comment_lines(provenance) + validation::surface_identification_csv(c.surfaces));
+  session.commit();
+  const std::string method = options.method + " on " +
+                             (options.threads > 0 ? std::to_string(options.threads) : std::string("every")) +
+                             " thread(s)";
+  std::string md = validation::calibration_summary_markdown(c.result, c.scene, c.references.front(), provenance, method,
+                                                            c.seconds, name);
+  if (c.recordings.size() > 1) md += validation::recordings_markdown(c.recordings, c.scene);
+  if (c.scatter) md += validation::repeat_scatter_markdown(c.recordings, c.groups, c.scene);
+  if (options.surface_fit) md += surface_fit_markdown(c.surfaces);
+  // A measured reference: what was detected on it (contact, phases, drops), to check before trusting the fit.
+  if (!options.references.empty()) validation::run_plot_script("plot_reference_detection.py", dir, out, err);
+  for (const std::string& p : validation::run_plot_script("plot_calibration.py", dir, out, err))
+    md += "\n![" + p + "](" + p + ")\n";
+  io::OutputSession md_session(dir);
+  md_session.write_text("calibration_summary.md", md);
+  md_session.commit();
 }
 
 }  // namespace
@@ -267,17 +354,16 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
   std::ostream& out = options.quiet ? quiet : stdout_stream;
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
   return report_errors(err, "", [&]() -> int {
-    Scene scene = load_scene(scene_path);
-    if (!options.layer_thickness_mm.empty()) scene = scene_on_slab(scene_path, options.layer_thickness_mm);
+    Calibrated c;
+    c.scene = load_scene(scene_path);
+    if (!options.layer_thickness_mm.empty()) c.scene = scene_on_slab(scene_path, options.layer_thickness_mm);
     const std::filesystem::path dir =
-        options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_calibration") : options.output_dir;
-    std::vector<validation::ReferenceCurve> references;
+        options.output_dir.empty() ? std::filesystem::path("out") / (c.scene.name + "_calibration") : options.output_dir;
     std::filesystem::path fem_dir;
-    if (!load_references(options, scene, out, references, fem_dir)) return 0;  // the other ranks only help with the FEM
-    const validation::ReferenceCurve& reference = references.front();
-    validation::CalibrationOptions calibration = calibration_options(options, scene);
-    std::vector<validation::SurfaceIdentificationResult> surfaces;
-    if (options.surface_fit) surfaces = fit_surfaces(fem_dir, scene, calibration, options.threads, out);
+    if (!load_references(options, c.scene, out, c.references, c.held_out, fem_dir))
+      return 0;  // the other ranks only help with the FEM
+    c.calibration = calibration_options(options, c.scene);
+    if (options.surface_fit) c.surfaces = fit_surfaces(fem_dir, c.scene, c.calibration, options.threads, out);
     validation::CalibrationProgressCallback progress;
     if (!options.quiet || options.progress)
       progress = [&](const validation::CalibrationProgress& p) {
@@ -287,49 +373,22 @@ int calibrate_command(const CalibrateOptions& options, std::ostream& stdout_stre
         if (options.progress) options.progress(p);
       };
     const auto t_start = std::chrono::steady_clock::now();
-    const validation::CalibrationResult result = validation::calibrate(scene, references, calibration, progress);
-    const double calibration_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    c.result = validation::calibrate(c.scene, c.references, c.calibration, progress);
+    c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    c.recordings = validation::judge_recordings(c.scene, c.result, c.references, c.held_out, c.calibration);
+    c.scatter = options.references.size() + options.held_out.size() > 1;
+    if (c.scatter) c.groups = validation::repeat_scatter(c.recordings);
 
-    io::OutputSession session(dir);
-    const std::string name = options.preset_name.empty() ? scene.name + "_tuned" : options.preset_name;
-    const io::Provenance provenance = io::make_provenance(command_line(options, scene_path, dir, name, calibration.integrator));
-    std::vector<validation::CalibratedValue> surface_values;
-    for (const validation::SurfaceIdentificationResult& r : surfaces)
-      for (const validation::SurfaceParameterStatus& st : validation::surface_parameter_statuses(r))
-        surface_values.push_back({r.layer, st.pointer, st.status, st.reason, "surface fit", st.relative_standard_error});
-    validation::write_tuned_preset(session, name, result, references, calibration, surface_values);
-    // The model curves the objective compared, before and after, for the report.
-    session.write_text("calibration_curves.csv", validation::calibration_curves_csv(curve_list(references, result), provenance));
-    if (options.surface_fit)
-      session.write_text("surface_identification.csv",
-                         io::provenance_comment_lines(provenance) + validation::surface_identification_csv(surfaces));
-    session.commit();
-    const std::string method = options.method + " on " +
-                               (options.threads > 0 ? std::to_string(options.threads) : std::string("every")) +
-                               " thread(s)";
-    std::string md = validation::calibration_summary_markdown(result, scene, reference, provenance, method, calibration_s, name);
-    if (references.size() > 1) md += every_reference_markdown(references, result);
-    if (options.surface_fit)
-      md += "\n## Force meshes identified from the FEM's surface (--surface-fit)\n\nBefore the stages below, each "
-            "layer with FEM surface profiles taken while its surface follows the tip had K, k_s, k_a and z_v "
-            "identified from the FEM's tip force and deflection profile together (quasi-static mesh; "
-            "validation/calibration/include/puncture/validation/surface_identification.hpp); those layers carry "
-            "no tip stiffening (the mesh stiffens itself, so Eq. 5 carries the pressing force) and K and the "
-            "stiffening were kept by the stages. Values +- relative standard error (Gauss-Newton); RMSEs before "
-            "-> after, over the FEM's largest force and deflection of those samples; per sample and ring in "
-            "surface_identification.csv.\n\n" +
-            validation::surface_identification_markdown(surfaces);
-    // A measured reference: what was detected on it (contact, phases, drops), to check before trusting the fit.
-    if (!options.reference.empty()) validation::run_plot_script("plot_reference_detection.py", dir, out, err);
-    for (const std::string& p : validation::run_plot_script("plot_calibration.py", dir, out, err))
-      md += "\n![" + p + "](" + p + ")\n";
-    io::OutputSession md_session(dir);
-    md_session.write_text("calibration_summary.md", md);
-    md_session.commit();
-
-    out << "\n" << validation::calibration_terms_table(result) << "\n" << validation::calibration_parameters_table(result);
+    const std::string name = options.preset_name.empty() ? c.scene.name + "_tuned" : options.preset_name;
+    write_report(options, scene_path, dir, name, c, out, err);
+    out << "\n" << validation::calibration_terms_table(c.result) << "\n"
+        << validation::calibration_parameters_table(c.result);
+    for (const validation::JudgedRecording& j : c.recordings)
+      if (j.held_out)
+        out << "held out " << j.reference.curve.source << ": objective " << j.before.objective << " -> "
+            << j.after.objective << '\n';
     // Warnings go to stderr: -q silences stdout only.
-    for (const std::string& w : result.warnings) err << "warning: " << w << "\n";
+    for (const std::string& w : c.result.warnings) err << "warning: " << w << "\n";
     out << "\nTuned preset: " << (dir / (name + ".json")).string()
         << "\n  run it with: puncture run " << (dir / (name + ".json")).string() << '\n';
     return 0;

@@ -48,7 +48,7 @@ TEST(CalibrateCommand, RecoversSkinStiffnessFromAReferenceCurveAndWritesARunnabl
 
   CalibrateOptions options;
   options.scene = kSourceDir / "scenes" / "default.json";
-  options.reference = work / "truth_run" / "realtime_curve.csv";
+  options.references = {work / "truth_run" / "realtime_curve.csv"};
   options.output_dir = work / "calibration";
   options.layers = {"skin"};
   options.integrator = "quasi_static";  // the fast runs (the scene's implicit one is the default)
@@ -115,7 +115,7 @@ TEST(CalibrateCommand, DepthAndForceCurveWithGivenPunctureDepthsReportsEveryTerm
   }
   CalibrateOptions options;
   options.scene = kSourceDir / "scenes" / "default.json";
-  options.reference = work / "depth_force.csv";
+  options.references = {work / "depth_force.csv"};
   options.output_dir = work / "calibration";
   options.layers = {"skin"};
   options.integrator = "quasi_static";
@@ -148,7 +148,7 @@ TEST(CalibrateCommand, BadKeepOrPunctureDepthsAreErrorsWithNoOutput) {
   for (int which = 0; which < 6; ++which) {
     CalibrateOptions options;
     options.scene = kSourceDir / "scenes" / "default.json";
-    options.reference = ref_dir / "curve.csv";
+    options.references = {ref_dir / "curve.csv"};
     options.output_dir = dir;
     options.quiet = true;
     if (which == 0) options.keep = {"everything"};
@@ -176,7 +176,7 @@ TEST(CalibrateCommand, UnknownExtraParameterIsAnErrorWithNoOutput) {
   }
   CalibrateOptions options;
   options.scene = kSourceDir / "scenes" / "default.json";
-  options.reference = ref_dir / "curve.csv";
+  options.references = {ref_dir / "curve.csv"};
   options.output_dir = dir;
   options.also_tune = {"stiffness_of_everything"};
   options.quiet = true;
@@ -191,7 +191,7 @@ TEST(CalibrateCommand, MissingReferenceFileIsAnErrorWithNoOutput) {
   const fs::path dir = fresh_dir("calibrate_bad");
   CalibrateOptions options;
   options.scene = kSourceDir / "scenes" / "default.json";
-  options.reference = "/nonexistent/curve.csv";
+  options.references = {"/nonexistent/curve.csv"};
   options.output_dir = dir;
   options.quiet = true;
   std::ostringstream out, err;
@@ -212,7 +212,7 @@ TEST(CalibrateCommand, AReferenceThatCannotBeFittedIsBadInputWithNoOutput) {
   for (const auto& [file, why] : cases) {
     CalibrateOptions options;
     options.scene = kSourceDir / "scenes" / "default.json";
-    options.reference = ref_dir / file;
+    options.references = {ref_dir / file};
     options.output_dir = dir;
     options.quiet = true;
     std::ostringstream out, err;
@@ -232,7 +232,7 @@ TEST(CalibrateCommand, UnsurePunctureDetectionAsksForPunctureDepthsWithNoOutput)
   const fs::path dir = fresh_dir("calibrate_unsure");
   CalibrateOptions options;
   options.scene = kSourceDir / "scenes" / "default.json";
-  options.reference = reference;
+  options.references = {reference};
   options.output_dir = dir;
   options.quiet = true;
   std::ostringstream out, err;

@@ -32,7 +32,7 @@ fs::path fresh_dir(const std::string& name) {
 CalibrateOptions phantom_options(const fs::path& reference, const fs::path& out) {
   CalibrateOptions o;
   o.scene = kSourceDir / "scenes" / "skin_on_muscle_phantom.json";
-  o.reference = reference;
+  if (!reference.empty()) o.references = {reference};
   o.output_dir = out;
   o.quiet = true;
   return o;

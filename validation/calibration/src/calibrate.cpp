@@ -71,20 +71,6 @@ void check_options(const Scene& scene, const std::vector<ReferenceCurve>& refere
   for (const ReferenceCurve& r : references) insertion_phase(r.curve);  // throws with the file name if unusable
 }
 
-std::vector<std::size_t> selected_layers(const Scene& scene, const CalibrationOptions& options) {
-  for (const std::string& name : options.layers) {
-    bool found = false;
-    for (const Layer& l : scene.layers) found = found || l.name == name;
-    if (!found) throw std::invalid_argument("calibrate: the scene has no layer '" + name + "'");
-  }
-  std::vector<std::size_t> layers;
-  for (std::size_t k = 0; k < scene.layers.size(); ++k)
-    if (options.layers.empty() ||
-        std::find(options.layers.begin(), options.layers.end(), scene.layers[k].name) != options.layers.end())
-      layers.push_back(k);
-  return layers;
-}
-
 /// The references' punctures, checked (reference_checks.hpp), and what they identify per layer (any reference counts).
 void find_reference_events(Calibration& c, CalibrationResult& result) {
   const CalibrationOptions& o = c.options;
@@ -400,7 +386,9 @@ bool tunes_release_rate(const Calibration& c, std::size_t k) {
 }
 
 /// The rate stage: d of every calibrated layer, the rate exponent n of every
-/// breakthrough threshold that has one (breakthrough_rate.hpp), the viscous
+/// breakthrough threshold that has one (breakthrough_rate.hpp) with the
+/// threshold's level at v_ref when the layer stage tuned it (fitted there to
+/// every speed at the start n, a compromise n alone cannot undo), the viscous
 /// fraction b of every cutting force the references cut and the rate exponent
 /// m of every rupture release length in use (cutting.hpp), on the
 /// whole trajectory of references at two or more speeds; every other
@@ -412,7 +400,12 @@ Scene run_rate_stage(Calibration& c, CalibrationResult& result, const Scene& cur
   std::vector<Parameter> ds;
   for (std::size_t k : c.layers) {
     ds.push_back(c.parameter(k, ParamKind::Damping));
-    if (has_breakthrough_rate(c.scene, k)) ds.push_back(c.parameter(k, ParamKind::BreakthroughRate));
+    if (has_breakthrough_rate(c.scene, k)) {
+      ds.push_back(c.parameter(k, ParamKind::BreakthroughRate));
+      // With n its level F_c,ref (or G,ref): the layer stage fitted it to every speed at the start n.
+      for (const Parameter& p : std::vector<Parameter>(c.parameters))
+        if (p.layer == k && (p.kind == ParamKind::CriticalForce || p.kind == ParamKind::CriticalEnergy)) ds.push_back(p);
+    }
     if (tunes_cutting_rate(c, k)) {
       ds.push_back(c.parameter(k, ParamKind::CuttingRate));
       CuttingRate& rate = current.layers[k].force_law.cutting_rate;
@@ -485,29 +478,13 @@ void evaluate_before_and_after(Calibration& c, CalibrationResult& result) {
   }
 }
 
-TunedParameterRecord parameter_record(const Calibration& c, const Scene& tuned, std::size_t i) {
-  const Parameter& p = c.parameters[i];
-  const ParamInfo in = info(p.kind);
-  TunedParameterRecord rec;
-  rec.layer = c.scene.layers[p.layer].name;
-  rec.name = in.name;
-  rec.unit = in.unit;
-  rec.start = param_value(c.scene, p.layer, p.kind) * in.to_unit;
-  rec.tuned = param_value(tuned, p.layer, p.kind) * in.to_unit;
-  rec.lower = p.value_lo * in.to_unit;
-  rec.upper = p.value_hi * in.to_unit;
-  rec.at_bound = bound_name(p, p.x_of(std::max(param_value(tuned, p.layer, p.kind), p.log_space ? 1e-300 : 0.0)));
-  rec.start_moved_inside = c.moved_inside[i];
-  return rec;
-}
-
 void record_parameters(const Calibration& c, CalibrationResult& result) {
   for (std::size_t i = 0; i < c.parameters.size(); ++i) {
     if (!c.calibrated(c.parameters[i].layer) && c.parameters[i].kind != ParamKind::Damping &&
         c.parameters[i].kind != ParamKind::BreakthroughRate && c.parameters[i].kind != ParamKind::CuttingRate &&
         c.parameters[i].kind != ParamKind::ReleaseRate)
       continue;
-    const TunedParameterRecord rec = parameter_record(c, result.tuned_scene, i);
+    const TunedParameterRecord rec = parameter_record(c.scene, result.tuned_scene, c.parameters[i], c.moved_inside[i]);
     if (rec.start_moved_inside)
       result.warnings.push_back("layer " + rec.layer + ": " + rec.name + " started outside its physical bounds (" +
                                 std::to_string(rec.start) + " " + rec.unit + "), moved inside");
@@ -565,25 +542,6 @@ void report_identifiability(Calibration& c, CalibrationResult& result) {
   result.identifiability = identifiability_report(whole, withheld, c.options);
 }
 
-/// The critical-force starts of the scaled start (scaled_start.cpp), in words.
-std::string critical_force_start_note(const Calibration& c, const Scene& scene) {
-  if (!c.options.scaled_start) return {};
-  std::ostringstream note;
-  for (std::size_t k : c.layers) {
-    const std::vector<ParamKind> kinds = layer_kinds(scene, k, c.options.parameters, nullptr);
-    if (std::find(kinds.begin(), kinds.end(), ParamKind::CriticalForce) == kinds.end()) continue;
-    const Layer& l = scene.layers[k];
-    note << (note.tellp() > 0 ? "; " : "") << l.name << ": ";
-    if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy && l.puncture.toughness_J_per_m2 > 0.0)
-      note << "G_c x 2a = " << l.puncture.toughness_J_per_m2 << " J/m^2 x " << 2e3 * scene.needle.radius_m
-           << " mm = " << l.puncture.toughness_J_per_m2 * 2.0 * scene.needle.radius_m
-           << " N (the layer's fracture toughness)";
-    else
-      note << "the reference's puncture force less the model's other terms there (no fracture toughness)";
-  }
-  return note.str();
-}
-
 }  // namespace
 
 CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve>& references,
@@ -600,8 +558,13 @@ CalibrationResult calibrate(const Scene& scene, const std::vector<ReferenceCurve
   check_enough_samples(references.front().curve, result.reference_events.front(),
                        n_tuned + (result.damping_tuned ? c.layers.size() : 0), n_requested);
 
-  result.critical_force_note = critical_force_start_note(c, scene);
-  Scene current = scene;
+  result.critical_force_note = critical_force_start_note(scene, c.layers, options);
+  std::vector<bool> level_tuned(scene.layers.size(), false);
+  for (std::size_t k : c.layers)
+    level_tuned[k] = options.parameters.deformed_threshold && withheld_reason(c, result, k, ParamKind::CriticalForce).empty();
+  Scene current = result.damping_tuned ? rate_exponent_start(scene, c.layers, level_tuned, references,
+                                                             result.reference_events, result.warnings)
+                                       : scene;
   const int passes = options.passes > 0 ? options.passes
                                         : (scene.effects.layer_interaction && c.layers.size() > 1 ? 2 : 1);
   for (int pass = 0; pass < passes; ++pass)

@@ -250,4 +250,33 @@ std::string bound_name(const Parameter& p, double x) {
   return "";
 }
 
+TunedParameterRecord parameter_record(const Scene& start, const Scene& tuned, const Parameter& p, bool moved_inside) {
+  const ParamInfo in = info(p.kind);
+  TunedParameterRecord rec;
+  rec.layer = start.layers[p.layer].name;
+  rec.name = in.name;
+  rec.unit = in.unit;
+  rec.start = param_value(start, p.layer, p.kind) * in.to_unit;
+  rec.tuned = param_value(tuned, p.layer, p.kind) * in.to_unit;
+  rec.lower = p.value_lo * in.to_unit;
+  rec.upper = p.value_hi * in.to_unit;
+  rec.at_bound = bound_name(p, p.x_of(std::max(param_value(tuned, p.layer, p.kind), p.log_space ? 1e-300 : 0.0)));
+  rec.start_moved_inside = moved_inside;
+  return rec;
+}
+
+std::vector<std::size_t> selected_layers(const Scene& scene, const CalibrationOptions& options) {
+  for (const std::string& name : options.layers) {
+    bool found = false;
+    for (const Layer& l : scene.layers) found = found || l.name == name;
+    if (!found) throw std::invalid_argument("calibrate: the scene has no layer '" + name + "'");
+  }
+  std::vector<std::size_t> layers;
+  for (std::size_t k = 0; k < scene.layers.size(); ++k)
+    if (options.layers.empty() ||
+        std::find(options.layers.begin(), options.layers.end(), scene.layers[k].name) != options.layers.end())
+      layers.push_back(k);
+  return layers;
+}
+
 }  // namespace puncture::validation::calibration_detail

@@ -93,5 +93,9 @@ std::vector<double> x_values(const Scene& s, const std::vector<Parameter>& param
 void clamp_into_bounds(Scene& s, const std::vector<Parameter>& params);
 /// "lower", "upper" or "" (x within 0.1 % of the span, and of its own size, of a bound).
 std::string bound_name(const Parameter& p, double x);
+/// The layers options.layers names (all when empty), top to bottom; std::invalid_argument for a name the scene lacks.
+std::vector<std::size_t> selected_layers(const Scene& scene, const CalibrationOptions& options);
+/// The result's record of a tuned parameter: start (in `start`) and tuned values, bounds, at a bound.
+TunedParameterRecord parameter_record(const Scene& start, const Scene& tuned, const Parameter& p, bool moved_inside);
 
 }  // namespace puncture::validation::calibration_detail

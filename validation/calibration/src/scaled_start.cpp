@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "model_runs.hpp"
 #include "puncture/stiffening.hpp"
@@ -212,6 +213,53 @@ Scene scaled_start(const Scene& candidate, std::size_t k, const ReferenceCurve& 
     clamp_into_bounds(s, parameters);
   }
   return s;
+}
+
+Scene rate_exponent_start(const Scene& scene, const std::vector<std::size_t>& layers,
+                          const std::vector<bool>& level_tuned, const std::vector<ReferenceCurve>& references,
+                          const std::vector<ReferenceEvents>& events, std::vector<std::string>& notes) {
+  Scene s = scene;
+  for (std::size_t k : layers) {
+    if (!level_tuned[k] || s.layers[k].force_law.breakthrough.kind != BreakthroughCriterion::Kind::CriticalForce)
+      continue;
+    std::vector<double> x, y;  // ln v, ln F of every puncture of layer k
+    for (std::size_t r = 0; r < references.size() && r < events.size(); ++r) {
+      const auto& p = events[r].punctures;
+      if (k >= p.size() || !p[k].found || !(p[k].force_N > 0.0)) continue;
+      x.push_back(std::log(reference_speed(scene, references[r].curve)));
+      y.push_back(std::log(p[k].force_N));
+    }
+    if (x.size() < 2) continue;
+    double mx = 0.0, my = 0.0, sxx = 0.0, sxy = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) mx += x[i] / x.size(), my += y[i] / x.size();
+    for (std::size_t i = 0; i < x.size(); ++i) sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
+    if (!(sxx > 1e-6)) continue;  // one speed
+    const double n = std::clamp(sxy / sxx, 0.0, 1.0);
+    s.layers[k].force_law.breakthrough.rate_exponent = n;
+    notes.push_back("layer " + s.layers[k].name + ": breakthrough_rate_exponent started at " + std::to_string(n) +
+                    ", the slope of ln F against ln v of its " + std::to_string(x.size()) +
+                    " punctures (then tuned with its critical force)");
+  }
+  return s;
+}
+
+std::string critical_force_start_note(const Scene& scene, const std::vector<std::size_t>& layers,
+                                      const CalibrationOptions& options) {
+  if (!options.scaled_start) return {};
+  std::ostringstream note;
+  for (std::size_t k : layers) {
+    const std::vector<ParamKind> kinds = layer_kinds(scene, k, options.parameters, nullptr);
+    if (std::find(kinds.begin(), kinds.end(), ParamKind::CriticalForce) == kinds.end()) continue;
+    const Layer& l = scene.layers[k];
+    note << (note.tellp() > 0 ? "; " : "") << l.name << ": ";
+    if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy && l.puncture.toughness_J_per_m2 > 0.0)
+      note << "G_c x 2a = " << l.puncture.toughness_J_per_m2 << " J/m^2 x " << 2e3 * scene.needle.radius_m
+           << " mm = " << l.puncture.toughness_J_per_m2 * 2.0 * scene.needle.radius_m
+           << " N (the layer's fracture toughness)";
+    else
+      note << "the reference's puncture force less the model's other terms there (no fracture toughness)";
+  }
+  return note.str();
 }
 
 }  // namespace puncture::validation::calibration_detail

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "calibration_parameters.hpp"
@@ -27,5 +28,19 @@ namespace puncture::validation::calibration_detail {
 Scene scaled_start(const Scene& candidate, std::size_t k, const ReferenceCurve& reference, const ReferenceEvents& ref_ev,
                    const std::vector<LayerGeometry>& layers, const CalibrationOptions& options, const SurfaceCache& cache,
                    const std::vector<Parameter>& parameters);
+
+/// The critical-force starts of the scaled start, in words (empty without scaled_start).
+std::string critical_force_start_note(const Scene& scene, const std::vector<std::size_t>& layers,
+                                      const CalibrationOptions& options);
+
+/// The start of the breakthrough rate exponent n of each layer in `layers`
+/// whose critical force is tuned (`level_tuned`), from the references'
+/// punctures of it at two or more speeds: the slope of ln F against ln v
+/// (least squares), clamped to n's bounds [0, 1]; the layer stage then fits
+/// F_c at that n (started at n = 0 it fits one F_c to every speed, a
+/// compromise the rate stage could not undo). A note per layer started so.
+Scene rate_exponent_start(const Scene& scene, const std::vector<std::size_t>& layers,
+                          const std::vector<bool>& level_tuned, const std::vector<ReferenceCurve>& references,
+                          const std::vector<ReferenceEvents>& events, std::vector<std::string>& notes);
 
 }  // namespace puncture::validation::calibration_detail

@@ -74,7 +74,13 @@ int validate_command(const ValidateOptions& options, std::ostream& out, std::ost
 
 struct CalibrateOptions {
   std::filesystem::path scene;
-  std::filesystem::path reference;    ///< measured curve CSV; empty: FEM reference of the scene (cached)
+  /// Measured curves or raw recordings calibrated against together (repeats
+  /// and other speeds of one tissue, each at its own speed); empty: the FEM
+  /// reference of the scene (cached).
+  std::vector<std::filesystem::path> references;
+  /// Recordings of the same tissue left out of the fit: judged with the tuned
+  /// model in the same report (and counted in the scatter of repeats).
+  std::vector<std::filesystem::path> held_out;
   /// How to read a raw rig recording (recording.hpp): a format file
   /// (--recording-format; empty: the sidecar <reference stem>.json if present)
   /// and the command line's fields over it (--time-column, ...).

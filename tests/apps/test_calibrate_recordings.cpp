@@ -1,0 +1,208 @@
+// `puncture calibrate` on several bench recordings at once (issue 49): raw
+// recordings made from a KNOWN model (the real-time model with a skin whose
+// critical force grows with the pressing speed, F_c (v / 10 mm/s)^0.3), at two
+// speeds, with seeded sensor noise and an untared offset, each with its
+// sidecar. One recording cannot identify the rate exponent n (it stays at its
+// start, 0, and the report says why; the recording at the other speed, held
+// out, shows the model's puncture force off); two recordings at two speeds
+// recover n. A held-out repeat of one speed is judged in the same report, and
+// the scatter of the repeats stands beside the model's error.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+
+#include "puncture/apps/commands.hpp"
+#include "puncture/scene_io.hpp"
+#include "puncture/validation/calibration.hpp"
+#include "puncture/validation/fem_reference_curve.hpp"
+
+namespace fs = std::filesystem;
+namespace pv = puncture::validation;
+
+namespace puncture::apps {
+namespace {
+
+constexpr double kTrueExponent = 0.3;
+
+/// Skin (critical force 2 N at 10 mm/s, rate exponent 0.3) on a fat layer that
+/// does not break within the 6 mm insertion; quasi-static mesh, low SH degree.
+Scene truth_scene() {
+  Scene s = parse_scene(R"({
+    "schema_version": 1, "name": "rate_truth",
+    "sample": { "diameter_mm": 60.0 },
+    "needle": { "radius_mm": 0.635, "tip": "blunt" },
+    "layers": [
+      { "name": "skin", "thickness_mm": 0.8, "density_kg_per_m3": 1100,
+        "force_mesh": { "K_N_per_mm": 0.16, "w": 8, "L_mm": 2.0, "surface_stiffness_N_per_mm": 0.2,
+                        "deformed_threshold_mm": 0.01, "node_damping_N_s_per_m": 0.05 },
+        "damping_d_N_s_per_m2": 3000, "resumption_rate": 0.05,
+        "force_law": { "breakthrough": { "criterion": "critical_force", "critical_force_N": 2.0,
+                                         "rate_exponent": 0.3, "reference_speed_mm_per_s": 10.0 } },
+        "material": { "model": "neo_hookean", "youngs_modulus_kPa": 35.0, "poisson_ratio": 0.48 } },
+      { "name": "fat", "thickness_mm": 20.0, "density_kg_per_m3": 920,
+        "force_mesh": { "K_N_per_mm": 0.08, "w": 4, "L_mm": 1.0, "surface_stiffness_N_per_mm": 0.05,
+                        "deformed_threshold_mm": 0.15, "node_damping_N_s_per_m": 0.05 },
+        "damping_d_N_s_per_m2": 1000, "resumption_rate": 0.05,
+        "force_law": { "breakthrough": { "criterion": "critical_force", "critical_force_N": 40.0 } },
+        "material": { "model": "neo_hookean", "youngs_modulus_kPa": 2.0, "poisson_ratio": 0.48 } }
+    ],
+    "insertion": { "start_height_mm": 3.0, "speed_mm_per_s": 10.0, "target_depth_mm": 6.0,
+                   "dwell_s": 0.0, "withdrawal_speed_mm_per_s": 50.0, "angle_deg": 0.0 },
+    "realtime": { "sh_degree": 8, "haptic_rate_Hz": 5000, "integrator": "quasi_static", "frame_rate_Hz": 10 },
+    "effects": ["surface_force", "damping", "resumption"]
+  })", "rate_truth");
+  return s;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("puncture_cmd_recordings_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string text_of(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// The truth inserted at `speed_mm_per_s`, written as a rig writes it: 200 Hz,
+/// time (s), stage position (mm, 30 mm at the surface, growing into the
+/// tissue), force with a 0.3 N offset and Gaussian noise of `noise_N` (seeded);
+/// its sidecar <stem>.json beside it. sample_scale != 1: a repeat on another
+/// sample (the skin's K and critical force times it).
+fs::path write_recording(const fs::path& dir, const std::string& stem, double speed_mm_per_s, unsigned seed,
+                         double sample_scale = 1.0, double noise_N = 0.01) {
+  Scene truth = truth_scene();
+  // Another sample of the tissue: the skin's K and critical force scaled.
+  truth.layers[0].force_mesh.virtual_stiffness_N_per_m *= sample_scale;
+  truth.layers[0].force_law.breakthrough.critical_force_N *= sample_scale;
+  const pv::InsertionCurve c = pv::simulate_insertion_curve(pv::scene_at_insertion_speed(truth, speed_mm_per_s * 1e-3));
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, noise_N);
+  std::ofstream csv(dir / (stem + ".csv"));
+  csv << "# synthetic bench recording of the test's truth model at " << speed_mm_per_s << " mm/s\nt_s,stage_mm,F_N\n";
+  double next = 0.0;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (c.time_s[i] + 1e-12 < next) continue;
+    csv << c.time_s[i] << ',' << 30.0 + c.depth_m[i] * 1e3 << ',' << 0.3 + c.force_N[i] + noise(rng) << '\n';
+    next += 0.005;
+  }
+  std::ofstream(dir / (stem + ".json")) << R"({"time": {"column": "t_s", "unit": "s"},
+    "position": {"column": "stage_mm", "unit": "mm", "into_tissue": "increasing"},
+    "force": {"column": "F_N", "unit": "N", "sign": 1}})";
+  return dir / (stem + ".csv");
+}
+
+/// The start: the truth with n = 0, d 30 % low and F_c 20 % low, as a scene file.
+fs::path write_start_scene(const fs::path& dir) {
+  Scene start = truth_scene();
+  start.layers[0].force_law.breakthrough.rate_exponent = 0.0;
+  start.layers[0].damping_N_s_per_m2 *= 0.7;
+  start.layers[0].force_law.breakthrough.critical_force_N = 1.6;
+  std::ofstream(dir / "start.json") << scene_to_json_text(start);
+  return dir / "start.json";
+}
+
+CalibrateOptions skin_options(const fs::path& scene, const fs::path& out) {
+  CalibrateOptions o;
+  o.scene = scene;
+  o.output_dir = out;
+  o.layers = {"skin"};
+  // The skin's K kept: its critical force at v_ref (F_c), d and n are tuned.
+  o.keep = {"K"};
+  o.quiet = true;
+  return o;
+}
+
+const nlohmann::json* parameter(const nlohmann::json& identifiability, const std::string& name) {
+  for (const nlohmann::json& p : identifiability.at("parameters"))
+    if (p.at("layer") == "skin" && p.at("parameter") == name) return &p;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST(CalibrateRecordings, TwoSpeedsIdentifyTheRateExponentThatOneLeavesUnidentified) {
+  const fs::path work = fresh_dir("rate");
+  const fs::path fast = write_recording(work, "fast", 10.0, 11);
+  const fs::path slow = write_recording(work, "slow", 4.0, 12);
+  const fs::path stiffer = write_recording(work, "fast_stiffer_sample", 10.0, 13, 1.08);
+  const fs::path softer = write_recording(work, "fast_softer_sample", 10.0, 14, 0.92);
+  const fs::path scene = write_start_scene(work);
+  std::ostringstream out, err;
+
+  // One recording (10 mm/s), the 4 mm/s one held out: n stays at 0, and the report says why.
+  CalibrateOptions one = skin_options(scene, work / "one");
+  one.references = {fast};
+  one.held_out = {slow};
+  ASSERT_EQ(calibrate_command(one, out, err), 0) << err.str();
+  const nlohmann::json prov1 = nlohmann::json::parse(text_of(work / "one" / "rate_truth_tuned.provenance.json"));
+  const nlohmann::json* n1 = parameter(prov1.at("identifiability"), "breakthrough_rate_exponent");
+  ASSERT_NE(n1, nullptr);
+  EXPECT_EQ(n1->at("value").get<double>(), 0.0);
+  EXPECT_EQ(n1->at("status"), "not identifiable");
+  EXPECT_NE(n1->at("reason").get<std::string>().find("one speed"), std::string::npos) << n1->dump();
+  const std::string md1 = text_of(work / "one" / "calibration_summary.md");
+  EXPECT_NE(md1.find("| " + slow.string() + " | **held out** | 4 |"), std::string::npos) << md1;
+
+  // Both speeds fitted, two repeats of 10 mm/s on other samples held out: n recovered.
+  CalibrateOptions two = skin_options(scene, work / "two");
+  two.references = {fast, slow};
+  two.held_out = {stiffer, softer};
+  ASSERT_EQ(calibrate_command(two, out, err), 0) << err.str();
+  const nlohmann::json prov2 = nlohmann::json::parse(text_of(work / "two" / "rate_truth_tuned.provenance.json"));
+  const nlohmann::json* n2 = parameter(prov2.at("identifiability"), "breakthrough_rate_exponent");
+  ASSERT_NE(n2, nullptr);
+  EXPECT_NEAR(n2->at("value").get<double>(), kTrueExponent, 0.05);
+  EXPECT_EQ(n2->at("status"), "identified");
+  const Scene tuned = load_scene(work / "two" / "rate_truth_tuned.json");
+  EXPECT_NEAR(tuned.layers[0].force_law.breakthrough.rate_exponent, kTrueExponent, 0.05);
+  EXPECT_NEAR(tuned.layers[0].force_law.breakthrough.critical_force_N, 2.0, 0.1);
+
+  // The report: the held-out repeats judged, and the scatter of the three
+  // 10 mm/s recordings (punctures 0.92-1.08 x 2 N) beside the model, which
+  // lies between them.
+  const std::string md2 = text_of(work / "two" / "calibration_summary.md");
+  EXPECT_NE(md2.find("| " + stiffer.string() + " | **held out** | 10 |"), std::string::npos) << md2;
+  EXPECT_NE(md2.find("| " + softer.string() + " | **held out** | 10 |"), std::string::npos) << md2;
+  EXPECT_NE(md2.find("## Scatter of repeats"), std::string::npos);
+  EXPECT_NE(md2.find("### 4 mm/s: 1 recording(s)"), std::string::npos) << md2;
+  const std::size_t group = md2.find("### 10 mm/s: 3 recording(s)");
+  ASSERT_NE(group, std::string::npos) << md2;
+  EXPECT_NE(md2.find("| skin (3 of 3) |", group), std::string::npos) << md2;
+  EXPECT_NE(md2.find("| yes |", group), std::string::npos) << md2;  // the model's puncture force within the repeats'
+  EXPECT_NE(md2.find("it sits inside the scatter.", group), std::string::npos) << md2;
+  EXPECT_NE(text_of(work / "two" / "repeat_scatter.csv").find("group,speed_mm_per_s,depth_mm"), std::string::npos);
+  if (!::testing::Test::HasFailure()) fs::remove_all(work);
+}
+
+TEST(CalibrateRecordings, ARecordingWithoutSpeedOrFittedAndHeldOutIsBadInputWithNoOutput) {
+  const fs::path work = fresh_dir("bad");
+  const fs::path fast = write_recording(work, "fast", 10.0, 11);
+  std::ofstream(work / "curve.csv") << "depth_mm,force_N\n0,0\n1,0.5\n2,1.0\n3,0.2\n";
+  const fs::path scene = write_start_scene(work);
+  std::ostringstream out, err;
+  CalibrateOptions o = skin_options(scene, work / "out");
+  o.references = {fast, work / "curve.csv"};
+  EXPECT_EQ(calibrate_command(o, out, err), 2);
+  EXPECT_NE(err.str().find((work / "curve.csv").string() + ": no insertion speed"), std::string::npos) << err.str();
+  EXPECT_FALSE(fs::exists(work / "out"));
+  o.references = {fast};
+  o.held_out = {fast};
+  err.str("");
+  EXPECT_EQ(calibrate_command(o, out, err), 2);
+  EXPECT_NE(err.str().find("is also a --reference"), std::string::npos) << err.str();
+  EXPECT_FALSE(fs::exists(work / "out"));
+  fs::remove_all(work);
+}
+
+}  // namespace puncture::apps
