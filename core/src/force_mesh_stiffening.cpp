@@ -95,33 +95,34 @@ double surface_spring_energy_J(const ForceMeshParams& p, double delta) {
   return e;
 }
 
-void ForceMesh::setup_nonlinear() {
-  // The step is solved on the lattice's cells (lattice_cells.hpp): one
-  // unknown per free cell a = cell - 1, the tangent weighted by the cells'
-  // sizes (symmetric: |A| n_AB = |B| n_BA springs between A and B).
-  const int n = lattice_.node_count();
-  const double dt = settings_.time_step_s;
-  step_mass_term_ = use_implicit_ ? mass_kg_ / (dt * dt) + params_.node_damping_N_s_per_m / dt : 0.0;
+void ForceMesh::setup_cells() {
+  // The lattice's cells (lattice_cells.hpp) and the pairs of adjacent cells.
   const detail::LatticeCells cells = detail::equitable_cells(lattice_);
   const int nc = cells.count();
-  const int mf = nc - 1;
   cell_of_ = cells.cell_of;
   cell_rep_ = cells.representative;
   cell_size_.resize(nc);
   for (int a = 0; a < nc; ++a) cell_size_[a] = cells.size[a];
   pairs_.clear();
   contact_pairs_.clear();
-  std::vector<std::pair<int, int>> lower;  // free-cell indices a = cell - 1
-  for (int a = 0; a < mf; ++a) lower.push_back({a, a});
   for (const detail::LatticeCells::Pair& p : cells.pairs) {
     const CellPair pair{p.a, p.b, static_cast<double>(p.edges), p.edges / cell_size_[p.a], p.edges / cell_size_[p.b]};
-    if (p.a == 0) {
-      contact_pairs_.push_back(pair);
-    } else {
-      pairs_.push_back(pair);
-      lower.push_back({p.b - 1, p.a - 1});
-    }
+    (p.a == 0 ? contact_pairs_ : pairs_).push_back(pair);
   }
+}
+
+void ForceMesh::setup_nonlinear() {
+  // The step is solved on the lattice's cells: one unknown per free cell
+  // a = cell - 1, the tangent weighted by the cells' sizes (symmetric:
+  // |A| n_AB = |B| n_BA springs between A and B).
+  const int n = lattice_.node_count();
+  const double dt = settings_.time_step_s;
+  step_mass_term_ = use_implicit_ ? mass_kg_ / (dt * dt) + params_.node_damping_N_s_per_m / dt : 0.0;
+  const int nc = static_cast<int>(cell_size_.size());
+  const int mf = nc - 1;
+  std::vector<std::pair<int, int>> lower;  // free-cell indices a = cell - 1
+  for (int a = 0; a < mf; ++a) lower.push_back({a, a});
+  for (const CellPair& p : pairs_) lower.push_back({p.b - 1, p.a - 1});
   qz_.setZero(n);
   qv_.setZero(n);
   cell_z_.setZero(nc);

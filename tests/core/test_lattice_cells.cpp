@@ -45,7 +45,12 @@ TEST(LatticeCells, CellsAreTheOrbitsOfTheSixFoldSymmetry) {
   }
 }
 
-TEST(LatticeCells, ImplicitStepOnTheCellsMatchesADenseSolveOfEveryNode) {
+namespace {
+
+/// Largest deviation (m) of an implicit mesh's deflections, and of its
+/// velocities times dt, from a dense backward-Euler Newton solve over every
+/// node, over 60 steps of a ramp then a hold of the contact deflection.
+double deviation_from_dense_solve(double axial_stiffness_N_per_m, double virtual_stiffening_m) {
   ForceMeshParams p;
   p.rings_w = 5;
   p.virtual_stiffness_N_per_m = 20.0;
@@ -53,8 +58,8 @@ TEST(LatticeCells, ImplicitStepOnTheCellsMatchesADenseSolveOfEveryNode) {
   p.spacing_L_m = 1.5e-3;
   p.deformed_threshold_m = 0.05e-3;
   p.node_damping_N_s_per_m = 0.05;
-  p.surface_axial_stiffness_N_per_m = 2000.0;
-  p.virtual_stiffening_m = 2e-3;
+  p.surface_axial_stiffness_N_per_m = axial_stiffness_N_per_m;
+  p.virtual_stiffening_m = virtual_stiffening_m;
   const PlaneSurface plane(0.0);
   const double dt = 1e-3;
   MeshIntegrationSettings s;
@@ -92,8 +97,19 @@ TEST(LatticeCells, ImplicitStepOnTheCellsMatchesADenseSolveOfEveryNode) {
     v = (x - z) / dt;
     z = x;
     worst = std::max(worst, (mesh.deflections_m() - z).cwiseAbs().maxCoeff());
+    worst = std::max(worst, dt * (mesh.velocities_m_per_s().tail(n - 1) - v.tail(n - 1)).cwiseAbs().maxCoeff());
   }
-  EXPECT_LT(worst, 1e-9 * 6e-3);  // the mesh stops at a residual of 1e-10 of its springs' force
-  EXPECT_LT((mesh.velocities_m_per_s().tail(n - 1) - v.tail(n - 1)).cwiseAbs().maxCoeff(), 2e-9 * 6e-3 / dt);
-  EXPECT_GT(z[n - 1], 0.0);  // the outer ring moved: not a trivial comparison
+  EXPECT_GT(z[n - 1], 1e-6);  // the outer ring moved: not a trivial comparison
+  return worst;
+}
+
+}  // namespace
+
+TEST(LatticeCells, StiffeningImplicitStepOnTheCellsMatchesADenseSolveOfEveryNode) {
+  // The mesh's Newton stops at a residual of 1e-10 of its springs' force.
+  EXPECT_LT(deviation_from_dense_solve(2000.0, 2e-3), 2e-9 * 6e-3);
+}
+
+TEST(LatticeCells, LinearImplicitStepOnTheCellsMatchesADenseSolveOfEveryNode) {
+  EXPECT_LT(deviation_from_dense_solve(0.0, 0.0), 1e-12 * 6e-3);
 }

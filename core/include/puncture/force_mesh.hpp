@@ -94,8 +94,9 @@
 //       implicit integrator instead.
 //   Implicit:    backward Euler; the sparse LDLT of (M/dt^2 + C/dt + K_ff) is
 //       factorised once at construction (contact node eliminated as a
-//       prescribed value); each step is two triangular solves on
-//       preallocated storage (no allocation).
+//       prescribed value), on the lattice's cells as the stiffening mesh's
+//       step (the state stays constant on them); each step is two triangular
+//       solves on preallocated storage (no allocation).
 #pragma once
 
 #include <Eigen/Core>
@@ -265,6 +266,8 @@ class ForceMesh {
   /// Free-node state after one step from (z_, v_) with contact deflection
   /// z0_old -> z0_new, written to (z_, v_) (used at construction for the unit response).
   void step_free_nodes(double z0_old, double z0_new);
+  /// The lattice's cells (core/src/lattice_cells.hpp): cell_of_, cell_rep_, cell_size_, pairs_, contact_pairs_.
+  void setup_cells();
   // --- stiffening mesh ---
   void setup_nonlinear();
   // The constructor's phases (linear mesh): the static influence vector and
@@ -317,9 +320,10 @@ class ForceMesh {
   double reaction_slope_N_per_m_ = 0.0;
   double predicted_z0_ = 0.0;  ///< contact deflection the prediction is linearised at (0: linear mesh)
   bool predicted_ = false;
-  // Stiffening mesh, solved on the lattice's cells (cell 0 = the contact node; free cell index
-  // a = cell - 1): the step's tangent on its fixed pattern (diagonal entries 0..mf-1, then one
-  // entry per pair of free cells), the pairs of adjacent cells, scratch vectors.
+  // The lattice's cells (cell 0 = the contact node; free cell index a = cell - 1), on which the
+  // implicit step and the stiffening mesh's step are solved. Stiffening mesh: the step's tangent
+  // on its fixed pattern (diagonal entries 0..mf-1, then one entry per pair of free cells),
+  // scratch vectors.
   struct CellPair {
     int a = 0, b = 0;           ///< cells, a < b
     double edges = 0.0;         ///< springs between them
@@ -342,7 +346,7 @@ class ForceMesh {
   Eigen::VectorXd ring_mean_m_;
   Eigen::VectorXd ring_size_;
 
-  // LDLT factors of the implicit system over the free nodes (index f = node - 1):
+  // LDLT factors of the implicit system over the free cells (index a = cell - 1; linear mesh):
   // P A P^T = L D L^T, L unit lower, stored column-wise (CSC, strictly lower part).
   std::vector<int> l_col_start_, l_row_;
   std::vector<double> l_val_;
