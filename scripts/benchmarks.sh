@@ -239,6 +239,8 @@ md.append(f"- Date: {now}")
 md.append(f"- Git revision: {revision}")
 md.append(f"- Build: CMake Release; Google Benchmark library build type: {ctx.get('library_build_type', 'n/a')}")
 md.append("- Raw data: `bench_tick.json`, `bench_effects.json` next to this file")
+md.append("- Before and after a change of the tick, the same scenes' `puncture run` interleaved: "
+          "[tick_before_after.md](tick_before_after.md) (`scripts/tick_ab.sh`)")
 md.append("- Spread: coefficient of variation (stddev / mean) of the wall time over the 5 repetitions, %")
 md.append("- The Debian libbenchmark package reports itself as a debug build; that concerns the timing "
           "harness only, the project code is compiled Release (-O3)")
