@@ -166,6 +166,66 @@ def time_row(label, name, ref_name, extra=()):
             fmt_ratio(r.get("median_cpu_us"), ref.get("median_cpu_us")), spread(r)]
 
 
+def tuned_sections():
+    """The tuned preset's target, phases, single-tick distribution and effects (the page leads with them)."""
+    out = []
+    dist = get("BM_tick_distribution/tuned/whole_insertion")
+    def c(key):
+        v = dist.get("counter:" + key)
+        return fmt_time(v) if v is not None else "n/a"
+    p99, worst = dist.get("counter:contact_p99_us"), dist.get("counter:contact_worst_tick_us")
+    if p99 is not None and worst is not None:
+        verdict = "met" if p99 <= 10.0 and worst <= 50.0 else "NOT met"
+        out.append(f"**Target: tuned preset, ticks with contact p99 <= 10 us and no tick over 50 us: {verdict}.** "
+                   f"Over the {fmt_count(dist, 'contact_ticks')} ticks with contact: mean {c('contact_mean_us')} us, "
+                   f"p50 {c('contact_p50_us')} us, p99 {c('contact_p99_us')} us; the slowest tick by its own cost "
+                   f"(the largest over the ticks of a tick's fastest time over the 10 insertions of a run) "
+                   f"{c('contact_worst_tick_us')} us; the largest single measurement {c('contact_max_us')} us "
+                   "includes the preemptions of this shared machine (table 'Single-tick distribution, tuned preset').")
+        out.append("")
+    out.append("## Tick by phase of the insertion (tuned preset)")
+    out.append("")
+    out.append("Phases as for the default scene below; in press_skin the stiffening skin mesh is solved by "
+               "Newton's method every tick, and the muscle mesh from its contact until it breaks. Ratio: to "
+               "whole_insertion.")
+    out.append("")
+    out.append(table(["phase", "ticks in phase", "median us / tick", "CPU us / tick", "ratio", "spread %"],
+                     [time_row(p, f"BM_tick_phase/tuned/{p}", "BM_tick_phase/tuned/whole_insertion", ("phase_ticks",))
+                      for p in ("press_skin", "after_skin_break", "inside_punctured", "in_tissue",
+                                "whole_insertion")]))
+    out.append("")
+    out.append("## Single-tick distribution, tuned preset")
+    out.append("")
+    out.append("As 'Single-tick distribution (default scene)' below. worst tick: the largest over the ticks of a "
+               "tick's fastest time over the 10 insertions of one benchmark run (what the tick itself costs; the "
+               "max column also holds the ticks during which the process was preempted).")
+    out.append("")
+    out.append(table(["ticks", "p50 us", "p90 us", "p99 us", "max us", "worst tick us"],
+                     [["all ticks of the insertion", c("p50_us"), c("p90_us"), c("p99_us"), c("max_us"), ""],
+                      ["press_skin ticks", c("press_p50_us"), "", c("press_p99_us"), c("press_max_us"), ""],
+                      [f"ticks with contact ({fmt_count(dist, 'contact_ticks')}; mean {c('contact_mean_us')} us)",
+                       c("contact_p50_us"), "", c("contact_p99_us"), c("contact_max_us"), c("contact_worst_tick_us")]]))
+    out.append("")
+    out.append("## Effects on / off, tuned preset")
+    out.append("")
+    out.append("As 'Effects on / off' below, on the tuned preset. mesh_stiffening_off: linear force meshes (no "
+               "axial surface springs, no virtual-spring stiffening; the skin then never reaches its critical "
+               "force, so nothing is punctured and the phases after a puncture are empty); tip_stiffening_off: "
+               "no strain-stiffening of the tip spring; surface_force_off also removes resumption. Ratio: to "
+               "all_on for the same phase.")
+    out.append("")
+    lines = []
+    for cfg in ("all_on", "mesh_stiffening_off", "tip_stiffening_off", "damping_off", "resumption_off",
+                "cutting_off", "friction_off", "surface_force_off", "all_off"):
+        for phase in ("press_skin", "in_tissue", "inside_punctured", "whole_insertion"):
+            lines.append(time_row(f"{cfg} / {phase}", f"BM_effects/tuned/{cfg}/{phase}",
+                                  f"BM_effects/tuned/all_on/{phase}", ("phase_ticks", "punctures")))
+    out.append(table(["effects / phase", "ticks in phase", "punctures", "median us / tick", "CPU us / tick", "ratio",
+                      "spread %"], lines))
+    out.append("")
+    return out
+
+
 ctx = contexts[0] if contexts else {}
 now = run_info["started_utc"]
 md = []
@@ -180,6 +240,8 @@ md.append(f"- Date: {now}")
 md.append(f"- Git revision: {revision}")
 md.append(f"- Build: CMake Release; Google Benchmark library build type: {ctx.get('library_build_type', 'n/a')}")
 md.append("- Raw data: `bench_tick.json`, `bench_effects.json` next to this file")
+md.append("- Before and after a change of the tick, the same scenes' `puncture run` interleaved: "
+          "[tick_before_after.md](tick_before_after.md) (`scripts/tick_ab.sh`)")
 md.append("- Spread: coefficient of variation (stddev / mean) of the wall time over the 5 repetitions, %")
 md.append("- The Debian libbenchmark package reports itself as a debug build; that concerns the timing "
           "harness only, the project code is compiled Release (-O3)")
@@ -191,9 +253,14 @@ md.append("")
 md.append("The haptic tick is stateful, so every benchmark replays the scene's scripted insertion "
           "(tick i at t = i ms) over a tick range ('phase') and rebuilds the simulator outside the "
           "timed region when the range ends (tests/benchmarks/bench_replay.hpp). One iteration is "
-          "one `PunctureSimulator::tick()`. Default configuration: scenes/default.json, every effect "
-          "on, SH degree l = 16, implicit force-mesh integrator, w = 8 / 4 / 10 (skin / fat / muscle).")
+          "one `PunctureSimulator::tick()`. Two models: the tuned preset "
+          "(results/tuned_preset/default_tuned.json, the model the app and every validation run: "
+          "stiffening skin and muscle force meshes, whose step is a Newton solve in every tick that "
+          "presses them; tip stiffening, cutting, friction) and the default scene (scenes/default.json, "
+          "every effect on, linear force meshes). Both: SH degree l = 16, implicit force-mesh integrator, "
+          "w = 8 / 4 / 10 (skin / fat / muscle).")
 md.append("")
+md.extend(tuned_sections())
 
 whole = get("BM_tick_phase/whole_insertion").get("median_us")
 dist = get("BM_tick_distribution/whole_insertion")

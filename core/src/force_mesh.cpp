@@ -105,6 +105,7 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   ring_size_.setZero(params.rings_w);
   for (int i = 0; i < n; ++i) ring_size_[lattice_.ring[i] - 1] += 1.0;
 
+  setup_cells();
   compute_static_influence();
   choose_integration();
   if (nonlinear_) {
@@ -162,12 +163,25 @@ void ForceMesh::choose_integration() {
 }
 
 void ForceMesh::factor_implicit_system() {
-  const int nf = lattice_.node_count() - 1;
+  // Backward Euler on the lattice's cells (every free node's equation is its
+  // cell's; see "Stiffening in the mesh" in the header): row a = cell - 1
+  // times the cell's size, so that the matrix is symmetric.
+  const int mf = static_cast<int>(cell_size_.size()) - 1;
   const double dt = settings_.time_step_s;
-  const double c = params_.node_damping_N_s_per_m;
-  const double shift = mass_kg_ / (dt * dt) + c / dt;
-  Eigen::SimplicialLDLT<SparseMatrix> ldlt(
-      free_stiffness(lattice_, params_.virtual_stiffness_N_per_m, params_.surface_stiffness_N_per_m, shift));
+  const double shift = mass_kg_ / (dt * dt) + params_.node_damping_N_s_per_m / dt;
+  const double K = params_.virtual_stiffness_N_per_m, ks = params_.surface_stiffness_N_per_m;
+  std::vector<Eigen::Triplet<double>> t;
+  for (int a = 1; a <= mf; ++a) t.emplace_back(a - 1, a - 1, cell_size_[a] * (K + shift));
+  for (const CellPair& p : pairs_) {
+    t.emplace_back(p.a - 1, p.a - 1, p.edges * ks);
+    t.emplace_back(p.b - 1, p.b - 1, p.edges * ks);
+    t.emplace_back(p.a - 1, p.b - 1, -p.edges * ks);
+    t.emplace_back(p.b - 1, p.a - 1, -p.edges * ks);
+  }
+  for (const CellPair& p : contact_pairs_) t.emplace_back(p.b - 1, p.b - 1, p.edges * ks);
+  SparseMatrix A(mf, mf);
+  A.setFromTriplets(t.begin(), t.end());
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt(A);
   if (ldlt.info() != Eigen::Success)
     throw std::runtime_error("force mesh: implicit system matrix could not be factorised");
   // Copy the factors into plain arrays so that a step is allocation-free.
@@ -177,14 +191,14 @@ void ForceMesh::factor_implicit_system() {
   l_col_start_.assign(1, 0);
   l_row_.clear();
   l_val_.clear();
-  for (int j = 0; j < nf; ++j) {
+  for (int j = 0; j < mf; ++j) {
     for (SparseMatrix::InnerIterator it(Lm, j); it; ++it)
       if (it.row() > j) l_row_.push_back(static_cast<int>(it.row())), l_val_.push_back(it.value());
     l_col_start_.push_back(static_cast<int>(l_row_.size()));
   }
   d_inv_ = ldlt.vectorD().cwiseInverse();
-  perm_.resize(nf);
-  for (int k = 0; k < nf; ++k) perm_[k] = ldlt.permutationP().indices()[k];
+  perm_.resize(mf);
+  for (int k = 0; k < mf; ++k) perm_[k] = ldlt.permutationP().indices()[k];
 }
 
 void ForceMesh::compute_unit_step_response() {
@@ -299,7 +313,7 @@ void ForceMesh::explicit_substep(double dt, double z0) {
 }
 
 void ForceMesh::implicit_solve() {
-  const int nf = lattice_.node_count() - 1;
+  const int nf = static_cast<int>(cell_size_.size()) - 1;  // one equation per free cell
   // Solve P^T L D L^T P x = rhs_ into work_.
   for (int k = 0; k < nf; ++k) work_[perm_[k]] = rhs_[k];
   for (int j = 0; j < nf; ++j) {
@@ -327,15 +341,19 @@ void ForceMesh::step_free_nodes(double z0_old, double z0_new) {
     const double m_dt2 = mass_kg_ / (dt * dt);
     const double c_dt = params_.node_damping_N_s_per_m / dt;
     const double ks = params_.surface_stiffness_N_per_m;
-    // rhs = M/dt^2 (z + dt v) + C/dt z + b z0
-    for (int i = 1; i < n; ++i) rhs_[i - 1] = m_dt2 * (z_[i] + dt * v_[i]) + c_dt * z_[i];
-    for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
-      rhs_[lattice_.neighbours[k] - 1] += ks * z0_new;
+    // Per free cell (its first node's state; the state is constant on the
+    // cells), times its size: rhs = M/dt^2 (z + dt v) + C/dt z + b z0.
+    const int nc = static_cast<int>(cell_size_.size());
+    for (int a = 1; a < nc; ++a) {
+      const int i = cell_rep_[a];
+      rhs_[a - 1] = cell_size_[a] * (m_dt2 * (z_[i] + dt * v_[i]) + c_dt * z_[i]);
+    }
+    for (const CellPair& p : contact_pairs_) rhs_[p.b - 1] += p.edges * ks * z0_new;
     implicit_solve();
-    for (int k = 0; k < nf; ++k) {
-      const double z_new = work_[perm_[k]];
-      v_[k + 1] = (z_new - z_[k + 1]) / dt;
-      z_[k + 1] = z_new;
+    for (int i = 1; i < n; ++i) {
+      const double z_new = work_[perm_[cell_of_[i] - 1]];
+      v_[i] = (z_new - z_[i]) / dt;
+      z_[i] = z_new;
     }
   }
   z_[0] = z0_new;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "fixed_pattern_ldlt.hpp"
+#include "lattice_cells.hpp"
 #include "puncture/force_mesh.hpp"
 
 namespace puncture {
@@ -94,109 +95,106 @@ double surface_spring_energy_J(const ForceMeshParams& p, double delta) {
   return e;
 }
 
+void ForceMesh::setup_cells() {
+  // The lattice's cells (lattice_cells.hpp) and the pairs of adjacent cells.
+  const detail::LatticeCells cells = detail::equitable_cells(lattice_);
+  const int nc = cells.count();
+  cell_of_ = cells.cell_of;
+  cell_rep_ = cells.representative;
+  cell_size_.resize(nc);
+  for (int a = 0; a < nc; ++a) cell_size_[a] = cells.size[a];
+  pairs_.clear();
+  contact_pairs_.clear();
+  for (const detail::LatticeCells::Pair& p : cells.pairs) {
+    const CellPair pair{p.a, p.b, static_cast<double>(p.edges), p.edges / cell_size_[p.a], p.edges / cell_size_[p.b]};
+    (p.a == 0 ? contact_pairs_ : pairs_).push_back(pair);
+  }
+}
+
 void ForceMesh::setup_nonlinear() {
+  // The step is solved on the lattice's cells: one unknown per free cell
+  // a = cell - 1, the tangent weighted by the cells' sizes (symmetric:
+  // |A| n_AB = |B| n_BA springs between A and B).
   const int n = lattice_.node_count();
-  const int nf = n - 1;
   const double dt = settings_.time_step_s;
   step_mass_term_ = use_implicit_ ? mass_kg_ / (dt * dt) + params_.node_damping_N_s_per_m / dt : 0.0;
-  spring_i_.clear();
-  spring_j_.clear();
-  std::vector<std::pair<int, int>> lower;  // free-node indices f = node - 1
-  for (int f = 0; f < nf; ++f) lower.push_back({f, f});
-  for (int i = 1; i < n; ++i)
-    for (int k = lattice_.neighbour_offsets[i]; k < lattice_.neighbour_offsets[i + 1]; ++k) {
-      const int j = lattice_.neighbours[k];
-      if (j > i) {
-        spring_i_.push_back(i);
-        spring_j_.push_back(j);
-        lower.push_back({j - 1, i - 1});
-      }
-    }
+  const int nc = static_cast<int>(cell_size_.size());
+  const int mf = nc - 1;
+  std::vector<std::pair<int, int>> lower;  // free-cell indices a = cell - 1
+  for (int a = 0; a < mf; ++a) lower.push_back({a, a});
+  for (const CellPair& p : pairs_) lower.push_back({p.b - 1, p.a - 1});
   qz_.setZero(n);
   qv_.setZero(n);
-  inertial_target_.setZero(std::max(nf, 1));
-  trial_z_.setZero(n);
-  newton_step_.setZero(std::max(nf, 1));
+  cell_z_.setZero(nc);
+  trial_cell_z_.setZero(nc);
+  const int m = std::max(mf, 1);
+  inertial_target_.setZero(m);
+  cell_residual_.setZero(m);
+  newton_step_.setZero(m);
   tangent_values_.assign(lower.size(), 0.0);
-  if (nf > 0) {
+  if (mf > 0) {
     tangent_.create();
-    tangent_->analyse(nf, lower);
+    tangent_->analyse(mf, lower);
   }
   reaction_slope_N_per_m_ = static_stiffness_N_per_m_;
 }
 
-
 double ForceMesh::nonlinear_residual(double z0) {
-  // Node terms, then every spring once (free-free springs, then those to the contact node).
-  const int n = lattice_.node_count();
+  // Every free node's residual, one per cell (cell_z_[0] = z0): node terms,
+  // then the springs between cells, each pair once.
+  const int nc = static_cast<int>(cell_size_.size());
   const SurfaceSpringLaw law{params_.surface_stiffness_N_per_m, params_.surface_axial_stiffness_N_per_m,
                              params_.spacing_L_m};
-  pz_[0] = z0;
-  for (int i = 1; i < n; ++i)
-    rhs_[i - 1] = step_mass_term_ * (pz_[i] - inertial_target_[i - 1]) + virtual_spring_force_N(params_, pz_[i]);
+  cell_z_[0] = z0;
+  for (int a = 1; a < nc; ++a)
+    cell_residual_[a - 1] =
+        step_mass_term_ * (cell_z_[a] - inertial_target_[a - 1]) + virtual_spring_force_N(params_, cell_z_[a]);
   double f = 0.0, k = 0.0;
-  for (std::size_t e = 0; e < spring_i_.size(); ++e) {
-    const int i = spring_i_[e], j = spring_j_[e];
-    law.evaluate(pz_[i] - pz_[j], f, k);
-    rhs_[i - 1] += f;
-    rhs_[j - 1] -= f;
+  for (const CellPair& p : pairs_) {
+    law.evaluate(cell_z_[p.a] - cell_z_[p.b], f, k);
+    cell_residual_[p.a - 1] += p.per_node_a * f;
+    cell_residual_[p.b - 1] -= p.per_node_b * f;
   }
-  for (int q = lattice_.neighbour_offsets[0]; q < lattice_.neighbour_offsets[1]; ++q) {
-    const int i = lattice_.neighbours[q];
-    law.evaluate(pz_[i] - z0, f, k);
-    rhs_[i - 1] += f;
+  for (const CellPair& p : contact_pairs_) {
+    law.evaluate(cell_z_[p.b] - z0, f, k);
+    cell_residual_[p.b - 1] += p.per_node_b * f;
   }
-  return n > 1 ? rhs_.cwiseAbs().maxCoeff() : 0.0;
+  return nc > 1 ? cell_residual_.cwiseAbs().maxCoeff() : 0.0;
 }
 
 void ForceMesh::factorize_tangent(double z0) {
-  const int n = lattice_.node_count();
+  // The tangent of the cells' residuals, each row times the cell's size.
+  const int nc = static_cast<int>(cell_size_.size());
   const SurfaceSpringLaw law{params_.surface_stiffness_N_per_m, params_.surface_axial_stiffness_N_per_m,
                              params_.spacing_L_m};
-  pz_[0] = z0;
-  for (int i = 1; i < n; ++i) tangent_values_[i - 1] = step_mass_term_ + virtual_spring_stiffness_N_per_m(params_, pz_[i]);
-  const std::size_t diagonal = static_cast<std::size_t>(n - 1);
+  cell_z_[0] = z0;
+  for (int a = 1; a < nc; ++a)
+    tangent_values_[a - 1] = cell_size_[a] * (step_mass_term_ + virtual_spring_stiffness_N_per_m(params_, cell_z_[a]));
+  const std::size_t diagonal = static_cast<std::size_t>(nc - 1);
   double f = 0.0, k = 0.0;
-  for (std::size_t e = 0; e < spring_i_.size(); ++e) {
-    const int i = spring_i_[e], j = spring_j_[e];
-    law.evaluate(pz_[i] - pz_[j], f, k);
-    tangent_values_[i - 1] += k;
-    tangent_values_[j - 1] += k;
-    tangent_values_[diagonal + e] = -k;
+  for (std::size_t e = 0; e < pairs_.size(); ++e) {
+    const CellPair& p = pairs_[e];
+    law.evaluate(cell_z_[p.a] - cell_z_[p.b], f, k);
+    tangent_values_[p.a - 1] += p.edges * k;
+    tangent_values_[p.b - 1] += p.edges * k;
+    tangent_values_[diagonal + e] = -p.edges * k;
   }
-  for (int q = lattice_.neighbour_offsets[0]; q < lattice_.neighbour_offsets[1]; ++q) {
-    const int i = lattice_.neighbours[q];
-    law.evaluate(pz_[i] - z0, f, k);
-    tangent_values_[i - 1] += k;
+  for (const CellPair& p : contact_pairs_) {
+    law.evaluate(cell_z_[p.b] - z0, f, k);
+    tangent_values_[p.b - 1] += p.edges * k;
   }
   if (!tangent_->factorize(tangent_values_.data()))
     throw std::runtime_error("force mesh: the stiffening mesh's tangent is not positive definite (non-finite deflections?)");
   tangent_ready_ = true;
 }
 
-void ForceMesh::solve_nonlinear_step(double z0) {
-  const int n = lattice_.node_count();
-  const int nf = n - 1;
-  const double dt = settings_.time_step_s;
-  pz_ = z_;
-  pz_[0] = z0;
-  newton_iterations_ = 0;
-  if (nf == 0) {
-    pv_.setZero();
-    return;
-  }
-  if (use_implicit_) {
-    const double m_dt2 = mass_kg_ / (dt * dt), c_dt = params_.node_damping_N_s_per_m / dt;
-    for (int i = 1; i < n; ++i)
-      inertial_target_[i - 1] = (m_dt2 * (z_[i] + dt * v_[i]) + c_dt * z_[i]) / step_mass_term_;
-  }
+double ForceMesh::newton_solve_cells(double z0, double scale) {
   // Newton on the step equations; the energy is strictly convex, so a
   // backtracking line search on the residual's max norm keeps every step.
   // Converged when the full Newton step is below 1e-12 of the deflections or
   // the residual below 1e-10 of the springs' force at that deflection (their
-  // tangent stiffness there times the deflection).
-  double scale = std::max(std::abs(z0), params_.deformed_threshold_m);
-  for (int i = 1; i < n; ++i) scale = std::max(scale, std::abs(z_[i]));
+  // tangent stiffness there times the deflection). Returns the last full step (m).
+  const int mf = static_cast<int>(cell_size_.size()) - 1;
   const double tolerance_m = 1e-12 * scale;
   const double force_floor_N = 1e-10 * scale *
                                (virtual_spring_stiffness_N_per_m(params_, scale) +
@@ -204,22 +202,22 @@ void ForceMesh::solve_nonlinear_step(double z0) {
   constexpr int kMaxNewton = 40;
   constexpr int kMaxCuts = 40;
   double residual = nonlinear_residual(z0);
-  double last_step = 0.0;  // full Newton step of the last iteration (m)
+  double last_step = 0.0;
   while (residual > force_floor_N) {
     if (newton_iterations_ >= kMaxNewton)
       throw std::runtime_error("force mesh: the stiffening mesh's step did not converge in " +
                                std::to_string(kMaxNewton) + " Newton iterations (contact deflection " +
                                std::to_string(z0 * 1e3) + " mm)");
     factorize_tangent(z0);
-    rhs_ = -rhs_;
-    tangent_->solve(rhs_, newton_step_);
+    for (int a = 0; a < mf; ++a) cell_residual_[a] *= -cell_size_[a + 1];
+    tangent_->solve(cell_residual_, newton_step_);
     ++newton_iterations_;
     const double step_size = newton_step_.cwiseAbs().maxCoeff();
     if (!std::isfinite(step_size)) throw std::runtime_error("force mesh: non-finite Newton step in the stiffening mesh");
-    trial_z_ = pz_;
+    trial_cell_z_ = cell_z_;
     double alpha = 1.0;
     for (int cut = 0;; ++cut) {
-      for (int f = 0; f < nf; ++f) pz_[f + 1] = trial_z_[f + 1] + alpha * newton_step_[f];
+      for (int a = 0; a < mf; ++a) cell_z_[a + 1] = trial_cell_z_[a + 1] + alpha * newton_step_[a];
       const double r = nonlinear_residual(z0);
       if (r <= residual || r <= force_floor_N) {
         residual = r;
@@ -233,22 +231,49 @@ void ForceMesh::solve_nonlinear_step(double z0) {
     last_step = step_size;
     if (step_size <= tolerance_m) break;
   }
-  // pz_ converged (rhs_ holds its residual); the tangent there gives the
-  // sensitivity dz/dz0. The last factorisation is at most one tiny Newton
-  // step (<= 1e-3 of the deflections) away: it is kept then; the predicted
-  // slope is then off by about that fraction of the tangent's change over the
-  // step (a tick of needle travel), and the next predict() solves the true step.
-  if (!tangent_ready_ || last_step > 1e-3 * scale) factorize_tangent(z0);
-  rhs_.setZero();
-  for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k) {
-    const int j = lattice_.neighbours[k];
-    rhs_[j - 1] = surface_spring_stiffness_N_per_m(params_, pz_[j] - z0);
+  return last_step;
+}
+
+void ForceMesh::solve_nonlinear_step(double z0) {
+  const int n = lattice_.node_count();
+  const int nc = static_cast<int>(cell_size_.size());
+  const double dt = settings_.time_step_s;
+  newton_iterations_ = 0;
+  if (n == 1) {
+    pz_[0] = z0;
+    pv_.setZero();
+    return;
   }
-  tangent_->solve(rhs_, newton_step_);
+  // The committed state is constant on the cells: its cells' values are their first nodes'.
+  double scale = std::max(std::abs(z0), params_.deformed_threshold_m);
+  for (int a = 1; a < nc; ++a) {
+    const int i = cell_rep_[a];
+    cell_z_[a] = z_[i];
+    scale = std::max(scale, std::abs(z_[i]));
+    if (use_implicit_) {
+      const double m_dt2 = mass_kg_ / (dt * dt), c_dt = params_.node_damping_N_s_per_m / dt;
+      inertial_target_[a - 1] = (m_dt2 * (z_[i] + dt * v_[i]) + c_dt * z_[i]) / step_mass_term_;
+    }
+  }
+  const double last_step = newton_solve_cells(z0, scale);
+  // cell_z_ converged; the tangent there gives the sensitivity dz/dz0. The
+  // last factorisation is at most one tiny Newton step (<= 1e-3 of the
+  // deflections) away: it is kept then; the predicted slope is then off by
+  // about that fraction of the tangent's change over the step (a tick of
+  // needle travel), and the next predict() solves the true step.
+  if (!tangent_ready_ || last_step > 1e-3 * scale) factorize_tangent(z0);
+  cell_residual_.setZero();
+  for (const CellPair& p : contact_pairs_)
+    cell_residual_[p.b - 1] = p.edges * surface_spring_stiffness_N_per_m(params_, cell_z_[p.b] - z0);
+  tangent_->solve(cell_residual_, newton_step_);
+  pz_[0] = z0;
+  pv_[0] = 0.0;
   qz_[0] = 1.0;
   qv_[0] = 0.0;
   for (int i = 1; i < n; ++i) {
-    qz_[i] = newton_step_[i - 1];
+    const int a = cell_of_[i];
+    pz_[i] = cell_z_[a];
+    qz_[i] = newton_step_[a - 1];
     qv_[i] = use_implicit_ ? qz_[i] / dt : 0.0;
     pv_[i] = use_implicit_ ? (pz_[i] - z_[i]) / dt : 0.0;
   }

@@ -40,6 +40,10 @@
 namespace puncture::bench {
 
 inline Scene default_scene() { return load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/scenes/default.json"); }
+/// The committed tuned preset (scripts/results_validation.sh): the model the app and the validations run.
+inline Scene tuned_scene() {
+  return load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/results/tuned_preset/default_tuned.json");
+}
 
 /// Tick range [begin, end) of the scripted trajectory.
 struct TickRange {

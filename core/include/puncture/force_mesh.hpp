@@ -36,7 +36,12 @@
 // as a tissue surface does. Both laws are odd, convex in energy and strictly
 // increasing, so the tangent stays symmetric positive definite. The step is
 // then solved by Newton's method with a backtracking line search on the
-// residual (tangent refactorised on its fixed sparse pattern, no allocation);
+// residual (tangent refactorised on its fixed sparse pattern, no allocation).
+// It is solved on the lattice's cells (core/src/lattice_cells.hpp: the orbits
+// of its six-fold symmetry, 20 cells for w = 8 instead of 168 free nodes):
+// every node is alike and the needle loads node 0 only, so a state constant
+// on the cells stays so (the mesh starts at rest and is reset to rest when
+// laid out again), and each cell's equation is that of every node in it;
 // the explicit integrator does such a mesh implicitly (explicit_falls_back_to_implicit()).
 // With linear springs every formula below is the paper's.
 //
@@ -89,8 +94,9 @@
 //       implicit integrator instead.
 //   Implicit:    backward Euler; the sparse LDLT of (M/dt^2 + C/dt + K_ff) is
 //       factorised once at construction (contact node eliminated as a
-//       prescribed value); each step is two triangular solves on
-//       preallocated storage (no allocation).
+//       prescribed value), on the lattice's cells as the stiffening mesh's
+//       step (the state stays constant on them); each step is two triangular
+//       solves on preallocated storage (no allocation).
 #pragma once
 
 #include <Eigen/Core>
@@ -260,6 +266,8 @@ class ForceMesh {
   /// Free-node state after one step from (z_, v_) with contact deflection
   /// z0_old -> z0_new, written to (z_, v_) (used at construction for the unit response).
   void step_free_nodes(double z0_old, double z0_new);
+  /// The lattice's cells (core/src/lattice_cells.hpp): cell_of_, cell_rep_, cell_size_, pairs_, contact_pairs_.
+  void setup_cells();
   // --- stiffening mesh ---
   void setup_nonlinear();
   // The constructor's phases (linear mesh): the static influence vector and
@@ -272,10 +280,14 @@ class ForceMesh {
   void predict_linear();
   /// predict() of a stiffening mesh: the step solved at contact deflection z0_star and linearised there.
   void predict_nonlinear(double z0_star);
-  /// Residual of the free nodes' step equations at (pz_, contact z0) into rhs_; returns its max norm.
+  /// Residual of the free nodes' step equations at (cell_z_, contact z0), one per free cell, into
+  /// cell_residual_; returns its max norm.
   double nonlinear_residual(double z0);
-  /// Tangent of the step equations at pz_ factorised; throws std::runtime_error if not SPD.
+  /// Tangent of the cells' step equations at cell_z_ factorised; throws std::runtime_error if not SPD.
   void factorize_tangent(double z0);
+  /// Newton from cell_z_ to the step's solution at contact deflection z0 (scale: the deflections'
+  /// magnitude, m); returns the last full Newton step (m).
+  double newton_solve_cells(double z0, double scale);
   /// Solves the step to contact deflection z0 from (z_, v_) into (pz_, pv_), with its sensitivity in (qz_, qv_).
   void solve_nonlinear_step(double z0);
 
@@ -308,21 +320,33 @@ class ForceMesh {
   double reaction_slope_N_per_m_ = 0.0;
   double predicted_z0_ = 0.0;  ///< contact deflection the prediction is linearised at (0: linear mesh)
   bool predicted_ = false;
-  // Stiffening mesh: the step's tangent on its fixed pattern (free nodes: diagonal entries 0..nf-1,
-  // then one entry per free-free spring), the springs, scratch vectors.
+  // The lattice's cells (cell 0 = the contact node; free cell index a = cell - 1), on which the
+  // implicit step and the stiffening mesh's step are solved. Stiffening mesh: the step's tangent
+  // on its fixed pattern (diagonal entries 0..mf-1, then one entry per pair of free cells),
+  // scratch vectors.
+  struct CellPair {
+    int a = 0, b = 0;           ///< cells, a < b
+    double edges = 0.0;         ///< springs between them
+    double per_node_a = 0.0;    ///< neighbours in b of each node of a (edges / |a|)
+    double per_node_b = 0.0;    ///< neighbours in a of each node of b (edges / |b|)
+  };
   bool nonlinear_ = false;
   detail::TangentFactorization tangent_;
   std::vector<double> tangent_values_;
-  std::vector<int> spring_i_, spring_j_;  ///< free-free springs (node indices, i < j)
-  double step_mass_term_ = 0.0;           ///< m/dt^2 + c/dt (implicit), 0 (quasi-static)
-  Eigen::VectorXd inertial_target_;       ///< z_hat of the step equations (free nodes, index f = node - 1)
-  Eigen::VectorXd trial_z_, newton_step_;
+  std::vector<int> cell_of_, cell_rep_;        ///< cell of each node; first node of each cell
+  Eigen::VectorXd cell_size_;                  ///< nodes per cell
+  std::vector<CellPair> pairs_;                ///< adjacent free cells
+  std::vector<CellPair> contact_pairs_;        ///< cells adjacent to the contact node (a = 0)
+  double step_mass_term_ = 0.0;                ///< m/dt^2 + c/dt (implicit), 0 (quasi-static)
+  Eigen::VectorXd cell_z_, trial_cell_z_;      ///< deflection per cell ([0] = contact)
+  Eigen::VectorXd inertial_target_;            ///< z_hat of the step equations per free cell
+  Eigen::VectorXd cell_residual_, newton_step_;
   int newton_iterations_ = 0;
   bool tangent_ready_ = false;  ///< the tangent has been factorised at least once
   Eigen::VectorXd ring_mean_m_;
   Eigen::VectorXd ring_size_;
 
-  // LDLT factors of the implicit system over the free nodes (index f = node - 1):
+  // LDLT factors of the implicit system over the free cells (index a = cell - 1; linear mesh):
   // P A P^T = L D L^T, L unit lower, stored column-wise (CSC, strictly lower part).
   std::vector<int> l_col_start_, l_row_;
   std::vector<double> l_val_;

@@ -45,6 +45,33 @@ TEST(NoAllocationSh, OffAxisInsertionOnShSurfacesWithEveryEffectAllocatesNothing
     EXPECT_NEAR(model.simulator->force_mesh(k)->rest_positions()(0, 0), 3e-3, 1e-9) << k;
 }
 
+TEST(NoAllocationSh, TunedPresetOffAxisInsertionAllocatesNothing) {
+  // The committed tuned preset: stiffening skin and muscle meshes (a Newton
+  // solve in every tick that presses them), laid again off the axis.
+  const Scene scene = load_scene(std::string(PUNCTURE_SOURCE_DIR) + "/results/tuned_preset/default_tuned.json");
+  RealtimeModel model = build_realtime_model(scene);
+  ASSERT_TRUE(scene.layers[0].force_mesh.nonlinear() && scene.layers[2].force_mesh.nonlinear());
+  const ScriptedTrajectory tr(scene.insertion);
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  std::vector<NeedleState> states;
+  for (int i = 0; i * dt <= tr.duration(); ++i) {
+    states.push_back(tr.sample(i * dt));
+    states.back().tip_position_m.x() += 3e-3;
+  }
+  double sum = 0.0;
+  int newton_ticks = 0;
+  test::start_counting_allocations();
+  for (const NeedleState& s : states) {
+    sum += model.simulator->tick(s).total_force_N;
+    if (model.simulator->force_mesh(0)->last_newton_iterations() > 0) ++newton_ticks;
+  }
+  EXPECT_EQ(test::stop_counting_allocations(), 0);
+  EXPECT_TRUE(std::isfinite(sum));
+  EXPECT_EQ(model.simulator->puncture_events().size(), 3u);
+  EXPECT_GT(newton_ticks, 100);
+  EXPECT_NEAR(model.simulator->force_mesh(2)->rest_positions()(0, 0), 3e-3, 1e-9);
+}
+
 TEST(ContactPointSh, OffAxisMeshIsProjectedOntoTheShSurfaceOverTicks) {
   // An off-axis needle on the fitted SH surfaces: the skin's mesh is laid in
   // the tangent plane at the contact at once, its nodes are projected onto
