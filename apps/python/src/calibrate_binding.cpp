@@ -51,20 +51,33 @@ apps::CalibrateOptions calibrate_options(py::dict kw) {
   take(kw, "keep", o.keep);
   take(kw, "layer_thickness_mm", o.layer_thickness_mm);
   take(kw, "recording_format", o.recording.format_file);
+  take(kw, "held_out", o.held_out);
   if (!kw.empty())
     throw py::type_error("calibrate() got an unexpected keyword argument '" +
                          py::str(py::list(kw.attr("keys")())[0]).cast<std::string>() + "'");
   return o;
 }
 
-/// The reference: None (the FEM's), a CSV path, or {column: array} written to `dir`.
-std::filesystem::path reference_path(const py::object& reference, const std::filesystem::path& dir) {
-  if (reference.is_none()) return {};
+/// One reference: a CSV path, or {column: array} written to `dir` as the i-th curve.
+std::filesystem::path reference_path(const py::object& reference, const std::filesystem::path& dir, std::size_t i) {
   if (py::isinstance<py::str>(reference) || py::hasattr(reference, "__fspath__"))
     return reference.cast<std::filesystem::path>();
-  const std::filesystem::path path = dir / "reference_curve.csv";
+  const std::filesystem::path path = dir / ("reference_curve_" + std::to_string(i) + ".csv");
   write_reference_curve(reference, path);
   return path;
+}
+
+/// The references: None (the FEM's), one reference, or a list of them (repeats
+/// and other speeds of the same tissue, calibrated against together).
+std::vector<std::filesystem::path> reference_paths(const py::object& reference, const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> out;
+  if (reference.is_none()) return out;
+  if (py::isinstance<py::list>(reference) || py::isinstance<py::tuple>(reference)) {
+    for (const py::handle& r : reference) out.push_back(reference_path(py::reinterpret_borrow<py::object>(r), dir, out.size()));
+    return out;
+  }
+  out.push_back(reference_path(reference, dir, 0));
+  return out;
 }
 
 py::dict calibrate(const SceneHandle& scene, const py::object& reference, const std::optional<std::filesystem::path>& output_dir,
@@ -72,7 +85,7 @@ py::dict calibrate(const SceneHandle& scene, const py::object& reference, const 
   TemporaryDirectory tmp;
   apps::CalibrateOptions o = calibrate_options(py::dict(kwargs));
   o.scene = write_scene_file(scene.scene, tmp.path());
-  o.reference = reference_path(reference, tmp.path());
+  o.references = reference_paths(reference, tmp.path());
   o.output_dir = output_dir ? *output_dir : tmp.path() / "calibration";
   o.quiet = true;
   PythonCallback callback(progress);
@@ -99,8 +112,10 @@ void bind_calibrate(py::module_& m) {
   m.def("calibrate", &calibrate, py::arg("scene"), py::kw_only(), py::arg("reference") = py::none(),
         py::arg("output_dir") = py::none(), py::arg("progress") = py::none(),
         "`puncture calibrate` on the scene: the force law tuned per layer against reference = None (the scene's FEM "
-        "reference, cached in cache_dir), a CSV path (a curve or a raw recording), or {column: array} (depth_mm and "
-        "force_N; time_s, phase, <layer>_state, ... optional). The command's options as keywords: cache_dir, method, "
+        "reference, cached in cache_dir), a CSV path (a curve or a raw recording), {column: array} (depth_mm and "
+        "force_N; time_s, phase, <layer>_state, ... optional), or a list of these (repeats and other speeds of the "
+        "same tissue, each at its own speed). The command's options as keywords: cache_dir, method, held_out (paths "
+        "of recordings judged, not fitted), "
         "preset_name, layers, threads, tune_unidentifiable, reference_depth_offset_mm, stage_turn_margin_mm, "
         "bound_factor, also_tune, integrator, depth_weight, force_weight, puncture_depths_mm, fem_speeds_mm_per_s, "
         "surface_fit, cutting_from_next_puncture, keep, layer_thickness_mm, recording_format. progress(p) is called "
