@@ -301,44 +301,17 @@ json heldout_summary_json(const std::vector<CaseOutcome>& outcomes, const std::s
           {"provenance", provenance}};
 }
 
-std::string heldout_summary_markdown(const json& summary, const std::string& command,
-                                     const std::string& provenance_line) {
-  std::ostringstream md;
-  md << "# Held-out validation of the tuned real-time model\n\n"
-     << "Command: `" << command << "`, " << provenance_line << ".\n\n"
-     << "Model: `" << summary.value("model", std::string()) << "`";
-  const std::string note = summary.value("model_note", std::string());
-  if (!note.empty()) md << " (" << note << ")";
-  md << ". Cases: `" << summary.value("cases_file", std::string())
-     << "`. A case with overrides is held out: the model was not tuned on it. Acceptance per layer: pressing and "
-        "cutting force RMSE <= 10 % of the FEM peak, puncture depth within L, puncture force within 10 %, "
-        "deflection RMSE of the layer's surface <= 15 % of the FEM's largest deflection before the breakthrough "
-        "and <= 25 % after it (the acceptance of `puncture validate`).\n\n"
-     << "| case | held out | layer | force RMSE / peak | deflection RMSE / largest, before the break | after the "
-        "break | puncture depth error (mm) | puncture force error | accepted | what misses |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|\n";
-  std::size_t held = 0, accepted = 0;
-  for (const json& c : summary["cases"]) {
-    const bool held_out = c["held_out"].get<bool>();
-    for (const json& l : c["layers"]) {
-      std::string misses;
-      for (const json& m : l["misses"]) misses += (misses.empty() ? "" : "; ") + m.get<std::string>();
-      md << "| " << c["name"].get<std::string>() << " | " << (held_out ? "yes" : "no (in sample)") << " | "
-         << l["layer"].get<std::string>() << " | " << fixed(l["force_rmse_relative"], 3) << " | "
-         << fixed(l["deflection_relative_rmse"], 2) << " | " << fixed(l["deflection_after_break_relative_rmse"], 2)
-         << " | " << fixed(l["puncture_depth_error_mm"], 2, true) << " | "
-         << fixed(l["puncture_force_error_relative"], 3, true) << " | " << (l["accepted"].get<bool>() ? "yes" : "no")
-         << " | " << (misses.empty() ? "-" : misses) << " |\n";
-      if (held_out) {
-        ++held;
-        if (l["accepted"].get<bool>()) ++accepted;
-      }
-    }
-  }
-  md << "\nHeld out: " << accepted << " of " << held
-     << " layer-cases accepted. Each case that changes the slab says below where its real-time parameters come from "
-        "(the model's slab rule, or the cases file's rule). Each case's report "
-        "(validation_summary.md, plots, the case's scene.json) is in its folder.\n";
+namespace {
+
+/// A layer-case's misses, "; "-separated.
+std::string joined_misses(const json& layer) {
+  std::string misses;
+  for (const json& m : layer["misses"]) misses += (misses.empty() ? "" : "; ") + m.get<std::string>();
+  return misses;
+}
+
+/// The held-out page's table of the whole trajectory per case (nothing if no case has one).
+void write_whole_trajectory_table(std::ostringstream& md, const json& summary) {
   // The whole trajectory per case: the columns are the first case's terms.
   std::vector<std::string> terms;
   for (const json& c : summary["cases"])
@@ -365,18 +338,17 @@ std::string heldout_summary_markdown(const json& summary, const std::string& com
       md << "\n";
     }
   }
-  for (const json& c : summary["cases"])
-    for (const char* key : {"rule", "note"})
-      if (c.contains(key) && c[key].is_string())
-        md << "\n`" << c["name"].get<std::string>() << "` (" << key << "): " << c[key].get<std::string>() << ".\n";
+}
+
+/// The held-out page's reasons for each miss (when the summary names a reasons file).
+void write_miss_reasons(std::ostringstream& md, const json& summary) {
   if (summary.contains("reasons_file") && summary["reasons_file"].is_string()) {
     md << "\n## Why each miss\n\nThe model's reasons (`" << summary["reasons_file"].get<std::string>()
        << "`, written after reading these results), for every layer-case that misses.\n\n";
     for (const json& c : summary["cases"])
       for (const json& l : c["layers"]) {
         if (l["accepted"].get<bool>()) continue;
-        std::string misses;
-        for (const json& m : l["misses"]) misses += (misses.empty() ? "" : "; ") + m.get<std::string>();
+        const std::string misses = joined_misses(l);
         md << "- **" << c["name"].get<std::string>() << ", " << l["layer"].get<std::string>() << "** (" << misses
            << "): " << (l.contains("why") && l["why"].is_string() ? l["why"].get<std::string>() : "no reason given")
            << "\n";
@@ -389,6 +361,53 @@ std::string heldout_summary_markdown(const json& summary, const std::string& com
            << r["why"].get<std::string>() << "\n";
     }
   }
+}
+
+}  // namespace
+
+std::string heldout_summary_markdown(const json& summary, const std::string& command,
+                                     const std::string& provenance_line) {
+  std::ostringstream md;
+  md << "# Held-out validation of the tuned real-time model\n\n"
+     << "Command: `" << command << "`, " << provenance_line << ".\n\n"
+     << "Model: `" << summary.value("model", std::string()) << "`";
+  const std::string note = summary.value("model_note", std::string());
+  if (!note.empty()) md << " (" << note << ")";
+  md << ". Cases: `" << summary.value("cases_file", std::string())
+     << "`. A case with overrides is held out: the model was not tuned on it. Acceptance per layer: pressing and "
+        "cutting force RMSE <= 10 % of the FEM peak, puncture depth within L, puncture force within 10 %, "
+        "deflection RMSE of the layer's surface <= 15 % of the FEM's largest deflection before the breakthrough "
+        "and <= 25 % after it (the acceptance of `puncture validate`).\n\n"
+     << "| case | held out | layer | force RMSE / peak | deflection RMSE / largest, before the break | after the "
+        "break | puncture depth error (mm) | puncture force error | accepted | what misses |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|\n";
+  std::size_t held = 0, accepted = 0;
+  for (const json& c : summary["cases"]) {
+    const bool held_out = c["held_out"].get<bool>();
+    for (const json& l : c["layers"]) {
+      const std::string misses = joined_misses(l);
+      md << "| " << c["name"].get<std::string>() << " | " << (held_out ? "yes" : "no (in sample)") << " | "
+         << l["layer"].get<std::string>() << " | " << fixed(l["force_rmse_relative"], 3) << " | "
+         << fixed(l["deflection_relative_rmse"], 2) << " | " << fixed(l["deflection_after_break_relative_rmse"], 2)
+         << " | " << fixed(l["puncture_depth_error_mm"], 2, true) << " | "
+         << fixed(l["puncture_force_error_relative"], 3, true) << " | " << (l["accepted"].get<bool>() ? "yes" : "no")
+         << " | " << (misses.empty() ? "-" : misses) << " |\n";
+      if (held_out) {
+        ++held;
+        if (l["accepted"].get<bool>()) ++accepted;
+      }
+    }
+  }
+  md << "\nHeld out: " << accepted << " of " << held
+     << " layer-cases accepted. Each case that changes the slab says below where its real-time parameters come from "
+        "(the model's slab rule, or the cases file's rule). Each case's report "
+        "(validation_summary.md, plots, the case's scene.json) is in its folder.\n";
+  write_whole_trajectory_table(md, summary);
+  for (const json& c : summary["cases"])
+    for (const char* key : {"rule", "note"})
+      if (c.contains(key) && c[key].is_string())
+        md << "\n`" << c["name"].get<std::string>() << "` (" << key << "): " << c[key].get<std::string>() << ".\n";
+  write_miss_reasons(md, summary);
   return md.str();
 }
 
