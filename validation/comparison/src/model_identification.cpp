@@ -295,6 +295,64 @@ bool near_stiffness_scale_bound(double scale) {
   return scale > 0.0 && std::abs(std::log(scale)) >= std::log(kStiffnessScaleBound) - std::log(1.1);
 }
 
+namespace {
+
+// The fitted factors (of `fitted`, top down, each on its window) refined
+// jointly: a layer's factor also shapes the force while the layers above it
+// are pressed (a volumetric model's skin rests on its fat), which the
+// bottom-up pass, each layer on its own window, cannot weigh.
+void refine_factors_jointly(const std::string& model, const std::shared_ptr<const comparison::TetMesh>& mesh,
+                            const std::vector<double>& depths_m, const std::vector<double>& until_s,
+                            const std::vector<std::size_t>& fitted, const std::vector<Window>& fitted_windows,
+                            Scene& trial, ModelIdentification& result, const IdentificationStepProgress& progress) {
+  const std::size_t deepest = fitted.back();
+  prepare_layer_run(trial, deepest, depths_m);
+  std::vector<double> rmse_after(trial.layers.size(), kNaN);
+  double own_cost = 0.0;  // in the optimiser's units: sum of (residual / window scale)^2
+  for (std::size_t j = 0; j < fitted.size(); ++j) {
+    const double rmse = result.layers[fitted[j]].window_rmse_after_N / fitted_windows[j].scale_N;
+    own_cost += static_cast<double>(fitted_windows[j].depth_m.size()) * rmse * rmse;
+  }
+  result.joint_note = joint_refinement(model, trial, fitted, fitted_windows, own_cost, mesh, until_s[deepest],
+                                       trial.comparison.stiffness_scale, rmse_after, result.model_runs, progress);
+  for (std::size_t k : fitted)
+    if (std::isfinite(rmse_after[k])) {
+      result.layers[k].stiffness_scale = trial.comparison.stiffness_scale[k];
+      result.layers[k].window_rmse_after_N = rmse_after[k];
+    }
+}
+
+// The critical forces, top down, with the final factors: layer k's force
+// where the reference breaks it, the layers above broken there too (as their
+// own critical forces then do).
+void identify_critical_forces(const std::string& model, const std::shared_ptr<const comparison::TetMesh>& mesh,
+                              const std::vector<double>& depths_m, const std::vector<double>& until_s, Scene& trial,
+                              ModelIdentification& result, const IdentificationStepProgress& progress) {
+  for (std::size_t k = 0; k < depths_m.size(); ++k) {
+    prepare_layer_run(trial, k, depths_m);
+    const ModelRun run = run_until(model, trial, mesh, until_s[k]);
+    ++result.model_runs;
+    LayerIdentification& layer = result.layers[k];
+    const double force = run.failed() || run.steps() == 0 ? 0.0 : run.contact_force_N.back();
+    if (!(force > 0.0) || !std::isfinite(force)) {
+      layer.note = run.failed() ? "the model run failed: " + run.failure
+                                : "the model's contact force is not positive at the reference's puncture depth";
+      for (std::size_t j = k; j < depths_m.size(); ++j) result.layers[j].stiffness_scale = 1.0;
+      result.layers.resize(k + 1);
+      break;
+    }
+    layer.identified = true;
+    layer.critical_force_N = force;
+    if (progress) {
+      std::ostringstream line;
+      line << layer.layer << ": modulus x " << layer.stiffness_scale << ", breaks at " << force << " N";
+      progress(line.str());
+    }
+  }
+}
+
+}  // namespace
+
 ModelIdentification identify_comparison_model(const std::string& model, const Scene& scene,
                                               std::shared_ptr<const comparison::TetMesh> mesh,
                                               const ReferenceData& reference, bool identify_stiffness,
@@ -351,51 +409,11 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
       fitted_windows.insert(fitted_windows.begin(), window);
     }
   }
-  // 1b. The fitted factors jointly: a layer's factor also shapes the force
-  //     while the layers above it are pressed (a volumetric model's skin rests
-  //     on its fat), which the bottom-up pass, each layer on its own window,
-  //     cannot weigh.
-  if (fitted.size() >= 2) {
-    const std::size_t deepest = fitted.back();
-    prepare_layer_run(trial, deepest, depths_m);
-    std::vector<double> rmse_after(scene.layers.size(), kNaN);
-    double own_cost = 0.0;  // in the optimiser's units: sum of (residual / window scale)^2
-    for (std::size_t j = 0; j < fitted.size(); ++j) {
-      const double rmse = result.layers[fitted[j]].window_rmse_after_N / fitted_windows[j].scale_N;
-      own_cost += static_cast<double>(fitted_windows[j].depth_m.size()) * rmse * rmse;
-    }
-    result.joint_note = joint_refinement(model, trial, fitted, fitted_windows, own_cost, mesh, until_s[deepest],
-                                         trial.comparison.stiffness_scale, rmse_after, result.model_runs, progress);
-    for (std::size_t k : fitted)
-      if (std::isfinite(rmse_after[k])) {
-        result.layers[k].stiffness_scale = trial.comparison.stiffness_scale[k];
-        result.layers[k].window_rmse_after_N = rmse_after[k];
-      }
-  }
-  // 2. The critical forces, top down, with the final factors: layer k's force
-  //    where the reference breaks it, the layers above broken there too (as
-  //    their own critical forces then do).
-  for (std::size_t k = 0; k < depths_m.size(); ++k) {
-    prepare_layer_run(trial, k, depths_m);
-    const ModelRun run = run_until(model, trial, mesh, until_s[k]);
-    ++result.model_runs;
-    LayerIdentification& layer = result.layers[k];
-    const double force = run.failed() || run.steps() == 0 ? 0.0 : run.contact_force_N.back();
-    if (!(force > 0.0) || !std::isfinite(force)) {
-      layer.note = run.failed() ? "the model run failed: " + run.failure
-                                : "the model's contact force is not positive at the reference's puncture depth";
-      for (std::size_t j = k; j < depths_m.size(); ++j) result.layers[j].stiffness_scale = 1.0;
-      result.layers.resize(k + 1);
-      break;
-    }
-    layer.identified = true;
-    layer.critical_force_N = force;
-    if (progress) {
-      std::ostringstream line;
-      line << layer.layer << ": modulus x " << layer.stiffness_scale << ", breaks at " << force << " N";
-      progress(line.str());
-    }
-  }
+  // 1b. The fitted factors jointly (refine_factors_jointly).
+  if (fitted.size() >= 2)
+    refine_factors_jointly(model, mesh, depths_m, until_s, fitted, fitted_windows, trial, result, progress);
+  // 2. The critical forces, top down, with the final factors (identify_critical_forces).
+  identify_critical_forces(model, mesh, depths_m, until_s, trial, result, progress);
   result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
