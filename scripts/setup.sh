@@ -23,25 +23,10 @@ PACKAGES=(
   clang libclang-rt-14-dev          # libFuzzer target of the scene reader (tests/fuzz/)
 )
 
-# The BLAS and LAPACK under UMFPACK (the FEM's direct solves) and CHOLMOD
-# (the tensor-mass models' factorisations): Debian's reference BLAS, pinned
-# when another one (e.g. OpenBLAS, pulled in by some other package) would be
-# selected. The FEM reference's Newton path depends on the BLAS's rounding:
-# with the serial OpenBLAS the default reference punctured the muscle at
-# 1.509 N instead of 1.469 N and then stalled in the dwell at 30 mm even at
-# 1/256 of the load step, so the committed references are reproduced only
-# with the BLAS they were made with (every output's machine line names it).
-# OpenBLAS would make the tensor-mass factorisations 3.4x faster
-# (results/comparison/README.md).
-select_reference_blas() {
-  local arch dir
-  arch="$(dpkg-architecture -qDEB_HOST_MULTIARCH 2>/dev/null || echo x86_64-linux-gnu)"
-  dir="/usr/lib/$arch"
-  [ -f "$dir/blas/libblas.so.3" ] || return 0
-  $SUDO update-alternatives --quiet --set "libblas.so.3-$arch" "$dir/blas/libblas.so.3"
-  [ -f "$dir/lapack/liblapack.so.3" ] && $SUDO update-alternatives --quiet --set "liblapack.so.3-$arch" "$dir/lapack/liblapack.so.3"
-  return 0
-}
+# The BLAS is left as the machine selects it: the FEM reference's committed
+# scenes give the same curves under Debian's reference BLAS and the serial
+# OpenBLAS to 1e-10 of the peak force (results/fem_reproducibility/), and
+# every output's machine line names the BLAS it ran with.
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -54,7 +39,6 @@ for p in "${PACKAGES[@]}"; do
 done
 
 if [ ${#missing[@]} -eq 0 ]; then
-  select_reference_blas
   echo "setup: all ${#PACKAGES[@]} packages already installed"
   exit 0
 fi
@@ -63,5 +47,4 @@ echo "setup: installing ${#missing[@]} missing packages: ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-select_reference_blas
 echo "setup: done"
