@@ -19,18 +19,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from results_io import number, read_csv_rows  # noqa: E402
-
-
-def provenance_lines(path):
-    out = {}
-    with open(path) as f:
-        for line in f:
-            if not line.startswith("#"):
-                break
-            key, _, value = line[1:].partition(":")
-            out[key.strip()] = value.strip()
-    return out
+from results_io import number, read_csv_comments  # noqa: E402
 
 
 def main():
@@ -45,8 +34,9 @@ def main():
             sys.exit(f"main_summary: {p}: missing")
     with open(summary_path) as f:
         events = {e["layer"]: e for e in json.load(f).get("puncture_events", [])}
-    fem = {r["layer"]: r for r in read_csv_rows(metrics_path)}
-    prov = provenance_lines(metrics_path)
+    comments, rows = read_csv_comments(metrics_path)
+    fem = {r["layer"]: r for r in rows}
+    prov = {k.strip(): v.strip() for k, _, v in (c.partition(":") for c in comments)}  # "# key: value"
     print("")
     print("Punctures of the tuned model (this run) beside the FEM reference's")
     print(f"(FEM: {args.validation}/, `{prov.get('command', '?')}`, git {prov.get('git_revision', '?')}, "

@@ -20,7 +20,6 @@ Out: DIR/calibration_force_depth.png  force against depth: the reference and the
      (markers) at up to six contact deflections, and the tip force against
      the contact deflection, FEM and mesh.
 """
-import csv
 import os
 import sys
 
@@ -34,11 +33,10 @@ import results_io  # noqa: E402  (scripts/, beside this file)
 
 def main(folder):
     path = os.path.join(folder, "calibration_curves.csv")
-    with open(path, newline="") as f:
-        lines = f.readlines()
-    note = lines[0][1:].strip() if lines and lines[0].startswith("#") else ""
+    comments, rows = results_io.read_csv_comments(path)
+    note = comments[0] if comments else ""
     curves = {}
-    for row in csv.DictReader(l for l in lines if not l.startswith("#")):
+    for row in rows:
         phase = row.get("phase") or "insertion"
         c = curves.setdefault(row["curve"], {})
         part = c.setdefault("withdrawal" if phase == "withdrawal" else "insertion", ([], []))
@@ -100,11 +98,10 @@ def plot_repeat_scatter(folder):
     path = os.path.join(folder, "repeat_scatter.csv")
     if not os.path.exists(path):
         return
-    with open(path, newline="") as f:
-        lines = f.readlines()
-    note = lines[0][1:].strip() if lines and lines[0].startswith("#") else ""
+    comments, rows = results_io.read_csv_comments(path)
+    note = comments[0] if comments else ""
     groups = {}
-    for row in csv.DictReader(l for l in lines if not l.startswith("#")):
+    for row in rows:
         g = groups.setdefault(row["group"], {"speed": float(row["speed_mm_per_s"]), "d": [], "lo": [], "hi": [],
                                               "mean": [], "model": []})
         for key, col in (("d", "depth_mm"), ("lo", "band_min_N"), ("hi", "band_max_N"), ("mean", "mean_N"),
@@ -132,11 +129,10 @@ def plot_surface_identification(folder):
     path = os.path.join(folder, "surface_identification.csv")
     if not os.path.exists(path):
         return
-    with open(path, newline="") as f:
-        lines = f.readlines()
-    note = lines[0][1:].strip() if lines and lines[0].startswith("#") else ""
+    comments, rows = results_io.read_csv_comments(path)
+    note = comments[0] if comments else ""
     layers = {}
-    for row in csv.DictReader(l for l in lines if not l.startswith("#")):
+    for row in rows:
         samples = layers.setdefault(row["layer"], {})
         s = samples.setdefault(int(row["sample"]), {"z0": float(row["contact_deflection_mm"]),
                                                     "fem_F": float(row["fem_force_N"]),

@@ -6,6 +6,8 @@ save_figure(fig, path, dpi=120): a matplotlib figure as the PNG at path.
 And how it reads the project's CSV outputs:
 read_csv_rows(path): the rows (dicts by column name) of a CSV whose
     provenance lines ("# key: value") come before the header.
+read_csv_comments(path): (the comment lines before the header, without their "#" and
+    surrounding blanks; the rows as read_csv_rows gives them).
 number(text): the float in a CSV cell, NaN where it is empty or not a number.
 pareto_front(points): of (cost, error, ...) tuples, the (cost, error) pairs no
     other point beats in both, cheapest first (the accuracy-cost plots).
@@ -31,6 +33,13 @@ def save_figure(fig, path, dpi=120):
 def read_csv_rows(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(line for line in f if not line.startswith("#")))
+
+
+def read_csv_comments(path):
+    with open(path, newline="") as f:
+        lines = f.readlines()
+    comments = [line[1:].strip() for line in lines if line.startswith("#")]
+    return comments, list(csv.DictReader(line for line in lines if not line.startswith("#")))
 
 
 def number(text):

@@ -9,7 +9,6 @@ import importlib.util
 import io
 import pathlib
 import sys
-import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 _spec = importlib.util.spec_from_file_location("check_readme_figures", ROOT / "scripts" / "check_readme_figures.py")
@@ -128,20 +127,5 @@ def test_the_repository_readmes_pass():
 
 
 if __name__ == "__main__":
-    import inspect
-    passed = failed = 0
-    for name, fn in sorted(globals().items()):
-        if not (name.startswith("test_") and callable(fn)):
-            continue
-        try:
-            if "tmp_path" in inspect.signature(fn).parameters:
-                with tempfile.TemporaryDirectory() as d:
-                    fn(pathlib.Path(d))
-            else:
-                fn()
-            passed += 1
-        except Exception as e:   # report every failing test, then fail
-            failed += 1
-            print(f"FAILED {name}: {type(e).__name__}: {e}")
-    print(f"{passed} passed, {failed} failed")
-    sys.exit(1 if failed else 0)
+    import selftest  # tests/scripts/, beside this file
+    sys.exit(selftest.run(globals()))

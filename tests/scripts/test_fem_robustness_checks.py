@@ -8,7 +8,6 @@ its own without pytest, which is how ctest runs it (test scripts.fem_robustness_
 import json
 import pathlib
 import sys
-import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
@@ -81,16 +80,5 @@ def test_events_not_those_of_the_state_columns_are_reported(tmp_path):
 
 
 if __name__ == "__main__":
-    passed = failed = 0
-    for name, fn in sorted(globals().items()):
-        if not (name.startswith("test_") and callable(fn)):
-            continue
-        try:
-            with tempfile.TemporaryDirectory() as d:
-                fn(pathlib.Path(d))
-            passed += 1
-        except Exception as e:   # report every failing test, then fail
-            failed += 1
-            print(f"FAILED {name}: {type(e).__name__}: {e}")
-    print(f"{passed} passed, {failed} failed")
-    sys.exit(1 if failed else 0)
+    import selftest  # tests/scripts/, beside this file
+    sys.exit(selftest.run(globals()))

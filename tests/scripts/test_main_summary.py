@@ -9,7 +9,6 @@ import json
 import pathlib
 import subprocess
 import sys
-import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCRIPT = ROOT / "scripts" / "main_summary.py"
@@ -56,16 +55,5 @@ def test_a_missing_input_is_named(tmp_path):
 
 
 if __name__ == "__main__":
-    passed = failed = 0
-    for name, fn in sorted(globals().items()):
-        if not (name.startswith("test_") and callable(fn)):
-            continue
-        try:
-            with tempfile.TemporaryDirectory() as d:
-                fn(pathlib.Path(d))
-            passed += 1
-        except Exception as e:   # report every failing test, then fail
-            failed += 1
-            print(f"FAILED {name}: {type(e).__name__}: {e}")
-    print(f"{passed} passed, {failed} failed")
-    sys.exit(1 if failed else 0)
+    import selftest  # tests/scripts/, beside this file
+    sys.exit(selftest.run(globals()))
