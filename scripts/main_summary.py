@@ -55,13 +55,15 @@ def main():
         if not abs(md - vd) <= 0.005:
             stale.append(layer)
         print(f"{layer:<8} {md:>9.2f} {fd:>8.2f} {md - fd:>+9.2f}   {vf:>8.3f} {ff:>7.3f} {100 * (vf - ff) / ff:>+6.1f}%")
-    print("(Depths: this run. Forces: the peak of each layer's pressing, as the validation took them.)")
+    print("(Depths: this run. Forces: the peak of each layer's pressing, as the validation took them.")
+    print("In sample: the preset was calibrated against the FEM on this trajectory; the cases it never saw")
+    print("are judged in results/validation_heldout/heldout_summary.md.)")
     if stale:
         print(f"Note: this run punctures {', '.join(stale)} elsewhere than the validated model did: "
               f"{args.validation}/ is stale (bash scripts/results_validation.sh remakes it).")
     print("")
-    print("The validation report: results/validation_tuned/validation_summary.md (held-out cases:")
-    print("results/validation_heldout/). The paper's Table 2 model as published:")
+    print("The validation report: results/validation_tuned/validation_summary.md. The paper's Table 2")
+    print("model as published:")
     print("build/apps/puncture run scenes/default.json (its punctures are far from the FEM's:")
     print("results/validation_paper_table2/).")
     return 0
