@@ -3,7 +3,7 @@
 // (reference_fem/). Eigen and the scene types only.
 //
 // In:  a Scene (SI units: sample diameter, layer thicknesses, needle radius
-//      a, tip kind, insertion target depth) and its FemMeshSettings; the
+//      a, tip kind; not the target depth) and its FemMeshSettings; the
 //      crack radius r_c (where the needle's cutting edge runs: 2a/pi for a
 //      bevel, the lumen radius for a hollow needle, a for a blunt punch);
 //      a refinement level (each level halves every element).
@@ -21,10 +21,11 @@
 // h_tip = a / elements_per_needle_radius across the core [0, r_c] and the
 // needle wall [r_c, a], then sizes growing by radial_growth up to the sample
 // radius. Axial lines: every layer interface and the path depth are lines;
-// along the needle path (depth <= path depth) each layer starts with h_tip at
+// along the needle path (depth <= path depth = total thickness - h_tip,
+// whatever the target depth) each layer starts with h_tip at
 // its top surface (where the needle meets it), grows by 1.2 per element up to
-// min(path_element_size, thickness / min_elements_per_layer); below the path
-// the sizes grow by radial_growth toward the base. Every layer gets at least
+// min(path_element_size, thickness / min_elements_per_layer), the element
+// reaching the path depth ending on it; below it, one element to the base. Every layer gets at least
 // min_elements_per_layer elements through its thickness.
 #pragma once
 
@@ -67,8 +68,9 @@ struct AxisymmetricSlabMesh {
 /// perimeter of the planar crack of width 2a), hollow the lumen radius, blunt a.
 double crack_radius_for_tip(const Needle& needle);
 
-/// Depth (m) down to which the crack line runs: the target depth plus a
-/// margin of max(2 mm, 4 a), kept one tip element above the base.
+/// Depth (m) down to which the crack line runs: through the whole slab to one
+/// tip element above the base, whatever the target depth (so the mesh is one
+/// for every target); a target below it is rejected.
 double crack_path_depth(const Scene& scene);
 
 /// Builds the mesh (see the file comment). Throws std::invalid_argument naming
