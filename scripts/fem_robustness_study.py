@@ -17,6 +17,11 @@ record) and OUT/runs/ (each run's outputs; not committed).
   python3 scripts/fem_robustness_study.py --only 17 --out DIR
   # the page from the per-scene results already in OUT (after the tasks):
   python3 scripts/fem_robustness_study.py --collect --out DIR
+  # go on with a study stopped part way: scenes with a result from the same
+  # FEM sources (git revision of reference_fem/, meshing/, core/) are kept:
+  python3 scripts/fem_robustness_study.py --resume
+  # a page from the results so far, the scenes not yet run listed as such:
+  python3 scripts/fem_robustness_study.py --collect --partial
 
 Exit status: 0 when every scene converged with consistent records, 1 otherwise.
 """
@@ -41,6 +46,17 @@ def scenes_of(count, seed, family):
     return [fr.draw_scene(rng, family, i) for i in range(count)]
 
 
+def fem_source_revision():
+    """The git revision of the last commit that changed the FEM's sources
+    (reference_fem/, meshing/, core/: the solver, its mesh and the scene it
+    reads): runs of one study must all come from it."""
+    try:
+        return subprocess.check_output(["git", "-C", fr.ROOT, "log", "-1", "--format=%h", "--", "reference_fem",
+                                        "meshing", "core"], text=True, stderr=subprocess.DEVNULL).strip() or "unknown"
+    except Exception:
+        return "unknown"
+
+
 def run_one(scene, out, binary, threads):
     """Runs the FEM on one scene; returns (and writes) its result record."""
     name = scene["name"]
@@ -55,7 +71,8 @@ def run_one(scene, out, binary, threads):
     rec = {"scene": name, "exit": p.returncode, "wall_s": round(wall, 1), "error": "", "problems": [],
            "tip": scene["needle"]["tip"], "target_mm": scene["insertion"]["target_depth_mm"],
            "speed_mm_per_s": scene["insertion"]["speed_mm_per_s"], "hold_s": scene["insertion"]["dwell_s"],
-           "thickness_mm": [l["thickness_mm"] for l in scene["layers"]]}
+           "thickness_mm": [l["thickness_mm"] for l in scene["layers"]], "fem_source": fem_source_revision(),
+           "finished_utc": provenance.utc_now()}
     if p.returncode != 0:
         lines = [l for l in p.stderr.splitlines() if l.strip() and not l.startswith("warning")]
         rec["error"] = lines[-1] if lines else f"exit {p.returncode}"
@@ -73,6 +90,15 @@ def run_one(scene, out, binary, threads):
         rec["problems"] = fr.check_run(run_dir)
     results_io.write_text(os.path.join(out, "results", name + ".json"), json.dumps(rec, indent=1))
     return rec
+
+
+def existing_result(out, name):
+    """The record OUT/results/<name>.json, or None."""
+    path = os.path.join(out, "results", name + ".json")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        return json.load(f)
 
 
 def median(v):
@@ -102,14 +128,23 @@ def page(records, args, command):
     wrong = [r for r in records if r["exit"] == 0 and r["problems"]]
     walls = [r["wall_s"] for r in records if r["exit"] == 0]
     cuts = [r.get("step_cuts") or 0 for r in records if r["exit"] == 0]
+    missing = getattr(args, "missing", [])
+    times = [r["finished_utc"] for r in records if r.get("finished_utc")]
     lines = [
         "# FEM reference on scenes drawn at random",
         "",
-        f"Made by `{command}` on {provenance.machine()}, {provenance.utc_now()} UTC, git {provenance.git_revision()}.",
-        f"Scenes: {len(records)} drawn with seed {args.seed}, family `{args.family}` "
+        f"Made by `{command}` on {provenance.machine()}, {provenance.utc_now()} UTC, git {provenance.git_revision()}; "
+        f"every run from the FEM sources of git {', '.join(sorted({r.get('fem_source', 'unknown') for r in records}))}"
+        + (f", finished between {min(times)} and {max(times)} UTC." if times else "."),
+        f"Scenes: {len(records) + len(missing)} drawn with seed {args.seed}, family `{args.family}` "
         "(scripts/fem_robustness.py: the ranges are `RANGES` there), "
         f"{args.jobs} run(s) side by side with one assembly thread each.",
         "",
+    ]
+    if missing:
+        lines += [f"**Partial: {len(records)} of {len(records) + len(missing)} scenes run so far** (the study goes on "
+                  "with `--resume`); not yet run: " + ", ".join(missing) + ".", ""]
+    lines += [
         "| outcome | scenes |",
         "|---|---|",
         f"| converged, records consistent | {len(ok)} of {len(records)} |",
@@ -194,6 +229,10 @@ def main():
     ap.add_argument("--build", default=os.environ.get("PUNCTURE_BUILD_DIR", os.path.join(fr.ROOT, "build")))
     ap.add_argument("--only", type=int, default=-1, help="run scene ONLY alone (a cluster task)")
     ap.add_argument("--collect", action="store_true", help="write the page from the results in OUT")
+    ap.add_argument("--partial", action="store_true", help="with --collect: scenes without a result are listed "
+                    "as not yet run (the page says so) instead of stopping")
+    ap.add_argument("--resume", action="store_true", help="keep the scenes that have a result from the same FEM "
+                    "sources; run the others")
     args = ap.parse_args()
     binary = os.path.join(args.build, "apps", "puncture")
     command = "python3 scripts/fem_robustness_study.py " + " ".join(sys.argv[1:])
@@ -203,13 +242,20 @@ def main():
     for s in scenes:
         fr.write_scene(s, os.path.join(args.out, "scenes", s["name"] + ".json"))
     if args.collect:
-        records = []
+        records, missing = [], []
         for s in scenes:
-            path = os.path.join(args.out, "results", s["name"] + ".json")
-            if not os.path.exists(path):
-                sys.exit(f"fem_robustness_study: no result for {s['name']} in {args.out}/results")
-            with open(path) as f:
-                records.append(json.load(f))
+            rec = existing_result(args.out, s["name"])
+            if rec is None:
+                if not args.partial:
+                    sys.exit(f"fem_robustness_study: no result for {s['name']} in {args.out}/results")
+                missing.append(s["name"])
+            else:
+                records.append(rec)
+        sources = sorted({r.get("fem_source", "unknown") for r in records})
+        if len(sources) > 1:
+            sys.exit(f"fem_robustness_study: the results in {args.out}/results come from different FEM sources "
+                     f"({', '.join(sources)}): run again with --resume")
+        args.missing = missing
     elif args.only >= 0:
         if args.only >= len(scenes):
             sys.exit(f"fem_robustness_study: --only {args.only}: there are {len(scenes)} scenes")
@@ -221,18 +267,27 @@ def main():
             sys.exit(f"fem_robustness_study: {binary} not built (bash scripts/build.sh)")
         threads = 1 if args.jobs > 1 else max(1, os.cpu_count() or 1)
         records = [None] * len(scenes)
+        source = fem_source_revision()
+        if args.resume:
+            for i, s in enumerate(scenes):
+                rec = existing_result(args.out, s["name"])
+                if rec is not None and rec.get("fem_source") == source:
+                    records[i] = rec
+            print(f"fem_robustness_study: {sum(r is not None for r in records)} of {len(scenes)} scenes have a "
+                  f"result from FEM sources {source}; running the others", flush=True)
         t0 = time.monotonic()
         with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-            futures = {pool.submit(run_one, s, args.out, binary, threads): i for i, s in enumerate(scenes)}
+            futures = {pool.submit(run_one, s, args.out, binary, threads): i for i, s in enumerate(scenes)
+                       if records[i] is None}
             for n, f in enumerate(concurrent.futures.as_completed(futures), 1):
                 i = futures[f]
                 r = records[i] = f.result()
                 outcome = "error: " + r["error"] if r["exit"] else ("; ".join(r["problems"]) or "ok")
-                print(f"[{n}/{len(scenes)}, {time.monotonic() - t0:.0f} s] {r['scene']}: {r['wall_s']:.0f} s, "
+                print(f"[{n}/{len(futures)}, {time.monotonic() - t0:.0f} s] {r['scene']}: {r['wall_s']:.0f} s, "
                       f"{outcome}", flush=True)
     results_io.write_text(os.path.join(args.out, "README.md"), page(records, args, command))
     results_io.write_text(os.path.join(args.out, "runs.csv"), runs_csv(records))
-    good = all(r["exit"] == 0 and not r["problems"] for r in records)
+    good = all(r["exit"] == 0 and not r["problems"] for r in records) and not getattr(args, "missing", [])
     print(f"fem_robustness_study: {sum(1 for r in records if r['exit'] == 0 and not r['problems'])} of "
           f"{len(records)} converged with consistent records; page {args.out}/README.md")
     return 0 if good else 1
