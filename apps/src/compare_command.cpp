@@ -59,19 +59,19 @@ std::vector<std::string> all_model_names() {
   return names;
 }
 
-/// Bad --models, --identify or --frames: std::invalid_argument naming the option.
+/// Bad --models, --identify or --frames: UsageError (exit 2) naming the option.
 void check_options(const CompareOptions& options, const std::vector<std::string>& models) {
   const std::vector<std::string> known = all_model_names();
   std::set<std::string> seen;
   for (const std::string& m : models) {
     if (std::find(known.begin(), known.end(), m) == known.end())
-      throw std::invalid_argument("--models: unknown model '" + m + "' (known: " + joined(known, ", ") + ")");
-    if (!seen.insert(m).second) throw std::invalid_argument("--models: '" + m + "' listed twice");
+      throw UsageError("--models: unknown model '" + m + "' (known: " + joined(known, ", ") + ")");
+    if (!seen.insert(m).second) throw UsageError("--models: '" + m + "' listed twice");
   }
   for (const std::string& method : options.identify)
     if (method != "simulated_annealing" && method != "isres")
-      throw std::invalid_argument("--identify: unknown method '" + method + "' (known: simulated_annealing, isres)");
-  if (options.frames < 0) throw std::invalid_argument("--frames must be >= 0");
+      throw UsageError("--identify: unknown method '" + method + "' (known: simulated_annealing, isres)");
+  if (options.frames < 0) throw UsageError("--frames must be >= 0");
 }
 
 /// --cases: each case's FEM reference (the scene with the case's overrides;
@@ -155,7 +155,13 @@ int compare_command(const CompareOptions& options, std::ostream& out, std::ostre
     report.models = options.models.empty() ? all_model_names() : options.models;
     check_options(options, report.models);
     report.weights_path = options.weights.empty() ? default_delphi_weights_path() : options.weights;
-    const validation::DelphiWeights weights = validation::read_delphi_weights(report.weights_path);
+    const validation::DelphiWeights weights = [&] {
+      try {  // a missing or malformed weights file is bad input (exit 2); the message names it
+        return validation::read_delphi_weights(report.weights_path);
+      } catch (const std::exception& e) {
+        throw InputError(e.what());
+      }
+    }();
     report.output_dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_comparison") : options.output_dir;
 
@@ -163,6 +169,9 @@ int compare_command(const CompareOptions& options, std::ostream& out, std::ostre
     validation::FemReferenceOptions fem_options;
     if (!options.cache_dir.empty()) fem_options.cache_dir = options.cache_dir;
     fem_options.verbose = !options.quiet;
+    // The FEM's fields are needed for the ParaView output only: with --no-vtk
+    // a cached reference without them is used as it is (as validate does).
+    fem_options.write_vtu = options.write_vtk;
     const auto reference_start = std::chrono::steady_clock::now();
     const validation::FemReference reference = validation::obtain_fem_reference(scene, fem_options, out);
     const double reference_wall_time_s = seconds_since(reference_start);

@@ -361,7 +361,7 @@ TEST(CompareCommand, BadInputFailsCleanly) {
   options.quiet = true;
   std::ostringstream out, err;
   options.models = {"realtime", "cloth"};
-  EXPECT_EQ(compare_command(options, out, err), 1);
+  EXPECT_EQ(compare_command(options, out, err), 2) << "a bad --models value is bad input";
   EXPECT_NE(err.str().find("unknown model 'cloth'"), std::string::npos) << err.str();
   options.models = {"realtime"};
   const fs::path weights = dir / "weights.json";
@@ -369,7 +369,7 @@ TEST(CompareCommand, BadInputFailsCleanly) {
       {"name": "x", "metric": "force_rmse_relative", "best": 0, "worst": 1, "weight": 0.7}]})";
   options.weights = weights;
   err.str("");
-  EXPECT_EQ(compare_command(options, out, err), 1);
+  EXPECT_EQ(compare_command(options, out, err), 2) << "a malformed weights file is bad input";
   EXPECT_NE(err.str().find("/indicators: weights must sum to 1"), std::string::npos) << err.str();
   std::ofstream(dir / "bad.json") << R"({"schema_version": 1, "name": "x"})";
   options.scene = dir / "bad.json";

@@ -2,6 +2,7 @@
 #include "command_call.hpp"
 
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -59,7 +60,11 @@ py::dict csv_file_arrays(const std::filesystem::path& path) {
     bool numeric = true;
     for (const io::CsvRecord& r : doc.records) {
       double x = 0.0;
-      if (c >= r.fields.size() || !io::parse_finite_number(r.fields[c], x)) {
+      // A column of numbers where some are "nan" (a quantity a row does not
+      // have, e.g. the FEM's own build time) stays a float array with NaN.
+      const bool missing = c < r.fields.size() && (r.fields[c] == "nan" || r.fields[c] == "NaN");
+      if (missing) x = std::numeric_limits<double>::quiet_NaN();
+      else if (c >= r.fields.size() || !io::parse_finite_number(r.fields[c], x)) {
         numeric = false;
         break;
       }
