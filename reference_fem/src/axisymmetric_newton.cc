@@ -69,6 +69,7 @@ struct AxisymmetricSolver::Iterate {
   double scale = 0.0;  ///< force scale of the convergence test (N)
   bool stalled = false, strict = false, converged = false;
   double assemble_s = 0.0, solve_s = 0.0;
+  double direction_tip_elements = 0.0;  ///< the Newton direction's largest nodal move, in tip elements (before the cap)
   std::ostringstream line;  ///< the iterate's line of the Newton log
 };
 
@@ -113,7 +114,8 @@ AxisymmetricSolver::Failure AxisymmetricSolver::newton(Step& step, int max_itera
     if (const Failure why = newton_direction(step, x)) return why;
     double alpha = 0.0;
     if (const Failure why = line_search(step, x, alpha)) return why;
-    x.line << "  alpha " << std::defaultfloat << alpha << "  t_assemble " << std::setprecision(3) << x.assemble_s
+    x.line << "  du/h " << std::defaultfloat << std::setprecision(3) << x.direction_tip_elements << "  alpha "
+           << alpha << "  t_assemble " << std::setprecision(3) << x.assemble_s
            << " s  t_solve " << x.solve_s << " s";
     step.report.table.push_back(x.line.str());
     if (settings_.verbose) std::cout << "      " << step.report.table.back() << std::endl;
@@ -249,6 +251,20 @@ void AxisymmetricSolver::write_iterate_line(int it, Iterate& x) const {
   x.line << std::setw(4) << it << "  |R_free| " << std::scientific << std::setprecision(3) << x.free << " N  scale "
          << x.scale << " N  F_needle " << force_trial_.total_N << " N  contact " << force_trial_.nodes_in_contact
          << " sliding " << sliding << " damaged " << damaged << " broken " << broken << " closed " << closed;
+  // Switches of branch since the last logged iterate (kinks Newton crosses).
+  auto switches = [](const std::vector<unsigned char>& now, std::vector<unsigned char>& before, unsigned char mask) {
+    int n = 0;
+    if (before.size() == now.size())
+      for (std::size_t k = 0; k < now.size(); ++k) n += ((now[k] ^ before[k]) & mask) ? 1 : 0;
+    before = now;
+    return n;
+  };
+  const std::vector<unsigned char> cohesive_before = cohesive_branch_logged_;
+  const int loading = switches(cohesive_branch_, cohesive_branch_logged_, 1);
+  std::vector<unsigned char> tmp = cohesive_before;
+  const int opening = switches(cohesive_branch_, tmp, 2);
+  const int touching = switches(contact_branch_, contact_branch_logged_, 1);
+  if (it > 0) x.line << "  switched: loading " << loading << " opening " << opening << " contact " << touching;
 }
 
 bool AxisymmetricSolver::release_pulled_punch_nodes(std::vector<char>& released_in_step, double scale) {
@@ -328,6 +344,7 @@ AxisymmetricSolver::Failure AxisymmetricSolver::newton_direction(Step& step, Ite
   // stiffness would otherwise be thrown across the mesh by the full step).
   const double limit = settings_.max_newton_displacement * mesh_.tip_element_size_m;
   const double largest = step.du.linfty_norm();
+  x.direction_tip_elements = largest / mesh_.tip_element_size_m;
   if (limit > 0.0 && largest > limit && x.gap <= 0.0) step.du *= limit / largest;
   return std::nullopt;
 }

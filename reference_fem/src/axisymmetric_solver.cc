@@ -337,6 +337,8 @@ bool AxisymmetricSolver::add_cohesive_forces(const Vector<double>& u, bool with_
     const CohesiveResponse r = cohesive_response(law, cohesive_committed_[k], kn * dn, dt, dt_s_);
     if (!std::isfinite(r.traction[0]) || !std::isfinite(r.traction[1])) return false;
     cohesive_trial_[k] = r.history;
+    cohesive_branch_[k] = static_cast<unsigned char>((r.history.max_separation_m > cohesive_committed_[k].max_separation_m ? 1 : 0) |
+                                                     (dn > 0.0 ? 2 : 0));
     const double A = cp.area_m2 * area_scale;
     dissipated_trial_J_ += A * (r.history.dissipated_J_per_m2 - cohesive_committed_[k].dissipated_J_per_m2);
     if (cp.to_plane) {
@@ -376,6 +378,7 @@ void AxisymmetricSolver::add_needle_contact(const Vector<double>& u, bool with_m
                            settings_.friction_min_slip * mesh_.tip_element_size_m);
     }
     friction_trial_[i] = resp.history;
+    contact_branch_[i] = resp.history.in_contact ? 1 : 0;
     if (!resp.history.in_contact) continue;
     if (debug_contacts_)
       std::cout << "        node R " << nd.R * 1e3 << " Z " << nd.Z * 1e3 << (nd.core_side ? " core" : " outer")

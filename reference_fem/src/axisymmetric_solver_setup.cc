@@ -341,6 +341,8 @@ void AxisymmetricSolver::allocate_state() {
   cohesive_trial_ = cohesive_committed_;
   friction_committed_.assign(contact_nodes_.size(), FrictionHistory{});
   friction_trial_ = friction_committed_;
+  cohesive_branch_.assign(cohesive_points_.size(), 0);
+  contact_branch_.assign(contact_nodes_.size(), 0);
   punch_contact_.assign(contact_nodes_.size(), 0);
   punch_lateral_hold_.assign(contact_nodes_.size(), 0.0);
   penalty_.assign(contact_nodes_.size(), 0.0);

@@ -407,6 +407,12 @@ class AxisymmetricSolver {
   std::vector<CohesivePoint> cohesive_points_;
   std::vector<CohesiveHistory> cohesive_committed_, cohesive_trial_;
   std::vector<FrictionHistory> friction_committed_, friction_trial_;
+  /// The branch each cohesive point (bit 0: loading, bit 1: opening) and each
+  /// contact node (bit 0: in contact) is on at the last assembly, and at the
+  /// iterate before: the Newton log counts the switches between iterates (a
+  /// Newton that cycles at a kink of the laws shows them).
+  std::vector<unsigned char> cohesive_branch_, contact_branch_;
+  mutable std::vector<unsigned char> cohesive_branch_logged_, contact_branch_logged_;
   std::vector<double> penalty_;  ///< k_n per contact node (N/m)
   std::vector<char> broken_layers_;
   double dissipated_J_ = 0.0, dissipated_trial_J_ = 0.0;
