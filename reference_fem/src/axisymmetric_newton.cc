@@ -112,6 +112,7 @@ AxisymmetricSolver::Failure AxisymmetricSolver::newton(Step& step, int max_itera
       return why;
     }
     if (const Failure why = newton_direction(step, x)) return why;
+    if (std::getenv("PUNCTURE_FEM_CHECK_TANGENT") != nullptr && it > 0) x.line << "  " << tangent_check(step, step.du);
     double alpha = 0.0;
     if (const Failure why = line_search(step, x, alpha)) return why;
     x.line << "  du/h " << std::defaultfloat << std::setprecision(3) << x.direction_tip_elements << "  alpha "
@@ -134,14 +135,34 @@ AxisymmetricSolver::Failure AxisymmetricSolver::newton(Step& step, int max_itera
 // after a failed one. Once it is below continuation_final_ratio the viscous
 // stress is negligible and plain Newton finishes the step from there: the
 // accepted state solves the step's own equations, continuation only finds it.
+// Where that policy gives up, a slower one (continuation_retry_*: ratio
+// halved per converged pseudo-step, many more pseudo-steps) starts again from
+// the step's start: an equilibrium far away is reached in small moves.
 AxisymmetricSolver::Failure AxisymmetricSolver::continue_step(Step& step, const std::string& plain_failure) {
   std::ostringstream head;
   head << "  -> " << plain_failure << "; pseudo-transient continuation";
   step.report.table.push_back(head.str());
+  bool reached = pseudo_transient(step, settings_.continuation_steps, settings_.continuation_max_failures,
+                                  settings_.continuation_decrease, settings_.continuation_increase);
+  if (!reached && settings_.continuation_retry_steps > 0) {
+    step.report.table.push_back("  -> the slower continuation (retry policy)");
+    reached = pseudo_transient(step, settings_.continuation_retry_steps, settings_.continuation_retry_max_failures,
+                               settings_.continuation_retry_decrease, settings_.continuation_retry_increase);
+  }
+  continuation_ratio_ = 0.0;
+  ++step.report.continuation_steps;
+  if (!reached) return plain_failure + "; pseudo-transient continuation did not reach the step's equilibrium either";
+  step.report.table.push_back("  plain Newton from the continued state");
+  if (const Failure why = newton(step, settings_.max_newton_iterations))
+    return plain_failure + "; after pseudo-transient continuation: " + *why;
+  return std::nullopt;
+}
+
+bool AxisymmetricSolver::pseudo_transient(Step& step, int steps, int max_failures, double decrease, double increase) {
   restore_step_start(step);
   double ratio = settings_.continuation_initial_ratio;
   int failures = 0;
-  for (int k = 0; k < settings_.continuation_steps && ratio >= settings_.continuation_final_ratio; ++k) {
+  for (int k = 0; k < steps && ratio >= settings_.continuation_final_ratio; ++k) {
     continuation_reference_ = solution_;
     continuation_ratio_ = ratio;
     const Failure why = newton(step, settings_.continuation_max_iterations);
@@ -152,20 +173,14 @@ AxisymmetricSolver::Failure AxisymmetricSolver::continue_step(Step& step, const 
     if (settings_.verbose) std::cout << "      " << line.str() << std::endl;
     if (why) {
       solution_ = continuation_reference_;
-      if (++failures > settings_.continuation_max_failures) break;
-      ratio *= settings_.continuation_increase;
+      if (++failures > max_failures) break;
+      ratio *= increase;
     } else {
-      ratio /= settings_.continuation_decrease;
+      ratio /= decrease;
     }
   }
   continuation_ratio_ = 0.0;
-  ++step.report.continuation_steps;
-  if (ratio >= settings_.continuation_final_ratio)
-    return plain_failure + "; pseudo-transient continuation did not reach the step's equilibrium either";
-  step.report.table.push_back("  plain Newton from the continued state");
-  if (const Failure why = newton(step, settings_.max_newton_iterations))
-    return plain_failure + "; after pseudo-transient continuation: " + *why;
-  return std::nullopt;
+  return ratio < settings_.continuation_final_ratio;
 }
 
 void AxisymmetricSolver::start_step(Step& step, double predictor_scale) {
@@ -347,6 +362,52 @@ AxisymmetricSolver::Failure AxisymmetricSolver::newton_direction(Step& step, Ite
   x.direction_tip_elements = largest / mesh_.tip_element_size_m;
   if (limit > 0.0 && largest > limit && x.gap <= 0.0) step.du *= limit / largest;
   return std::nullopt;
+}
+
+std::string AxisymmetricSolver::tangent_check(const Step& step, const Vector<double>& direction) {
+  // K v against (R(u + e v) - R(u - e v)) / 2e on the free dofs, with e such
+  // that the largest nodal move is 1e-4 tip elements.
+  const double largest = direction.linfty_norm();
+  if (!(largest > 0.0)) return "tangent check: no direction";
+  const double eps = 1e-4 * mesh_.tip_element_size_m / largest;
+  Vector<double> Kv(direction.size()), plus(direction.size()), minus(direction.size());
+  tangent_.vmult(Kv, direction);
+  const Vector<double> u = solution_;
+  Vector<double> shifted = u;
+  shifted.add(eps, direction);
+  const bool ok_plus = assemble(shifted, false);
+  plus = residual_;
+  shifted = u;
+  shifted.add(-eps, direction);
+  const bool ok_minus = assemble(shifted, false);
+  minus = residual_;
+  assemble(u, true);  // the state, residual and tangent as they were
+  if (!ok_plus || !ok_minus) return "tangent check: a shifted state is inadmissible";
+  std::vector<char> kind(direction.size(), 0);  // 0 other, 1 contact node, 2 cohesive
+  for (const ContactNode& n : contact_nodes_) kind[n.dof_r] = kind[n.dof_z] = 1;
+  for (const CohesivePoint& c : cohesive_points_)
+    for (unsigned d : {c.core_r, c.core_z, c.outer_r, c.outer_z})
+      if (d < kind.size()) kind[d] = 2;
+  double err[3] = {0.0, 0.0, 0.0}, ref[3] = {0.0, 0.0, 0.0}, worst = 0.0;
+  std::size_t worst_dof = 0;
+  for (std::size_t i = 0; i < direction.size(); ++i) {
+    if (step.constraints.is_constrained(i)) continue;
+    const double fd = (plus(i) - minus(i)) / (2.0 * eps);
+    const double e = Kv(i) - fd;
+    err[kind[i]] += e * e;
+    ref[kind[i]] += fd * fd;
+    if (std::abs(e) > worst) {
+      worst = std::abs(e);
+      worst_dof = i;
+    }
+  }
+  std::ostringstream line;
+  const double all_ref = std::sqrt(ref[0] + ref[1] + ref[2]);
+  line << std::scientific << std::setprecision(2) << "tangent check |Kv - FD| / |FD|: all "
+       << std::sqrt(err[0] + err[1] + err[2]) / all_ref << " (contact " << std::sqrt(err[1]) / all_ref << ", cohesive "
+       << std::sqrt(err[2]) / all_ref << ", other " << std::sqrt(err[0]) / all_ref << "), worst dof " << worst_dof
+       << " (" << (kind[worst_dof] == 1 ? "contact" : kind[worst_dof] == 2 ? "cohesive" : "other") << ")";
+  return line.str();
 }
 
 AxisymmetricSolver::Failure AxisymmetricSolver::line_search(Step& step, const Iterate& x, double& alpha) {

@@ -131,6 +131,17 @@ struct AxisymmetricSettings {
   double continuation_decrease = 4.0;
   double continuation_increase = 8.0;
   int continuation_max_failures = 8;
+  /// A second, slower continuation where the first does not reach the
+  /// step's equilibrium (0 steps: none): from the step's start again, the
+  /// ratio down by 2 per converged pseudo-step and up by 4 per failed one, for
+  /// up to 400 pseudo-steps and 80 failures. A snap whose equilibrium lies far
+  /// from the step's start (a layer giving way under the tip just after the
+  /// one above broke) is crossed in many small pseudo-steps, where the first
+  /// policy's ratio oscillates between failing and converging and gives up.
+  int continuation_retry_steps = 400;
+  double continuation_retry_decrease = 2.0;
+  double continuation_retry_increase = 4.0;
+  int continuation_retry_max_failures = 80;
   bool verbose = false;
 };
 
@@ -331,6 +342,15 @@ class AxisymmetricSolver {
   Failure newton_direction(Step& step, Iterate& x);
   /// Backtracking line search along du from solution_: the step length alpha and step.trial.
   Failure line_search(Step& step, const Iterate& x, double& alpha);
+  /// Pseudo-steps from the step's start under one policy of the ratio; true
+  /// if the ratio fell below continuation_final_ratio (the state is then
+  /// near the step's equilibrium).
+  bool pseudo_transient(Step& step, int steps, int max_failures, double decrease, double increase);
+  /// Diagnostic (PUNCTURE_FEM_CHECK_TANGENT set): the assembled tangent along
+  /// the Newton direction against central differences of the residual, on
+  /// the free dofs, split into contact-node, cohesive and other dofs; one
+  /// line for the Newton log. Leaves the state as it found it (reassembles).
+  std::string tangent_check(const Step& step, const dealii::Vector<double>& direction);
   /// At most max_iterations Newton iterations from solution_ to convergence
   /// (nullopt) or to why they fail.
   Failure newton(Step& step, int max_iterations);
