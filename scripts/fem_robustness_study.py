@@ -201,7 +201,10 @@ def page(records, args, command):
               "#SBATCH --array=0-59 --cpus-per-task=1",
               "python3 scripts/fem_robustness_study.py --count 60 --seed 48 --only $SLURM_ARRAY_TASK_ID --out $OUT",
               "# after the array:",
-              "python3 scripts/fem_robustness_study.py --count 60 --seed 48 --collect --out $OUT", "```", ""]
+              "python3 scripts/fem_robustness_study.py --count 60 --seed 48 --collect --out $OUT", "```", "",
+              "On one machine a study stopped part way goes on with `--resume` (the scenes with a result from "
+              "the current FEM sources are kept); `--collect --partial` writes this page from the results so far.",
+              ""]
     return "\n".join(lines)
 
 
