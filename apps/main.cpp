@@ -75,6 +75,8 @@ CLI::App* add_fem(CLI::App& app, CommandLine& c) {
   return fem_cmd;
 }
 
+void add_recording_options(CLI::App* cmd, puncture::validation::ReferenceRecordingOptions& r);
+
 CLI::App* add_validate(CLI::App& app, CommandLine& c) {
   CLI::App* validate_cmd = app.add_subcommand("validate", "Real-time model against the FEM reference on the same insertion");
   add_scene_options(validate_cmd, c, "Report directory; default: out/<scene name>_validation", true);
@@ -92,6 +94,12 @@ CLI::App* add_validate(CLI::App& app, CommandLine& c) {
                            "validation/cases/default_tuned_why_misses.json), shown under \"Why each miss\"");
   validate_cmd->add_option("--model-note", c.validate.model_note,
                            "With --cases: how the model was calibrated (which references), for the summary page");
+  validate_cmd->add_option("--reference", c.validate.references,
+                           "Measured curve or raw rig recording (repeatable; read as calibrate --reference reads it): "
+                           "judge the scene's model on each recording's own trajectory instead of the FEM "
+                           "(recordings_validation.md: force RMSE, punctures found on the recording beside the "
+                           "model's, the scatter of repeats)");
+  add_recording_options(validate_cmd, c.validate.recording);
   validate_cmd->add_flag("--no-vtk", [&c](std::int64_t) { c.validate.write_vtk = false; },
                          "CSV, PNG and markdown only (no .vtp, .vtu, validation.pvd)");
   validate_cmd->add_flag("-q,--quiet", c.validate.quiet, "Nothing on stdout (warnings and errors still on stderr)");

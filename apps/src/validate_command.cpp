@@ -57,6 +57,7 @@
 #ifdef PUNCTURE_HAVE_VTK  // frames are VTK files
 #include "puncture/io/realtime_frames.hpp"
 #endif
+#include "validate_recordings.hpp"
 
 namespace puncture::apps {
 
@@ -443,6 +444,8 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
   NullStream quiet;
   std::ostream& out = options.quiet ? quiet : stdout_stream;
   const std::filesystem::path scene_path = options.scene.empty() ? default_scene_path() : options.scene;
+  if (!options.references.empty())
+    return report_errors(err, "", [&]() { return validate_recordings(options, scene_path, out); });
   if (!options.cases.empty())
     return report_errors(err, options.cases.string(), [&]() { return validate_cases(options, scene_path, out, err); });
   return report_errors(err, scene_path.string(), [&]() -> int {

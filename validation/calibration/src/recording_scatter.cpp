@@ -230,11 +230,11 @@ std::string recordings_markdown(const std::vector<JudgedRecording>& recordings, 
 
 std::string repeat_scatter_markdown(const std::vector<JudgedRecording>& recordings,
                                     const std::vector<RepeatGroup>& groups, const Scene& scene,
-                                    const RepeatScatterOptions& o) {
+                                    const RepeatScatterOptions& o, const std::string& model_label) {
   std::ostringstream s;
   s << "\n## Scatter of repeats\n\nRecordings whose insertion speeds lie within " << num(o.speed_tolerance * 100, 3)
     << " % of each other are repeats of one condition. Per condition: each layer's puncture force and depth as "
-       "mean +- SD [min, max] over the repeats beside the calibrated model's, and the band of the repeats' insertion "
+       "mean +- SD [min, max] over the repeats beside the " << model_label << "'s, and the band of the repeats' insertion "
        "forces (pointwise min to max on " << o.grid_points << " depths from contact to the shallowest repeat's "
        "deepest sample; it holds the sensor noise too) with the model's place in it: the model sits inside when it "
        "lies in the band at >= " << num(o.inside_fraction * 100, 3) << " % of those depths. Band: repeat_scatter.csv.\n";

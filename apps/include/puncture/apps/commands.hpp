@@ -66,6 +66,11 @@ struct ValidateOptions {
   /// With cases: why the model misses where it does (validation_cases.hpp
   /// read_miss_reasons), for the summary's "Why each miss".
   std::filesystem::path why_misses;
+  /// Measured curves or raw rig recordings (read as calibrate's --reference,
+  /// with `recording`): the scene's model judged against each on its own
+  /// trajectory instead of against the FEM (apps/src/validate_recordings.hpp).
+  std::vector<std::filesystem::path> references;
+  validation::ReferenceRecordingOptions recording;
 };
 
 /// `puncture validate`: real-time model and FEM reference (cached) on the

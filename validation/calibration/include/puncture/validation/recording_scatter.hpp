@@ -100,9 +100,11 @@ std::vector<RepeatGroup> repeat_scatter(const std::vector<JudgedRecording>& reco
 /// "## Recordings": every recording (fitted or held out), speed, objective before and after, force RMSE and punctures.
 std::string recordings_markdown(const std::vector<JudgedRecording>& recordings, const Scene& scene);
 /// "## Scatter of repeats": per group its spread beside the model's error and the verdict.
+/// model_label names the model judged ("calibrated model"; `validate` judges the scene's own).
 std::string repeat_scatter_markdown(const std::vector<JudgedRecording>& recordings,
                                     const std::vector<RepeatGroup>& groups, const Scene& scene,
-                                    const RepeatScatterOptions& options = {});
+                                    const RepeatScatterOptions& options = {},
+                                    const std::string& model_label = "calibrated model");
 /// group,speed_mm_per_s,depth_mm,band_min_N,band_max_N,mean_N,model_N rows (groups of two or more).
 std::string repeat_scatter_csv(const std::vector<RepeatGroup>& groups, const io::Provenance& provenance);
 
