@@ -94,3 +94,22 @@ def test_fem_computes_a_missing_reference_into_the_cache_or_says_why_not(short_s
     again = puncture.fem(scene, cache_dir=tmp_path / "cache")
     assert again["from_cache"] and again["dir"] == first["dir"]
     np.testing.assert_array_equal(again["fem_force_depth"]["force_N"], force)
+
+
+def test_validate_against_a_recording_of_the_model_itself(short_scene, tmp_path):
+    """validate(references=[...]): the scene's model judged against a recording (here its own run, written as a
+    measured curve with its speed): its force RMSE is about 0 and the skin's puncture is where the recording's is."""
+    run = puncture.Simulator(short_scene).run()
+    lines = ["# speed_mm_per_s: 10", "time_s,depth_mm,force_N"]
+    for t, d, f in zip(run.time_s[::10], run.depth_mm[::10], run.force_N[::10]):
+        lines.append(f"{t!r},{d!r},{f!r}")
+    recording = tmp_path / "own_run.csv"
+    recording.write_text("\n".join(lines) + "\n")
+    result = puncture.validate(short_scene, references=[recording], output_dir=tmp_path / "report")
+    entry = result["recordings_validation"]["recordings"][0]
+    assert entry["recording"] == str(recording)
+    assert entry["force_rmse_relative"] < 0.02
+    skin = entry["layers"][0]
+    assert skin["recording_punctured"] and skin["model_punctured"]
+    assert abs(skin["model"]["depth_mm"] - skin["recording"]["depth_mm"]) <= 0.2
+    assert (tmp_path / "report" / "recording_curves.csv").is_file()
