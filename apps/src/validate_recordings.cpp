@@ -142,7 +142,7 @@ int validate_recordings(const ValidateOptions& options, const std::filesystem::p
     throw UsageError("--refinement and --degree set the FEM reference: not with --reference (recordings)");
   const Scene scene = load_scene(scene_path);
   const std::filesystem::path dir =
-      options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_recordings") : options.output_dir;
+      options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_validation") : options.output_dir;
   std::vector<validation::ReferenceCurve> recordings;
   double speed = 0.0;
   for (const std::filesystem::path& path : options.references) {
