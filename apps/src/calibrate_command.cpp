@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "command_errors.hpp"
+#include "measured_reference.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/validation/fem_reference.hpp"
 #include "puncture/io/provenance.hpp"
@@ -85,20 +86,17 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
 /// two or more speeds d and the rate laws are tuned).
 validation::ReferenceCurve read_measured(const std::filesystem::path& path, const CalibrateOptions& options,
                                          std::ostream& out) {
-  validation::ReferenceCurve reference;
-  reference.curve = validation::read_reference_recording(path, options.recording);
-  reference.kind = "measured";
+  validation::ReferenceCurve reference = read_measured_reference(path, options.recording);
   auto& meta = reference.curve.metadata;
   if (meta.count("recording_format"))
     out << "[calibrate] raw recording " << path.string() << " (format: " << meta.at("recording_format")
         << "): contact at " << meta.at("contact_time_s") << " s, tare " << meta.at("tare_N") << " N, noise "
         << meta.at("noise_N") << " N, insertion at " << meta.at("speed_mm_per_s") << " mm/s\n";
-  if (!meta.count("rate_dependent") && !meta.count("quasi_static")) meta["rate_dependent"] = "true";
   if (options.reference_depth_offset_mm != 0.0) {
     for (double& d : reference.curve.depth_m) d -= options.reference_depth_offset_mm * 1e-3;
     meta["depth_offset_mm"] = std::to_string(options.reference_depth_offset_mm);
+    validation::insertion_phase(reference.curve);  // still an insertion after the offset (names the file)
   }
-  validation::insertion_phase(reference.curve);  // bad input before any model run (names the file)
   return reference;
 }
 
@@ -148,14 +146,12 @@ bool load_references(const CalibrateOptions& options, const Scene& scene, std::o
     for (const std::filesystem::path& path : options.references) references.push_back(read_measured(path, options, out));
   }
   for (const std::filesystem::path& path : options.held_out) held_out.push_back(read_measured(path, options, out));
-  const std::size_t measured = options.references.size() + held_out.size();
-  double speed = 0.0;
-  if (measured > 1)
+  if (options.references.size() + held_out.size() > 1) {
+    std::vector<const validation::ReferenceCurve*> all;
     for (const auto* list : {&references, &held_out})
-      for (const validation::ReferenceCurve& r : *list)
-        if (r.kind == "measured" && !r.curve.metadata_number("speed_mm_per_s", speed))
-          throw UsageError(r.curve.source + ": no insertion speed: with several recordings each needs its own (a raw "
-                           "recording's stage gives it; a curve needs a '# speed_mm_per_s: V' line)");
+      for (const validation::ReferenceCurve& r : *list) all.push_back(&r);
+    require_insertion_speeds(all);
+  }
   return true;
 }
 

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command_errors.hpp"
+#include "measured_reference.hpp"
 #include "puncture/io/output_session.hpp"
 #include "puncture/io/provenance.hpp"
 #include "puncture/io/provenance_json.hpp"
@@ -25,18 +26,6 @@ namespace puncture::apps {
 namespace {
 
 std::string num(double x, int digits = 4) { return validation::significant_digits(x, digits); }
-
-/// The recording as calibrate reads it (a raw rig recording through its
-/// format; a measured curve's rate dependence assumed unless it says).
-validation::ReferenceCurve read_recording(const std::filesystem::path& path, const ValidateOptions& options) {
-  validation::ReferenceCurve reference;
-  reference.curve = validation::read_reference_recording(path, options.recording);
-  reference.kind = "measured";
-  auto& meta = reference.curve.metadata;
-  if (!meta.count("rate_dependent") && !meta.count("quasi_static")) meta["rate_dependent"] = "true";
-  validation::insertion_phase(reference.curve);  // bad input before any model run (names the file)
-  return reference;
-}
 
 std::string command_line(const ValidateOptions& options, const std::filesystem::path& scene_path,
                          const std::filesystem::path& dir) {
@@ -144,13 +133,11 @@ int validate_recordings(const ValidateOptions& options, const std::filesystem::p
   const std::filesystem::path dir =
       options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_validation") : options.output_dir;
   std::vector<validation::ReferenceCurve> recordings;
-  double speed = 0.0;
-  for (const std::filesystem::path& path : options.references) {
-    recordings.push_back(read_recording(path, options));
-    if (options.references.size() > 1 && !recordings.back().curve.metadata_number("speed_mm_per_s", speed))
-      throw UsageError(path.string() + ": no insertion speed: with several recordings each needs its own (a raw "
-                       "recording's stage gives it; a curve needs a '# speed_mm_per_s: V' line)");
-  }
+  for (const std::filesystem::path& path : options.references)
+    recordings.push_back(read_measured_reference(path, options.recording));
+  std::vector<const validation::ReferenceCurve*> all;
+  for (const validation::ReferenceCurve& r : recordings) all.push_back(&r);
+  require_insertion_speeds(all);
   out << "[validate] the scene's model on " << recordings.size() << " recording(s)\n";
   validation::CalibrationResult as_is;  // no fitting: the scene's own model is the one judged
   as_is.tuned_scene = scene;
