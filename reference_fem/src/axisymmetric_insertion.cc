@@ -293,6 +293,7 @@ void AxisymmetricInsertionRun::walk_trajectory() {
       detect_punctures();
       record_step(phase, *step);
       check_intact_friction();
+      if (options_.on_step) options_.on_step(depth_, plan_.back().time_s > 0.0 ? time_ / plan_.back().time_s : 1.0);
     }
   }
   check_force_drops();

@@ -251,6 +251,7 @@ FemRunSummary SlabInsertionRun::run() {
     for (int step = 1; step <= n_steps_; ++step) {
       advance_to(std::min(-start_height_ + step * load_step_, final_depth_));
       record_load_step(step);
+      if (options_.on_step) options_.on_step(depth_, static_cast<double>(step) / n_steps_);
     }
   } catch (const std::exception& e) {
     write_outputs("failed", e.what());

@@ -217,11 +217,14 @@ class AxisymmetricSolver {
   /// Time step of the coming solve (s), for the cohesive viscosity and the
   /// viscoelastic layers.
   void set_time_step(double dt_s) { dt_s_ = dt_s; }
-  /// A stalled Newton solve whose free residual is below this force (N) is
-  /// accepted as well (as below stall_acceptance_tolerance x the step's
-  /// force scale): the insertion sets it to 1e-3 x the largest needle force
-  /// of the run so far, so that the steps where the needle force is
-  /// millinewtons (the end of a withdrawal) are held to the run's scale.
+  /// When set (> 0), a stalled Newton solve is accepted below this force (N),
+  /// or below stall_acceptance_tolerance x the current needle force if that
+  /// is larger, instead of below the tolerance x the step's force scale (which
+  /// also holds the reactions at ties and supports, at times a hundred times
+  /// the needle force). The insertion sets it to 1e-3 x the largest needle
+  /// force of the run so far: every accepted step is then exact to 0.1 % of
+  /// the run's peak, and the steps where the needle force is millinewtons
+  /// (the end of a withdrawal) are held to the run's scale, not their own.
   void set_stall_acceptance_floor(double force_N) { stall_acceptance_floor_N_ = force_N; }
 
   // --- solving ----------------------------------------------------------------

@@ -51,6 +51,7 @@
 
 #include <mpi.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -84,6 +85,14 @@ struct FemRunOptions {
   int max_vtu_frames = 40;            ///< at most about this many VTU frames (plus events)
   bool verbose = true;                ///< progress and Newton tables on rank 0's stdout
   bool write_files = true;            ///< false: no files at all (tests)
+  /// Called after every converged load (sub)step with the tip depth (m) and
+  /// the share of the trajectory done (0..1, by time; by depth in 3D). It may
+  /// throw to stop the run: the run writes its outputs with "status":
+  /// "failed" and rethrows (as std::runtime_error with the same message).
+  /// The Python module checks Ctrl-C here. Axisymmetric geometry: called on
+  /// rank 0, which solves alone; 3D: on every rank, and it must throw on all
+  /// of them or on none.
+  std::function<void(double depth_m, double fraction_done)> on_step;
 };
 
 struct PunctureEvent {
