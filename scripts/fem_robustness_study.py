@@ -50,10 +50,15 @@ def scenes_of(count, seed, family):
 def fem_source_revision():
     """The git revision of the last commit that changed the FEM's sources
     (reference_fem/, meshing/, core/: the solver, its mesh and the scene it
-    reads): runs of one study must all come from it."""
+    reads; not the comparison models of `puncture compare` and their
+    tetrahedral meshes, which the FEM neither links nor reads): runs of one
+    study must all come from it."""
+    not_fem = [":(exclude)core/models", ":(exclude)core/src/comparison", ":(exclude)core/include/puncture/comparison",
+               ":(exclude,glob)meshing/**/*tet_*"]
     try:
         return subprocess.check_output(["git", "-C", fr.ROOT, "log", "-1", "--format=%h", "--", "reference_fem",
-                                        "meshing", "core"], text=True, stderr=subprocess.DEVNULL).strip() or "unknown"
+                                        "meshing", "core"] + not_fem, text=True,
+                                       stderr=subprocess.DEVNULL).strip() or "unknown"
     except Exception:
         return "unknown"
 
