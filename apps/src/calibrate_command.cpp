@@ -110,6 +110,7 @@ bool load_fem_references(const CalibrateOptions& options, const Scene& scene, st
   validation::FemReferenceOptions fem;
   if (!options.cache_dir.empty()) fem.cache_dir = options.cache_dir;
   fem.verbose = !options.quiet;
+  fem.on_step = options.fem_step;
   std::vector<Scene> scenes{scene};
   for (double v : options.fem_speeds_mm_per_s) {
     if (!(v > 0.0) || !std::isfinite(v)) throw UsageError("--fem-speeds: speeds must be finite and > 0 (mm/s)");

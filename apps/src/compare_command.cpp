@@ -169,6 +169,7 @@ int compare_command(const CompareOptions& options, std::ostream& out, std::ostre
     validation::FemReferenceOptions fem_options;
     if (!options.cache_dir.empty()) fem_options.cache_dir = options.cache_dir;
     fem_options.verbose = !options.quiet;
+    fem_options.on_step = options.fem_step;
     // The FEM's fields are needed for the ParaView output only: with --no-vtk
     // a cached reference without them is used as it is (as validate does).
     fem_options.write_vtu = options.write_vtk;

@@ -319,6 +319,7 @@ std::optional<SceneValidation> validate_scene(const Scene& scene, const std::str
   fem_options.degree = options.degree;
   fem_options.write_vtu = vtk;
   fem_options.verbose = !options.quiet;
+  fem_options.on_step = options.fem_step;
   const FemReference reference = obtain_fem_reference(scene, fem_options, out);
   if (!is_mpi_root()) return std::nullopt;  // the other ranks only help with the FEM
   const FemResultFiles fem = read_fem_result(reference.dir, scene);

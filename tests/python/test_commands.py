@@ -2,6 +2,8 @@
 the commands use (seeded here, so the test needs no FEM run), copied where
 asked; bad input with the command line's message, nothing written."""
 import json
+import os
+import signal
 
 import numpy as np
 import pytest
@@ -87,13 +89,36 @@ def test_fem_computes_a_missing_reference_into_the_cache_or_says_why_not(short_s
             puncture.fem(scene, cache_dir=tmp_path / "cache")
         assert not (tmp_path / "cache").exists()
         return
-    first = puncture.fem(scene, cache_dir=tmp_path / "cache")
+    fractions = []
+    first = puncture.fem(scene, cache_dir=tmp_path / "cache", progress=fractions.append)
+    assert len(fractions) >= 3 and np.all(np.diff(fractions) > 0.0) and fractions[-1] == pytest.approx(1.0)
     force = first["fem_force_depth"]["force_N"]
     assert not first["from_cache"] and first["fem_summary"].get("status") != "failed"
     assert np.all(np.isfinite(force)) and force.max() > 0.0
     again = puncture.fem(scene, cache_dir=tmp_path / "cache")
     assert again["from_cache"] and again["dir"] == first["dir"]
     np.testing.assert_array_equal(again["fem_force_depth"]["force_N"], force)
+
+
+def test_ctrl_c_stops_the_fem_at_its_next_load_step_and_caches_nothing(short_scene, tmp_path):
+    """SIGINT sent from the progress callback (as a user's Ctrl-C arrives while the FEM runs): the call
+    raises KeyboardInterrupt after that step, no further step is solved, the cache holds nothing."""
+    scene = short_scene.updated({"insertion/target_depth_mm": 1.5, "insertion/dwell_s": 0.0})
+    if not puncture.HAVE_FEM:
+        with pytest.raises(puncture.RunError, match="this build has no FEM"):
+            puncture.fem(scene, cache_dir=tmp_path / "cache", progress=lambda f: None)
+        return
+    fractions = []
+
+    def progress(fraction):
+        fractions.append(fraction)
+        if len(fractions) == 2:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt):
+        puncture.fem(scene, cache_dir=tmp_path / "cache", progress=progress)
+    assert len(fractions) == 2 and 0.0 < fractions[0] < fractions[1] < 1.0
+    assert list((tmp_path / "cache").glob("*")) == []
 
 
 def test_validate_against_a_recording_of_the_model_itself(short_scene, tmp_path):

@@ -90,6 +90,7 @@ py::dict calibrate(const SceneHandle& scene, const py::object& reference, const 
   o.quiet = true;
   PythonCallback callback(progress);
   o.progress = [&callback](const validation::CalibrationProgress& p) { callback(p); };
+  o.fem_step = [&callback](double, double) { callback.check_signals(); };
   const CommandOutput printed =
       run_command([&](std::ostream& out, std::ostream& err) { return apps::calibrate_command(o, out, err); }, &callback);
   py::dict result = read_outputs(o.output_dir);
@@ -119,8 +120,8 @@ void bind_calibrate(py::module_& m) {
         "preset_name, layers, threads, tune_unidentifiable, reference_depth_offset_mm, stage_turn_margin_mm, "
         "bound_factor, also_tune, integrator, depth_weight, force_weight, puncture_depths_mm, fem_speeds_mm_per_s, "
         "surface_fit, cutting_from_next_puncture, keep, layer_thickness_mm, recording_format. progress(p) is called "
-        "after every model run (a CalibrationProgress); raising in it, or Ctrl-C, stops the calibration (nothing is "
-        "written) and re-raises. Returns 'preset' (the tuned Scene), the files by stem (calibration_curves, "
+        "after every model run (a CalibrationProgress); raising in it, or Ctrl-C (also while an FEM reference is being "
+        "computed), stops the calibration (nothing is written) and re-raises. Returns 'preset' (the tuned Scene), the files by stem (calibration_curves, "
         "calibration_summary, <preset>.provenance, ...), 'warnings', 'output_dir' (the files go there when given).");
 }
 

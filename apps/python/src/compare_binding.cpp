@@ -10,6 +10,7 @@
 #include "command_outputs.hpp"
 #include "errors.hpp"
 #include "puncture/apps/commands.hpp"
+#include "python_progress.hpp"
 #include "scene_handle.hpp"
 
 namespace py = pybind11;
@@ -40,7 +41,10 @@ py::dict compare(const SceneHandle& scene, const std::vector<std::string>& model
   o.frames = frames;
   o.write_vtk = write_vtk;
   o.quiet = true;
-  const CommandOutput printed = run_command([&](std::ostream& out, std::ostream& err) { return apps::compare_command(o, out, err); });
+  PythonCallback interrupt{py::none()};
+  o.fem_step = [&interrupt](double, double) { interrupt.check_signals(); };
+  const CommandOutput printed =
+      run_command([&](std::ostream& out, std::ostream& err) { return apps::compare_command(o, out, err); }, &interrupt);
   py::dict result = read_outputs(o.output_dir);
   result["output_dir"] = output_dir ? py::cast(*output_dir) : py::none();
   result["warnings"] = warning_lines(printed.err);

@@ -11,6 +11,7 @@
 #include "command_call.hpp"
 #include "command_outputs.hpp"
 #include "errors.hpp"
+#include "python_progress.hpp"
 #include "puncture/validation/fem_reference.hpp"
 #include "scene_handle.hpp"
 
@@ -32,8 +33,10 @@ validation::FemReferenceOptions fem_options(const std::filesystem::path& cache_d
 }
 
 py::dict fem(const SceneHandle& scene, const std::filesystem::path& cache_dir, int refinement, int degree, bool write_vtu,
-             const std::optional<std::filesystem::path>& output_dir, bool verbose) {
-  const validation::FemReferenceOptions options = fem_options(cache_dir, refinement, degree, write_vtu, verbose);
+             const std::optional<std::filesystem::path>& output_dir, bool verbose, const py::object& progress) {
+  validation::FemReferenceOptions options = fem_options(cache_dir, refinement, degree, write_vtu, verbose);
+  PythonCallback callback(progress);
+  options.on_step = [&callback](double, double fraction_done) { callback(fraction_done); };
   validation::FemReference ref;
   std::ostringstream log;
   run_command([&](std::ostream&, std::ostream& err) {
@@ -44,7 +47,7 @@ py::dict fem(const SceneHandle& scene, const std::filesystem::path& cache_dir, i
       err << "error: " << scene.source << ": " << e.what() << '\n';
       return 1;
     }
-  });
+  }, &callback);
   if (output_dir) run_command([&](std::ostream&, std::ostream& err) {
       try {
         copy_outputs(ref.dir, *output_dir);
@@ -68,12 +71,14 @@ py::dict fem(const SceneHandle& scene, const std::filesystem::path& cache_dir, i
 void bind_fem(py::module_& m) {
   m.def("fem", &fem, py::arg("scene"), py::kw_only(), py::arg("cache_dir") = std::filesystem::path(),
         py::arg("refinement") = -1, py::arg("degree") = -1, py::arg("write_vtu") = false,
-        py::arg("output_dir") = py::none(), py::arg("verbose") = false,
+        py::arg("output_dir") = py::none(), py::arg("verbose") = false, py::arg("progress") = py::none(),
         "The deal.II FEM reference of the scene's insertion, from the cache of `puncture validate` and `calibrate` "
         "(cache_dir, default out/.fem_cache; key: everything the FEM reads) or computed into it. Returns a dict: "
         "'fem_force_depth' ({column: array}), 'fem_summary' (dict), the other files by stem, 'files', 'dir', "
         "'hash', 'from_cache', 'log'. output_dir: a copy of the files there. refinement / degree -1: the scene's. "
-        "The GIL is released while the FEM runs; Ctrl-C is seen when it returns.");
+        "progress(fraction) is called after every load step of an FEM being computed (fraction of the trajectory "
+        "done, by time). The GIL is released while the FEM runs; Ctrl-C, or an exception raised in progress, stops "
+        "it at its next load step (nothing is cached) and re-raises.");
   m.def(
       "fem_cache_key",
       [](const SceneHandle& scene, int refinement, int degree) {

@@ -30,21 +30,20 @@ class PythonCallback {
   /// `callback` may be None (then only signals are checked). Needs the GIL.
   explicit PythonCallback(pybind11::object callback) : callback_(std::move(callback)) {}
 
-  /// From any thread that does not hold the GIL.
+  /// From any thread that does not hold the GIL: checks Ctrl-C, then calls
+  /// the callback (when not None) with `args`.
   template <class... Args>
   void operator()(Args&&... args) {
-    if (raised_) throw CallbackAborted();
-    std::lock_guard<std::mutex> lock(mutex_);  // one call into Python at a time
-    if (raised_) throw CallbackAborted();
-    pybind11::gil_scoped_acquire gil;
-    try {
-      if (PyErr_CheckSignals() != 0) throw pybind11::error_already_set();
-      if (!callback_.is_none()) callback_(std::forward<Args>(args)...);
-    } catch (pybind11::error_already_set& e) {
-      error_ = std::make_shared<pybind11::error_already_set>(std::move(e));
-      raised_ = true;
-      throw CallbackAborted();
-    }
+    invoke([&](const pybind11::object& callback) {
+      if (!callback.is_none()) callback(std::forward<Args>(args)...);
+    });
+  }
+
+  /// From any thread that does not hold the GIL: checks Ctrl-C only (for the
+  /// steps of a long call the callback does not report, e.g. an FEM reference
+  /// computed inside a calibration).
+  void check_signals() {
+    invoke([](const pybind11::object&) {});
   }
 
   bool raised() const { return raised_; }
@@ -55,6 +54,22 @@ class PythonCallback {
   }
 
  private:
+  template <class Call>
+  void invoke(Call&& call) {
+    if (raised_) throw CallbackAborted();
+    std::lock_guard<std::mutex> lock(mutex_);  // one call into Python at a time
+    if (raised_) throw CallbackAborted();
+    pybind11::gil_scoped_acquire gil;
+    try {
+      if (PyErr_CheckSignals() != 0) throw pybind11::error_already_set();
+      call(callback_);
+    } catch (pybind11::error_already_set& e) {
+      error_ = std::make_shared<pybind11::error_already_set>(std::move(e));
+      raised_ = true;
+      throw CallbackAborted();
+    }
+  }
+
   pybind11::object callback_;
   std::mutex mutex_;
   std::atomic<bool> raised_{false};

@@ -7,6 +7,7 @@
 #include "bindings.hpp"
 #include "command_call.hpp"
 #include "command_outputs.hpp"
+#include "python_progress.hpp"
 #include "puncture/apps/commands.hpp"
 #include "scene_handle.hpp"
 
@@ -37,7 +38,10 @@ py::dict validate(const SceneHandle& scene, const OptionalPath& output_dir, cons
   o.references = references;
   o.recording.format_file = recording_format.value_or(std::filesystem::path());
   o.quiet = true;
-  const CommandOutput printed = run_command([&](std::ostream& out, std::ostream& err) { return apps::validate_command(o, out, err); });
+  PythonCallback interrupt{py::none()};
+  o.fem_step = [&interrupt](double, double) { interrupt.check_signals(); };
+  const CommandOutput printed =
+      run_command([&](std::ostream& out, std::ostream& err) { return apps::validate_command(o, out, err); }, &interrupt);
   py::dict result = read_outputs(o.output_dir);
   result["output_dir"] = output_dir ? py::cast(*output_dir) : py::none();
   result["warnings"] = warning_lines(printed.err);
@@ -59,7 +63,8 @@ void bind_validate(py::module_& m) {
         "nothing half-written). Options as the command's (--cases, --model-note, --slab-rule, --why-misses; "
         "write_vtk = not --no-vtk). references: measured curves or raw recordings (--reference; recording_format: "
         "--recording-format): the scene's model judged against them instead of the FEM (recordings_validation, "
-        "recording_curves, repeat_scatter). Raises puncture.InputError / RunError / OutputError with the command's message.");
+        "recording_curves, repeat_scatter). Raises puncture.InputError / RunError / OutputError with the command's message. "
+        "The GIL is released; Ctrl-C stops an FEM reference being computed at its next load step.");
 }
 
 }  // namespace puncture::python

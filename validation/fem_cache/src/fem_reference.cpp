@@ -199,6 +199,7 @@ FemReference obtain_fem_reference(const Scene& scene, const FemReferenceOptions&
   fem_options.write_vtu = options.write_vtu;
   fem_options.verbose = options.verbose;
   fem_options.mesh = options.mesh;
+  fem_options.on_step = options.on_step;
   try {
     fem::run_needle_insertion(scene, fem_options, MPI_COMM_WORLD);
     if (root) {

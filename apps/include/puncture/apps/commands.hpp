@@ -7,6 +7,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -71,6 +72,10 @@ struct ValidateOptions {
   /// trajectory instead of against the FEM (apps/src/validate_recordings.hpp).
   std::vector<std::filesystem::path> references;
   validation::ReferenceRecordingOptions recording;
+  /// Called after every load step of an FEM reference computed on the way
+  /// (not when it comes from the cache) with the tip depth (m) and the share
+  /// of its trajectory done; may throw to stop (the Python module's Ctrl-C).
+  std::function<void(double depth_m, double fraction_done)> fem_step;
 };
 
 /// `puncture validate`: real-time model and FEM reference (cached) on the
@@ -145,6 +150,10 @@ struct CalibrateOptions {
   /// module's progress callback); may throw to stop the calibration
   /// (calibration.hpp), which then writes nothing and fails with the message.
   validation::CalibrationProgressCallback progress;
+  /// Called after every load step of an FEM reference computed on the way
+  /// (not when it comes from the cache) with the tip depth (m) and the share
+  /// of its trajectory done; may throw to stop (the Python module's Ctrl-C).
+  std::function<void(double depth_m, double fraction_done)> fem_step;
 };
 
 /// `puncture calibrate`: tunes the force-law parameters against a reference
@@ -201,6 +210,10 @@ struct CompareOptions {
   int frames = 20;                    ///< ParaView frames per model over the trajectory (0: none)
   bool write_vtk = true;
   bool quiet = false;
+  /// Called after every load step of an FEM reference computed on the way
+  /// (not when it comes from the cache) with the tip depth (m) and the share
+  /// of its trajectory done; may throw to stop (the Python module's Ctrl-C).
+  std::function<void(double depth_m, double fraction_done)> fem_step;
 };
 
 /// `puncture compare`: every comparison model and the real-time model on the

@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <iosfwd>
+#include <functional>
 #include <string>
 
 #include "puncture/scene.hpp"
@@ -29,6 +30,10 @@ struct FemReferenceOptions {
   int degree = -1;      ///< -1: from the scene
   bool write_vtu = true;
   bool verbose = true;
+  /// When the reference is computed: called after every converged load step
+  /// with the tip depth (m) and the share of the trajectory done (0..1); may
+  /// throw to stop the FEM (nothing is cached). FemRunOptions::on_step.
+  std::function<void(double depth_m, double fraction_done)> on_step;
 #ifdef PUNCTURE_HAVE_FEM
   meshing::SlabMeshOptions mesh;  ///< hex mesh resolution (tests and studies use coarser ones)
 #endif
