@@ -189,6 +189,7 @@ int compare_command(const CompareOptions& options, std::ostream& out, std::ostre
     report.frames = options.frames;
     report.write_vtk = options.write_vtk;
     report.quiet = options.quiet;
+    report.check_interrupt = options.model_step;
     report.command_line = compare_command_line(options, scene_path, report.output_dir);
     const validation::ComparisonOutcome outcome = validation::write_model_comparison(
         scene, weights, {reference.dir, reference.hash, reference.from_cache, reference_wall_time_s}, report, out, err);

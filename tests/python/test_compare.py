@@ -5,6 +5,10 @@ graded with no error, and bad input raising the command line's message with
 nothing written."""
 import csv
 import json
+import os
+import signal
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -81,3 +85,20 @@ def test_compare_with_an_unknown_model_raises_the_command_lines_message(short_sc
     assert done.returncode == 2
     assert done.stderr.strip().splitlines()[-1] == "error: " + str(raised.value)
     assert not (tmp_path / "out").exists() and not (tmp_path / "cli").exists()
+
+
+def test_ctrl_c_stops_compare_during_a_model_run_writing_nothing(short_scene, tmp_path):
+    """SIGINT 2 s into a comparison of the volumetric mass-spring model (about 25 s to run): the call raises
+    KeyboardInterrupt well before the run could have ended, and no output folder is left."""
+    seed_fem_reference(short_scene, tmp_path / "cache")
+    timer = threading.Timer(2.0, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            puncture.compare(short_scene, models=["msm"], scene_parameters=True, cache_dir=tmp_path / "cache",
+                             frames=0, write_vtk=False, output_dir=tmp_path / "out")
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 10.0
+    assert not (tmp_path / "out").exists()

@@ -133,8 +133,10 @@ ModelRunOptions ComparisonRunner::run_options(const std::string& key, const comp
       }
     };
   }
-  if (!options_.quiet)
+  if (!options_.quiet || options_.check_interrupt)
     o.on_progress = [this, key, &last_tenth](double fraction) {
+      if (options_.check_interrupt) options_.check_interrupt();
+      if (options_.quiet) return;
       const int tenth = static_cast<int>(fraction * 10.0);
       if (tenth != last_tenth) {
         last_tenth = tenth;
@@ -174,6 +176,7 @@ nlohmann::json ComparisonRunner::identify(const std::string& method) {
   const Scene& base = msm != model_scenes_.end() ? msm->second : scene_;
   const IdentificationResult r = identify_mass_spring_stiffness(
       base, mesh_, reference_.data, id_options, [&](int evaluation, double objective, double best) {
+        if (options_.check_interrupt) options_.check_interrupt();
         if (!options_.quiet)
           out_ << "[identify " << method << "] evaluation " << evaluation << ": objective " << shown(objective, 4)
                << " (best " << shown(best, 4) << ")\n" << std::flush;
@@ -190,6 +193,7 @@ Scene ComparisonRunner::identify_model(const std::string& key) {
   const ModelIdentification id = identify_comparison_model(
       key, scene_, comparison::is_volumetric_model(key) ? mesh_ : nullptr, reference_.data,
       options_.identify_stiffness, [&](const std::string& line) {
+        if (options_.check_interrupt) options_.check_interrupt();
         if (!options_.quiet) out_ << "[compare] " << key << ": " << line << "\n" << std::flush;
       });
   nlohmann::json layers = nlohmann::json::array();

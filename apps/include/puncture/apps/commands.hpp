@@ -214,6 +214,9 @@ struct CompareOptions {
   /// (not when it comes from the cache) with the tip depth (m) and the share
   /// of its trajectory done; may throw to stop (the Python module's Ctrl-C).
   std::function<void(double depth_m, double fraction_done)> fem_step;
+  /// Called every 5 % of each model run and after every identification run;
+  /// may throw to stop (nothing is written): the Python module's Ctrl-C.
+  std::function<void()> model_step;
 };
 
 /// `puncture compare`: every comparison model and the real-time model on the

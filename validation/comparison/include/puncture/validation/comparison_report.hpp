@@ -32,6 +32,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -81,6 +82,10 @@ struct ComparisonReportOptions {
   int frames = 20;                ///< ParaView frames per model over the trajectory (0: none)
   bool write_vtk = true;          ///< mesh.vtu, frames, comparison.pvd
   bool quiet = false;             ///< no progress lines on `out`
+  /// Called every 5 % of each model run and after every run of an
+  /// identification; may throw to stop the comparison (nothing is written).
+  /// The Python module's Ctrl-C.
+  std::function<void()> check_interrupt;
   std::filesystem::path output_dir;
   std::filesystem::path weights_path;  ///< recorded in comparison_summary.json
   std::string command_line;            ///< provenance of every file and comparison.md
