@@ -346,7 +346,7 @@ class FrameDriver {
       screenshot_taken_ = true;
     }
     view_.render(channels_.snapshots.front(), status_, final_frame_);
-    statistics_.add_frame(start, monotonic_now_s());
+    statistics_.add(start, monotonic_now_s());
     return !loop_.finished() && !interrupted;
   }
 
@@ -435,12 +435,12 @@ void print_summary(const Options& o, const nlohmann::json& stats, const HapticLo
   const HapticLoopCounters& c = loop.counters();
   const nlohmann::json& h = stats["haptic"];
   std::cout << std::fixed << std::setprecision(1) << "[app] haptic " << h["achieved_rate_Hz"].get<double>()
-            << " Hz over " << st.ticks << " ticks; period p50 " << h["tick_period_us"]["p50"].get<double>()
+            << " Hz over " << st.count << " ticks; period p50 " << h["tick_period_us"]["p50"].get<double>()
             << " us, p99 " << h["tick_period_us"]["p99"].get<double>() << " us, max "
             << h["tick_period_us"]["max"].get<double>() << " us; compute p50 "
             << h["tick_compute_us"]["p50"].get<double>() << " us, p99 " << h["tick_compute_us"]["p99"].get<double>()
             << " us; missed deadlines " << st.missed_deadlines << "; " << loop.scheduling() << "\n";
-  std::cout << "[app] view " << view.achieved_fps() << " fps over " << view.frames << " frames\n";
+  std::cout << "[app] view " << view.achieved_rate_Hz() << " fps over " << view.count << " frames\n";
   std::cout << "[app] guard: magnitude clamped " << c.magnitude_clamped << " ticks, rate clamped " << c.rate_clamped
             << " ticks\n";
   if (!o.record.empty()) std::cout << "[app] recorded " << end.recorded_ticks << " ticks to " << o.record << "\n";

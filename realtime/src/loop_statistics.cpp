@@ -51,20 +51,24 @@ std::int64_t DurationHistogram::count_above(double threshold_s) const {
   return n;
 }
 
-void LoopStatistics::add_tick(double start_s, double end_s, double deadline_s) noexcept {
-  if (ticks == 0)
+void PeriodicTiming::add(double start_s, double end_s) noexcept {
+  if (count == 0)
     first_start_s = start_s;
   else
     period.add(start_s - last_start_s);
   last_start_s = start_s;
-  compute.add(end_s - start_s);
-  if (end_s > deadline_s) ++missed_deadlines;
-  ++ticks;
+  work.add(end_s - start_s);
+  ++count;
 }
 
-double LoopStatistics::achieved_rate_Hz() const {
-  if (ticks < 2 || !(last_start_s > first_start_s)) return 0.0;
-  return static_cast<double>(ticks - 1) / (last_start_s - first_start_s);
+double PeriodicTiming::achieved_rate_Hz() const {
+  if (count < 2 || !(last_start_s > first_start_s)) return 0.0;
+  return static_cast<double>(count - 1) / (last_start_s - first_start_s);
+}
+
+void LoopStatistics::add_tick(double start_s, double end_s, double deadline_s) noexcept {
+  add(start_s, end_s);
+  if (end_s > deadline_s) ++missed_deadlines;
 }
 
 }  // namespace puncture::realtime

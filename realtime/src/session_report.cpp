@@ -4,27 +4,13 @@
 
 namespace puncture::realtime {
 
-void ViewStatistics::add_frame(double start_s, double end_s) {
-  if (frames == 0)
-    first_s = start_s;
-  else
-    frame_period.add(start_s - last_s);
-  last_s = start_s;
-  render.add(end_s - start_s);
-  ++frames;
-}
-
-double ViewStatistics::achieved_fps() const {
-  return frames >= 2 && last_s > first_s ? static_cast<double>(frames - 1) / (last_s - first_s) : 0.0;
-}
-
 nlohmann::json haptic_statistics_json(const LoopStatistics& s, double target_rate_Hz) {
   auto us = [](double seconds) { return seconds * 1e6; };
   const double rate = s.achieved_rate_Hz();
   return {{"target_rate_Hz", target_rate_Hz},
           {"achieved_rate_Hz", rate},
           {"rate_error_percent", target_rate_Hz > 0 ? 100.0 * (rate - target_rate_Hz) / target_rate_Hz : 0.0},
-          {"ticks", s.ticks},
+          {"ticks", s.count},
           {"duration_s", s.last_start_s - s.first_start_s},
           {"tick_period_us",
            {{"p50", us(s.period.quantile_s(0.5))},
@@ -34,10 +20,10 @@ nlohmann::json haptic_statistics_json(const LoopStatistics& s, double target_rat
             {"min", us(s.period.min_s())},
             {"mean", us(s.period.mean_s())}}},
           {"tick_compute_us",
-           {{"p50", us(s.compute.quantile_s(0.5))},
-            {"p99", us(s.compute.quantile_s(0.99))},
-            {"max", us(s.compute.max_s())},
-            {"mean", us(s.compute.mean_s())}}},
+           {{"p50", us(s.work.quantile_s(0.5))},
+            {"p99", us(s.work.quantile_s(0.99))},
+            {"max", us(s.work.max_s())},
+            {"mean", us(s.work.mean_s())}}},
           {"missed_deadlines", s.missed_deadlines},
           {"skipped_periods", s.skipped_periods},
           {"histogram_bin_us", us(s.period.bin_s())}};
@@ -46,16 +32,16 @@ nlohmann::json haptic_statistics_json(const LoopStatistics& s, double target_rat
 nlohmann::json view_statistics_json(const ViewStatistics& s, double target_fps) {
   auto ms = [](double seconds) { return seconds * 1e3; };
   return {{"target_fps", target_fps},
-          {"frames", s.frames},
-          {"achieved_fps", s.achieved_fps()},
+          {"frames", s.count},
+          {"achieved_fps", s.achieved_rate_Hz()},
           {"frame_period_ms",
-           {{"p50", ms(s.frame_period.quantile_s(0.5))},
-            {"p99", ms(s.frame_period.quantile_s(0.99))},
-            {"max", ms(s.frame_period.max_s())}}},
+           {{"p50", ms(s.period.quantile_s(0.5))},
+            {"p99", ms(s.period.quantile_s(0.99))},
+            {"max", ms(s.period.max_s())}}},
           {"render_ms",
-           {{"p50", ms(s.render.quantile_s(0.5))},
-            {"p99", ms(s.render.quantile_s(0.99))},
-            {"max", ms(s.render.max_s())}}}};
+           {{"p50", ms(s.work.quantile_s(0.5))},
+            {"p99", ms(s.work.quantile_s(0.99))},
+            {"max", ms(s.work.max_s())}}}};
 }
 
 nlohmann::json load_average_json() {

@@ -160,7 +160,7 @@ TEST(HapticLoop, PacedRunReportsItsTicks) {
   loop.join();
   EXPECT_TRUE(loop.finished());
   EXPECT_TRUE(loop.error().empty()) << loop.error();
-  EXPECT_EQ(loop.statistics().ticks, 300);
+  EXPECT_EQ(loop.statistics().count, 300);
   EXPECT_EQ(loop.statistics().period.count(), 299);
   EXPECT_EQ(loop.counters().model_ticks, 300);
   EXPECT_GT(loop.statistics().achieved_rate_Hz(), 0.0);

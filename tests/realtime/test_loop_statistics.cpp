@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "puncture/realtime/loop_statistics.hpp"
+#include "puncture/realtime/session_report.hpp"
 
 namespace puncture::realtime {
 namespace {
@@ -55,13 +56,28 @@ TEST(LoopStatistics, CountsMissedDeadlinesAndRate) {
     const double end = start + ((n == 100 || n == 500) ? 1.2e-3 : 10e-6);
     s.add_tick(start, end, start + T);
   }
-  EXPECT_EQ(s.ticks, 1001);
+  EXPECT_EQ(s.count, 1001);
   EXPECT_EQ(s.missed_deadlines, 2);
   EXPECT_NEAR(s.achieved_rate_Hz(), 1000.0, 1e-6);
   EXPECT_EQ(s.period.count(), 1000);
   EXPECT_NEAR(s.period.quantile_s(0.5), T, s.period.bin_s());
-  EXPECT_NEAR(s.compute.quantile_s(0.99), 10e-6, s.compute.bin_s());
-  EXPECT_NEAR(s.compute.max_s(), 1.2e-3, 1e-12);
+  EXPECT_NEAR(s.work.quantile_s(0.99), 10e-6, s.work.bin_s());
+  EXPECT_NEAR(s.work.max_s(), 1.2e-3, 1e-12);
+}
+
+TEST(ViewStatistics, FramesAtSixtyHertzGiveTheirRateAndRenderTimesInTheReport) {
+  ViewStatistics v;
+  // 121 frames 1/60 s apart, each rendered in 4 ms but the last in 30 ms.
+  for (int n = 0; n <= 120; ++n) {
+    const double start = 2.0 + n / 60.0;
+    v.add(start, start + (n == 120 ? 30e-3 : 4e-3));
+  }
+  const nlohmann::json j = view_statistics_json(v, 60.0);
+  EXPECT_EQ(j.at("frames").get<std::int64_t>(), 121);
+  EXPECT_NEAR(j.at("achieved_fps").get<double>(), 60.0, 1e-9);
+  EXPECT_NEAR(j.at("frame_period_ms").at("p50").get<double>(), 1e3 / 60.0, 1.01e-2);  // a quantile is its bin's upper edge (10 us)
+  EXPECT_NEAR(j.at("render_ms").at("p50").get<double>(), 4.0, 1.01e-2);
+  EXPECT_NEAR(j.at("render_ms").at("max").get<double>(), 30.0, 1e-9);
 }
 
 }  // namespace

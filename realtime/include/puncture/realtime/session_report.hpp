@@ -12,14 +12,9 @@
 
 namespace puncture::realtime {
 
-struct ViewStatistics {
-  ViewStatistics() : frame_period(10e-6, 1.0), render(10e-6, 1.0) {}
-  DurationHistogram frame_period;  ///< start-to-start interval between frames (s)
-  DurationHistogram render;        ///< time to update and render one frame (s)
-  std::int64_t frames = 0;
-  double first_s = 0.0, last_s = 0.0;
-  void add_frame(double start_s, double end_s);
-  double achieved_fps() const;
+/// The view's frames (work: update and render one frame), binned at 10 us up to 1 s.
+struct ViewStatistics : PeriodicTiming {
+  ViewStatistics() : PeriodicTiming(10e-6, 1.0) {}
 };
 
 nlohmann::json haptic_statistics_json(const LoopStatistics& stats, double target_rate_Hz);
