@@ -20,7 +20,7 @@
 #include "puncture/scene_limits.hpp"
 #include "puncture/validation/plausibility.hpp"
 #ifdef PUNCTURE_HAVE_VTK  // frames are VTK files
-#include "puncture/io/realtime_frames.hpp"
+#include "puncture/vtk_io/realtime_frames.hpp"
 #endif
 
 namespace puncture::apps {

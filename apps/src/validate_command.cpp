@@ -55,7 +55,7 @@
 #include "puncture/validation/number_format.hpp"
 #include "puncture/validation/validation_cases.hpp"
 #ifdef PUNCTURE_HAVE_VTK  // frames are VTK files
-#include "puncture/io/realtime_frames.hpp"
+#include "puncture/vtk_io/realtime_frames.hpp"
 #endif
 #include "validate_recordings.hpp"
 

@@ -1,5 +1,5 @@
 // bench_comparison_step.cpp: cost of one haptic step of every comparison
-// model of `puncture compare` (core/comparison) against its resolution, on the
+// model of `puncture compare` (core/models) against its resolution, on the
 // default scene (scenes/default.json) while the needle presses the skin.
 //
 // BM_comparison_step/<model>/<resolution>:
@@ -77,12 +77,12 @@ Scene scene_with_diameter(double diameter_mm) {
   return scene;
 }
 
-std::shared_ptr<const comparison::TetMesh> mesh_for(double diameter_mm) {
-  static std::map<double, std::shared_ptr<const comparison::TetMesh>> cache;
+std::shared_ptr<const meshing::TetMesh> mesh_for(double diameter_mm) {
+  static std::map<double, std::shared_ptr<const meshing::TetMesh>> cache;
   auto it = cache.find(diameter_mm);
   if (it == cache.end()) {
     const Scene scene = scene_with_diameter(diameter_mm);
-    it = cache.emplace(diameter_mm, std::make_shared<const comparison::TetMesh>(meshing::build_tet_slab_mesh(
+    it = cache.emplace(diameter_mm, std::make_shared<const meshing::TetMesh>(meshing::build_tet_slab_mesh(
                                         scene, meshing::tet_slab_mesh_options(scene))))
              .first;
   }
@@ -146,7 +146,7 @@ void BM_build_tet_mesh(benchmark::State& state, double factor, double diameter_m
   meshing::TetSlabMeshOptions options = meshing::tet_slab_mesh_options(scene);
   options.size_at_axis_m *= factor;
   options.size_far_m *= factor;
-  comparison::TetMesh mesh;
+  meshing::TetMesh mesh;
   for (auto _ : state) mesh = meshing::build_tet_slab_mesh(scene, options);
   state.counters["vertices"] = mesh.node_count();
   // Where the vertices are: near the needle column, within 5 mm of the axis, on the sample's side.

@@ -3,7 +3,7 @@
 // earlier files survive a failed run and are replaced by a committed one.
 #include <puncture/io/output_session.hpp>
 #include <puncture/io/csv_table.hpp>
-#include <puncture/io/vtk_polydata.hpp>
+#include <puncture/vtk_io/vtk_polydata.hpp>
 
 #include "test_io_common.hpp"
 

@@ -2,7 +2,7 @@
 // with VTK's XML parser (vtkXMLUtilities).
 #include <puncture/io/output_session.hpp>
 #include <puncture/io/pvd.hpp>
-#include <puncture/io/vtk_polydata.hpp>
+#include <puncture/vtk_io/vtk_polydata.hpp>
 
 #include "test_io_common.hpp"
 

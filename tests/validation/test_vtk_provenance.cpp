@@ -18,7 +18,7 @@
 
 #include "puncture/io/output_session.hpp"
 #include "puncture/io/pvd.hpp"
-#include "puncture/io/vtk_polydata.hpp"
+#include "puncture/vtk_io/vtk_polydata.hpp"
 #include "puncture/io/vtk_xml_field_data.hpp"
 #include "test_io_common.hpp"
 

@@ -12,7 +12,7 @@
 #include <vtkXMLUnstructuredGridReader.h>
 
 #include "puncture/io/output_session.hpp"
-#include "puncture/io/vtk_unstructured.hpp"
+#include "puncture/vtk_io/vtk_unstructured.hpp"
 
 namespace puncture::io {
 namespace {

@@ -350,7 +350,7 @@ struct ComparisonMeshSettings {
   double grading = 0.5;            ///< growth of the size per metre of distance from the needle radius
 };
 
-/// Settings of the comparison models of `puncture compare` (core/comparison):
+/// Settings of the comparison models of `puncture compare` (core/models):
 /// volumetric mass-spring, tensor-mass (linear, StVK, visco-elastic), BEM, SHF.
 struct ComparisonSettings {
   ComparisonMeshSettings mesh;

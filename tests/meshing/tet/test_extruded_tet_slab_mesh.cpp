@@ -33,7 +33,7 @@ constexpr double kPi = 3.14159265358979323846;
 double polygon_area(int n, double r) { return 0.5 * n * r * r * std::sin(2.0 * kPi / n); }
 
 /// Vertices of the mesh on the plane z at radius r (relative tolerance 1e-9).
-int nodes_at_radius(const comparison::TetMesh& mesh, double z, double r) {
+int nodes_at_radius(const meshing::TetMesh& mesh, double z, double r) {
   int count = 0;
   for (int a = 0; a < mesh.node_count(); ++a) {
     const Eigen::Vector3d p = mesh.points_m.col(a);
@@ -47,7 +47,7 @@ class ExtrudedDefaultMesh : public ::testing::Test {
   static void SetUpTestSuite() {
     scene_ = new Scene(testing::default_scene());
     report_ = new ExtrudedSlabMeshReport;
-    mesh_ = new comparison::TetMesh(
+    mesh_ = new meshing::TetMesh(
         build_extruded_tet_slab_mesh(*scene_, extruded_slab_mesh_options(*scene_), report_));
   }
   static void TearDownTestSuite() {
@@ -56,11 +56,11 @@ class ExtrudedDefaultMesh : public ::testing::Test {
     delete scene_;
   }
   static Scene* scene_;
-  static comparison::TetMesh* mesh_;
+  static meshing::TetMesh* mesh_;
   static ExtrudedSlabMeshReport* report_;
 };
 Scene* ExtrudedDefaultMesh::scene_ = nullptr;
-comparison::TetMesh* ExtrudedDefaultMesh::mesh_ = nullptr;
+meshing::TetMesh* ExtrudedDefaultMesh::mesh_ = nullptr;
 ExtrudedSlabMeshReport* ExtrudedDefaultMesh::report_ = nullptr;
 
 TEST_F(ExtrudedDefaultMesh, LayerAndNeedleColumnVolumesAreThoseOfTheExtrudedPolygons) {
@@ -70,12 +70,12 @@ TEST_F(ExtrudedDefaultMesh, LayerAndNeedleColumnVolumesAreThoseOfTheExtrudedPoly
   const int needle_rim_nodes = nodes_at_radius(*mesh_, 0.0, a);
   ASSERT_GE(rim_nodes, 12);
   ASSERT_GE(needle_rim_nodes, 12);
-  const std::vector<double> volume = comparison::layer_volumes_m3(*mesh_, 3);
+  const std::vector<double> volume = meshing::layer_volumes_m3(*mesh_, 3);
   std::vector<double> column(3, 0.0);
   for (std::size_t t = 0; t < mesh_->tets.size(); ++t) {
     if (!mesh_->needle_column[t]) continue;
     const Eigen::Vector4i& v = mesh_->tets[t];
-    column[static_cast<std::size_t>(mesh_->layer[t])] += comparison::tet_signed_volume(
+    column[static_cast<std::size_t>(mesh_->layer[t])] += meshing::tet_signed_volume(
         mesh_->points_m.col(v[0]), mesh_->points_m.col(v[1]), mesh_->points_m.col(v[2]), mesh_->points_m.col(v[3]));
   }
   for (std::size_t k = 0; k < 3; ++k) {
@@ -135,8 +135,8 @@ TEST(ExtrudedTetSlabMesh, VertexCountFollowsTheSizesAndTheMeshIsRepeatable) {
   const Scene scene = testing::default_scene();
   ExtrudedSlabMeshOptions options = extruded_slab_mesh_options(scene);
   ExtrudedSlabMeshReport coarse, fine;
-  const comparison::TetMesh a = build_extruded_tet_slab_mesh(scene, options, &coarse);
-  const comparison::TetMesh b = build_extruded_tet_slab_mesh(scene, options);
+  const meshing::TetMesh a = build_extruded_tet_slab_mesh(scene, options, &coarse);
+  const meshing::TetMesh b = build_extruded_tet_slab_mesh(scene, options);
   EXPECT_EQ((a.points_m - b.points_m).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_TRUE(a.tets == b.tets);
   EXPECT_EQ(coarse.vertices, coarse.plan_nodes * coarse.levels);
@@ -162,7 +162,7 @@ TEST(ComparisonTetMesh, TheSceneChoosesTheMesher) {
   Scene scene = testing::small_slab_scene();
   ComparisonTetMeshReport report;
   EXPECT_EQ(scene.comparison.mesh.kind, "extruded");
-  const comparison::TetMesh extruded = build_comparison_tet_mesh(scene, &report);
+  const meshing::TetMesh extruded = build_comparison_tet_mesh(scene, &report);
   EXPECT_EQ(report.kind, "extruded");
   EXPECT_EQ(report.vertices, extruded.node_count());
   scene.comparison.mesh.kind = "delaunay";
@@ -182,7 +182,7 @@ TEST(ExtrudedTetSlabMesh, LinearTensorMassIndentationConvergesToTheLayeredHalfSp
   double previous = 0.0;
   for (double size : {0.3e-3, 0.2e-3}) {
     const Scene s = testing::single_layer_scene(0.3, size);
-    const auto mesh = std::make_shared<comparison::TetMesh>(build_comparison_tet_mesh(s));
+    const auto mesh = std::make_shared<meshing::TetMesh>(build_comparison_tet_mesh(s));
     auto model = comparison::make_comparison_model("mass_tensor", s, mesh);
     const ScriptedTrajectory trajectory(s.insertion);
     const double until = s.insertion.target_depth_m / s.insertion.speed_m_per_s;

@@ -37,7 +37,7 @@ TEST(ModelIdentificationVolumetric, TheJointFitRunsWhereTheLayersShareTheForce) 
   scene.comparison.mesh.size_at_axis_m = 0.8e-3;
   scene.comparison.mesh.size_far_m = 3e-3;
   const auto mesh =
-      std::make_shared<comparison::TetMesh>(meshing::build_tet_slab_mesh(scene, meshing::tet_slab_mesh_options(scene)));
+      std::make_shared<meshing::TetMesh>(meshing::build_tet_slab_mesh(scene, meshing::tet_slab_mesh_options(scene)));
   Scene truth = scene;
   truth.comparison.stiffness_scale = {2.0, 0.5, 1.0};
   auto model = comparison::make_comparison_model("msm", truth, mesh);

@@ -28,7 +28,7 @@ class DefaultSceneMesh : public ::testing::Test {
     options.size_far_m = 8e-3;
     options.grading = 0.5;
     report_ = new TetSlabMeshReport;
-    mesh_ = new comparison::TetMesh(build_tet_slab_mesh(*scene_, options, report_));
+    mesh_ = new meshing::TetMesh(build_tet_slab_mesh(*scene_, options, report_));
   }
   static void TearDownTestSuite() {
     delete mesh_;
@@ -36,16 +36,16 @@ class DefaultSceneMesh : public ::testing::Test {
     delete scene_;
   }
   static Scene* scene_;
-  static comparison::TetMesh* mesh_;
+  static meshing::TetMesh* mesh_;
   static TetSlabMeshReport* report_;
 };
 Scene* DefaultSceneMesh::scene_ = nullptr;
-comparison::TetMesh* DefaultSceneMesh::mesh_ = nullptr;
+meshing::TetMesh* DefaultSceneMesh::mesh_ = nullptr;
 TetSlabMeshReport* DefaultSceneMesh::report_ = nullptr;
 
 TEST_F(DefaultSceneMesh, LayerVolumesWithinOnePercentOfTheCylinders) {
   const double R = 0.5 * scene_->sample.diameter_m;
-  const std::vector<double> volume = comparison::layer_volumes_m3(*mesh_, 3);
+  const std::vector<double> volume = meshing::layer_volumes_m3(*mesh_, 3);
   for (std::size_t k = 0; k < 3; ++k) {
     const double exact = kPi * R * R * scene_->layers[k].thickness_m;
     EXPECT_NEAR(volume[k], exact, 0.01 * exact) << scene_->layers[k].name;
@@ -57,7 +57,7 @@ TEST_F(DefaultSceneMesh, LayerVolumesWithinOnePercentOfTheCylinders) {
   for (std::size_t t = 0; t < mesh_->tets.size(); ++t) {
     if (!mesh_->needle_column[t]) continue;
     const Eigen::Vector4i& v = mesh_->tets[t];
-    column[static_cast<std::size_t>(mesh_->layer[t])] += comparison::tet_signed_volume(
+    column[static_cast<std::size_t>(mesh_->layer[t])] += meshing::tet_signed_volume(
         mesh_->points_m.col(v[0]), mesh_->points_m.col(v[1]), mesh_->points_m.col(v[2]), mesh_->points_m.col(v[3]));
   }
   for (std::size_t k = 0; k < 3; ++k) {
@@ -91,8 +91,8 @@ TEST_F(DefaultSceneMesh, TetrahedraTileTheSlabWithoutHoles) {
 }
 
 TEST_F(DefaultSceneMesh, QualityBoundsHold) {
-  const comparison::TetQuality& q = report_->quality;
-  EXPECT_GT(q.min_dihedral_deg, 1.0) << comparison::describe(q);
+  const meshing::TetQuality& q = report_->quality;
+  EXPECT_GT(q.min_dihedral_deg, 1.0) << meshing::describe(q);
   EXPECT_LT(q.max_dihedral_deg, 178.0);
   EXPECT_LT(q.max_radius_edge_ratio, 20.0);
   EXPECT_LT(q.mean_radius_edge_ratio, 1.5);
@@ -101,10 +101,10 @@ TEST_F(DefaultSceneMesh, QualityBoundsHold) {
   EXPECT_LT(q.min_edge_m, 0.5e-3);
   EXPECT_GT(q.max_edge_m, 4e-3);
   // The independent recomputation of one element's angles: the regular tetrahedron.
-  const std::vector<double> regular = comparison::tet_dihedral_angles_deg(
+  const std::vector<double> regular = meshing::tet_dihedral_angles_deg(
       Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, -1, -1), Eigen::Vector3d(-1, 1, -1), Eigen::Vector3d(-1, -1, 1));
   for (double angle : regular) EXPECT_NEAR(angle, std::acos(1.0 / 3.0) * 180.0 / kPi, 1e-9);
-  EXPECT_NEAR(comparison::tet_radius_edge_ratio(Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, -1, -1),
+  EXPECT_NEAR(meshing::tet_radius_edge_ratio(Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, -1, -1),
                                                 Eigen::Vector3d(-1, 1, -1), Eigen::Vector3d(-1, -1, 1)),
               std::sqrt(6.0) / 4.0, 1e-12);
 }
@@ -129,18 +129,18 @@ TEST(TetSlabMesh, RepeatableAndFinerWithSmallerSizes) {
   const Scene scene = testing::small_slab_scene();
   TetSlabMeshOptions options = tet_slab_mesh_options(scene);
   ASSERT_TRUE(options.exude_slivers);
-  const comparison::TetMesh a = build_tet_slab_mesh(scene, options);
-  const comparison::TetMesh b = build_tet_slab_mesh(scene, options);
+  const meshing::TetMesh a = build_tet_slab_mesh(scene, options);
+  const meshing::TetMesh b = build_tet_slab_mesh(scene, options);
   ASSERT_EQ(a.node_count(), b.node_count());
   ASSERT_EQ(a.tets.size(), b.tets.size());
   EXPECT_EQ((a.points_m - b.points_m).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_TRUE(a.tets == b.tets);
   options.exude_slivers = false;
-  const comparison::TetMesh c = build_tet_slab_mesh(scene, options);
-  const std::vector<double> va = comparison::layer_volumes_m3(a, 3), vc = comparison::layer_volumes_m3(c, 3);
+  const meshing::TetMesh c = build_tet_slab_mesh(scene, options);
+  const std::vector<double> va = meshing::layer_volumes_m3(a, 3), vc = meshing::layer_volumes_m3(c, 3);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(vc[k], va[k], 1e-3 * va[k]);
   // Exudation raises the smallest dihedral angle and removes slivers.
-  const comparison::TetQuality qa = comparison::measure_tet_quality(a), qc = comparison::measure_tet_quality(c);
+  const meshing::TetQuality qa = meshing::measure_tet_quality(a), qc = meshing::measure_tet_quality(c);
   EXPECT_GT(qa.min_dihedral_deg, qc.min_dihedral_deg);
   EXPECT_LT(qa.tets_below_10_deg, qc.tets_below_10_deg);
   options.size_at_axis_m *= 0.6;

@@ -46,7 +46,7 @@ std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t hash) {
 /// "vertices N tetrahedra M digest H": H hashes every coordinate's bit
 /// pattern, every tetrahedron's four vertex indices in order, its layer id and
 /// its needle-column flag.
-std::string describe_mesh(const comparison::TetMesh& mesh) {
+std::string describe_mesh(const meshing::TetMesh& mesh) {
   std::uint64_t hash = 0xcbf29ce484222325ULL;
   for (Eigen::Index a = 0; a < mesh.points_m.cols(); ++a)
     for (int i = 0; i < 3; ++i) {
@@ -64,7 +64,7 @@ std::string describe_mesh(const comparison::TetMesh& mesh) {
 }
 
 /// The scene and the production options (those `puncture compare` uses).
-comparison::TetMesh production_mesh() {
+meshing::TetMesh production_mesh() {
   const Scene scene = testing::small_slab_scene();
   return build_tet_slab_mesh(scene, tet_slab_mesh_options(scene));
 }
@@ -137,7 +137,7 @@ TEST(TetSlabMeshDeterminism, DigestSeesOneUlpAndOneSwappedVertex) {
   // The comparison above is only as good as the digest: it must change when
   // one coordinate moves by one ulp or one tetrahedron lists its vertices in
   // another order. Two tetrahedra sharing the face (0, 1, 2).
-  comparison::TetMesh mesh;
+  meshing::TetMesh mesh;
   mesh.points_m.resize(3, 5);
   mesh.points_m << 0, 1e-3, 0, 0, 0,  //
       0, 0, 1e-3, 0, 0,               //
@@ -146,13 +146,13 @@ TEST(TetSlabMeshDeterminism, DigestSeesOneUlpAndOneSwappedVertex) {
   mesh.layer = {0, 1};
   mesh.needle_column = {1, 0};
   const std::string original = describe_mesh(mesh);
-  comparison::TetMesh moved = mesh;
+  meshing::TetMesh moved = mesh;
   moved.points_m(2, 3) = std::nextafter(moved.points_m(2, 3), 1.0);
   EXPECT_NE(describe_mesh(moved), original);
-  comparison::TetMesh swapped = mesh;
+  meshing::TetMesh swapped = mesh;
   std::swap(swapped.tets[1][0], swapped.tets[1][1]);
   EXPECT_NE(describe_mesh(swapped), original);
-  comparison::TetMesh relabelled = mesh;
+  meshing::TetMesh relabelled = mesh;
   relabelled.needle_column[1] = 1;
   EXPECT_NE(describe_mesh(relabelled), original);
   EXPECT_EQ(describe_mesh(mesh), original);

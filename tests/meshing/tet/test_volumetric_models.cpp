@@ -358,7 +358,7 @@ TEST(MassSpringIdentification, RecoversFactorsOfASyntheticReference) {
   mesh_options.size_at_axis_m = 0.8e-3;
   mesh_options.size_far_m = 3e-3;
   mesh_options.exude_slivers = false;
-  const auto mesh = std::make_shared<comparison::TetMesh>(meshing::build_tet_slab_mesh(scene, mesh_options));
+  const auto mesh = std::make_shared<meshing::TetMesh>(meshing::build_tet_slab_mesh(scene, mesh_options));
   const std::vector<double> truth_factors{3.0, 2.0, 1.0};
   comparison::VolumetricSettings settings = comparison::volumetric_settings(scene);
   settings.quasi_static = true;

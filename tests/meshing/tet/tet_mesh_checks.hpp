@@ -9,14 +9,14 @@
 
 #include <gtest/gtest.h>
 
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 
 namespace puncture::testing {
 
 /// Every face of the tetrahedra shared by at most two of them, and every face
 /// of one only on the slab's outer surface: the top z = 0, the base z = -H or
 /// the side r = R (within side_tolerance_m). Returns the boundary faces.
-inline int check_closed_tiling(const comparison::TetMesh& mesh, double R, double H, double side_tolerance_m,
+inline int check_closed_tiling(const meshing::TetMesh& mesh, double R, double H, double side_tolerance_m,
                                double plane_tolerance_m) {
   std::map<std::array<int, 3>, int> faces;
   static constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};

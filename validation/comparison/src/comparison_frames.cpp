@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "puncture/io/vtk_polydata.hpp"
-#include "puncture/io/vtk_unstructured.hpp"
+#include "puncture/vtk_io/vtk_polydata.hpp"
+#include "puncture/vtk_io/vtk_unstructured.hpp"
 
 namespace puncture::validation::comparison_report_detail {
 
@@ -58,7 +58,7 @@ void write_volume_frame(io::OutputSession& session, const std::string& name, con
                        {{"layer", f.layer}});
 }
 
-void write_mesh_vtu(io::OutputSession& session, const std::string& name, const comparison::TetMesh& mesh) {
+void write_mesh_vtu(io::OutputSession& session, const std::string& name, const meshing::TetMesh& mesh) {
   Eigen::MatrixX4i tets(mesh.tet_count(), 4);
   Eigen::VectorXd layer(mesh.tet_count()), column(mesh.tet_count());
   for (int t = 0; t < mesh.tet_count(); ++t) {

@@ -18,7 +18,7 @@
 #include <Eigen/Core>
 
 #include "puncture/comparison/comparison_model.hpp"
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 #include "puncture/io/output_session.hpp"
 #include "puncture/scene.hpp"
 
@@ -40,6 +40,6 @@ class DiscFrames {
 void write_volume_frame(io::OutputSession& session, const std::string& name, const comparison::ComparisonModel& model,
                         double x_offset_m);
 
-void write_mesh_vtu(io::OutputSession& session, const std::string& name, const comparison::TetMesh& mesh);
+void write_mesh_vtu(io::OutputSession& session, const std::string& name, const meshing::TetMesh& mesh);
 
 }  // namespace puncture::validation::comparison_report_detail

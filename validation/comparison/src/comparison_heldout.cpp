@@ -32,7 +32,7 @@ constexpr int kHeldOutThreads = 2;
 struct CaseSetup {
   Scene base;
   ComparisonReference reference;
-  std::shared_ptr<const comparison::TetMesh> mesh;
+  std::shared_ptr<const meshing::TetMesh> mesh;
 };
 
 CaseSetup setup_case(const ComparisonCase& c, const Scene& scene, const std::map<std::string, Scene>& model_scenes) {
@@ -41,7 +41,7 @@ CaseSetup setup_case(const ComparisonCase& c, const Scene& scene, const std::map
   setup.reference = read_comparison_reference(setup.base, c.fem.dir);
   if (std::any_of(model_scenes.begin(), model_scenes.end(),
                   [](const auto& m) { return comparison::is_volumetric_model(m.first); }))
-    setup.mesh = std::make_shared<comparison::TetMesh>(meshing::build_comparison_tet_mesh(setup.base));
+    setup.mesh = std::make_shared<meshing::TetMesh>(meshing::build_comparison_tet_mesh(setup.base));
   return setup;
 }
 

@@ -88,10 +88,10 @@ ComparisonMesh build_comparison_mesh(const Scene& scene, const ComparisonReportO
   if (!needed) return m;
   if (!options.quiet)
     out << "[compare] tetrahedral mesh of the slab (" << scene.comparison.mesh.kind << ") ...\n" << std::flush;
-  auto mesh = std::make_shared<comparison::TetMesh>(meshing::build_comparison_tet_mesh(scene, &m.report));
+  auto mesh = std::make_shared<meshing::TetMesh>(meshing::build_comparison_tet_mesh(scene, &m.report));
   if (!options.quiet)
     out << "[compare] mesh: " << m.report.vertices << " vertices, " << m.report.tetrahedra << " tetrahedra in "
-        << shown(m.report.wall_time_s) << " s; " << comparison::describe(m.report.quality) << "\n";
+        << shown(m.report.wall_time_s) << " s; " << meshing::describe(m.report.quality) << "\n";
   if (options.write_vtk) write_mesh_vtu(session, "mesh.vtu", *mesh);
   m.mesh = mesh;
   return m;
@@ -99,7 +99,7 @@ ComparisonMesh build_comparison_mesh(const Scene& scene, const ComparisonReportO
 
 ComparisonRunner::ComparisonRunner(const Scene& scene, const ComparisonReportOptions& options,
                                    const ComparisonReference& reference,
-                                   std::shared_ptr<const comparison::TetMesh> mesh, io::OutputSession& session,
+                                   std::shared_ptr<const meshing::TetMesh> mesh, io::OutputSession& session,
                                    std::ostream& out, std::ostream& err)
     : scene_(scene), options_(options), reference_(reference), mesh_(std::move(mesh)), session_(session), out_(out),
       err_(err), discs_(scene) {

@@ -30,7 +30,7 @@
 #include <nlohmann/json.hpp>
 
 #include "comparison_frames.hpp"
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 #include "puncture/io/output_session.hpp"
 #include "puncture/io/pvd.hpp"
 #include "puncture/meshing/comparison_tet_slab_mesh.hpp"
@@ -49,7 +49,7 @@ struct ComparisonReference {
 ComparisonReference read_comparison_reference(const Scene& scene, const std::filesystem::path& fem_dir);
 
 struct ComparisonMesh {
-  std::shared_ptr<const comparison::TetMesh> mesh;  ///< null: no model needs one
+  std::shared_ptr<const meshing::TetMesh> mesh;  ///< null: no model needs one
   meshing::ComparisonTetMeshReport report;
 };
 ComparisonMesh build_comparison_mesh(const Scene& scene, const ComparisonReportOptions& options,
@@ -58,7 +58,7 @@ ComparisonMesh build_comparison_mesh(const Scene& scene, const ComparisonReportO
 class ComparisonRunner {
  public:
   ComparisonRunner(const Scene& scene, const ComparisonReportOptions& options, const ComparisonReference& reference,
-                   std::shared_ptr<const comparison::TetMesh> mesh, io::OutputSession& session, std::ostream& out,
+                   std::shared_ptr<const meshing::TetMesh> mesh, io::OutputSession& session, std::ostream& out,
                    std::ostream& err);
   /// Builds the model `factory_name` on model_scene and runs it as row `key`.
   void run(const std::string& key, const Scene& model_scene, const std::string& factory_name);
@@ -82,7 +82,7 @@ class ComparisonRunner {
   const Scene& scene_;
   const ComparisonReportOptions& options_;
   const ComparisonReference& reference_;
-  std::shared_ptr<const comparison::TetMesh> mesh_;
+  std::shared_ptr<const meshing::TetMesh> mesh_;
   io::OutputSession& session_;
   std::ostream& out_;
   std::ostream& err_;

@@ -6,7 +6,7 @@
 #include <map>
 #include <sstream>
 
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 #include "puncture/validation/number_format.hpp"
 
 namespace puncture::validation::comparison_report_detail {
@@ -37,7 +37,7 @@ void markdown_header(std::ostringstream& md, const ComparisonContent& c) {
   if (c.mesh.mesh)
     md << "Tetrahedral mesh (" << c.mesh.report.kind << ": " << c.mesh.report.description
        << "): " << c.mesh.report.vertices << " vertices, " << c.mesh.report.tetrahedra
-       << " tetrahedra; " << comparison::describe(c.mesh.report.quality) << ".\n\n";
+       << " tetrahedra; " << meshing::describe(c.mesh.report.quality) << ".\n\n";
 }
 
 /// The inverted-tetrahedra cell: "n/a" without a tetrahedral mesh, "0 (J >=

@@ -21,7 +21,7 @@ namespace puncture::validation {
 namespace {
 
 /// The quasi-static mass-spring curve of the insertion, sampled every step_m.
-ModelRun quasi_static_run(const Scene& scene, std::shared_ptr<const comparison::TetMesh> mesh,
+ModelRun quasi_static_run(const Scene& scene, std::shared_ptr<const meshing::TetMesh> mesh,
                           const std::vector<double>& scale, double deepest_m, double step_m) {
   comparison::VolumetricSettings settings = comparison::volumetric_settings(scene);
   settings.quasi_static = true;
@@ -63,7 +63,7 @@ double deepest_insertion_depth(const InsertionCurve& curve) {
 
 struct SearchState {
   const Scene* scene;
-  std::shared_ptr<const comparison::TetMesh> mesh;
+  std::shared_ptr<const meshing::TetMesh> mesh;
   const ReferenceData* reference;
   const IdentificationOptions* options;
   std::vector<double> log_start;
@@ -120,7 +120,7 @@ double siman_distance(void* a, void* b) {
 
 }  // namespace
 
-IdentificationEvaluation evaluate_mass_spring(const Scene& scene, std::shared_ptr<const comparison::TetMesh> mesh,
+IdentificationEvaluation evaluate_mass_spring(const Scene& scene, std::shared_ptr<const meshing::TetMesh> mesh,
                                              const ReferenceData& reference, const std::vector<double>& scale,
                                              const IdentificationOptions& options,
                                              std::vector<LayerPunctureComparison>* punctures) {
@@ -212,7 +212,7 @@ void run_evolution_strategy(SearchState& state, const IdentificationOptions& opt
 
 }  // namespace
 
-IdentificationResult identify_mass_spring_stiffness(const Scene& scene, std::shared_ptr<const comparison::TetMesh> mesh,
+IdentificationResult identify_mass_spring_stiffness(const Scene& scene, std::shared_ptr<const meshing::TetMesh> mesh,
                                                     const ReferenceData& reference, const IdentificationOptions& options,
                                                     const IdentificationProgress& progress) {
   if (options.method != "simulated_annealing" && options.method != "isres")

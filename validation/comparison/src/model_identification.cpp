@@ -36,7 +36,7 @@ void set_critical_force(Scene& scene, std::size_t layer, double force_N) {
 }
 
 /// The model on `scene` until `until_s` (layer k's rule: never breaks).
-ModelRun run_until(const std::string& model, const Scene& scene, std::shared_ptr<const comparison::TetMesh> mesh,
+ModelRun run_until(const std::string& model, const Scene& scene, std::shared_ptr<const meshing::TetMesh> mesh,
                    double until_s) {
   std::unique_ptr<comparison::ComparisonModel> m =
       comparison::make_comparison_model(model, scene, comparison::is_volumetric_model(model) ? mesh : nullptr);
@@ -161,7 +161,7 @@ LevenbergMarquardtOptions factor_fit_options(int max_evaluations) {
 /// the modulus from run A, then Levenberg-Marquardt on ln s_k with the full
 /// model (levenberg_marquardt.hpp). Books the runs and the window's RMSE.
 double identified_scale(const std::string& model, const Scene& trial, std::size_t k,
-                        std::shared_ptr<const comparison::TetMesh> mesh, double until_s, const ModelRun& run_a,
+                        std::shared_ptr<const meshing::TetMesh> mesh, double until_s, const ModelRun& run_a,
                         const Window& w, LayerIdentification& layer, int& runs,
                         const IdentificationStepProgress& progress) {
   std::vector<double> r;
@@ -221,7 +221,7 @@ constexpr double kJointCouplingTolerance = 0.01;
 /// factors when the fit does not lower the cost. Returns the note for the report.
 std::string joint_refinement(const std::string& model, const Scene& trial, const std::vector<std::size_t>& fitted,
                              const std::vector<Window>& windows, double own_cost,
-                             std::shared_ptr<const comparison::TetMesh> mesh, double until_s,
+                             std::shared_ptr<const meshing::TetMesh> mesh, double until_s,
                              std::vector<double>& scale, std::vector<double>& rmse_after_N, int& runs,
                              const IdentificationStepProgress& progress) {
   std::mutex progress_mutex;
@@ -301,7 +301,7 @@ namespace {
 // jointly: a layer's factor also shapes the force while the layers above it
 // are pressed (a volumetric model's skin rests on its fat), which the
 // bottom-up pass, each layer on its own window, cannot weigh.
-void refine_factors_jointly(const std::string& model, const std::shared_ptr<const comparison::TetMesh>& mesh,
+void refine_factors_jointly(const std::string& model, const std::shared_ptr<const meshing::TetMesh>& mesh,
                             const std::vector<double>& depths_m, const std::vector<double>& until_s,
                             const std::vector<std::size_t>& fitted, const std::vector<Window>& fitted_windows,
                             Scene& trial, ModelIdentification& result, const IdentificationStepProgress& progress) {
@@ -325,7 +325,7 @@ void refine_factors_jointly(const std::string& model, const std::shared_ptr<cons
 // The critical forces, top down, with the final factors: layer k's force
 // where the reference breaks it, the layers above broken there too (as their
 // own critical forces then do).
-void identify_critical_forces(const std::string& model, const std::shared_ptr<const comparison::TetMesh>& mesh,
+void identify_critical_forces(const std::string& model, const std::shared_ptr<const meshing::TetMesh>& mesh,
                               const std::vector<double>& depths_m, const std::vector<double>& until_s, Scene& trial,
                               ModelIdentification& result, const IdentificationStepProgress& progress) {
   for (std::size_t k = 0; k < depths_m.size(); ++k) {
@@ -354,7 +354,7 @@ void identify_critical_forces(const std::string& model, const std::shared_ptr<co
 }  // namespace
 
 ModelIdentification identify_comparison_model(const std::string& model, const Scene& scene,
-                                              std::shared_ptr<const comparison::TetMesh> mesh,
+                                              std::shared_ptr<const meshing::TetMesh> mesh,
                                               const ReferenceData& reference, bool identify_stiffness,
                                               const IdentificationStepProgress& progress) {
   const auto start = std::chrono::steady_clock::now();

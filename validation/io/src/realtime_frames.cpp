@@ -1,10 +1,10 @@
-#include "puncture/io/realtime_frames.hpp"
+#include "puncture/vtk_io/realtime_frames.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <utility>
 
-#include "puncture/io/vtk_polydata.hpp"
+#include "puncture/vtk_io/vtk_polydata.hpp"
 #include "puncture/model/force_mesh_field.hpp"
 
 namespace puncture::io {

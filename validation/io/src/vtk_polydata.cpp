@@ -1,4 +1,4 @@
-#include <puncture/io/vtk_polydata.hpp>
+#include <puncture/vtk_io/vtk_polydata.hpp>
 
 #include <puncture/io/output_session.hpp>
 #include <puncture/io/vtk_xml_field_data.hpp>

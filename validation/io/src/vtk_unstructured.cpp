@@ -1,4 +1,4 @@
-#include <puncture/io/vtk_unstructured.hpp>
+#include <puncture/vtk_io/vtk_unstructured.hpp>
 
 #include <puncture/io/output_session.hpp>
 

@@ -12,7 +12,7 @@
 
 #include <string>
 
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 #include "puncture/scene.hpp"
 
 namespace puncture::meshing {
@@ -23,9 +23,9 @@ struct ComparisonTetMeshReport {
   double wall_time_s = 0.0;
   int vertices = 0;
   int tetrahedra = 0;
-  comparison::TetQuality quality;
+  meshing::TetQuality quality;
 };
 
-comparison::TetMesh build_comparison_tet_mesh(const Scene& scene, ComparisonTetMeshReport* report = nullptr);
+meshing::TetMesh build_comparison_tet_mesh(const Scene& scene, ComparisonTetMeshReport* report = nullptr);
 
 }  // namespace puncture::meshing

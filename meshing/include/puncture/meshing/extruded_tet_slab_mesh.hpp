@@ -1,7 +1,7 @@
 // extruded_tet_slab_mesh.hpp: a tetrahedral mesh of the layered cylindrical
 // slab built as a plan triangulation of the disc extruded through the layers
 // (every prism split into three tetrahedra), for the comparison models of
-// core/comparison. No CGAL: the mesh is a pure function of the scene and the
+// core/models. No CGAL: the mesh is a pure function of the scene and the
 // options (the same numbers in every run and on every machine), and its
 // vertex count follows the mesh sizes, also in the thin skin (the Delaunay
 // mesher of tet_slab_mesh.hpp fills a 0.8 mm skin across a 60 mm disc with
@@ -10,7 +10,7 @@
 // In:  a Scene (SI units, frame of scene.hpp: cylinder of radius
 //      sample.diameter_m / 2 on the z axis, skin top at z = 0, layers stacked
 //      downward), ExtrudedSlabMeshOptions.
-// Out: comparison::TetMesh (points 3 x N in m, positively oriented
+// Out: meshing::TetMesh (points 3 x N in m, positively oriented
 //      tetrahedra, layer index and needle_column flag per tetrahedron).
 //
 // Plan (the disc r <= R): a centre node and rings of nodes. Inside the needle
@@ -37,7 +37,7 @@
 // Throws std::invalid_argument for bad options or scene geometry.
 #pragma once
 
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 #include "puncture/scene.hpp"
 
 namespace puncture::meshing {
@@ -60,10 +60,10 @@ struct ExtrudedSlabMeshReport {
   int levels = 0;           ///< node levels in z
   int vertices = 0;
   int tetrahedra = 0;
-  comparison::TetQuality quality;
+  meshing::TetQuality quality;
 };
 
-comparison::TetMesh build_extruded_tet_slab_mesh(const Scene& scene, const ExtrudedSlabMeshOptions& options,
+meshing::TetMesh build_extruded_tet_slab_mesh(const Scene& scene, const ExtrudedSlabMeshOptions& options,
                                                  ExtrudedSlabMeshReport* report = nullptr);
 
 }  // namespace puncture::meshing

@@ -1,12 +1,12 @@
 // tet_slab_mesh.hpp: tetrahedral mesh of the layered cylindrical slab of a
 // Scene, made with CGAL Mesh_3 (Delaunay refinement of a labelled implicit
 // domain with protected circular features), for the comparison models of
-// core/comparison. The only CGAL translation unit of the project.
+// core/models. The only CGAL translation unit of the project.
 //
 // In:  a Scene (SI units; geometry of scene.hpp: cylinder of radius
 //      sample.diameter_m / 2 on the z axis, skin top at z = 0, layers stacked
 //      downward), TetSlabMeshOptions.
-// Out: comparison::TetMesh (plain arrays: points 3 x N in m, positively
+// Out: meshing::TetMesh (plain arrays: points 3 x N in m, positively
 //      oriented tetrahedra, layer index per tetrahedron, needle_column flag).
 //
 // Domain: every layer is split into two subdomains, the needle column
@@ -36,7 +36,7 @@
 
 #include <string>
 
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 #include "puncture/scene.hpp"
 
 namespace puncture::meshing {
@@ -58,10 +58,10 @@ struct TetSlabMeshReport {
   double exudation_time_s = 0.0;   ///< sliver exudation (0 when exude_slivers is off), s
   int vertices = 0;
   int tetrahedra = 0;
-  comparison::TetQuality quality;
+  meshing::TetQuality quality;
 };
 
-comparison::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOptions& options,
+meshing::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOptions& options,
                                         TetSlabMeshReport* report = nullptr);
 
 }  // namespace puncture::meshing

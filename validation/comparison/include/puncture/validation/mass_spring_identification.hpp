@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 #include "puncture/scene.hpp"
 #include "puncture/validation/model_comparison.hpp"
 
@@ -64,13 +64,13 @@ using IdentificationProgress = std::function<void(int evaluation, double objecti
 
 /// mesh: the comparison mesh of the scene. Throws std::invalid_argument for
 /// an unknown method or bad options.
-IdentificationResult identify_mass_spring_stiffness(const Scene& scene, std::shared_ptr<const comparison::TetMesh> mesh,
+IdentificationResult identify_mass_spring_stiffness(const Scene& scene, std::shared_ptr<const meshing::TetMesh> mesh,
                                                     const ReferenceData& reference, const IdentificationOptions& options,
                                                     const IdentificationProgress& progress = {});
 
 /// One quasi-static run of the mass-spring model with the given layer
 /// factors, evaluated with the objective above (exposed for tests).
-IdentificationEvaluation evaluate_mass_spring(const Scene& scene, std::shared_ptr<const comparison::TetMesh> mesh,
+IdentificationEvaluation evaluate_mass_spring(const Scene& scene, std::shared_ptr<const meshing::TetMesh> mesh,
                                              const ReferenceData& reference, const std::vector<double>& scale,
                                              const IdentificationOptions& options,
                                              std::vector<LayerPunctureComparison>* punctures = nullptr);

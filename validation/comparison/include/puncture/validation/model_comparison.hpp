@@ -3,7 +3,7 @@
 // insertion; accuracy against the reference, cost per step, memory).
 //
 // run_comparison_model(model, scene, options):
-//   drives a ComparisonModel (core/comparison) one haptic step at a time
+//   drives a ComparisonModel (core/models) one haptic step at a time
 //   (dt = 1 / realtime.haptic_rate_Hz) along the scene's scripted trajectory
 //   (approach, insertion, dwell, withdrawal), timing every step, and records
 //   per step: time, depth, velocity, the contact force, the post-puncture

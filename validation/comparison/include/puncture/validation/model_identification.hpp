@@ -62,7 +62,7 @@
 #include <string>
 #include <vector>
 
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 #include "puncture/scene.hpp"
 #include "puncture/validation/model_comparison.hpp"
 
@@ -105,7 +105,7 @@ struct ModelIdentification {
 using IdentificationStepProgress = std::function<void(const std::string& line)>;
 
 ModelIdentification identify_comparison_model(const std::string& model, const Scene& scene,
-                                              std::shared_ptr<const comparison::TetMesh> mesh,
+                                              std::shared_ptr<const meshing::TetMesh> mesh,
                                               const ReferenceData& reference, bool identify_stiffness,
                                               const IdentificationStepProgress& progress = {});
 

@@ -77,9 +77,11 @@
 #include "puncture/comparison/layer_breakthrough.hpp"
 #include "puncture/comparison/sparse_spd_factor.hpp"
 #include "puncture/comparison/sundials_integrator.hpp"
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 
 namespace puncture::comparison {
+
+using meshing::TetMesh;  // the comparison models work on meshing's tetrahedral slab
 
 struct VolumetricSettings {
   IntegratorKind integrator = IntegratorKind::ImplicitBdf;

@@ -20,9 +20,9 @@ ElementInversion measure_element_inversion(const TetMesh& mesh, const Eigen::Ref
   for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
     if (!removed.empty() && removed[t]) continue;
     const Eigen::Vector4i& v = mesh.tets[t];
-    const double rest = tet_signed_volume(mesh.points_m.col(v[0]), mesh.points_m.col(v[1]), mesh.points_m.col(v[2]),
+    const double rest = meshing::tet_signed_volume(mesh.points_m.col(v[0]), mesh.points_m.col(v[1]), mesh.points_m.col(v[2]),
                                           mesh.points_m.col(v[3]));
-    const double now = tet_signed_volume(x_m.segment<3>(3 * v[0]), x_m.segment<3>(3 * v[1]),
+    const double now = meshing::tet_signed_volume(x_m.segment<3>(3 * v[0]), x_m.segment<3>(3 * v[1]),
                                          x_m.segment<3>(3 * v[2]), x_m.segment<3>(3 * v[3]));
     const double ratio = now / rest;
     ++result.elements;

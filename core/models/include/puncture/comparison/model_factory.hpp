@@ -17,9 +17,11 @@
 #include <vector>
 
 #include "puncture/comparison/comparison_model.hpp"
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 
 namespace puncture::comparison {
+
+using meshing::TetMesh;  // the comparison models work on meshing's tetrahedral slab
 
 /// The names above, in table order.
 const std::vector<std::string>& comparison_model_names();

@@ -21,9 +21,11 @@
 
 #include <Eigen/Core>
 
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 
 namespace puncture::comparison {
+
+using meshing::TetMesh;  // the comparison models work on meshing's tetrahedral slab
 
 struct ElementInversion {
   long elements = 0;  ///< tetrahedra counted (the remaining ones); 0: no tetrahedral mesh

@@ -21,7 +21,7 @@
 
 #include <Eigen/Core>
 
-namespace puncture::comparison {
+namespace puncture::meshing {
 
 struct TetMesh {
   Eigen::Matrix3Xd points_m;
@@ -67,4 +67,4 @@ double tet_radius_edge_ratio(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
 /// One line per quantity, for reports.
 std::string describe(const TetQuality& quality);
 
-}  // namespace puncture::comparison
+}  // namespace puncture::meshing

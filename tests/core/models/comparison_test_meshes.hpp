@@ -6,12 +6,12 @@
 #include <array>
 #include <cmath>
 
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 
 namespace puncture::comparison::testing {
 
-inline TetMesh kuhn_box(int n, double h, int layers = 1) {
-  TetMesh mesh;
+inline meshing::TetMesh kuhn_box(int n, double h, int layers = 1) {
+  meshing::TetMesh mesh;
   const int m = n + 1;
   mesh.points_m.resize(3, m * m * m);
   auto id = [m](int i, int j, int k) { return i + m * (j + m * k); };
@@ -30,7 +30,7 @@ inline TetMesh kuhn_box(int n, double h, int layers = 1) {
             ++c[order[static_cast<std::size_t>(s)]];
             tet[s + 1] = id(c[0], c[1], c[2]);
           }
-          const double v = tet_signed_volume(mesh.points_m.col(tet[0]), mesh.points_m.col(tet[1]),
+          const double v = meshing::tet_signed_volume(mesh.points_m.col(tet[0]), mesh.points_m.col(tet[1]),
                                              mesh.points_m.col(tet[2]), mesh.points_m.col(tet[3]));
           if (v < 0) std::swap(tet[2], tet[3]);
           mesh.tets.push_back(tet);

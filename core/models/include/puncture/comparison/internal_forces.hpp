@@ -57,9 +57,11 @@
 
 #include "puncture/comparison/block_sparse.hpp"
 #include "puncture/comparison/tet_elements.hpp"
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 
 namespace puncture::comparison {
+
+using meshing::TetMesh;  // the comparison models work on meshing's tetrahedral slab
 
 using VectorRef = Eigen::Ref<const Eigen::VectorXd>;
 using MutableVectorRef = Eigen::Ref<Eigen::VectorXd>;

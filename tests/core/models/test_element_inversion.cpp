@@ -36,7 +36,7 @@ Eigen::VectorXd mapped(const TetMesh& mesh, const Eigen::Matrix3d& A, const Eige
 
 TEST(ElementInversion, TheVolumeRatioOfAnAffineMapIsItsDeterminant) {
   const TetMesh mesh = two_tetrahedra();
-  ASSERT_GT(tet_signed_volume(mesh.points_m.col(4), mesh.points_m.col(2), mesh.points_m.col(1), mesh.points_m.col(3)),
+  ASSERT_GT(meshing::tet_signed_volume(mesh.points_m.col(4), mesh.points_m.col(2), mesh.points_m.col(1), mesh.points_m.col(3)),
             0.0);
   Eigen::Matrix3d A;
   A << 1.3, 0.4, -0.2,  //

@@ -51,7 +51,7 @@ TetMesh distorted_box() {
   for (int a = 0; a < mesh.node_count(); ++a)
     for (int i = 0; i < 3; ++i) mesh.points_m(i, a) += jitter(rng);
   for (Eigen::Vector4i& t : mesh.tets)
-    if (tet_signed_volume(mesh.points_m.col(t[0]), mesh.points_m.col(t[1]), mesh.points_m.col(t[2]),
+    if (meshing::tet_signed_volume(mesh.points_m.col(t[0]), mesh.points_m.col(t[1]), mesh.points_m.col(t[2]),
                           mesh.points_m.col(t[3])) < 0)
       std::swap(t[2], t[3]);
   return mesh;

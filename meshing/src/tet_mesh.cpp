@@ -1,5 +1,5 @@
 // tet_mesh.cpp: checks, volumes and quality of a tetrahedral mesh; see tet_mesh.hpp.
-#include "puncture/comparison/tet_mesh.hpp"
+#include "puncture/meshing/tet_mesh.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 
 #include <Eigen/Dense>
 
-namespace puncture::comparison {
+namespace puncture::meshing {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
@@ -140,4 +140,4 @@ std::string describe(const TetQuality& q) {
   return s.str();
 }
 
-}  // namespace puncture::comparison
+}  // namespace puncture::meshing

@@ -16,7 +16,7 @@ void VolumetricNeedleModel::compute_masses() {
   for (std::size_t t = 0; t < mesh_->tets.size(); ++t) {
     if (removed_[t]) continue;
     const Eigen::Vector4i& v = mesh_->tets[t];
-    const double volume = tet_signed_volume(mesh_->points_m.col(v[0]), mesh_->points_m.col(v[1]),
+    const double volume = meshing::tet_signed_volume(mesh_->points_m.col(v[0]), mesh_->points_m.col(v[1]),
                                             mesh_->points_m.col(v[2]), mesh_->points_m.col(v[3]));
     const double m = scene_->layers[static_cast<std::size_t>(mesh_->layer[t])].density_kg_per_m3 * volume / 4.0;
     for (int i = 0; i < 4; ++i) node_mass[static_cast<std::size_t>(v[i])] += m;
