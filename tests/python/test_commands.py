@@ -115,8 +115,13 @@ def test_ctrl_c_stops_the_fem_at_its_next_load_step_and_caches_nothing(short_sce
         if len(fractions) == 2:
             os.kill(os.getpid(), signal.SIGINT)
 
-    with pytest.raises(KeyboardInterrupt):
-        puncture.fem(scene, cache_dir=tmp_path / "cache", progress=progress)
+    # Python's own Ctrl-C handler, also where the test runner was started with SIGINT ignored.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            puncture.fem(scene, cache_dir=tmp_path / "cache", progress=progress)
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert len(fractions) == 2 and 0.0 < fractions[0] < fractions[1] < 1.0
     assert list((tmp_path / "cache").glob("*")) == []
 

@@ -92,6 +92,8 @@ def test_ctrl_c_stops_compare_during_a_model_run_writing_nothing(short_scene, tm
     KeyboardInterrupt well before the run could have ended, and no output folder is left."""
     seed_fem_reference(short_scene, tmp_path / "cache")
     timer = threading.Timer(2.0, os.kill, (os.getpid(), signal.SIGINT))
+    # Python's own Ctrl-C handler, also where the test runner was started with SIGINT ignored.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     start = time.monotonic()
     timer.start()
     try:
@@ -100,5 +102,6 @@ def test_ctrl_c_stops_compare_during_a_model_run_writing_nothing(short_scene, tm
                              frames=0, write_vtk=False, output_dir=tmp_path / "out")
     finally:
         timer.cancel()
+        signal.signal(signal.SIGINT, previous)
     assert time.monotonic() - start < 10.0
     assert not (tmp_path / "out").exists()
