@@ -39,9 +39,8 @@ def own_header(root, name):
     """A header of the core libraries: core/include/<name> exists and is not a folder of another library."""
     if not name.startswith("puncture/"):
         return False
-    if "/" not in name[len("puncture/"):]:
-        return os.path.isfile(os.path.join(root, "core", "include", name))
-    return name.startswith(OWN_PREFIXES) and os.path.isfile(os.path.join(root, "core", "include", name))
+    top_level = "/" not in name[len("puncture/"):]
+    return (top_level or name.startswith(OWN_PREFIXES)) and os.path.isfile(os.path.join(root, "core", "include", name))
 
 
 def include_violations(root):

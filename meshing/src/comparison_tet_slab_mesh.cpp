@@ -9,11 +9,11 @@
 
 namespace puncture::meshing {
 
-meshing::TetMesh build_comparison_tet_mesh(const Scene& scene, ComparisonTetMeshReport* report) {
+TetMesh build_comparison_tet_mesh(const Scene& scene, ComparisonTetMeshReport* report) {
   const std::string& kind = scene.comparison.mesh.kind;
   ComparisonTetMeshReport r;
   r.kind = kind;
-  meshing::TetMesh mesh;
+  TetMesh mesh;
   if (kind == "extruded") {
     ExtrudedSlabMeshReport e;
     mesh = build_extruded_tet_slab_mesh(scene, extruded_slab_mesh_options(scene), &e);

@@ -142,8 +142,8 @@ Levels levels_of(const Scene& scene, const ExtrudedSlabMeshOptions& o) {
 }
 
 /// The prisms between neighbouring levels, three tetrahedra each.
-meshing::TetMesh extrude(const PlanMesh& plan, const Levels& levels) {
-  meshing::TetMesh mesh;
+TetMesh extrude(const PlanMesh& plan, const Levels& levels) {
+  TetMesh mesh;
   const int np = static_cast<int>(plan.nodes.size());
   const int nl = static_cast<int>(levels.z_m.size());
   mesh.points_m.resize(3, static_cast<Eigen::Index>(np) * nl);
@@ -160,7 +160,7 @@ meshing::TetMesh extrude(const PlanMesh& plan, const Levels& levels) {
       const int t0 = b0 + np, t1 = b1 + np, t2 = b2 + np;
       for (Eigen::Vector4i tet : {Eigen::Vector4i(b0, b1, b2, t2), Eigen::Vector4i(b0, b1, t1, t2),
                                   Eigen::Vector4i(b0, t0, t1, t2)}) {
-        const double volume = meshing::tet_signed_volume(mesh.points_m.col(tet[0]), mesh.points_m.col(tet[1]),
+        const double volume = tet_signed_volume(mesh.points_m.col(tet[0]), mesh.points_m.col(tet[1]),
                                                             mesh.points_m.col(tet[2]), mesh.points_m.col(tet[3]));
         if (volume < 0.0) std::swap(tet[2], tet[3]);
         mesh.tets.push_back(tet);
@@ -183,7 +183,7 @@ ExtrudedSlabMeshOptions extruded_slab_mesh_options(const Scene& scene) {
   return o;
 }
 
-meshing::TetMesh build_extruded_tet_slab_mesh(const Scene& scene, const ExtrudedSlabMeshOptions& options,
+TetMesh build_extruded_tet_slab_mesh(const Scene& scene, const ExtrudedSlabMeshOptions& options,
                                                  ExtrudedSlabMeshReport* report) {
   require(!scene.layers.empty(), "the scene has no layers");
   require(options.size_at_axis_m > 0.0, "options.size_at_axis_m must be > 0");
@@ -200,8 +200,8 @@ meshing::TetMesh build_extruded_tet_slab_mesh(const Scene& scene, const Extruded
   const auto start = std::chrono::steady_clock::now();
   const PlanMesh plan = plan_mesh(scene.needle.radius_m, radius_m, options);
   const Levels levels = levels_of(scene, options);
-  meshing::TetMesh mesh = extrude(plan, levels);
-  meshing::check_tet_mesh(mesh, static_cast<int>(scene.layers.size()));
+  TetMesh mesh = extrude(plan, levels);
+  check_tet_mesh(mesh, static_cast<int>(scene.layers.size()));
   if (report) {
     report->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     report->plan_nodes = static_cast<int>(plan.nodes.size());
@@ -209,7 +209,7 @@ meshing::TetMesh build_extruded_tet_slab_mesh(const Scene& scene, const Extruded
     report->levels = static_cast<int>(levels.z_m.size());
     report->vertices = mesh.node_count();
     report->tetrahedra = mesh.tet_count();
-    report->quality = meshing::measure_tet_quality(mesh);
+    report->quality = measure_tet_quality(mesh);
   }
   return mesh;
 }

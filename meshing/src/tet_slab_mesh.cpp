@@ -163,10 +163,10 @@ Complex refine_slab(const SlabGeometry& g, const TetSlabMeshOptions& options) {
 /// complex alone would leave a hole through the skin. Cells whose vertices
 /// all lie on one boundary surface are flat slivers on that surface (of the
 /// convex hull or of the complex).
-meshing::TetMesh slab_tetrahedra(const Complex& c3t3, const SlabGeometry& g, const TetSlabMeshOptions& options) {
+TetMesh slab_tetrahedra(const Complex& c3t3, const SlabGeometry& g, const TetSlabMeshOptions& options) {
   constexpr double kMmPerM = 1e3;
   const SizeField size{g.needle_mm, options.size_at_axis_m * kMmPerM, options.size_far_m * kMmPerM, options.grading};
-  meshing::TetMesh mesh;
+  TetMesh mesh;
   const Triangulation& tr = c3t3.triangulation();
   std::map<Triangulation::Vertex_handle, int> index;
   std::vector<Eigen::Vector3d> points;
@@ -208,7 +208,7 @@ meshing::TetMesh slab_tetrahedra(const Complex& c3t3, const SlabGeometry& g, con
     double longest = 0.0;
     for (int i = 0; i < 4; ++i)
       for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (q[i] - q[j]).norm());
-    const double volume = meshing::tet_signed_volume(q[0], q[1], q[2], q[3]);
+    const double volume = tet_signed_volume(q[0], q[1], q[2], q[3]);
     if (std::abs(volume) < 1e-8 * longest * longest * longest) continue;  // flat cell on a boundary plane
     Eigen::Vector4i tet;
     for (int i = 0; i < 4; ++i) {
@@ -223,13 +223,13 @@ meshing::TetMesh slab_tetrahedra(const Complex& c3t3, const SlabGeometry& g, con
   }
   mesh.points_m.resize(3, static_cast<Eigen::Index>(points.size()));
   for (std::size_t i = 0; i < points.size(); ++i) mesh.points_m.col(static_cast<Eigen::Index>(i)) = points[i];
-  meshing::check_tet_mesh(mesh, n_layers);
+  check_tet_mesh(mesh, n_layers);
   return mesh;
 }
 
 }  // namespace
 
-meshing::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOptions& options,
+TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOptions& options,
                                         TetSlabMeshReport* report) {
   require(!scene.layers.empty(), "the scene has no layers");
   require(options.size_at_axis_m > 0.0, "options.size_at_axis_m must be > 0");
@@ -254,7 +254,7 @@ meshing::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOption
   const auto refined = std::chrono::steady_clock::now();
   if (options.exude_slivers) exude_slivers_to_completion(c3t3);
   const auto exuded = std::chrono::steady_clock::now();
-  meshing::TetMesh mesh = slab_tetrahedra(c3t3, g, options);
+  TetMesh mesh = slab_tetrahedra(c3t3, g, options);
 
   if (report) {
     report->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -262,7 +262,7 @@ meshing::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOption
     report->exudation_time_s = std::chrono::duration<double>(exuded - refined).count();
     report->vertices = mesh.node_count();
     report->tetrahedra = mesh.tet_count();
-    report->quality = meshing::measure_tet_quality(mesh);
+    report->quality = measure_tet_quality(mesh);
   }
   return mesh;
 }

@@ -20,6 +20,12 @@ namespace puncture::apps {
 /// Exit codes of the `puncture` program (apps/README.md); 128 + n when ended by signal n.
 enum ExitCode : int { kExitOk = 0, kExitFailure = 1, kExitBadInput = 2, kExitOutput = 3 };
 
+/// Called after every load step of an FEM reference a command computes on the
+/// way (not when it comes from the cache) with the tip depth (m) and the share
+/// of its trajectory done; may throw to stop the command (the Python module's
+/// Ctrl-C). Empty: nothing is called.
+using FemStepCallback = std::function<void(double depth_m, double fraction_done)>;
+
 /// The scene `puncture run` uses without arguments: scenes/default.json in the
 /// working directory if present, else the one in the source tree.
 std::filesystem::path default_scene_path();
@@ -72,10 +78,7 @@ struct ValidateOptions {
   /// trajectory instead of against the FEM (apps/src/validate_recordings.hpp).
   std::vector<std::filesystem::path> references;
   validation::ReferenceRecordingOptions recording;
-  /// Called after every load step of an FEM reference computed on the way
-  /// (not when it comes from the cache) with the tip depth (m) and the share
-  /// of its trajectory done; may throw to stop (the Python module's Ctrl-C).
-  std::function<void(double depth_m, double fraction_done)> fem_step;
+  FemStepCallback fem_step;  ///< see FemStepCallback
 };
 
 /// `puncture validate`: real-time model and FEM reference (cached) on the
@@ -150,10 +153,7 @@ struct CalibrateOptions {
   /// module's progress callback); may throw to stop the calibration
   /// (calibration.hpp), which then writes nothing and fails with the message.
   validation::CalibrationProgressCallback progress;
-  /// Called after every load step of an FEM reference computed on the way
-  /// (not when it comes from the cache) with the tip depth (m) and the share
-  /// of its trajectory done; may throw to stop (the Python module's Ctrl-C).
-  std::function<void(double depth_m, double fraction_done)> fem_step;
+  FemStepCallback fem_step;  ///< see FemStepCallback
 };
 
 /// `puncture calibrate`: tunes the force-law parameters against a reference
@@ -210,10 +210,7 @@ struct CompareOptions {
   int frames = 20;                    ///< ParaView frames per model over the trajectory (0: none)
   bool write_vtk = true;
   bool quiet = false;
-  /// Called after every load step of an FEM reference computed on the way
-  /// (not when it comes from the cache) with the tip depth (m) and the share
-  /// of its trajectory done; may throw to stop (the Python module's Ctrl-C).
-  std::function<void(double depth_m, double fraction_done)> fem_step;
+  FemStepCallback fem_step;  ///< see FemStepCallback
   /// Called every 5 % of each model run and after every identification run;
   /// may throw to stop (nothing is written): the Python module's Ctrl-C.
   std::function<void()> model_step;

@@ -23,9 +23,9 @@ struct ComparisonTetMeshReport {
   double wall_time_s = 0.0;
   int vertices = 0;
   int tetrahedra = 0;
-  meshing::TetQuality quality;
+  TetQuality quality;
 };
 
-meshing::TetMesh build_comparison_tet_mesh(const Scene& scene, ComparisonTetMeshReport* report = nullptr);
+TetMesh build_comparison_tet_mesh(const Scene& scene, ComparisonTetMeshReport* report = nullptr);
 
 }  // namespace puncture::meshing

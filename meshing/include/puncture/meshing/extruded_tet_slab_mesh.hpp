@@ -60,10 +60,10 @@ struct ExtrudedSlabMeshReport {
   int levels = 0;           ///< node levels in z
   int vertices = 0;
   int tetrahedra = 0;
-  meshing::TetQuality quality;
+  TetQuality quality;
 };
 
-meshing::TetMesh build_extruded_tet_slab_mesh(const Scene& scene, const ExtrudedSlabMeshOptions& options,
+TetMesh build_extruded_tet_slab_mesh(const Scene& scene, const ExtrudedSlabMeshOptions& options,
                                                  ExtrudedSlabMeshReport* report = nullptr);
 
 }  // namespace puncture::meshing

@@ -1,6 +1,7 @@
 // tet_mesh.hpp: a tetrahedral mesh of the layered slab as plain arrays, the
-// form in which the CGAL mesher (meshing/tet/) hands it to the comparison
-// models, so core/ stays free of CGAL.
+// form in which the slab meshers (tet_slab_mesh.hpp with CGAL,
+// extruded_tet_slab_mesh.hpp) hand it to the comparison models (core/models),
+// so those need no CGAL. Library puncture_tet_mesh, Eigen only.
 //
 // In/out (SI units, scene frame of scene.hpp: axis = z, skin top z = 0):
 //   points_m       3 x N vertex positions (m)

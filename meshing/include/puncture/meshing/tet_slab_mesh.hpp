@@ -58,10 +58,10 @@ struct TetSlabMeshReport {
   double exudation_time_s = 0.0;   ///< sliver exudation (0 when exude_slivers is off), s
   int vertices = 0;
   int tetrahedra = 0;
-  meshing::TetQuality quality;
+  TetQuality quality;
 };
 
-meshing::TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOptions& options,
+TetMesh build_tet_slab_mesh(const Scene& scene, const TetSlabMeshOptions& options,
                                         TetSlabMeshReport* report = nullptr);
 
 }  // namespace puncture::meshing
