@@ -128,12 +128,8 @@ def released_share(out, scene):
     return s["crack_energy_released_J"] / total
 
 
-def page(records, args, command):
-    ok = [r for r in records if r["exit"] == 0 and not r["problems"]]
-    failed = [r for r in records if r["exit"] != 0]
-    wrong = [r for r in records if r["exit"] == 0 and r["problems"]]
-    walls = [r["wall_s"] for r in records if r["exit"] == 0]
-    cuts = [r.get("step_cuts") or 0 for r in records if r["exit"] == 0]
+def page_header(records, args, command):
+    """Records, options and command -> the page's title, provenance, scene count and partial-study notice."""
     missing = getattr(args, "missing", [])
     times = [r["finished_utc"] for r in records if r.get("finished_utc")]
     lines = [
@@ -150,7 +146,14 @@ def page(records, args, command):
     if missing:
         lines += [f"**Partial: {len(records)} of {len(records) + len(missing)} scenes run so far** (the study goes on "
                   "with `--resume`); not yet run: " + ", ".join(missing) + ".", ""]
-    lines += [
+    return lines
+
+
+def outcome_summary(records, ok, wrong, failed):
+    """Records sorted by outcome -> the outcome table, wall times, step cuts, residuals and the checks made."""
+    walls = [r["wall_s"] for r in records if r["exit"] == 0]
+    cuts = [r.get("step_cuts") or 0 for r in records if r["exit"] == 0]
+    return [
         "| outcome | scenes |",
         "|---|---|",
         f"| converged, records consistent | {len(ok)} of {len(records)} |",
@@ -174,6 +177,11 @@ def page(records, args, command):
         "a cutting part below zero or above the force beyond friction.",
         "",
     ]
+
+
+def failures_section(failed, wrong):
+    """Runs that stopped and runs whose records contradict the forces -> the Failures table (empty if none)."""
+    lines = []
     if failed or wrong:
         lines += ["## Failures", "", "| scene | what | |", "|---|---|---|"]
         for r in failed:
@@ -181,17 +189,28 @@ def page(records, args, command):
         for r in wrong:
             lines.append(f"| {r['scene']} | inconsistent | {'; '.join(r['problems'])} |")
         lines.append("")
-    shares = [q for r in records if (q := released_share(args.out, r["scene"])) is not None]
+    return lines
+
+
+def crack_energy_section(records, out):
+    """Records and OUT -> the section on the share of crack dissipation from stored energy (empty without runs)."""
+    lines = []
+    shares = [q for r in records if (q := released_share(out, r["scene"])) is not None]
     if shares:
         lines += ["## The cutting part and crack runs", "",
                   "The cutting part of the force is the crack's dissipation per unit advance, at most the force "
                   "beyond friction (reference_fem/README.md); what a crack run dissipates beyond that is energy "
                   "the tissue had stored (`crack_energy_released_J`). Its share of the crack's dissipation: "
                   f"median {100 * median(shares):.0f} %, max {100 * max(shares):.0f} % over {len(shares)} runs.", ""]
-    lines += ["## Every scene", "",
-              "Scene files in `scenes/`; `puncture fem scenes/<scene>.json` runs one again.", "",
-              "| scene | tip | skin / fat / muscle mm | speed mm/s | target mm | hold s | wall s | steps | cuts | punctures (layer mm N) | outcome |",
-              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    return lines
+
+
+def scene_table(records):
+    """Records -> the table of every scene: its draw, its run and its outcome."""
+    lines = ["## Every scene", "",
+             "Scene files in `scenes/`; `puncture fem scenes/<scene>.json` runs one again.", "",
+             "| scene | tip | skin / fat / muscle mm | speed mm/s | target mm | hold s | wall s | steps | cuts | punctures (layer mm N) | outcome |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in records:
         th = " / ".join(f"{t:g}" for t in r["thickness_mm"])
         pun = "; ".join(f"{n} {d:g} {f:.3g}" for n, d, f in r.get("punctures", []))
@@ -199,17 +218,35 @@ def page(records, args, command):
         lines.append(f"| {r['scene']} | {r['tip']} | {th} | {r['speed_mm_per_s']:g} | {r['target_mm']:g} | "
                      f"{r['hold_s']:g} | {r['wall_s']:.0f} | {r.get('load_steps', '')} | {r.get('step_cuts', '')} | "
                      f"{pun} | {outcome} |")
-    lines += ["", "## On a cluster", "",
-              "Each scene is one task (`--only I` draws the scenes and runs scene I alone, writing "
-              "`results/<scene>.json`); `--collect` then writes this page from those files. A Slurm array:",
-              "", "```bash",
-              "#SBATCH --array=0-59 --cpus-per-task=1",
-              "python3 scripts/fem_robustness_study.py --count 60 --seed 48 --only $SLURM_ARRAY_TASK_ID --out $OUT",
-              "# after the array:",
-              "python3 scripts/fem_robustness_study.py --count 60 --seed 48 --collect --out $OUT", "```", "",
-              "On one machine a study stopped part way goes on with `--resume` (the scenes with a result from "
-              "the current FEM sources are kept); `--collect --partial` writes this page from the results so far.",
-              ""]
+    return lines
+
+
+def cluster_section():
+    """-> the page's closing section: how to run the study as cluster tasks, or resume it."""
+    return ["", "## On a cluster", "",
+            "Each scene is one task (`--only I` draws the scenes and runs scene I alone, writing "
+            "`results/<scene>.json`); `--collect` then writes this page from those files. A Slurm array:",
+            "", "```bash",
+            "#SBATCH --array=0-59 --cpus-per-task=1",
+            "python3 scripts/fem_robustness_study.py --count 60 --seed 48 --only $SLURM_ARRAY_TASK_ID --out $OUT",
+            "# after the array:",
+            "python3 scripts/fem_robustness_study.py --count 60 --seed 48 --collect --out $OUT", "```", "",
+            "On one machine a study stopped part way goes on with `--resume` (the scenes with a result from "
+            "the current FEM sources are kept); `--collect --partial` writes this page from the results so far.",
+            ""]
+
+
+def page(records, args, command):
+    """Records, options and command -> the text of OUT/README.md."""
+    ok = [r for r in records if r["exit"] == 0 and not r["problems"]]
+    failed = [r for r in records if r["exit"] != 0]
+    wrong = [r for r in records if r["exit"] == 0 and r["problems"]]
+    lines = page_header(records, args, command)
+    lines += outcome_summary(records, ok, wrong, failed)
+    lines += failures_section(failed, wrong)
+    lines += crack_energy_section(records, args.out)
+    lines += scene_table(records)
+    lines += cluster_section()
     return "\n".join(lines)
 
 

@@ -89,28 +89,26 @@ def radial_pressure_notes(summary, rows, layers, a_mm):
             "hoop load; the split between these was not measured."]
 
 
-def main():
-    if len(sys.argv) not in (4, 5):
+def read_inputs(argv):
+    """Command line -> (FEM dir, scene path, output path, rate.json or None, fem_summary, scene, CSV rows)."""
+    if len(argv) not in (4, 5):
         sys.exit(__doc__)
-    fem_dir, scene_path, out = sys.argv[1:4]
-    rate = json.load(open(sys.argv[4])) if len(sys.argv) == 5 else None
+    fem_dir, scene_path, out = argv[1:4]
+    rate = json.load(open(argv[4])) if len(argv) == 5 else None
     summary = json.load(open(os.path.join(fem_dir, "fem_summary.json")))
     scene = json.load(open(scene_path))
     rows = list(csv.DictReader(l for l in open(os.path.join(fem_dir, "fem_force_depth.csv")) if not l.startswith("#")))
+    return fem_dir, scene_path, out, rate, summary, scene, rows
+
+
+def page_header(fem_dir, scene_path, out, rate_path, rate, scene):
+    """Run, scene and command -> the page's title, provenance, needle and layers, and the table's head."""
     a_mm = scene["needle"]["radius_mm"]
     layers = scene["layers"]
-    events = {p["name"]: p for p in summary.get("punctures", [])}
-    order = [p["name"] for p in summary.get("punctures", [])]
-
-    def f(r, k):
-        return float(r[k])
-
-    ins = [r for r in rows if r["phase"] == "insertion"]
-    wd = [r for r in rows if r["phase"] == "withdrawal"]
     L = []
     L.append("# FEM reference against measurements\n")
     rev = provenance.git_revision()
-    rate_arg = f" {sys.argv[4]}" if rate else ""
+    rate_arg = f" {rate_path}" if rate else ""
     L.append(f"Command: `scripts/fem_vs_literature.py {fem_dir} {scene_path} {out}{rate_arg}` on the FEM run in `{fem_dir}` "
              f"(scene `{scene_path}`), git {rev}.  ")
     L.append(f"Machine: {provenance.machine()}.  ")
@@ -120,11 +118,24 @@ def main():
              + ", ".join(f"{l['name']} {l['thickness_mm']} mm" for l in layers) + ".\n")
     L.append("| quantity | FEM reference | measurement / expectation | source |")
     L.append("|---|---|---|---|")
+    return L
+
+
+def puncture_rows(events, order):
+    """Punctures by layer and their order -> the rows of the skin's puncture force and of the puncture order."""
+    L = []
     skin = events.get("skin")
     L.append(f"| skin puncture force | {skin['force_N']:.2f} N at {skin['depth_mm']:.1f} mm tip depth |" if skin else
              "| skin puncture force | no puncture |")
     L[-1] += " median 1.22 N over 24 studies (range 0.5 mN-19.2 N); plausibility band for 18 G: 1-3 N | van Gerwen et al. 2012, Med. Eng. Phys. 34:665 (LITERATURE.md) |"
     L.append(f"| order of the punctures | {' -> '.join(order) if order else 'none'} | skin -> fat -> muscle | geometry |")
+    return L
+
+
+def cutting_force_rows(layers, events, ins, a_mm):
+    """Layers, punctures and insertion rows -> per fracture-energy layer, the FEM's cutting force beside G_c x 2a."""
+    L = []
+    column = fem_metrics.value
     # Cutting force = G_c x cut width (2a): expected per layer, and the FEM's
     # mean cutting column while the tip is inside the layer (after its puncture).
     for i, l in enumerate(layers):
@@ -138,7 +149,7 @@ def main():
         if ev:
             nxt = events.get(layers[i + 1]["name"]) if i + 1 < len(layers) else None
             hi = nxt["depth_mm"] if nxt else 1e9
-            vals = [f(r, "cutting_force_N") for r in ins if ev["depth_mm"] + 0.5 <= f(r, "depth_mm") < hi]
+            vals = [column(r, "cutting_force_N") for r in ins if ev["depth_mm"] + 0.5 <= column(r, "depth_mm") < hi]
         if vals:
             fem = f"{sum(vals) / len(vals):.2f} N (mean of {len(vals)} steps inside the layer after its puncture)"
         elif ev:
@@ -147,11 +158,18 @@ def main():
             fem = "not punctured"
         L.append(f"| cutting force in {l['name']} | {fem} | G_c x 2a = {gc:g} J/m^2 x {2 * a_mm:g} mm = {expected:.2f} N | "
                  f"{p.get('source', '')[:100]} |")
+    return L
+
+
+def friction_rows(summary, rows, ins, order):
+    """Summary, rows, insertion rows and puncture order -> the friction share, per unit length and at the target."""
+    L = []
+    column = fem_metrics.value
     # Friction share of the total at the deepest insertion point.
     if ins:
         last = ins[-1]
-        tot = f(last, "force_N")
-        fr = f(last, "friction_force_N")
+        tot = column(last, "force_N")
+        fr = column(last, "friction_force_N")
         share = 100 * fr / tot if tot > 0 else float("nan")
         L.append(f"| friction share of the force at the target depth | {fr:.3f} of {tot:.3f} N ({share:.0f} %) | "
                  "21 % (tearing 61 %, spreading 18 %) | Barnett, Lee, Moore 2016, J. Manuf. Sci. Eng. 138:011005 |")
@@ -168,9 +186,15 @@ def main():
                      "bovine liver 0.013 N/mm sliding, 0.018 N/mm static (Karnopp fit per metre of contact); "
                      "PVC phantom 0.034 / 0.059 / 0.080 N/mm at 1 / 3 / 9 mm/s | "
                      "Okamura, Simone, O'Leary 2004, IEEE TBME 51:1707; DiMaio & Salcudean 2003 (via van Gerwen 2012) |")
-        L.append(f"| friction force at the target depth | {f(ins[-1], 'friction_force_N'):.2f} N | survey of maximum "
+        L.append(f"| friction force at the target depth | {column(ins[-1], 'friction_force_N'):.2f} N | survey of maximum "
                  "friction forces: median 1.0 N, range 0.15-2.8 N (10 papers) | van Gerwen, Dankelman, "
                  "van den Dobbelsteen 2012, Med. Eng. Phys. 34:665, Table 2 |")
+    return L
+
+
+def relaxation_rows(rows, layers):
+    """Rows and layers -> the row of the force's relaxation in the hold (none without a hold)."""
+    L = []
     relax = fem_metrics.dwell_relaxation(rows)
     if relax:
         f0, f1, hold, frac = relax
@@ -181,6 +205,12 @@ def main():
                  "percent within seconds of a hold; passive muscle under a sudden indentation: long-term / short-term "
                  "shear modulus 0.07-0.14, plateau after about 20 s | Okamura 2004, Mahvash & Dupont 2010 "
                  "(LITERATURE.md); Palevski et al. 2006, J. Biomech. Eng. 128:782 |")
+    return L
+
+
+def speed_trend_rows(rate, layers):
+    """rate.json (or None) and layers -> the puncture forces and friction at the slowest and fastest speed."""
+    L = []
     if rate:
         runs = sorted(rate["runs"], key=lambda r: r["speed_mm_per_s"])
         lo, hi = runs[0], runs[-1]
@@ -198,26 +228,57 @@ def main():
             L.append(f"| shaft friction per unit length, {lo['speed_mm_per_s']:g} -> {hi['speed_mm_per_s']:g} mm/s | "
                      f"{a:.3f} -> {b:.3f} N/mm ({100 * (b / a - 1):+.0f} %) | PVC phantom 0.034 -> 0.080 N/mm at "
                      "1 -> 9 mm/s (+135 %) | DiMaio & Salcudean 2003 (via van Gerwen 2012) [2nd] |")
-    pressure_notes = radial_pressure_notes(summary, rows, layers, a_mm)
-    pressure_notes += drop_notes(summary, rows, layers)
+    return L
+
+
+def withdrawal_and_energy_rows(summary, wd):
+    """Summary and withdrawal rows -> the rows of the force on withdrawal and of the energy balance."""
+    L = []
+    column = fem_metrics.value
     if wd:
-        mn = min(f(r, "force_N") for r in wd)
-        mf = min(f(r, "friction_force_N") for r in wd)
+        mn = min(column(r, "force_N") for r in wd)
+        mf = min(column(r, "friction_force_N") for r in wd)
         L.append(f"| force on withdrawal | min {mn:.3f} N (friction min {mf:.3f} N) | negative: friction reverses | "
                  "Okamura, Simone, O'Leary 2004, IEEE TBME 51:1707 |")
     L.append(f"| energy: needle work (insertion) / crack dissipation / stabilisation | "
              f"{summary.get('needle_work_insertion_J', float('nan')) * 1e3:.2f} / {summary.get('cohesive_dissipation_J', 0) * 1e3:.2f} / "
              f"{summary.get('stabilization_dissipation_J', 0) * 1e3:.3f} mJ | stabilisation a small share | numerical check |")
+    return L
+
+
+def write_page(out, L):
+    """Output path and page lines -> the page written through OUT.part (no half-written page)."""
+    tmp = out + ".part"
+    open(tmp, "w").write("\n".join(L) + "\n")
+    os.replace(tmp, out)
+    print("wrote", out)
+
+
+def main():
+    """Command line (FEM_DIR SCENE_JSON OUT_MD [RATE_JSON]) -> the page OUT_MD."""
+    fem_dir, scene_path, out, rate, summary, scene, rows = read_inputs(sys.argv)
+    a_mm = scene["needle"]["radius_mm"]
+    layers = scene["layers"]
+    events = {p["name"]: p for p in summary.get("punctures", [])}
+    order = [p["name"] for p in summary.get("punctures", [])]
+    ins = [r for r in rows if r["phase"] == "insertion"]
+    wd = [r for r in rows if r["phase"] == "withdrawal"]
+    L = page_header(fem_dir, scene_path, out, sys.argv[4] if rate else None, rate, scene)
+    L += puncture_rows(events, order)
+    L += cutting_force_rows(layers, events, ins, a_mm)
+    L += friction_rows(summary, rows, ins, order)
+    L += relaxation_rows(rows, layers)
+    L += speed_trend_rows(rate, layers)
+    pressure_notes = radial_pressure_notes(summary, rows, layers, a_mm)
+    pressure_notes += drop_notes(summary, rows, layers)
+    L += withdrawal_and_energy_rows(summary, wd)
     L.append("")
     L.append("Notes. The cutting column is the crack's fracture energy dissipated per unit tip advance (rate-independent "
              "part of the cohesive law); while a crack runs ahead of the tip it also carries energy the tissue releases, "
              "so single steps can exceed the needle force. The skin tents deeply on the 60 mm slab before it cuts, "
              "which puts the puncture depth beyond the few millimetres of in vivo tests on skin held by the body.")
     L += [""] + pressure_notes
-    tmp = out + ".part"
-    open(tmp, "w").write("\n".join(L) + "\n")
-    os.replace(tmp, out)
-    print("wrote", out)
+    write_page(out, L)
 
 
 if __name__ == "__main__":

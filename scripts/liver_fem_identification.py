@@ -233,7 +233,8 @@ def held_out_rmse(ins, curve, lo, hi):
     return math.sqrt(sum(e * e for e in err) / len(err)) if err else None
 
 
-def main():
+def parse_arguments():
+    """Command line -> argparse namespace (scene, curve, out_dir, puncture and the options)."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene")
     ap.add_argument("curve")
@@ -245,23 +246,36 @@ def main():
     ap.add_argument("--ranks", type=int, default=2)
     ap.add_argument("--from-evaluations", help="an evaluations.csv of an earlier search: take its best run instead of "
                     "searching again (the page is rewritten from it)")
-    args = ap.parse_args()
-    t_start = time.time()
-    scene = json.load(open(args.scene), object_pairs_hook=collections.OrderedDict)
-    curve = read_curve(args.curve, args.offset_mm)
-    measured = curve_features(curve)
-    bins = binned(curve, 0.0, args.fit_depth_mm)
-    x0 = [scene["layers"][0]["puncture"]["cohesive_strength_kPa"], scene["layers"][1]["material"]["youngs_modulus_kPa"],
-          scene["layers"][1]["shaft_friction"]["coefficient"]]
-    os.makedirs(args.out_dir, exist_ok=True)
-    work = tempfile.mkdtemp()
-    log_path = os.path.join(args.out_dir, "evaluations.csv")
+    return ap.parse_args()
+
+
+def literature_values(scene):
+    """Scene -> its [capsule sigma_c kPa, parenchyma E kPa, friction coefficient] (the search's start)."""
+    return [scene["layers"][0]["puncture"]["cohesive_strength_kPa"], scene["layers"][1]["material"]["youngs_modulus_kPa"],
+            scene["layers"][1]["shaft_friction"]["coefficient"]]
+
+
+def read_evaluations(path):
+    """evaluations.csv of an earlier search (or None) -> its rows as lists of strings, without the head (or None)."""
     previous = None
-    if args.from_evaluations:
-        with open(args.from_evaluations) as f:
+    if path:
+        with open(path) as f:
             previous = [l.strip().split(",") for l in f if l.strip()][1:]
+    return previous
+
+
+def best_of_evaluations(previous, from_path, log_path):
+    """An earlier search's rows -> (its lowest-J parameters, its number of FEM runs); its CSV copied to log_path."""
+    if os.path.abspath(from_path) != os.path.abspath(log_path):
+        shutil.copyfile(from_path, log_path)
+    best = min(previous, key=lambda r: float(r[4]))
+    return [float(v) for v in best[1:4]], len(previous)
+
+
+def search(scene, x0, work, args, measured, bins, log_path):
+    """Literature values -> (identified parameters, FEM runs made) by Nelder-Mead on the logarithms; writes evaluations.csv."""
     count = [0]
-    log = None  # evaluations.csv.part while the search runs
+    log = open(log_path + ".part", "w")  # evaluations.csv.part while the search runs
 
     def evaluate(logx):
         x = [math.exp(v) for v in logx]
@@ -280,57 +294,38 @@ def main():
               "  ".join(f"{n}={v:.4g}" for n, v in zip(NAMES, x)) + f"  J={J:.4g}  ({wall:.0f} s)", flush=True)
         return J
 
-    # The whole insertion (the measured curve has no withdrawal).
-    target = scene["insertion"]["target_depth_mm"]
-    print("liver identification: FEM at the literature values (whole insertion)", flush=True)
-    full_before, _ = run_fem(with_parameters(scene, x0), work, "before", args, target)
-    if full_before is None:
-        sys.exit("liver identification: the FEM run at the literature values failed")
-    if previous:
-        if os.path.abspath(args.from_evaluations) != os.path.abspath(log_path):
-            shutil.copyfile(args.from_evaluations, log_path)
-        best = min(previous, key=lambda r: float(r[4]))
-        x_best = [float(v) for v in best[1:4]]
-        count[0] = len(previous)
-    else:
-        log = open(log_path + ".part", "w")
-        log.write("run," + ",".join(NAMES) + ",J,rmse_N,puncture_depth_mm,puncture_force_N,wall_s\n")
-        start = [math.log(v) for v in x0]
-        best_log, best_J = nelder_mead(evaluate, start, [math.log(2.0)] * 3, args.evaluations)
-        log.close()
-        os.replace(log_path + ".part", log_path)
-        x_best = [math.exp(v) for v in best_log]
-    print("liver identification: FEM at the identified values (whole insertion)", flush=True)
-    identified = with_parameters(scene, x_best)
-    full_after, _ = run_fem(identified, work, "after", args, target)
-    if full_after is None:
-        sys.exit("liver identification: the FEM run at the identified values failed")
-    ins_b, feat_b = fem_features(*full_before)
-    ins_a, feat_a = fem_features(*full_after)
-    obj_b, obj_a = objective(ins_b, feat_b, measured, bins), objective(ins_a, feat_a, measured, bins)
-    last = max(d for d, _ in curve)
-    held_b, held_a = held_out_rmse(ins_b, curve, args.fit_depth_mm, last), held_out_rmse(ins_a, curve, args.fit_depth_mm, last)
-    command = (f"scripts/liver_fem_identification.sh (= liver_fem_identification.py {args.scene} {args.curve} {args.out_dir} "
-               f"PUNCTURE --offset-mm {args.offset_mm:g} --evaluations {args.evaluations} --fit-depth-mm {args.fit_depth_mm:g}"
-               + (f" --from-evaluations {args.from_evaluations}" if args.from_evaluations else "") + ")")
-    stamp = (f"bash scripts/liver_fem_identification.sh, git {provenance.git_revision()}, {provenance.machine()}, "
-             f"{provenance.utc_now()} UTC")
-    plot(os.path.join(args.out_dir, "liver_fem_vs_okamura.png"), curve, ins_b, ins_a, args.fit_depth_mm, stamp)
+    log.write("run," + ",".join(NAMES) + ",J,rmse_N,puncture_depth_mm,puncture_force_N,wall_s\n")
+    start = [math.log(v) for v in x0]
+    best_log, best_J = nelder_mead(evaluate, start, [math.log(2.0)] * 3, args.evaluations)
+    log.close()
+    os.replace(log_path + ".part", log_path)
+    return [math.exp(v) for v in best_log], count[0]
+
+
+def command_line(args):
+    """Options -> the command that made the page, as the page and identification.json give it."""
+    return (f"scripts/liver_fem_identification.sh (= liver_fem_identification.py {args.scene} {args.curve} {args.out_dir} "
+            f"PUNCTURE --offset-mm {args.offset_mm:g} --evaluations {args.evaluations} --fit-depth-mm {args.fit_depth_mm:g}"
+            + (f" --from-evaluations {args.from_evaluations}" if args.from_evaluations else "") + ")")
+
+
+def write_identified_scene(out_dir, identified, x_best):
+    """Identified scene and parameters -> OUT_DIR/liver_identified.json (its description names the values)."""
     identified["description"] += (" Identified against the Okamura curve: " +
                                   ", ".join(f"{n} {v:.4g}" for n, v in zip(NAMES, x_best)) + ".")
-    results_io.write_text(os.path.join(args.out_dir, "liver_identified.json"),
+    results_io.write_text(os.path.join(out_dir, "liver_identified.json"),
                           json.dumps(identified, indent=2, ensure_ascii=False) + "\n")
-    result = {"parameters": NAMES, "literature": x0, "identified": x_best, "objective_before": obj_b,
-              "objective_after": obj_a, "measured": measured, "fem_before": feat_b, "fem_after": feat_a,
-              "held_out_rmse_N": {"before": held_b, "after": held_a, "range_mm": [args.fit_depth_mm, last]},
-              "fem_runs": count[0] + 2, "wall_s": time.time() - t_start, "command": command}
-    results_io.write_text(os.path.join(args.out_dir, "identification.json"), json.dumps(result, indent=2) + "\n")
+
+
+def readme_lines(args, command, runs, reused, minutes, x0, x_best, fits, last, scene):
+    """Options, parameters and fits (measured, features, objectives, held-out RMSE before/after) -> README.md's lines."""
+    measured, feat_b, feat_a, obj_b, obj_a, held_b, held_a = fits
     L = ["# Liver FEM beside a measured insertion (Okamura, Simone & O'Leary 2004)\n",
          f"Command: `{command}`.  ", f"Git {provenance.git_revision()}; machine: {provenance.machine()}; "
          f"date {provenance.utc_now()} UTC; " +
-         (f"the search's {count[0]} FEM runs are those of `evaluations.csv` (an earlier run of the same script on "
-          f"the same scene and code); this run made the two whole insertions in {(time.time() - t_start) / 60:.1f} min.\n"
-          if previous else f"{count[0] + 2} FEM runs in {(time.time() - t_start) / 60:.1f} min.\n"),
+         (f"the search's {runs} FEM runs are those of `evaluations.csv` (an earlier run of the same script on "
+          f"the same scene and code); this run made the two whole insertions in {minutes:.1f} min.\n"
+          if reused else f"{runs + 2} FEM runs in {minutes:.1f} min.\n"),
          f"Scene `{args.scene}` (capsule 0.5 mm, parenchyma 50 mm, 18 G bevel needle at 3 mm/s, every value with its "
          "source in the scene). Measured: `../shared/data/okamura2004_liver_depth_force.csv` (bovine liver ex vivo, "
          f"digitised Fig. 1; depth shifted by {args.offset_mm:g} mm so that 0 is the contact).\n",
@@ -345,10 +340,58 @@ def main():
           f"{held_a:.3f} |" if held_a is not None else "| identified | | | | | | |", "",
           f"Objective J = (force RMSE / measured capsule puncture force)^2 + (puncture force error / measured)^2 + "
           f"(puncture depth error / measured)^2 over 0-{args.fit_depth_mm:g} mm of tip depth, minimised by Nelder-Mead on "
-          f"the logarithms of the three parameters ({count[0]} FEM runs stopped at {args.fit_depth_mm + 1:g} mm; "
+          f"the logarithms of the three parameters ({runs} FEM runs stopped at {args.fit_depth_mm + 1:g} mm; "
           "evaluations.csv lists each). Beyond the fitted range the measured trace rises and drops again at structures "
           "inside the liver (vessels) that the two-layer scene does not model; its RMSE there is shown, not fitted. "
           "The identified scene is `liver_identified.json`.", "", friction_note(feat_a, x_best, scene)]
+    return L
+
+
+def main():
+    """Command line -> the FEM runs, and README.md, identification.json, the plot and the identified scene in OUT_DIR."""
+    args = parse_arguments()
+    t_start = time.time()
+    scene = json.load(open(args.scene), object_pairs_hook=collections.OrderedDict)
+    curve = read_curve(args.curve, args.offset_mm)
+    measured = curve_features(curve)
+    bins = binned(curve, 0.0, args.fit_depth_mm)
+    x0 = literature_values(scene)
+    os.makedirs(args.out_dir, exist_ok=True)
+    work = tempfile.mkdtemp()
+    log_path = os.path.join(args.out_dir, "evaluations.csv")
+    previous = read_evaluations(args.from_evaluations)
+    # The whole insertion (the measured curve has no withdrawal).
+    target = scene["insertion"]["target_depth_mm"]
+    print("liver identification: FEM at the literature values (whole insertion)", flush=True)
+    full_before, _ = run_fem(with_parameters(scene, x0), work, "before", args, target)
+    if full_before is None:
+        sys.exit("liver identification: the FEM run at the literature values failed")
+    if previous:
+        x_best, runs = best_of_evaluations(previous, args.from_evaluations, log_path)
+    else:
+        x_best, runs = search(scene, x0, work, args, measured, bins, log_path)
+    print("liver identification: FEM at the identified values (whole insertion)", flush=True)
+    identified = with_parameters(scene, x_best)
+    full_after, _ = run_fem(identified, work, "after", args, target)
+    if full_after is None:
+        sys.exit("liver identification: the FEM run at the identified values failed")
+    ins_b, feat_b = fem_features(*full_before)
+    ins_a, feat_a = fem_features(*full_after)
+    obj_b, obj_a = objective(ins_b, feat_b, measured, bins), objective(ins_a, feat_a, measured, bins)
+    last = max(d for d, _ in curve)
+    held_b, held_a = held_out_rmse(ins_b, curve, args.fit_depth_mm, last), held_out_rmse(ins_a, curve, args.fit_depth_mm, last)
+    command = command_line(args)
+    stamp = (f"bash scripts/liver_fem_identification.sh, git {provenance.git_revision()}, {provenance.machine()}, "
+             f"{provenance.utc_now()} UTC")
+    plot(os.path.join(args.out_dir, "liver_fem_vs_okamura.png"), curve, ins_b, ins_a, args.fit_depth_mm, stamp)
+    write_identified_scene(args.out_dir, identified, x_best)
+    result = {"parameters": NAMES, "literature": x0, "identified": x_best, "objective_before": obj_b,
+              "objective_after": obj_a, "measured": measured, "fem_before": feat_b, "fem_after": feat_a,
+              "held_out_rmse_N": {"before": held_b, "after": held_a, "range_mm": [args.fit_depth_mm, last]},
+              "fem_runs": runs + 2, "wall_s": time.time() - t_start, "command": command}
+    results_io.write_text(os.path.join(args.out_dir, "identification.json"), json.dumps(result, indent=2) + "\n")
+    fits = (measured, feat_b, feat_a, obj_b, obj_a, held_b, held_a)
+    L = readme_lines(args, command, runs, bool(previous), (time.time() - t_start) / 60, x0, x_best, fits, last, scene)
     results_io.write_text(os.path.join(args.out_dir, "README.md"), "\n".join(L) + "\n")
     shutil.rmtree(work, ignore_errors=True)
     print("wrote", args.out_dir)

@@ -89,115 +89,154 @@ def transmitted(r_src, u_src, rho, h, n_s=3000, n_t=720):
 
 
 def row(values):
+    """Numbers -> one markdown row's cells, two decimals."""
     return " | ".join(f"{v:.2f}" for v in values)
 
 
-def main():
-    if len(sys.argv) != 4:
-        sys.exit(__doc__)
-    fem_dir, scene_path, out_dir = sys.argv[1:]
-    scene = json.load(open(scene_path))
-    tops = np.cumsum([0.0] + [l["thickness_mm"] for l in scene["layers"]])[:3]
-    ins = scene["insertion"]
+def frames_by_depth(fem_dir, ins):
+    """FEM dir and the scene's insertion -> {tip depth mm: VTU frame path}, insertion frames only (first per depth)."""
     frames = re.findall(r'timestep="([^"]*)" part="0" file="([^"]*)"', open(os.path.join(fem_dir, "fem_fields.pvd")).read())
     by_depth = {}
     for t, f in frames:
         depth = round(ins["speed_mm_per_s"] * float(t) - ins["start_height_mm"], 1)
         if float(t) * ins["speed_mm_per_s"] <= ins["start_height_mm"] + ins["target_depth_mm"] + 1e-9:
             by_depth.setdefault(depth, os.path.join(fem_dir, f))
-    names = [l["name"] for l in scene["layers"]]
-    header = "| depth (mm) | surface | " + " | ".join(f"r = {r} mm" for r in RADII_MM) + " |"
-    rule = "|---|---|" + "---|" * len(RADII_MM)
-    lines = ["# How the FEM's layer surfaces move together\n",
-             f"Command: `scripts/surface_transmission_study.py {fem_dir} {scene_path} {out_dir}`, git "
-             f"{provenance.git_revision()}, {provenance.machine()}, {provenance.utc_now()} UTC.\n",
-             f"FEM reference: `{fem_dir}` (axisymmetric frames of scene `{scene_path}`). Deflections in mm, > 0 into "
-             "the tissue, of each layer's top surface (the material surface at its rest depth). The half-space "
-             "transmission is the kernel of core/coupled_surfaces.hpp, evaluated here by plain quadrature. The rules "
-             "have no fitted parameter, but they were chosen by looking at this reference (the default slab at 10 mm/s): "
-             "these tables are in sample. Out of sample, the same rules in the real-time model are judged on the "
-             "held-out cases (results/validation_heldout).\n",
-             f"## 1. While the {names[0]} is pressed: the surfaces below it\n", header, rule]
+    return by_depth
 
-    def source_and_targets(depths, source, targets, through):
-        """The source layer's top, then each target's top beside its transmission from the source."""
-        for d in depths:
-            if d not in by_depth:
-                continue
-            rs, us = surface_profile(by_depth[d], tops[source])
-            lines.append(f"| {d:.1f} | {names[source]} top (FEM) | {row(np.interp(RADII_MM, rs, us))} |")
-            for k in targets:
-                rt, ut = surface_profile(by_depth[d], tops[k])
-                h = abs(tops[k] - tops[source])
-                lines.append(f"| {d:.1f} | {names[k]} top (FEM) | {row(np.interp(RADII_MM, rt, ut))} |")
-                lines.append(f"| {d:.1f} | {names[k]} top: transmission {through} {h:.1f} mm | "
-                             f"{row([transmitted(rs, us, x, h) for x in RADII_MM])} |")
 
-    source_and_targets((2.0, 4.0, 6.0, 8.0), 0, (1, 2), "through")
-    lines += ["", f"## 2. After the {names[0]} and the {names[1]} broke: the broken surfaces over the pressed "
-              f"{names[2]}\n", header, rule]
-    source_and_targets((11.4, 13.4, 18.4, 28.4), 2, (1, 0), "up through")
-    # 3. and 4. Broken layers held by the needle's load (reciprocity).
+def table_head(last_column=None):
+    """-> the head and rule of a table of deflections at RADII_MM (with one more column if given)."""
+    extra = f" {last_column} |" if last_column else ""
+    return ["| depth (mm) | surface | " + " | ".join(f"r = {r} mm" for r in RADII_MM) + " |" + extra,
+            "|---|---|" + "---|" * (len(RADII_MM) + (1 if last_column else 0))]
+
+
+def page_head(fem_dir, scene_path, out_dir, names):
+    """Command and layer names -> the page's title, provenance, what it compares, and section 1's head."""
+    return ["# How the FEM's layer surfaces move together\n",
+            f"Command: `scripts/surface_transmission_study.py {fem_dir} {scene_path} {out_dir}`, git "
+            f"{provenance.git_revision()}, {provenance.machine()}, {provenance.utc_now()} UTC.\n",
+            f"FEM reference: `{fem_dir}` (axisymmetric frames of scene `{scene_path}`). Deflections in mm, > 0 into "
+            "the tissue, of each layer's top surface (the material surface at its rest depth). The half-space "
+            "transmission is the kernel of core/coupled_surfaces.hpp, evaluated here by plain quadrature. The rules "
+            "have no fitted parameter, but they were chosen by looking at this reference (the default slab at 10 mm/s): "
+            "these tables are in sample. Out of sample, the same rules in the real-time model are judged on the "
+            "held-out cases (results/validation_heldout).\n",
+            f"## 1. While the {names[0]} is pressed: the surfaces below it\n"] + table_head()
+
+
+def source_and_targets(by_depth, tops, names, depths, source, targets, through):
+    """Frames, layer tops and names -> rows: the source layer's top, then each target's top beside its transmission."""
+    lines = []
+    for d in depths:
+        if d not in by_depth:
+            continue
+        rs, us = surface_profile(by_depth[d], tops[source])
+        lines.append(f"| {d:.1f} | {names[source]} top (FEM) | {row(np.interp(RADII_MM, rs, us))} |")
+        for k in targets:
+            rt, ut = surface_profile(by_depth[d], tops[k])
+            h = abs(tops[k] - tops[source])
+            lines.append(f"| {d:.1f} | {names[k]} top (FEM) | {row(np.interp(RADII_MM, rt, ut))} |")
+            lines.append(f"| {d:.1f} | {names[k]} top: transmission {through} {h:.1f} mm | "
+                         f"{row([transmitted(rs, us, x, h) for x in RADII_MM])} |")
+    return lines
+
+
+def insertion_curve(fem_dir):
+    """FEM dir -> the insertion rows of fem_force_depth.csv (dicts of strings)."""
     rows = [l for l in open(os.path.join(fem_dir, "fem_force_depth.csv")) if not l.startswith("#")]
     head = rows[0].strip().split(",")
     curve = [dict(zip(head, r.strip().split(","))) for r in rows[1:]]
-    curve = [r for r in curve if r["phase"] == "insertion"]
+    return [r for r in curve if r["phase"] == "insertion"]
+
+
+def break_depth(curve, name):
+    """Insertion rows and a layer's name -> the tip depth (mm, 0.1) of its first punctured row, or None."""
+    broke = next((r for r in curve if r.get(f"{name}_state") == "punctured"), None)
+    return None if broke is None else round(float(broke["depth_mm"]), 1)
+
+
+def load_rule_rows(by_depth, tops, names, force, k, zb, depths):
+    """Layer k's top past its break at zb beside the load rule with the FEM's own forces -> table rows."""
+    lines = []
+    rb, ub = surface_profile(by_depth[zb], tops[k])
+    fb = float(force[zb]["force_N"])
+    for d in depths:
+        if d not in by_depth or d not in force:
+            continue
+        r = force[d]
+        tip = float(r["tip_force_N"]) + float(r["cutting_force_N"])
+        shaft = float(r["friction_force_N"])
+        c = d - zb
+        rule_values = np.array([tip / fb * transmitted(rb, ub, x, c) + shaft / fb * transmitted(rb, ub, x, c / 2)
+                                for x in RADII_MM])
+        rt, ut = surface_profile(by_depth[d], tops[k])
+        fem = np.interp(RADII_MM, rt, ut)
+        rel = np.sqrt(np.mean((rule_values - fem) ** 2)) / np.max(np.abs(fem))
+        lines.append(f"| {d:.1f} | {names[k]} top (FEM) | {row(fem)} | |")
+        lines.append(f"| {d:.1f} | {names[k]} top: the load rule | {row(rule_values)} | {rel:.2f} |")
+    return lines
+
+
+LOAD_RULE_TEXT = ("Rule (core/coupled_surfaces.hpp): the shape at the break times (force at the tip / force at the "
+                  "break) transmitted through c, plus (shaft force / force at the break) through c / 2, c = depth - "
+                  "{zb:.1f} mm; the FEM's own forces (fem_force_depth.csv: the needle's whole force at the break; tip + "
+                  "cutting at the tip, friction along the shaft). Relative RMSE over the six radii, of the FEM's "
+                  "largest.\n")
+
+
+def load_rule_sections(fem_dir, by_depth, tops, names):
+    """FEM dir, frames, layer tops and names -> sections 3 and 4: broken layers held by the needle's load."""
+    # 3. and 4. Broken layers held by the needle's load (reciprocity).
+    curve = insertion_curve(fem_dir)
     force = {round(float(r["depth_mm"]), 1): r for r in curve}
-
-    def break_depth(k):
-        broke = next((r for r in curve if r.get(f"{names[k]}_state") == "punctured"), None)
-        return None if broke is None else round(float(broke["depth_mm"]), 1)
-
-    def load_rule_rows(k, zb, depths):
-        """Layer k's top past its break at zb beside the load rule with the FEM's own forces."""
-        rb, ub = surface_profile(by_depth[zb], tops[k])
-        fb = float(force[zb]["force_N"])
-        for d in depths:
-            if d not in by_depth or d not in force:
-                continue
-            r = force[d]
-            tip = float(r["tip_force_N"]) + float(r["cutting_force_N"])
-            shaft = float(r["friction_force_N"])
-            c = d - zb
-            rule_values = np.array([tip / fb * transmitted(rb, ub, x, c) + shaft / fb * transmitted(rb, ub, x, c / 2)
-                                    for x in RADII_MM])
-            rt, ut = surface_profile(by_depth[d], tops[k])
-            fem = np.interp(RADII_MM, rt, ut)
-            rel = np.sqrt(np.mean((rule_values - fem) ** 2)) / np.max(np.abs(fem))
-            lines.append(f"| {d:.1f} | {names[k]} top (FEM) | {row(fem)} | |")
-            lines.append(f"| {d:.1f} | {names[k]} top: the load rule | {row(rule_values)} | {rel:.2f} |")
-
-    rule_text = ("Rule (core/coupled_surfaces.hpp): the shape at the break times (force at the tip / force at the "
-                 "break) transmitted through c, plus (shaft force / force at the break) through c / 2, c = depth - "
-                 "{zb:.1f} mm; the FEM's own forces (fem_force_depth.csv: the needle's whole force at the break; tip + "
-                 "cutting at the tip, friction along the shaft). Relative RMSE over the six radii, of the FEM's "
-                 "largest.\n")
-    table_head = ["| depth (mm) | surface | " + " | ".join(f"r = {r} mm" for r in RADII_MM) + " | RMSE / largest |",
-                  "|---|---|" + "---|" * (len(RADII_MM) + 1)]
-    zb = break_depth(2)
+    lines = []
+    zb = break_depth(curve, names[2])
     if zb is not None and zb in by_depth:
         lines += ["", f"## 3. The {names[2]} after its break ({zb:.1f} mm): held by the needle's load\n",
-                  rule_text.format(zb=zb)] + table_head
-        load_rule_rows(2, zb, (16.4, 18.4, 20.4, 24.4, 28.4))
-    zf = break_depth(1)
+                  LOAD_RULE_TEXT.format(zb=zb)] + table_head("RMSE / largest")
+        lines += load_rule_rows(by_depth, tops, names, force, 2, zb, (16.4, 18.4, 20.4, 24.4, 28.4))
+    zf = break_depth(curve, names[1])
     if zf is not None and zf in by_depth:
         lines += ["", f"## 4. The {names[1]} after its break ({zf:.1f} mm), squeezed between the tip and the "
                   f"{names[2]}: held by the needle's load\n",
                   f"The tip broke the {names[1]} below the {names[2]}'s rest surface; until the {names[2]} is pressed "
                   f"by the tip itself the broken {names[1]} carries the needle's load (in the real-time model: until the "
-                  f"{names[2]}'s mesh has taken over the deformation it was met with). " + rule_text.format(zb=zf)] + table_head
-        load_rule_rows(1, zf, tuple(d for d in sorted(by_depth) if zf < d <= zf + 1.5))
-    lines += ["",
-              "Reading: below a pressed surface the half-space transmission follows the FEM through the thin skin "
-              "(the fat's top) at every depth; through the thick fat onto the stiffer muscle it is right near the "
-              "break (8 mm) but too large earlier, because the FEM's fat stiffens as it is squeezed (the muscle's "
-              "share of the skin's centre deflection grows with the depth, the linear kernel's does not). Above a "
-              "pressed surface the broken layers rest on it: within 0.1 mm of the muscle's top from r = 6 mm on, up "
-              "to 0.5 mm shallower at 2-4 mm (the fat bridges), the skin deeper right at the axis (the shaft drags "
-              "the hole's rim); the upward transmission is 2-4 times too small near the axis, so coupled_surfaces "
-              "draws a broken surface on the layer below it, not through a kernel. The last layer after its break "
-              "follows the load rule of section 3 as the tip goes deeper, and so does a broken layer squeezed onto "
-              "the layer below it until that layer bears the tip (section 4)."]
+                  f"{names[2]}'s mesh has taken over the deformation it was met with). " + LOAD_RULE_TEXT.format(zb=zf)
+                  ] + table_head("RMSE / largest")
+        lines += load_rule_rows(by_depth, tops, names, force, 1, zf,
+                                tuple(d for d in sorted(by_depth) if zf < d <= zf + 1.5))
+    return lines
+
+
+READING = ("Reading: below a pressed surface the half-space transmission follows the FEM through the thin skin "
+           "(the fat's top) at every depth; through the thick fat onto the stiffer muscle it is right near the "
+           "break (8 mm) but too large earlier, because the FEM's fat stiffens as it is squeezed (the muscle's "
+           "share of the skin's centre deflection grows with the depth, the linear kernel's does not). Above a "
+           "pressed surface the broken layers rest on it: within 0.1 mm of the muscle's top from r = 6 mm on, up "
+           "to 0.5 mm shallower at 2-4 mm (the fat bridges), the skin deeper right at the axis (the shaft drags "
+           "the hole's rim); the upward transmission is 2-4 times too small near the axis, so coupled_surfaces "
+           "draws a broken surface on the layer below it, not through a kernel. The last layer after its break "
+           "follows the load rule of section 3 as the tip goes deeper, and so does a broken layer squeezed onto "
+           "the layer below it until that layer bears the tip (section 4).")
+
+
+def main():
+    """Command line (FEM_DIR SCENE_JSON OUT_DIR) -> OUT_DIR/README.md."""
+    if len(sys.argv) != 4:
+        sys.exit(__doc__)
+    fem_dir, scene_path, out_dir = sys.argv[1:]
+    scene = json.load(open(scene_path))
+    tops = np.cumsum([0.0] + [l["thickness_mm"] for l in scene["layers"]])[:3]
+    by_depth = frames_by_depth(fem_dir, scene["insertion"])
+    names = [l["name"] for l in scene["layers"]]
+    lines = page_head(fem_dir, scene_path, out_dir, names)
+    lines += source_and_targets(by_depth, tops, names, (2.0, 4.0, 6.0, 8.0), 0, (1, 2), "through")
+    lines += ["", f"## 2. After the {names[0]} and the {names[1]} broke: the broken surfaces over the pressed "
+              f"{names[2]}\n"] + table_head()
+    lines += source_and_targets(by_depth, tops, names, (11.4, 13.4, 18.4, 28.4), 2, (1, 0), "up through")
+    lines += load_rule_sections(fem_dir, by_depth, tops, names)
+    lines += ["", READING]
     os.makedirs(out_dir, exist_ok=True)
     results_io.write_text(os.path.join(out_dir, "README.md"), "\n".join(lines) + "\n")
     print("wrote", os.path.join(out_dir, "README.md"))
