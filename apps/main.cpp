@@ -329,7 +329,8 @@ int main(int argc, char** argv) {
   CLI::App app{"puncture: virtual needle-puncture simulation (real-time SHF + MSM model, FEM reference)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("puncture ") + puncture::io::program_version() + " (git " +
-                                        puncture::io::git_revision() + ")");
+                                        puncture::io::git_revision() + ", FEM sources " +
+                                        puncture::validation::fem_source_digest() + ")");
   app.footer("Exit codes: 0 success, 1 the run failed, 2 bad input (scene file, CSV, command line), "
              "3 output not writable, 128+n ended by signal n. -q: nothing on stdout (warnings and errors on stderr).");
   CommandLine c;

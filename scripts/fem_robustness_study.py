@@ -18,7 +18,8 @@ record) and OUT/runs/ (each run's outputs; not committed).
   # the page from the per-scene results already in OUT (after the tasks):
   python3 scripts/fem_robustness_study.py --collect --out DIR
   # go on with a study stopped part way: scenes with a result from the same
-  # FEM sources (git revision of reference_fem/, meshing/, core/) are kept:
+  # FEM sources are kept (the digest of the sources their geometry's run
+  # executes, scripts/fem_source_digest.py; comments do not count):
   python3 scripts/fem_robustness_study.py --resume
   # a page from the results so far, the scenes not yet run with the current
   # FEM sources listed as such:
@@ -38,6 +39,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import fem_robustness as fr  # noqa: E402
+import fem_source_digest as fsd  # noqa: E402
 import provenance  # noqa: E402
 import results_io  # noqa: E402
 
@@ -47,23 +49,41 @@ def scenes_of(count, seed, family):
     return [fr.draw_scene(rng, family, i) for i in range(count)]
 
 
-def fem_source_revision():
-    """The git revision of the last commit that changed the FEM's sources
-    (reference_fem/, meshing/, core/: the solver, its mesh and the scene it
-    reads; not the comparison models of `puncture compare` and their
-    tetrahedral meshes, which the FEM neither links nor reads): runs of one
-    study must all come from it."""
-    not_fem = [":(exclude)core/models", ":(exclude)core/src/comparison", ":(exclude)core/include/puncture/comparison",
-               ":(exclude,glob)meshing/**/*tet_*"]
+def current_fem_sources(binary):
+    """The program's git revision and, per FEM geometry, the digest of the sources its runs execute
+    (scripts/fem_source_digest.py). The program must be built from the FEM sources of this tree."""
+    revision, program_digest = fsd.program_version(binary)
+    if program_digest != fsd.digest():
+        sys.exit(f"fem_robustness_study: {binary} was built from other FEM sources ({program_digest}) than "
+                 f"this tree's ({fsd.digest()}): rebuild it (bash scripts/build.sh) or pass --build of a current build")
+    return revision, {g: fsd.digest(None, g) for g in fsd.GEOMETRIES}
+
+
+def record_digest(rec, scene):
+    """The digest of the FEM sources a record's run executed: its own field, or, for a record made
+    before records carried it, computed from the git revision it names (None if unknown)."""
+    if rec.get("fem_digest"):
+        return rec["fem_digest"]
+    revision = rec.get("fem_source", "unknown")
+    if revision == "unknown" or revision.endswith("-dirty"):
+        return None
     try:
-        return subprocess.check_output(["git", "-C", fr.ROOT, "log", "-1", "--format=%h", "--", "reference_fem",
-                                        "meshing", "core"] + not_fem, text=True,
-                                       stderr=subprocess.DEVNULL).strip() or "unknown"
-    except Exception:
-        return "unknown"
+        return fsd.digest(revision, fsd.scene_geometry(scene))
+    except (subprocess.CalledProcessError, OSError):
+        return None
 
 
-def run_one(scene, out, binary, threads):
+def current_record(out, scene, digests):
+    """OUT's record of SCENE when its run executed the current FEM sources of the scene's geometry, else None."""
+    rec = existing_result(out, scene["name"])
+    if rec is None or record_digest(rec, scene) != digests[fsd.scene_geometry(scene)]:
+        return None
+    rec.setdefault("fem_digest", record_digest(rec, scene))
+    rec.setdefault("geometry", fsd.scene_geometry(scene))
+    return rec
+
+
+def run_one(scene, out, binary, threads, sources):
     """Runs the FEM on one scene; returns (and writes) its result record."""
     name = scene["name"]
     scene_path = os.path.join(out, "scenes", name + ".json")
@@ -77,7 +97,8 @@ def run_one(scene, out, binary, threads):
     rec = {"scene": name, "exit": p.returncode, "wall_s": round(wall, 1), "error": "", "problems": [],
            "tip": scene["needle"]["tip"], "target_mm": scene["insertion"]["target_depth_mm"],
            "speed_mm_per_s": scene["insertion"]["speed_mm_per_s"], "hold_s": scene["insertion"]["dwell_s"],
-           "thickness_mm": [l["thickness_mm"] for l in scene["layers"]], "fem_source": fem_source_revision(),
+           "thickness_mm": [l["thickness_mm"] for l in scene["layers"]], "fem_source": sources[0],
+           "geometry": fsd.scene_geometry(scene), "fem_digest": sources[1][fsd.scene_geometry(scene)],
            "finished_utc": provenance.utc_now()}
     if p.returncode != 0:
         lines = [l for l in p.stderr.splitlines() if l.strip() and not l.startswith("warning")]
@@ -136,7 +157,9 @@ def page_header(records, args, command):
         "# FEM reference on scenes drawn at random",
         "",
         f"Made by `{command}` on {provenance.machine()}, {provenance.utc_now()} UTC, git {provenance.git_revision()}; "
-        f"every run from the FEM sources of git {', '.join(sorted({r.get('fem_source', 'unknown') for r in records}))}"
+        f"the runs from programs of git {', '.join(sorted({r.get('fem_source', 'unknown') for r in records}))}, "
+        "FEM sources per geometry (scripts/fem_source_digest.py) "
+        f"{', '.join(sorted({r.get('geometry', '?') + ' ' + str(r.get('fem_digest')) for r in records}))}"
         + (f", finished between {min(times)} and {max(times)} UTC." if times else "."),
         f"Scenes: {len(records) + len(missing)} drawn with seed {args.seed}, family `{args.family}` "
         "(scripts/fem_robustness.py: the ranges are `RANGES` there), "
@@ -265,6 +288,24 @@ def runs_csv(records):
     return "\n".join(out) + "\n"
 
 
+def collect_records(scenes, args):
+    """The records in OUT from the current FEM sources of each scene's geometry (this tree's) and the
+    scenes without one; without --partial a scene without a current record stops the collection."""
+    digests = {g: fsd.digest(None, g) for g in fsd.GEOMETRIES}
+    records, missing = [], []
+    for s in scenes:
+        rec = current_record(args.out, s, digests)
+        if rec is None and not args.partial:
+            old = existing_result(args.out, s["name"])
+            why = "no result" if old is None else "a result from other FEM sources"
+            sys.exit(f"fem_robustness_study: {why} for {s['name']} in {args.out}/results: run again with --resume")
+        if rec is None:
+            missing.append(s["name"])
+        else:
+            records.append(rec)
+    return records, missing
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--count", type=int, default=60)
@@ -288,45 +329,26 @@ def main():
     for s in scenes:
         fr.write_scene(s, os.path.join(args.out, "scenes", s["name"] + ".json"))
     if args.collect:
-        records, missing = [], []
-        source = fem_source_revision()
-        for s in scenes:
-            rec = existing_result(args.out, s["name"])
-            if rec is not None and rec.get("fem_source") != source:
-                if not args.partial:
-                    sys.exit(f"fem_robustness_study: the result for {s['name']} in {args.out}/results comes from "
-                             f"other FEM sources ({rec.get('fem_source', 'unknown')}, now {source}): run again "
-                             "with --resume")
-                rec = None  # made by another FEM: not yet run with this one
-            if rec is None:
-                if not args.partial:
-                    sys.exit(f"fem_robustness_study: no result for {s['name']} in {args.out}/results")
-                missing.append(s["name"])
-            else:
-                records.append(rec)
-        args.missing = missing
+        records, args.missing = collect_records(scenes, args)
     elif args.only >= 0:
         if args.only >= len(scenes):
             sys.exit(f"fem_robustness_study: --only {args.only}: there are {len(scenes)} scenes")
-        rec = run_one(scenes[args.only], args.out, binary, threads=1)
+        rec = run_one(scenes[args.only], args.out, binary, 1, current_fem_sources(binary))
         print(json.dumps(rec))
         return 0 if rec["exit"] == 0 and not rec["problems"] else 1
     else:
         if not os.access(binary, os.X_OK):
             sys.exit(f"fem_robustness_study: {binary} not built (bash scripts/build.sh)")
         threads = 1 if args.jobs > 1 else max(1, os.cpu_count() or 1)
-        records = [None] * len(scenes)
-        source = fem_source_revision()
+        sources = current_fem_sources(binary)
+        records = [current_record(args.out, s, sources[1]) if args.resume else None for s in scenes]
         if args.resume:
-            for i, s in enumerate(scenes):
-                rec = existing_result(args.out, s["name"])
-                if rec is not None and rec.get("fem_source") == source:
-                    records[i] = rec
             print(f"fem_robustness_study: {sum(r is not None for r in records)} of {len(scenes)} scenes have a "
-                  f"result from FEM sources {source}; running the others", flush=True)
+                  f"result from the current FEM sources of their geometry {sources[1]}; running the others",
+                  flush=True)
         t0 = time.monotonic()
         with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-            futures = {pool.submit(run_one, s, args.out, binary, threads): i for i, s in enumerate(scenes)
+            futures = {pool.submit(run_one, s, args.out, binary, threads, sources): i for i, s in enumerate(scenes)
                        if records[i] is None}
             for n, f in enumerate(concurrent.futures.as_completed(futures), 1):
                 i = futures[f]

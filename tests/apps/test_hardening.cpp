@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <thread>
 
@@ -84,10 +85,15 @@ std::vector<fs::path> staging_files(const fs::path& dir) {
   return found;
 }
 
-TEST(ProgramContract, VersionPrintsTheBuildRevision) {
+TEST(ProgramContract, VersionPrintsTheBuildRevisionAndTheFemSourceDigest) {
   const Result r = run_program("--version");
   EXPECT_EQ(r.exit_code, 0);
-  EXPECT_EQ(r.out, std::string("puncture ") + io::program_version() + " (git " + io::git_revision() + ")\n");
+  const std::string head = std::string("puncture ") + io::program_version() + " (git " + io::git_revision() +
+                           ", FEM sources ";
+  ASSERT_EQ(r.out.substr(0, head.size()), head);
+  // 16 hex digits of the sources' SHA-256 (the cache key's digest), never the
+  // "none" of a build that did not compute it.
+  EXPECT_TRUE(std::regex_match(r.out.substr(head.size()), std::regex("[0-9a-f]{16}\\)\n"))) << r.out;
 }
 
 TEST(ProgramContract, ExitCodesAreTheDocumentedOnes) {

@@ -74,6 +74,8 @@ bool reference_complete(const std::filesystem::path& dir, bool need_vtu, const s
 
 }  // namespace
 
+std::string fem_source_digest() { return PUNCTURE_FEM_SOURCE_DIGEST; }
+
 std::string fem_reference_key_text(const Scene& scene, const FemReferenceOptions& options) {
   return fem_reference_key_text(scene, key_options(options), PUNCTURE_FEM_SOURCE_DIGEST);
 }

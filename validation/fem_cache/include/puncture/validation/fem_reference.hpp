@@ -45,6 +45,11 @@ struct FemReference {
   bool from_cache = false;
 };
 
+/// This build's FEM source digest: 16 hex digits of the SHA-256 over the
+/// sources of reference_fem/ and meshing/ (validation/fem_cache/CMakeLists.txt);
+/// part of every cache key, and shown by `puncture --version`.
+std::string fem_source_digest();
+
 /// The key text of `scene` with `options` (fem_reference_key_text with this
 /// build's FEM source digest and the options' overrides and mesh).
 std::string fem_reference_key_text(const Scene& scene, const FemReferenceOptions& options);

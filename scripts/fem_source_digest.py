@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+"""fem_source_digest.py: which FEM sources a result was computed from.
+
+The program's FEM cache key holds a digest of every source of reference_fem/
+and meshing/ and of the two core headers the FEM compiles in (scene.hpp,
+puncture_force.hpp; validation/fem_cache/CMakeLists.txt: SHA-256 over the sorted
+files' SHA-256 hex digests, line comments left out, 16 hex digits; `puncture --version` shows it).
+This module computes the same digest from the working tree or from any git
+revision, and a digest per FEM geometry: the sources one geometry's run can
+execute, leaving out the files only the other geometry runs, so that a change
+to the 3D solver does not count as a change of the axisymmetric reference
+(and the other way round). A study of many FEM runs keys each run on its
+geometry's digest (scripts/fem_robustness_study.py).
+
+Which files belong to one geometry only (tests/scripts/test_fem_source_digest.py
+checks the rule that makes this sound):
+  3d only:           the 3D solver and run: the files that define only
+                     FiniteStrainSolver, SlabInsertionRun and the types of their
+                     interface; only the 3D branch of run_needle_insertion
+                     constructs them, and no axisymmetric file names them
+  axisymmetric only: the axisymmetric solver, run and mesh, which the 3D run
+                     never names
+Everything else (scene, materials, cohesive law, the dispatcher, the output
+helpers, the meshes' shared parts) is in both digests.
+
+  python3 scripts/fem_source_digest.py [--rev REV] [--geometry all|3d|axisymmetric]
+"""
+import argparse
+import hashlib
+import os
+import re
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SOURCE_DIRS = ("reference_fem/src", "reference_fem/include", "meshing/src", "meshing/include")
+# The two headers of core/ that the FEM compiles into its code (the Scene, the layer states).
+CORE_HEADERS = ("core/include/puncture/scene.hpp", "core/include/puncture/puncture_force.hpp")
+# The tetrahedral mesh and mesher of the comparison models are no FEM source
+# (the same filter as validation/fem_cache/CMakeLists.txt).
+NOT_FEM = re.compile(r"tet_slab_mesh|tet_mesh")
+ONLY = {
+    "3d": re.compile(r"^reference_fem/(src/(finite_strain_solver\.cc|finite_strain_assembly\.cc|"
+                     r"slab_insertion_output\.cc|slab_insertion_run\.hpp)|"
+                     r"include/puncture/fem/finite_strain_solver\.hpp)$"),
+    "axisymmetric": re.compile(r"^(reference_fem/src/axisymmetric_[a-z_]+\.(cc|hpp)|"
+                               r"reference_fem/include/puncture/fem/axisymmetric_solver\.hpp|"
+                               r"meshing/(src|include/puncture/meshing)/axisymmetric_slab_mesh\.(cpp|hpp))$"),
+}
+GEOMETRIES = tuple(ONLY)
+
+
+def source_files(rev=None):
+    """The FEM source files (paths relative to the repository) of the working tree, or of git revision REV."""
+    if rev is None:
+        files = [os.path.relpath(os.path.join(d, f), ROOT)
+                 for top in SOURCE_DIRS for d, _, names in os.walk(os.path.join(ROOT, top)) for f in names]
+    else:
+        files = subprocess.check_output(["git", "-C", ROOT, "ls-tree", "-r", "--name-only", rev, *SOURCE_DIRS],
+                                        text=True).split()
+    return sorted([f for f in files if not NOT_FEM.search(f)] + list(CORE_HEADERS))
+
+
+def file_bytes(path, rev=None):
+    """The content of PATH in the working tree or at revision REV, without its line comments
+    (from // to the end of the line, as CMake's digest: an edited comment changes no digest)."""
+    if rev is None:
+        with open(os.path.join(ROOT, path), "rb") as f:
+            content = f.read()
+    else:
+        content = subprocess.check_output(["git", "-C", ROOT, "show", f"{rev}:{path}"])
+    return re.sub(rb"//[^\n]*", b"", content)
+
+
+def geometry_files(files, geometry):
+    """FILES less those that belong only to the other geometries (geometry 'all': every file)."""
+    if geometry == "all":
+        return list(files)
+    if geometry not in ONLY:
+        raise ValueError(f"fem_source_digest: unknown geometry '{geometry}' (all, {', '.join(GEOMETRIES)})")
+    others = [ONLY[g] for g in GEOMETRIES if g != geometry]
+    return [f for f in files if not any(p.match(f) for p in others)]
+
+
+def digest(rev=None, geometry="all"):
+    """16 hex digits: SHA-256 over the SHA-256 hex digests of the geometry's FEM sources in path order
+    (geometry 'all' is the program's own digest, `puncture --version`)."""
+    hexes = "".join(hashlib.sha256(file_bytes(f, rev)).hexdigest()
+                    for f in geometry_files(source_files(rev), geometry))
+    return hashlib.sha256(hexes.encode()).hexdigest()[:16]
+
+
+def program_version(binary):
+    """(git revision, FEM source digest) that `BINARY --version` names; the revision may end in -dirty."""
+    out = subprocess.check_output([binary, "--version"], text=True)
+    m = re.search(r"\(git ([0-9a-f]+(?:-dirty)?|unknown), FEM sources ([0-9a-f]{16})\)", out)
+    if not m:
+        raise RuntimeError(f"fem_source_digest: cannot read the git revision and FEM digest from "
+                           f"'{binary} --version': {out.strip()}")
+    return m.group(1), m.group(2)
+
+
+def scene_geometry(scene):
+    """The FEM geometry a scene (dict) runs with: its fem.geometry, or by the tip for 'auto'."""
+    geometry = scene.get("fem", {}).get("geometry", "auto")
+    if geometry == "auto":
+        geometry = "3d" if scene["needle"]["tip"] == "blunt" else "axisymmetric"
+    return geometry
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--rev", default=None, help="a git revision (default: the working tree)")
+    ap.add_argument("--geometry", default="all", choices=("all",) + GEOMETRIES)
+    args = ap.parse_args()
+    print(digest(args.rev, args.geometry))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
