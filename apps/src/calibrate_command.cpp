@@ -181,9 +181,11 @@ std::vector<std::pair<std::string, const validation::InsertionCurve*>> curve_lis
   return curves;
 }
 
-/// --surface-fit: each layer with FEM surface profiles gets the force mesh
-/// identified from them and no tip stiffening (the mesh carries it); K and
-/// the stiffening are then kept. Returns the identifications for the report.
+/// --surface-fit: each layer with at least kMinPressingProfiles FEM surface
+/// profiles gets the force mesh identified from them and no tip stiffening
+/// (the mesh carries it); its K and stiffening are then kept, while a layer
+/// with fewer profiles has them tuned in its stage as without the surface
+/// fit. Returns the identifications for the report.
 std::vector<validation::SurfaceIdentificationResult> fit_surfaces(const std::filesystem::path& fem_dir, Scene& scene,
                                                                   validation::CalibrationOptions& calibration,
                                                                   int threads, std::ostream& out) {
@@ -197,7 +199,7 @@ std::vector<validation::SurfaceIdentificationResult> fit_surfaces(const std::fil
   for (std::size_t k = 0; k < scene.layers.size(); ++k) {
     Layer& layer = scene.layers[k];
     const validation::SurfacePressingReference ref = validation::surface_pressing_reference(fem, scene, k);
-    if (ref.size() < 3) {
+    if (ref.size() < validation::kMinPressingProfiles) {
       out << "[calibrate] surface fit: layer " << layer.name << ": " << ref.size()
           << " pressing profile(s) in the FEM, its force mesh stays\n";
       continue;
@@ -205,13 +207,12 @@ std::vector<validation::SurfaceIdentificationResult> fit_surfaces(const std::fil
     results.push_back(validation::identify_force_mesh(layer.force_mesh, layer.thickness_m, layer.density_kg_per_m3, ref, o));
     layer.force_mesh = results.back().after;
     layer.force_law.stiffening = StiffeningLaw{};  // the mesh stiffens itself
+    calibration.parameters.mesh_identified_layers.push_back(layer.name);
     out << "[calibrate] surface fit: layer " << layer.name << ": force RMSE "
         << results.back().quality_before.force_rmse_relative << " -> " << results.back().quality_after.force_rmse_relative
         << ", deflection RMSE " << results.back().quality_before.deflection_rmse_relative << " -> "
         << results.back().quality_after.deflection_rmse_relative << " (" << results.back().status << ")\n";
   }
-  calibration.parameters.virtual_stiffness = false;
-  calibration.parameters.stiffening = false;
   return results;
 }
 
@@ -289,7 +290,9 @@ std::string surface_fit_markdown(const std::vector<validation::SurfaceIdentifica
          "identified from the FEM's tip force and deflection profile together (quasi-static mesh; "
          "validation/calibration/include/puncture/validation/surface_identification.hpp); those layers carry "
          "no tip stiffening (the mesh stiffens itself, so Eq. 5 carries the pressing force) and K and the "
-         "stiffening were kept by the stages. Values +- relative standard error (Gauss-Newton); RMSEs before "
+         "stiffening were kept by the stages; a layer with fewer than " +
+         std::to_string(validation::kMinPressingProfiles) + " such profiles had its K and stiffening tuned in its "
+         "stage instead. Values +- relative standard error (Gauss-Newton); RMSEs before "
          "-> after, over the FEM's largest force and deflection of those samples; per sample and ring in "
          "surface_identification.csv.\n\n" +
          validation::surface_identification_markdown(surfaces);

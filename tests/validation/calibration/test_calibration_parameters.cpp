@@ -1,7 +1,10 @@
-// The parameter table's bounds (calibration_parameters.hpp): the rupture
-// release length is never shorter than the haptic ticks resolve.
+// The parameter table (calibration_parameters.hpp): the rupture release
+// length is never shorter than the haptic ticks resolve; a layer whose force
+// mesh the surface fit identified keeps K and the stiffening, the others tune
+// them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -51,4 +54,20 @@ TEST(CalibrationParameters, TheRuptureReleaseSpansAtLeastFiveHapticTicksAndATent
   EXPECT_TRUE(moved);
   EXPECT_DOUBLE_EQ(p.value_lo, 1e-4);
   EXPECT_DOUBLE_EQ(p.lower, std::log(1e-4));
+}
+
+TEST(CalibrationParameters, OnlyTheLayersWhoseMeshWasIdentifiedKeepKAndTheStiffening) {
+  const Scene s = default_scene();
+  ASSERT_TRUE(s.effects.surface_force && s.effects.stiffening);
+  puncture::validation::TunedParameterSet t;
+  t.mesh_identified_layers = {"skin"};  // the surface fit identified the skin only
+  const auto has = [](const std::vector<pc::ParamKind>& kinds, pc::ParamKind k) {
+    return std::find(kinds.begin(), kinds.end(), k) != kinds.end();
+  };
+  const std::vector<pc::ParamKind> skin = pc::layer_kinds(s, 0, t), muscle = pc::layer_kinds(s, 2, t);
+  EXPECT_FALSE(has(skin, pc::ParamKind::VirtualStiffness));
+  EXPECT_FALSE(has(skin, pc::ParamKind::StiffeningQuadratic) || has(skin, pc::ParamKind::StiffeningExponential));
+  EXPECT_TRUE(has(skin, pc::ParamKind::CriticalForce));
+  EXPECT_TRUE(has(muscle, pc::ParamKind::VirtualStiffness));
+  EXPECT_TRUE(has(muscle, pc::ParamKind::StiffeningQuadratic) || has(muscle, pc::ParamKind::StiffeningExponential));
 }

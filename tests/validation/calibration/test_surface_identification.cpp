@@ -78,6 +78,35 @@ TEST(SurfaceIdentification, RecoversKnownForceMeshParameters) {
   EXPECT_THROW(pv::identify_force_mesh(start, 1e-3, 1000.0, pv::SurfacePressingReference{}), std::invalid_argument);
 }
 
+TEST(SurfaceIdentification, TwoProfilesIdentifyTheMeshAndOneIsTooFew) {
+  // A layer broken soon after the tip meets it leaves two profiles (the
+  // default slab's muscle): their forces and ring deflections still fix the
+  // mesh; one profile is refused.
+  const ForceMeshParams truth = truth_params();
+  const pv::SurfacePressingReference all = reference_from(truth);
+  pv::SurfacePressingReference two;
+  two.layer = all.layer;
+  for (std::size_t i : {5u, 6u}) {  // z0 = 4.5 and 5.25 mm
+    two.contact_deflection_m.push_back(all.contact_deflection_m[i]);
+    two.force_N.push_back(all.force_N[i]);
+    two.profiles.push_back(all.profiles[i]);
+  }
+  ASSERT_EQ(two.size(), pv::kMinPressingProfiles);
+  ForceMeshParams start = truth;
+  start.virtual_stiffness_N_per_m *= 3.0;
+  start.surface_stiffness_N_per_m *= 0.4;
+  const pv::SurfaceIdentificationResult r = pv::identify_force_mesh(start, 1e-3, 1000.0, two);
+  EXPECT_GT(r.quality_before.force_rmse_relative, 0.1);
+  EXPECT_LT(r.quality_after.force_rmse_relative, 1e-3);
+  EXPECT_LT(r.quality_after.deflection_rmse_relative, 1e-3);
+  EXPECT_NEAR(r.after.virtual_stiffness_N_per_m / truth.virtual_stiffness_N_per_m, 1.0, 0.02);
+  pv::SurfacePressingReference one = two;
+  one.contact_deflection_m.pop_back();
+  one.force_N.pop_back();
+  one.profiles.pop_back();
+  EXPECT_THROW(pv::identify_force_mesh(start, 1e-3, 1000.0, one), std::invalid_argument);
+}
+
 TEST(SurfaceIdentification, RingCountFromTheExtentOfTheDeformedSurface) {
   // Profiles of a w = 7 mesh; a start at w = 5 searched over 3..7: the fit
   // with w = 7 reproduces them, smaller meshes leave the outer rings flat.

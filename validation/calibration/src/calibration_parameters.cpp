@@ -191,7 +191,10 @@ std::vector<ParamKind> layer_kinds(const Scene& scene, std::size_t k, const Tune
                                    const LayerIdentifiability* id) {
   std::vector<ParamKind> kinds;
   const Layer& l = scene.layers[k];
-  if (t.virtual_stiffness && scene.effects.surface_force) kinds.push_back(ParamKind::VirtualStiffness);
+  const bool mesh_identified = std::find(t.mesh_identified_layers.begin(), t.mesh_identified_layers.end(), l.name) !=
+                               t.mesh_identified_layers.end();
+  if (t.virtual_stiffness && !mesh_identified && scene.effects.surface_force)
+    kinds.push_back(ParamKind::VirtualStiffness);
   if (t.deformed_threshold && scene.effects.surface_force) {
     switch (l.force_law.breakthrough.kind) {
       case BreakthroughCriterion::Kind::Rings: kinds.push_back(ParamKind::DeformedThreshold); break;
@@ -201,7 +204,7 @@ std::vector<ParamKind> layer_kinds(const Scene& scene, std::size_t k, const Tune
   }
   if (t.surface_stiffness && scene.effects.surface_force) kinds.push_back(ParamKind::SurfaceStiffness);
   if (t.spacing && scene.effects.surface_force) kinds.push_back(ParamKind::Spacing);
-  if (t.stiffening && scene.effects.stiffening && scene.effects.surface_force) {
+  if (t.stiffening && !mesh_identified && scene.effects.stiffening && scene.effects.surface_force) {
     if (l.force_law.stiffening.kind == StiffeningLaw::Kind::Polynomial) {
       // a2 and a3: a measured pre-puncture rise is often closer to z^3 than z^2
       // (the default FEM's skin: F(8 mm) / F(4 mm) = 9.3).

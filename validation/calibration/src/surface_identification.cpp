@@ -163,8 +163,9 @@ namespace {
 SurfaceIdentificationResult fit_rings(const ForceMeshParams& start, double thickness_m, double density_kg_per_m3,
                                       const SurfacePressingReference& ref, const SurfaceIdentificationOptions& o,
                                       int compare_rings) {
-  if (ref.size() < 3) throw std::invalid_argument("identify_force_mesh: layer " + ref.layer +
-                                                  ": fewer than 3 pressing profiles in the reference");
+  if (ref.size() < kMinPressingProfiles)
+    throw std::invalid_argument("identify_force_mesh: layer " + ref.layer + ": fewer than " +
+                                std::to_string(kMinPressingProfiles) + " pressing profiles in the reference");
   if (!(o.bound_factor > 1.0)) throw std::invalid_argument("identify_force_mesh: bound_factor must be > 1");
   SurfaceIdentificationResult result;
   result.layer = ref.layer;

@@ -201,7 +201,8 @@ nlohmann::json optimiser_json(const CalibrationResult& result, const Calibration
                        {"stiffening", t.stiffening},
                        {"surface_stiffness", t.surface_stiffness},
                        {"L", t.spacing},
-                       {"w", t.rings}}},
+                       {"w", t.rings},
+                       {"K_and_stiffening_kept_for", t.mesh_identified_layers}}},
                      {"joint_polish", options.joint_polish},
                      {"passes", options.passes},
                      {"puncture_depths_mm", [&] {

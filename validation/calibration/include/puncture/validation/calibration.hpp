@@ -132,6 +132,11 @@ struct TunedParameterSet {
   bool spacing = false;            ///< L (needs a deflection profile)
   bool rings = false;              ///< w (integer, enumerated)
   DampingPolicy damping = DampingPolicy::Auto;
+  /// Layers (by name) whose force mesh was identified before the stages (the
+  /// surface fit, `puncture calibrate --surface-fit`): their K and stiffening
+  /// stay, whatever virtual_stiffness and stiffening say; the other layers'
+  /// follow those flags.
+  std::vector<std::string> mesh_identified_layers;
 };
 
 /// Weights of the objective terms (trajectory_objective.hpp).

@@ -29,6 +29,7 @@
 //   correlations) and the optimiser's status.
 #pragma once
 
+#include <cstddef>
 #include <limits>
 #include <string>
 #include <utility>
@@ -41,6 +42,13 @@
 namespace puncture::validation {
 
 constexpr double kFollowFraction = 0.8;
+/// Fewest profiles a force mesh is identified from. Each profile gives the
+/// force and the deflections of every ring inside its radii, so two give
+/// 2 (1 + w) residuals for the four parameters; whether the stiffening (k_a,
+/// z_v) is told apart over their depths is for the fit's standard errors to
+/// say (the report flags each parameter). A layer broken soon after the tip
+/// meets it (the default slab's muscle: two profiles) is still identified.
+constexpr std::size_t kMinPressingProfiles = 2;
 
 struct SurfacePressingReference {
   std::string layer;
