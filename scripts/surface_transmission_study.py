@@ -125,6 +125,19 @@ def page_head(fem_dir, scene_path, out_dir, names):
             f"## 1. While the {names[0]} is pressed: the surfaces below it\n"] + table_head()
 
 
+def nearest_frames(by_depth, wanted, tolerance_mm=0.6):
+    """Frames and the depths a table asks for (mm) -> the frame depths nearest to them, within the tolerance
+    (the FEM writes a frame every few load steps, so where they fall depends on its start height and cuts)."""
+    have = sorted(by_depth)
+    picked = []
+    for w in wanted:
+        if have:
+            d = min(have, key=lambda x: abs(x - w))
+            if abs(d - w) <= tolerance_mm and d not in picked:
+                picked.append(d)
+    return tuple(picked)
+
+
 def source_and_targets(by_depth, tops, names, depths, source, targets, through):
     """Frames, layer tops and names -> rows: the source layer's top, then each target's top beside its transmission."""
     lines = []
@@ -195,7 +208,8 @@ def load_rule_sections(fem_dir, by_depth, tops, names):
     if zb is not None and zb in by_depth:
         lines += ["", f"## 3. The {names[2]} after its break ({zb:.1f} mm): held by the needle's load\n",
                   LOAD_RULE_TEXT.format(zb=zb)] + table_head("RMSE / largest")
-        lines += load_rule_rows(by_depth, tops, names, force, 2, zb, (16.4, 18.4, 20.4, 24.4, 28.4))
+        lines += load_rule_rows(by_depth, tops, names, force, 2, zb,
+                                nearest_frames(by_depth, (16.4, 18.4, 20.4, 24.4, 28.4)))
     zf = break_depth(curve, names[1])
     if zf is not None and zf in by_depth:
         lines += ["", f"## 4. The {names[1]} after its break ({zf:.1f} mm), squeezed between the tip and the "
@@ -231,10 +245,12 @@ def main():
     by_depth = frames_by_depth(fem_dir, scene["insertion"])
     names = [l["name"] for l in scene["layers"]]
     lines = page_head(fem_dir, scene_path, out_dir, names)
-    lines += source_and_targets(by_depth, tops, names, (2.0, 4.0, 6.0, 8.0), 0, (1, 2), "through")
+    lines += source_and_targets(by_depth, tops, names, nearest_frames(by_depth, (2.0, 4.0, 6.0, 8.0)), 0, (1, 2),
+                                "through")
     lines += ["", f"## 2. After the {names[0]} and the {names[1]} broke: the broken surfaces over the pressed "
               f"{names[2]}\n"] + table_head()
-    lines += source_and_targets(by_depth, tops, names, (11.4, 13.4, 18.4, 28.4), 2, (1, 0), "up through")
+    lines += source_and_targets(by_depth, tops, names, nearest_frames(by_depth, (11.4, 13.4, 18.4, 28.4)), 2, (1, 0),
+                                "up through")
     lines += load_rule_sections(fem_dir, by_depth, tops, names)
     lines += ["", READING]
     os.makedirs(out_dir, exist_ok=True)
