@@ -71,3 +71,19 @@ TEST(CalibrationParameters, OnlyTheLayersWhoseMeshWasIdentifiedKeepKAndTheStiffe
   EXPECT_TRUE(has(muscle, pc::ParamKind::VirtualStiffness));
   EXPECT_TRUE(has(muscle, pc::ParamKind::StiffeningQuadratic) || has(muscle, pc::ParamKind::StiffeningExponential));
 }
+
+TEST(CalibrationParameters, AValueAtItsUpperBoundIsTheBoundExactlyAndTheSceneStaysValid) {
+  // exp(ln 0.05) rounds above 0.05 m: the fat's release length at its upper
+  // bound (a slab of the slab rule's family) failed the scene's limit of 50 mm.
+  Scene s = default_scene();
+  bool moved = false;
+  const pc::Parameter p = pc::make_parameter(s, 1, pc::ParamKind::RuptureRelease, 1000.0, moved);
+  ASSERT_TRUE(p.log_space);
+  EXPECT_LE(p.value_of(p.upper), p.value_hi);  // never above by rounding
+  EXPECT_NEAR(p.value_of(p.upper), p.value_hi, 1e-12 * p.value_hi);
+  EXPECT_GE(p.value_of(p.lower), p.value_lo);
+  EXPECT_EQ(p.value_of(p.upper + 1.0), p.value_hi);  // nor beyond
+  EXPECT_EQ(p.value_of(p.lower - 1.0), p.value_lo);
+  pc::set_param(s, p, p.value_of(p.upper));
+  EXPECT_NO_THROW(puncture::validate_scene(s, "test"));
+}

@@ -8,7 +8,11 @@
 namespace puncture::validation::calibration_detail {
 
 double Parameter::x_of(double v) const { return log_space ? std::log(v) : v / scale; }
-double Parameter::value_of(double x) const { return log_space ? std::exp(x) : x * scale; }
+// Clamped into [value_lo, value_hi]: exp(ln hi) can round above hi, and a
+// value one ulp outside the scene's limits fails its validation.
+double Parameter::value_of(double x) const {
+  return std::clamp(log_space ? std::exp(x) : x * scale, value_lo, value_hi);
+}
 
 ParamInfo info(ParamKind k) {
   switch (k) {
