@@ -76,16 +76,19 @@ def record_digest(rec, scene):
 def current_record(out, scene, digests):
     """OUT's record of SCENE when its run executed the current FEM sources of the scene's geometry, else None."""
     rec = existing_result(out, scene["name"])
-    if rec is None or record_digest(rec, scene) != digests[fsd.scene_geometry(scene)]:
+    if rec is None:
         return None
-    rec.setdefault("fem_digest", record_digest(rec, scene))
-    rec.setdefault("geometry", fsd.scene_geometry(scene))
+    geometry, digest = fsd.scene_geometry(scene), record_digest(rec, scene)
+    if digest != digests[geometry]:
+        return None
+    rec.setdefault("fem_digest", digest)
+    rec.setdefault("geometry", geometry)
     return rec
 
 
 def run_one(scene, out, binary, threads, sources):
     """Runs the FEM on one scene; returns (and writes) its result record."""
-    name = scene["name"]
+    name, geometry = scene["name"], fsd.scene_geometry(scene)
     scene_path = os.path.join(out, "scenes", name + ".json")
     run_dir = os.path.join(out, "runs", name)
     shutil.rmtree(run_dir, ignore_errors=True)
@@ -98,7 +101,7 @@ def run_one(scene, out, binary, threads, sources):
            "tip": scene["needle"]["tip"], "target_mm": scene["insertion"]["target_depth_mm"],
            "speed_mm_per_s": scene["insertion"]["speed_mm_per_s"], "hold_s": scene["insertion"]["dwell_s"],
            "thickness_mm": [l["thickness_mm"] for l in scene["layers"]], "fem_source": sources[0],
-           "geometry": fsd.scene_geometry(scene), "fem_digest": sources[1][fsd.scene_geometry(scene)],
+           "geometry": geometry, "fem_digest": sources[1][geometry],
            "finished_utc": provenance.utc_now()}
     if p.returncode != 0:
         lines = [l for l in p.stderr.splitlines() if l.strip() and not l.startswith("warning")]

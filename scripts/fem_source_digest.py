@@ -26,6 +26,7 @@ helpers, the meshes' shared parts) is in both digests.
   python3 scripts/fem_source_digest.py [--rev REV] [--geometry all|3d|axisymmetric]
 """
 import argparse
+import functools
 import hashlib
 import os
 import re
@@ -84,7 +85,17 @@ def geometry_files(files, geometry):
 
 def digest(rev=None, geometry="all"):
     """16 hex digits: SHA-256 over the SHA-256 hex digests of the geometry's FEM sources in path order
-    (geometry 'all' is the program's own digest, `puncture --version`)."""
+    (geometry 'all' is the program's own digest, `puncture --version`). A revision's digests are
+    computed once per process (a study reads many records of the same revision)."""
+    return _digest_of(None, geometry) if rev is None else _revision_digest(rev, geometry)
+
+
+@functools.lru_cache(maxsize=None)
+def _revision_digest(rev, geometry):
+    return _digest_of(rev, geometry)
+
+
+def _digest_of(rev, geometry):
     hexes = "".join(hashlib.sha256(file_bytes(f, rev)).hexdigest()
                     for f in geometry_files(source_files(rev), geometry))
     return hashlib.sha256(hexes.encode()).hexdigest()[:16]
