@@ -85,8 +85,8 @@ std::string command_line(const CalibrateOptions& options, const std::filesystem:
 /// otherwise (a bench recording is the tissue at its speed: with recordings at
 /// two or more speeds d and the rate laws are tuned).
 validation::ReferenceCurve read_measured(const std::filesystem::path& path, const CalibrateOptions& options,
-                                         std::ostream& out) {
-  validation::ReferenceCurve reference = read_measured_reference(path, options.recording);
+                                         const Scene& scene, std::ostream& out) {
+  validation::ReferenceCurve reference = read_measured_reference(path, options.recording, scene.insertion);
   auto& meta = reference.curve.metadata;
   if (meta.count("recording_format"))
     out << "[calibrate] raw recording " << path.string() << " (format: " << meta.at("recording_format")
@@ -140,13 +140,14 @@ bool load_references(const CalibrateOptions& options, const Scene& scene, std::o
       if (std::filesystem::weakly_canonical(h) == std::filesystem::weakly_canonical(r))
         throw UsageError("--held-out " + h.string() + " is also a --reference: a recording is fitted or held out");
   if (options.references.empty()) {
+    require_axial_for_fem(scene, scene.source_path, "the FEM reference");
     if (!load_fem_references(options, scene, out, references, fem_dir)) return false;
   } else {
     if (!options.fem_speeds_mm_per_s.empty()) throw UsageError("--fem-speeds takes the scene's FEM reference, not --reference");
     if (options.surface_fit) throw UsageError("--surface-fit needs the scene's FEM reference (its surface profiles), not --reference");
-    for (const std::filesystem::path& path : options.references) references.push_back(read_measured(path, options, out));
+    for (const std::filesystem::path& path : options.references) references.push_back(read_measured(path, options, scene, out));
   }
-  for (const std::filesystem::path& path : options.held_out) held_out.push_back(read_measured(path, options, out));
+  for (const std::filesystem::path& path : options.held_out) held_out.push_back(read_measured(path, options, scene, out));
   if (options.references.size() + held_out.size() > 1) {
     std::vector<const validation::ReferenceCurve*> all;
     for (const auto* list : {&references, &held_out})

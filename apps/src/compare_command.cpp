@@ -27,6 +27,7 @@
 #include <set>
 
 #include "command_errors.hpp"
+#include "measured_reference.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/comparison/model_factory.hpp"
 #include "puncture/io/atomic_file.hpp"
@@ -152,6 +153,7 @@ int compare_command(const CompareOptions& options, std::ostream& out, std::ostre
     validation::ComparisonReportOptions report;
     report.wall_start = std::chrono::steady_clock::now();
     const Scene scene = load_scene(scene_path);
+    require_axial_for_fem(scene, scene_path.string(), "the comparison (its FEM reference and models)");
     report.models = options.models.empty() ? all_model_names() : options.models;
     check_options(options, report.models);
     report.weights_path = options.weights.empty() ? default_delphi_weights_path() : options.weights;

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "command_errors.hpp"
+#include "measured_reference.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/validation/fem_reference.hpp"
 #include "puncture/scene_io.hpp"
@@ -25,6 +26,7 @@ int fem_command(const FemOptions& options, std::ostream& stdout_stream, std::ost
   NullStream silent;
   return report_errors(root ? err : silent, scene_path.string(), [&]() -> int {
     const Scene scene = load_scene(scene_path);
+    require_axial_for_fem(scene, scene_path.string(), "the FEM reference");
     fem::FemRunOptions fem_options;
     fem_options.output_dir =
         (options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_fem") : options.output_dir).string();

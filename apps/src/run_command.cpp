@@ -48,12 +48,17 @@ double quantile(std::vector<double> v, double q) {
 }
 
 /// realtime_curve.csv: one row per kept haptic tick (every tick unless the
-/// run is longer than scene_limits::kMaxCurveRows ticks): force, its parts
-/// (tip, cutting, friction), the phase, and per layer its state and forces.
+/// run is longer than scene_limits::kMaxCurveRows ticks): force along the
+/// needle, its parts (tip, cutting, friction), the phase, the depth along the
+/// needle, the force across it, the force vector on the needle (scene frame)
+/// and its moment about the entry point, and per layer its state and forces.
 std::string curve_csv(const Scene& scene, const ScriptedRunResult& run, const std::vector<std::size_t>& kept,
                       std::size_t stride, const io::Provenance& provenance) {
   std::vector<std::string> columns{"time_s",      "depth_mm",        "velocity_mm_per_s", "force_N",
-                                   "tip_force_N", "cutting_force_N", "friction_force_N",  "phase"};
+                                   "tip_force_N", "cutting_force_N", "friction_force_N",  "phase",
+                                   // The needle at an angle (needle.hpp): the force as a vector and its moment.
+                                   "path_depth_mm", "lateral_force_N", "force_x_N", "force_y_N", "force_z_N",
+                                   "torque_x_N_m", "torque_y_N_m", "torque_z_N_m"};
   for (const Layer& l : scene.layers)
     for (const char* c : {"_state", "_surface_force_N", "_cutting_force_N", "_friction_force_N", "_damping_force_N",
                           "_deformed_rings"})
@@ -71,6 +76,9 @@ std::string curve_csv(const Scene& scene, const ScriptedRunResult& run, const st
                                                                      : "withdrawal";
     csv.number(t.time_s).number(t.depth_m / kMm).number(t.velocity_m_per_s / kMm).number(t.total_force_N);
     csv.number(t.tip_force_N).number(t.cutting_force_N).number(t.friction_force_N).text(phase);
+    csv.number(t.path_depth_m / kMm).number(t.lateral_force_N);
+    for (int i = 0; i < 3; ++i) csv.number(t.force_on_needle_N[i]);
+    for (int i = 0; i < 3; ++i) csv.number(t.torque_about_entry_N_m[i]);
     for (const LayerTickResult& l : t.layers)
       csv.text(to_string(l.state))
           .number(l.surface_force_N)

@@ -39,6 +39,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command_errors.hpp"
+#include "measured_reference.hpp"
 #include "puncture/apps/commands.hpp"
 #include "puncture/validation/fem_reference.hpp"
 #include "puncture/io/atomic_file.hpp"
@@ -454,6 +455,7 @@ int validate_command(const ValidateOptions& options, std::ostream& stdout_stream
       throw UsageError("--slab-rule applies to the cases that change the slab: it needs --cases");
     if (!options.why_misses.empty()) throw UsageError("--why-misses explains the misses of cases: it needs --cases");
     const Scene scene = load_scene(scene_path);
+    require_axial_for_fem(scene, scene_path.string(), "the FEM reference");
     const std::filesystem::path dir =
         options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_validation") : options.output_dir;
     const std::string command_line = "puncture validate " + scene_path.string() + " -o " + dir.string() + vtk_flag(options);

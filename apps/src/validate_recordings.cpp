@@ -134,7 +134,7 @@ int validate_recordings(const ValidateOptions& options, const std::filesystem::p
       options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_validation") : options.output_dir;
   std::vector<validation::ReferenceCurve> recordings;
   for (const std::filesystem::path& path : options.references)
-    recordings.push_back(read_measured_reference(path, options.recording));
+    recordings.push_back(read_measured_reference(path, options.recording, scene.insertion));
   std::vector<const validation::ReferenceCurve*> all;
   for (const validation::ReferenceCurve& r : recordings) all.push_back(&r);
   require_insertion_speeds(all);

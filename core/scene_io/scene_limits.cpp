@@ -31,7 +31,8 @@ void check_length(double value_m, const std::string& file, const std::string& pa
 }  // namespace
 
 double scripted_duration_s(const Insertion& in) {
-  const double travel = in.start_height_m + in.target_depth_m;
+  // Start height and target depth are vertical; the needle travels along its inclined axis (needle.hpp).
+  const double travel = (in.start_height_m + in.target_depth_m) / std::cos(in.angle_deg * (M_PI / 180.0));
   return travel / in.speed_m_per_s + in.dwell_s + travel / in.withdrawal_speed_m_per_s;
 }
 

@@ -3,6 +3,7 @@
 // bound one field), in the file's units.
 #include "puncture/scene_schema.hpp"
 
+#include "puncture/insertion_angle.hpp"
 #include "puncture/scene_limits.hpp"
 
 namespace puncture {
@@ -132,7 +133,7 @@ std::vector<SceneField> insertion_and_realtime_fields() {
       {"/insertion/target_depth_mm", T::Number, "mm", kRequired, above(0), kFem, kWritten},
       {"/insertion/dwell_s", T::Number, "s", kOptional, within(0, scene_limits::kMaxDurationS), kFem, kWritten},
       {"/insertion/withdrawal_speed_mm_per_s", T::Number, "mm/s", kOptional, above(0), kFem, kWritten},
-      {"/insertion/angle_deg", T::Number, "deg", kOptional, within(0, 0), kFem, kWritten},
+      {"/insertion/angle_deg", T::Number, "deg", kOptional, within(0, kMaxInsertionAngleDeg), kFem, kWritten},
 
       {"/realtime/sh_degree", T::Integer, "", kOptional, within(2, 64), kRealtime, kWritten},
       {"/realtime/haptic_rate_Hz", T::Number, "Hz", kOptional, within(0, scene_limits::kMaxHapticRateHz, true),

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "puncture/insertion_angle.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/scene_limits.hpp"
 #include "scene_fields.hpp"
@@ -210,6 +211,32 @@ void validate_layers(const Scene& s, const std::string& file) {
   }
 }
 
+/// An inclined insertion (needle.hpp) must stay inside the sample: the tip at
+/// its start and at the target depth, and the force mesh of every layer it
+/// reaches, laid where the path crosses the layer's top, (w - 1) L around it.
+void validate_inclined_path(const Scene& s, const std::string& file) {
+  const Insertion& in = s.insertion;
+  const double tan_a = std::tan(in.angle_deg * (M_PI / 180.0));
+  const double radius = 0.5 * s.sample.diameter_m;
+  auto outside = [&](const std::string& what, double off_axis_m) {
+    std::ostringstream msg;
+    msg << "too steep for the sample: at " << in.angle_deg << " deg " << what << " lies " << off_axis_m / kMm
+        << " mm off the sample axis, beyond the sample radius " << radius / kMm
+        << " mm (reduce the angle or the target depth, or widen /sample/diameter_mm)";
+    throw SceneError(file, "/insertion/angle_deg", msg.str());
+  };
+  if (in.start_height_m * tan_a >= radius) outside("the tip's start", in.start_height_m * tan_a);
+  if (in.target_depth_m * tan_a + s.needle.radius_m >= radius)
+    outside("the needle at the target depth", in.target_depth_m * tan_a + s.needle.radius_m);
+  for (std::size_t k = 0; k < s.layers.size(); ++k) {
+    const double top = s.layer_top_depth_m(k);
+    if (top >= in.target_depth_m) break;
+    const ForceMeshParams& fm = s.layers[k].force_mesh;
+    const double reach = top * tan_a + (fm.rings_w - 1) * fm.spacing_L_m;
+    if (reach >= radius) outside("layer '" + s.layers[k].name + "''s force mesh, laid where the path meets it,", reach);
+  }
+}
+
 void validate_insertion(const Scene& s, const std::string& file) {
   const Insertion& in = s.insertion;
   require(in.start_height_m >= 0, file, "/insertion/start_height_mm", ">= 0", in.start_height_m / kMm);
@@ -223,8 +250,11 @@ void validate_insertion(const Scene& s, const std::string& file) {
   require(in.dwell_s >= 0, file, "/insertion/dwell_s", ">= 0", in.dwell_s);
   require(in.withdrawal_speed_m_per_s > 0, file, "/insertion/withdrawal_speed_mm_per_s", "> 0",
           in.withdrawal_speed_m_per_s / kMm);
-  require(in.angle_deg == 0.0, file, "/insertion/angle_deg",
-          "0: only insertion along the surface normal is supported", in.angle_deg);
+  require(in.angle_deg >= 0.0 && in.angle_deg <= kMaxInsertionAngleDeg, file, "/insertion/angle_deg",
+          "in [0, " + std::to_string(static_cast<int>(kMaxInsertionAngleDeg)) +
+              "] deg (the angle between the needle and the surface normal)",
+          in.angle_deg);
+  if (in.angle_deg > 0.0) validate_inclined_path(s, file);
 }
 
 void validate_realtime(const RealtimeSettings& rt, const std::string& file) {

@@ -7,17 +7,27 @@
 
 namespace puncture {
 
+Eigen::Vector3d insertion_direction(const Insertion& insertion) {
+  const double angle_rad = insertion.angle_deg * (M_PI / 180.0);
+  return Eigen::Vector3d(std::sin(angle_rad), 0.0, -std::cos(angle_rad));
+}
+
 ScriptedTrajectory::ScriptedTrajectory(const Insertion& insertion) : insertion_(insertion) {
-  if (insertion.angle_deg != 0.0)
-    throw std::invalid_argument("insertion.angle_deg = " + std::to_string(insertion.angle_deg) +
-                                ": only insertion along the surface normal is supported (angle 0)");
+  if (!(insertion.angle_deg >= 0.0 && insertion.angle_deg <= kMaxInsertionAngleDeg))
+    throw std::invalid_argument("insertion.angle_deg = " + std::to_string(insertion.angle_deg) + ": must lie in [0, " +
+                                std::to_string(kMaxInsertionAngleDeg) + "] deg");
   if (!(insertion.speed_m_per_s > 0.0) || !std::isfinite(insertion.speed_m_per_s))
     throw std::invalid_argument("insertion.speed_m_per_s must be positive for a scripted trajectory");
   if (!(insertion.withdrawal_speed_m_per_s > 0.0) || !std::isfinite(insertion.withdrawal_speed_m_per_s))
     throw std::invalid_argument("insertion.withdrawal_speed_m_per_s must be positive");
   if (!(insertion.dwell_s >= 0.0)) throw std::invalid_argument("insertion.dwell_s must be >= 0");
-  const double travel = insertion.start_height_m + insertion.target_depth_m;
-  if (!(travel > 0.0)) throw std::invalid_argument("insertion.target_depth_m must lie below the start height");
+  if (!(insertion.start_height_m + insertion.target_depth_m > 0.0))
+    throw std::invalid_argument("insertion.target_depth_m must lie below the start height");
+  direction_ = insertion_direction(insertion);
+  const double cos_a = -direction_.z();
+  start_path_m_ = -insertion.start_height_m / cos_a;
+  target_path_m_ = insertion.target_depth_m / cos_a;
+  const double travel = target_path_m_ - start_path_m_;
   insert_end_s_ = travel / insertion.speed_m_per_s;
   withdraw_duration_s_ = travel / insertion.withdrawal_speed_m_per_s;
 }
@@ -25,21 +35,22 @@ ScriptedTrajectory::ScriptedTrajectory(const Insertion& insertion) : insertion_(
 NeedleState ScriptedTrajectory::sample(double t) const {
   NeedleState s;
   s.time_s = t;
-  const double z_start = insertion_.start_height_m;
-  const double z_target = -insertion_.target_depth_m;
-  double z = z_start, v = 0.0;
+  // Path coordinate along direction_ (0 at the entry point, the origin).
+  double path = start_path_m_, v = 0.0;
   if (t <= 0.0) {
-    z = z_start;
+    path = start_path_m_;
   } else if (t < insert_end_s_) {
-    z = z_start - insertion_.speed_m_per_s * t;
+    path = start_path_m_ + insertion_.speed_m_per_s * t;
     v = insertion_.speed_m_per_s;
   } else if (t < withdrawal_start_s()) {
-    z = z_target;
+    path = target_path_m_;
   } else if (t < duration()) {
-    z = z_target + insertion_.withdrawal_speed_m_per_s * (t - withdrawal_start_s());
+    path = target_path_m_ - insertion_.withdrawal_speed_m_per_s * (t - withdrawal_start_s());
     v = -insertion_.withdrawal_speed_m_per_s;
   }
-  s.tip_position_m = Eigen::Vector3d(0.0, 0.0, z);
+  // Along the sample axis x is exactly 0 (not -0 from 0 * a negative path).
+  s.tip_position_m = Eigen::Vector3d(direction_.x() == 0.0 ? 0.0 : direction_.x() * path, 0.0, -path * -direction_.z());
+  s.direction = direction_;
   s.axial_velocity_m_per_s = v;
   return s;
 }

@@ -21,10 +21,12 @@ LayerShaftForce punctured_layer_shaft_force(double top_depth_m, double thickness
                                             bool damping_on, double damping_N_s_per_m2, const NeedleState& needle) {
   LayerShaftForce out;
   if (!damping_on && !friction) return out;
-  const double depth_m = needle.depth_m();
-  out.shaft_length_m = shaft_length_in_layer_m(depth_m, top_depth_m, thickness_m);
+  // The layer's depth range [top, top + thickness] holds its vertical extent
+  // of the shaft; along an inclined needle that is 1 / cos a as long.
+  const double cos_axis = std::max(needle.axis_cosine(), kMinAxisCosine);
+  out.shaft_length_m = shaft_length_in_layer_m(needle.depth_m(), top_depth_m, thickness_m) / cos_axis;
   if (friction)
-    out.friction_N = friction->stick_slip.update(needle.axial_velocity_m_per_s, depth_m) *
+    out.friction_N = friction->stick_slip.update(needle.axial_velocity_m_per_s, needle.axial_position_m()) *
                      friction->contact_pressure.update(out.shaft_length_m, needle.time_s);
   if (damping_on)
     out.damping_N = puncture_damping_force_N(damping_N_s_per_m2, out.shaft_length_m, needle.axial_velocity_m_per_s);

@@ -1,5 +1,7 @@
 #include "puncture/simulator.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -180,9 +182,7 @@ void PunctureSimulator::lay_mesh_on_axis(std::size_t k, const NeedleState& needl
     crossing = *hit;
   } else {
     double s = 0.0;
-    const Eigen::Vector3d origin =
-        needle.tip_position_m - needle.direction * (contact_search_height_m_ + std::abs(needle.tip_position_m.z()));
-    if (!layer.surface->intersect_ray(origin, needle.direction, s, crossing)) return;
+    if (!layer.surface->intersect_ray(search_origin(needle), needle.direction, s, crossing)) return;
   }
   if (layer.mesh->laid_at(crossing, relayout_tolerance_m_)) return;
   // Only a mesh at rest is moved (a loaded one keeps its layout until it relaxed).
@@ -191,13 +191,18 @@ void PunctureSimulator::lay_mesh_on_axis(std::size_t k, const NeedleState& needl
   if (layer.resumption && !layer.resumption->active()) layer.resumption->set_rest_positions(layer.mesh->rest_positions());
 }
 
+Eigen::Vector3d PunctureSimulator::search_origin(const NeedleState& needle) const {
+  const double cos_axis = std::max(needle.axis_cosine(), kMinAxisCosine);
+  return needle.tip_position_m -
+         needle.direction * ((contact_search_height_m_ + std::abs(needle.tip_position_m.z())) / cos_axis);
+}
+
 bool PunctureSimulator::try_contact(const NeedleState& needle) {
   LayerModel& layer = layers_[active_];
   const Eigen::Vector3d& tip = needle.tip_position_m;
   double s = 0.0;
   SurfacePoint hit;
-  const Eigen::Vector3d origin = tip - needle.direction * (contact_search_height_m_ + std::abs(tip.z()));
-  if (!layer.surface->intersect_ray(origin, needle.direction, s, hit)) return false;  // not over this surface
+  if (!layer.surface->intersect_ray(search_origin(needle), needle.direction, s, hit)) return false;  // not over this surface
   const double penetration = hit.normal.dot(hit.position - tip);
   const double surface_moved = interaction_ ? surface_deflection_m(active_) : 0.0;
   if (penetration < surface_moved) return false;  // the tip has not reached the surface yet
@@ -285,9 +290,11 @@ bool PunctureSimulator::breakthrough(std::size_t k, double surface_force_N, cons
   if (!layer.mesh) return result_.layers[k].contact_deflection_m > 0.0;
   if (layer.state != LayerState::Pressed) return false;
   const BreakthroughCriterion& c = layer.law.breakthrough;
+  // The surface is loaded at the tip's speed along its normal (v cos a for a needle at a to it).
+  const double normal_share = -layer.contact.normal.dot(needle.direction);
   const double rate = breakthrough_rate_factor(
-      c, mean_pressing_speed_m_per_s(layer.contact_axial_m, layer.contact_time_s,
-                                     needle.tip_position_m.dot(needle.direction), needle.time_s,
+      c, mean_pressing_speed_m_per_s(layer.contact_axial_m * normal_share, layer.contact_time_s,
+                                     needle.axial_position_m() * normal_share, needle.time_s,
                                      c.reference_speed_m_per_s));
   switch (c.kind) {
     case BreakthroughCriterion::Kind::Rings: return layer.mesh->broken();
@@ -316,7 +323,10 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   event.depth_m = needle.depth_m();
   event.surface_force_N = surface_force_N;
   event.cutting_force_N = cutting_force_N;
-  event.total_force_N = surface_force_N + cutting_force_N;  // tick() adds the shaft forces of the layers above
+  // Along the needle axis (tick() adds the shaft forces of the layers above):
+  // the surface force acts along the contact normal (see the header).
+  const double axial_share = -layer.contact.normal.dot(needle.direction);
+  event.total_force_N = surface_force_N * axial_share + cutting_force_N;
   if (layer.mesh) {
     event.eq5_force_N = layer.mesh->eq5_force_N();
     event.mesh_reaction_N = layer.mesh->contact_reaction_N();
@@ -334,10 +344,12 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   const double tip_axial = needle.tip_position_m.dot(needle.direction);
   layer.front_m = tip_axial;
   layer.break_axial_m = tip_axial;
-  // The load the tip carried, its surface force and the crack above still cut
-  // (a layer met at the tip), passes to this layer's crack.
-  layer.release_N =
-      cutting_on_ ? rupture_release_N(layer.law, surface_force_N + crack_above_N, needle.axial_velocity_m_per_s) : 0.0;
+  // The load the tip carried along the needle, its surface force's axial part
+  // and the crack above still cut (a layer met at the tip), passes to this
+  // layer's crack.
+  layer.release_N = cutting_on_ ? rupture_release_N(layer.law, surface_force_N * axial_share + crack_above_N,
+                                                    needle.axial_velocity_m_per_s)
+                                : 0.0;
   layer.release_length_m = rupture_release_length_m(layer.law, needle.axial_velocity_m_per_s);
   ++active_;
   if (active_ < layers_.size() && !interaction_) {
@@ -345,9 +357,7 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
     next.tip_contact_from_m = std::numeric_limits<double>::infinity();
     double s = 0.0;
     SurfacePoint hit;
-    const Eigen::Vector3d origin =
-        needle.tip_position_m - needle.direction * (contact_search_height_m_ + std::abs(needle.tip_position_m.z()));
-    if (next.surface->intersect_ray(origin, needle.direction, s, hit) &&
+    if (next.surface->intersect_ray(search_origin(needle), needle.direction, s, hit) &&
         hit.normal.dot(hit.position - needle.tip_position_m) > 0.0) {
       // The tip is already below the next rest surface, which does not move
       // without layer interaction: the broken layer left between them is
@@ -482,6 +492,27 @@ void PunctureSimulator::refine_pending_layouts() {
   }
 }
 
+void PunctureSimulator::resolve_force_vector(const NeedleState& needle, double surface_force_N,
+                                             const Eigen::Vector3d& surface_normal) {
+  const Eigen::Vector3d& d = needle.direction;
+  // The axial parts act along -d; the surface force's part across the axis
+  // is F (n - (n . d) d). Along the sample axis it is zero and is not added
+  // (the vector stays bit for bit -F d).
+  result_.force_on_needle_N = -result_.total_force_N * d;
+  result_.lateral_force_N = 0.0;
+  if (surface_force_N != 0.0) {
+    const Eigen::Vector3d lateral = surface_force_N * (surface_normal - surface_normal.dot(d) * d);
+    result_.lateral_force_N = lateral.norm();
+    if (result_.lateral_force_N > 0.0) result_.force_on_needle_N += lateral;
+  }
+  // The entry point: where the needle axis crosses the skin's undeformed plane z = 0.
+  const double cos_axis = needle.axis_cosine();
+  result_.path_depth_m = cos_axis >= kMinAxisCosine ? needle.depth_m() / cos_axis : needle.depth_m();
+  const Eigen::Vector3d arm = cos_axis >= kMinAxisCosine ? Eigen::Vector3d(result_.path_depth_m * d)
+                                                         : Eigen::Vector3d::Zero();
+  result_.torque_about_entry_N_m = arm.cross(result_.force_on_needle_N);
+}
+
 const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   if (!needle.tip_position_m.allFinite() || !needle.direction.allFinite() ||
       !std::isfinite(needle.axial_velocity_m_per_s) || !std::isfinite(needle.time_s))
@@ -503,6 +534,8 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   double cut = crack.total_N() + rupture_release(tip_axial_m);
   // 3. The chain under the needle (or the needle layer alone).
   double surface_force = press_needle_layer(needle, interaction_ ? cut : 0.0);
+  const Eigen::Vector3d surface_normal =
+      active_ < layers_.size() && layers_[active_].contact_set ? layers_[active_].contact.normal : -needle.direction;
   // 4. Breakthrough: the crack through the layer that just broke starts at the tip.
   const bool broke = break_through(needle, surface_force, cut, crack.total_N());
   if (broke) {
@@ -514,17 +547,19 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   // 5. Shaft friction and damping of the punctured layers.
   const double friction_total = shaft_friction_and_damping(needle);
   // The crack's viscous part (cutting.hpp) is the tissue the bevel wedges apart: tip force.
+  const double surface_axial = surface_force * -surface_normal.dot(needle.direction);
   result_.surface_force_N = surface_force;
-  result_.tip_force_N = surface_force + crack.bevel_N;
+  result_.tip_force_N = surface_axial + crack.bevel_N;
   result_.cutting_force_N = cut - crack.bevel_N;
   result_.friction_force_N = friction_total;
-  result_.total_force_N = surface_force + cut + friction_total;
+  result_.total_force_N = surface_axial + cut + friction_total;
+  resolve_force_vector(needle, surface_force, surface_normal);
   if (broke) add_shaft_forces_to_events(needle.time_s);
   // 6. Meshes laid at a new contact point get their nodes projected onto the
   // surface a few per tick.
   refine_pending_layouts();
 
-  if (!std::isfinite(result_.total_force_N))
+  if (!std::isfinite(result_.total_force_N) || !result_.force_on_needle_N.allFinite())
     throw std::runtime_error("PunctureSimulator::tick: the needle force became non-finite at t = " +
                              std::to_string(needle.time_s) + " s");
   return result_;

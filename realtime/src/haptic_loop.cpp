@@ -152,6 +152,7 @@ void HapticLoop::publish(std::int64_t n, double wall_time_s, const TickResult& r
     s.depth_m = result.depth_m;
     s.tissue_force_N = out.tissue_force_N;
     s.sent_axial_N = -out.force_sent_N.dot(dir);
+    s.lateral_force_N = result.lateral_force_N;
     s.layer_states = out.layer_states;
     s.flags = flags;
     s.model_generation = generation_;

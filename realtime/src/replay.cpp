@@ -12,7 +12,7 @@ TickOutputs compute_tick(PunctureSimulator& simulator, const NeedleState& needle
   const TickResult& r = simulator.tick(needle);
   TickOutputs o;
   o.tissue_force_N = r.total_force_N;
-  o.force_raw_N = -r.total_force_N * needle.direction;
+  o.force_raw_N = r.force_on_needle_N;
   o.force_sent_N = guard.apply(o.force_raw_N, guard_flags);
   o.layer_states = pack_layer_states(r);
   return o;

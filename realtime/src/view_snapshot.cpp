@@ -14,6 +14,7 @@ void init_snapshot(ViewSnapshot& s, const PunctureSimulator& sim) {
 
 void fill_snapshot(ViewSnapshot& s, const PunctureSimulator& sim, const TickResult& r) noexcept {
   s.tip_force_N = r.tip_force_N;
+  s.lateral_force_N = r.lateral_force_N;
   s.cutting_force_N = r.cutting_force_N;
   s.friction_force_N = r.friction_force_N;
   const std::size_t n = std::min(s.layers.size(), r.layers.size());

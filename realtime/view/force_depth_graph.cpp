@@ -73,16 +73,17 @@ void ForceDepthGraph::build(vtkRenderer* renderer, double x0, double y0, double 
   grid_ = make_actor(grid_data_, 0.6, 0.6, 0.6, 1.0);
   renderer->AddActor2D(grid_);
 
-  model_data_ = vtkSmartPointer<vtkPolyData>::New();
-  sent_data_ = vtkSmartPointer<vtkPolyData>::New();
-  model_data_->SetPoints(vtkSmartPointer<vtkPoints>::New());
-  model_data_->SetLines(vtkSmartPointer<vtkCellArray>::New());
-  sent_data_->SetPoints(vtkSmartPointer<vtkPoints>::New());
-  sent_data_->SetLines(vtkSmartPointer<vtkCellArray>::New());
+  for (vtkSmartPointer<vtkPolyData>* data : {&model_data_, &sent_data_, &lateral_data_}) {
+    *data = vtkSmartPointer<vtkPolyData>::New();
+    (*data)->SetPoints(vtkSmartPointer<vtkPoints>::New());
+    (*data)->SetLines(vtkSmartPointer<vtkCellArray>::New());
+  }
   sent_line_ = make_actor(sent_data_, 0.15, 0.35, 0.85, 3.0);
   model_line_ = make_actor(model_data_, 0.80, 0.10, 0.10, 1.5);
+  lateral_line_ = make_actor(lateral_data_, 0.10, 0.55, 0.20, 1.5);
   renderer->AddActor2D(sent_line_);
   renderer->AddActor2D(model_line_);
+  renderer->AddActor2D(lateral_line_);
 
   // Legend and axis titles (static).
   auto text = [&](const char* s, double x, double y, double r, double g, double b, int size, bool right = false) {
@@ -98,6 +99,7 @@ void ForceDepthGraph::build(vtkRenderer* renderer, double x0, double y0, double 
   };
   text("tissue force (N)", x0_ + 0.01, y1_ + 0.012, 0.8, 0.1, 0.1, 14);
   text("force to device (N)", x0_ + 0.16, y1_ + 0.012, 0.15, 0.35, 0.85, 14);
+  text("across (N)", x0_ + 0.33, y1_ + 0.012, 0.10, 0.55, 0.20, 14);
   text("depth (mm)", x1_, y0 + 0.005, 0.2, 0.2, 0.2, 13, true);
   rebuild_axes();
 }
@@ -149,20 +151,21 @@ void ForceDepthGraph::update(const std::deque<TickSample>& history, double until
     if (s.time_s > until_s) break;
     ++count;
     const double d = s.depth_m / kMm;
-    const double hi = std::max(s.tissue_force_N, s.sent_axial_N), lo = std::min(s.tissue_force_N, s.sent_axial_N);
+    const double hi = std::max({s.tissue_force_N, s.sent_axial_N, s.lateral_force_N});
+    const double lo = std::min(s.tissue_force_N, s.sent_axial_N);
     if (d > d1_) d1_ = 1.25 * d, grow = true;
     if (hi > f1_) f1_ = 1.25 * hi, grow = true;
     if (lo < f0_) f0_ = 1.25 * lo, grow = true;
   }
   if (grow) rebuild_axes();
-  auto fill = [&](vtkPolyData* data, bool sent) {
+  auto fill = [&](vtkPolyData* data, double TickSample::*force) {
     vtkPoints* pts = data->GetPoints();
     vtkCellArray* cells = data->GetLines();
     pts->SetNumberOfPoints(static_cast<vtkIdType>(count));
     vtkIdType i = 0;
     for (const TickSample& s : history) {
       if (i == static_cast<vtkIdType>(count)) break;
-      pts->SetPoint(i++, to_x(s.depth_m / kMm), to_y(sent ? s.sent_axial_N : s.tissue_force_N), 0.0);
+      pts->SetPoint(i++, to_x(s.depth_m / kMm), to_y(s.*force), 0.0);
     }
     cells->Reset();
     if (count >= 2) {
@@ -173,8 +176,9 @@ void ForceDepthGraph::update(const std::deque<TickSample>& history, double until
     cells->Modified();
     data->Modified();
   };
-  fill(model_data_, false);
-  fill(sent_data_, true);
+  fill(model_data_, &TickSample::tissue_force_N);
+  fill(sent_data_, &TickSample::sent_axial_N);
+  fill(lateral_data_, &TickSample::lateral_force_N);
 }
 
 void ForceDepthGraph::hide() {
@@ -183,6 +187,7 @@ void ForceDepthGraph::hide() {
   grid_->VisibilityOff();
   model_line_->VisibilityOff();
   sent_line_->VisibilityOff();
+  lateral_line_->VisibilityOff();
   for (auto& l : labels_) l->VisibilityOff();
   for (auto& l : titles_) l->VisibilityOff();
 }

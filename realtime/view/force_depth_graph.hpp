@@ -36,8 +36,8 @@ class ForceDepthGraph {
   vtkRenderer* renderer_ = nullptr;
   double x0_ = 0, y0_ = 0, x1_ = 1, y1_ = 1;
   double d0_ = -2, d1_ = 30, f0_ = -0.25, f1_ = 3;
-  vtkSmartPointer<vtkActor2D> background_, grid_, model_line_, sent_line_;
-  vtkSmartPointer<vtkPolyData> grid_data_, model_data_, sent_data_;
+  vtkSmartPointer<vtkActor2D> background_, grid_, model_line_, sent_line_, lateral_line_;
+  vtkSmartPointer<vtkPolyData> grid_data_, model_data_, sent_data_, lateral_data_;
   std::vector<vtkSmartPointer<vtkTextActor>> labels_, titles_;
   bool hidden_ = false;
 };

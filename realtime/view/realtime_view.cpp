@@ -480,7 +480,8 @@ void RealtimeView::Impl::update_text(const ViewSnapshot& snap, const ViewStatus&
   t << std::setprecision(3) << "t " << snap.needle.time_s << " s   depth " << std::setprecision(2)
     << snap.needle.depth_m() / kMm << " mm   v " << snap.needle.axial_velocity_m_per_s / kMm << " mm/s\n";
   t << std::setprecision(3) << "force " << snap.tissue_force_N << " N (tip " << snap.tip_force_N << ", cutting "
-    << snap.cutting_force_N << ", friction " << snap.friction_force_N << ")   to device " << snap.force_sent_N.norm()
+    << snap.cutting_force_N << ", friction " << snap.friction_force_N << ")   across " << snap.lateral_force_N
+    << " N   to device " << snap.force_sent_N.norm()
     << " N" << ((snap.flags & kOutMagnitudeClamped) ? "  [magnitude limit]" : "")
     << ((snap.flags & kOutRateClamped) ? "  [rate limit]" : "") << ((snap.flags & kOutNoPose) ? "  [no pose]" : "")
     << "\n";

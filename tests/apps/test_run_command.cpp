@@ -61,7 +61,8 @@ TEST(RunCommand, DefaultSceneWritesCurveSummaryAndFrames) {
   std::ifstream csv(dir / "realtime_curve.csv");
   const std::string header = test::header_after_provenance(csv);
   EXPECT_EQ(header.rfind("time_s,depth_mm,velocity_mm_per_s,force_N,tip_force_N,cutting_force_N,friction_force_N,"
-                         "phase,skin_state,",
+                         "phase,path_depth_mm,lateral_force_N,force_x_N,force_y_N,force_z_N,torque_x_N_m,torque_y_N_m,"
+                         "torque_z_N_m,skin_state,",
                          0),
             0u)
       << header;

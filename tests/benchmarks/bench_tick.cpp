@@ -18,7 +18,10 @@
 //   BM_sh_intersect_ray/<l>/<on_axis|off_axis>  LayerSurface::intersect_ray
 //       alone (the only SH query inside the tick, once per layer when it is
 //       first reached)
-//   BM_tick_distribution/tuned/whole_insertion, BM_tick_distribution/whole_insertion
+//   BM_tick_angle/<deg>/<phase>         tuned preset with the needle at 0, 15
+//       and 30 deg to the surface normal (press_skin, in_tissue, whole_insertion)
+//   BM_tick_distribution/tuned/whole_insertion, BM_tick_distribution/whole_insertion,
+//   BM_tick_distribution/tuned_30deg/whole_insertion
 //       one iteration = one whole insertion with every tick timed by
 //       steady_clock (~20 ns overhead per tick); counters: percentiles of
 //       the single-tick wall time (us) over all ticks, over the press_skin
@@ -285,6 +288,16 @@ void register_all() {
     register_phase("BM_tick_phase/" + phase, "default", default_scene(), phase);
   }
   register_distribution("BM_tick_distribution/tuned/whole_insertion", "tuned", tuned_scene());
+  // The needle at an angle to the surface normal (needle.hpp): the tuned preset at 0, 15 and 30 deg.
+  for (int angle : {0, 15, 30}) {
+    Scene inclined = tuned_scene();
+    inclined.insertion.angle_deg = angle;
+    const std::string key = "tuned angle=" + std::to_string(angle);
+    for (const std::string phase : {"press_skin", "in_tissue", "whole_insertion"})
+      register_phase("BM_tick_angle/" + std::to_string(angle) + "/" + phase, key, inclined, phase);
+    if (angle == 30)
+      register_distribution("BM_tick_distribution/tuned_30deg/whole_insertion", key, inclined);
+  }
   register_distribution("BM_tick_distribution/whole_insertion", "default", default_scene());
   register_relayout(0);
   register_relayout(2);

@@ -40,18 +40,6 @@ TEST(ScriptedTrajectory, PhasesPositionsAndVelocities) {
   EXPECT_EQ(s.axial_velocity_m_per_s, 0.0);
 }
 
-TEST(ScriptedTrajectory, RejectsObliqueInsertionNamingTheKey) {
-  Insertion in;
-  in.angle_deg = 15.0;
-  try {
-    ScriptedTrajectory tr(in);
-    FAIL() << "an oblique insertion was accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("insertion.angle_deg"), std::string::npos);
-    EXPECT_NE(std::string(e.what()).find("only insertion along the surface normal is supported"), std::string::npos);
-  }
-}
-
 TEST(ScriptedTrajectory, RejectsImpossibleMotions) {
   Insertion in;
   in.speed_m_per_s = 0.0;

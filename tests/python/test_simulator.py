@@ -87,7 +87,9 @@ def test_a_pressed_skin_pushes_back_along_the_needle(short_scene):
     for i in range(200):  # to 2 mm at 10 mm/s: the skin breaks at 2.36 mm
         tick = sim.tick(i * 0.01, velocity_mm_per_s=10.0)
     assert tick.layer_states["skin"] == "pressed" and tick.force_N > 0.0
-    np.testing.assert_allclose(tick.force_vector_N, [0.0, 0.0, tick.force_N])
+    # Along the axis (the SH surface's normal there is vertical to rounding).
+    np.testing.assert_allclose(tick.force_vector_N, [0.0, 0.0, tick.force_N], atol=1e-12)
+    assert tick.lateral_force_N < 1e-12
     assert tick.layers[0].surface_force_N == pytest.approx(tick.surface_force_N)
     nodes, rest = sim.force_mesh_nodes_mm("skin"), sim.force_mesh_nodes_mm(0, rest=True)
     assert nodes.shape == rest.shape and nodes.shape[1] == 3
@@ -104,6 +106,48 @@ def test_tick_pose_on_the_axis_equals_tick_by_depth(short_scene):
         a = by_depth.tick(i * 0.01, velocity_mm_per_s=10.0, time_s=i * 1e-3)
         b = by_pose.tick_pose([0.0, 0.0, -i * 0.01], [0.0, 0.0, -1.0], 10.0, time_s=i * 1e-3)
     assert b.force_N == pytest.approx(a.force_N, rel=1e-12) and a.force_N > 0.0
+
+
+@pytest.fixture(scope="module")
+def oblique_scene(short_scene):
+    """The short default insertion with the needle at 30 deg to the surface normal."""
+    return short_scene.updated({"name": "default_short_30deg", "insertion/angle_deg": 30.0})
+
+
+def test_an_inclined_run_equals_the_programs_csv_and_resolves_its_force(oblique_scene, program, tmp_path):
+    r = puncture.Simulator(oblique_scene).run()
+    scene_path = tmp_path / "oblique.json"
+    oblique_scene.save(scene_path)
+    run_program(program, "run", scene_path, "-o", tmp_path / "out", "--no-frames", "-q")
+    csv_columns = read_program_curve(tmp_path / "out" / "realtime_curve.csv")
+    for name in ["depth_mm", "path_depth_mm", "force_N", "lateral_force_N"]:
+        np.testing.assert_array_equal(np.array(csv_columns[name], dtype=float), r[name], err_msg=name)
+    for c, axis in enumerate("xyz"):
+        np.testing.assert_array_equal(np.array(csv_columns[f"force_{axis}_N"], dtype=float), r.force_vector_N[:, c])
+        np.testing.assert_array_equal(np.array(csv_columns[f"torque_{axis}_N_m"], dtype=float),
+                                      r.torque_about_entry_N_m[:, c])
+    # The needle's axis d = (sin 30, 0, -cos 30): the force along -d is force_N, across it lateral_force_N.
+    d = np.array([np.sin(np.radians(30.0)), 0.0, -np.cos(np.radians(30.0))])
+    f = r.force_vector_N
+    np.testing.assert_allclose(-f @ d, r.force_N, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(f - np.outer(f @ d, d), axis=1), r.lateral_force_N, atol=1e-12)
+    np.testing.assert_allclose(r.path_depth_mm, r.depth_mm / np.cos(np.radians(30.0)), rtol=1e-12, atol=1e-12)
+    # While the skin is pressed the tip's load acts along the surface normal: lateral / axial = tan 30.
+    pressed = (r.layer_state[:, 0] == r.state_names.index("pressed")) & (r.surface_force_N > 0.1)
+    assert pressed.sum() > 100
+    np.testing.assert_allclose(r.lateral_force_N[pressed] / r.force_N[pressed], np.tan(np.radians(30.0)), rtol=1e-6)
+
+
+def test_tick_by_depth_follows_the_scenes_inclined_line(oblique_scene):
+    by_depth, by_pose = puncture.Simulator(oblique_scene), puncture.Simulator(oblique_scene)
+    d = np.array([np.sin(np.radians(30.0)), 0.0, -np.cos(np.radians(30.0))])
+    for i in range(300):
+        depth = i * 0.01
+        a = by_depth.tick(depth, velocity_mm_per_s=10.0, time_s=i * 1e-3)
+        b = by_pose.tick_pose(d * depth / np.cos(np.radians(30.0)), d, 10.0, time_s=i * 1e-3)
+    assert a.force_N > 0.0 and a.lateral_force_N > 0.0
+    assert b.force_N == pytest.approx(a.force_N, rel=1e-12)
+    assert a.path_depth_mm == pytest.approx(2.99 / np.cos(np.radians(30.0)))
 
 
 def test_bad_ticks_raise(short_scene):

@@ -66,6 +66,25 @@ TEST(ScriptedDevice, OneCycleIsTheScenesTrajectory) {
   }
 }
 
+TEST(ScriptedDevice, AnInclinedInsertionIsPosedAlongItsLine) {
+  Scene scene = testing::short_insertion_scene();
+  scene.insertion.angle_deg = 30.0;
+  const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
+  ScriptedDevice device(scene.insertion, dt, /*repeat=*/false);
+  ScriptedTrajectory trajectory(scene.insertion);
+  NeedleFromPose convert(dt, 0.0);
+  DeviceInput in;
+  const Eigen::Vector3d d(0.5, 0.0, -std::sqrt(3.0) / 2.0);  // 30 deg from -z towards +x
+  for (int n = 0; n < static_cast<int>(trajectory.duration() / dt); ++n) {
+    device.read(n, n * dt, in);
+    const NeedleState got = convert.convert(in.pose, n * dt);
+    const NeedleState want = trajectory.sample(n * dt);
+    ASSERT_EQ(got.tip_position_m, want.tip_position_m) << n;
+    ASSERT_NEAR((got.direction - d).norm(), 0.0, 1e-15) << n;  // orientation * (0, 0, -1)
+    ASSERT_NEAR(got.axial_velocity_m_per_s, want.axial_velocity_m_per_s, 1e-15) << n;
+  }
+}
+
 TEST(ScriptedDevice, RepeatAsksForFreshTissueAndHoldsUntilGranted) {
   const Scene scene = testing::short_insertion_scene();
   const double dt = 1.0 / scene.realtime.haptic_rate_Hz;

@@ -2,7 +2,9 @@
 //
 // Arrays, one row per haptic tick (n ticks, L layers):
 //   time_s, depth_mm, velocity_mm_per_s, force_N, tip_force_N,
-//   surface_force_N, cutting_force_N, friction_force_N       (n,) float64
+//   surface_force_N, cutting_force_N, friction_force_N,
+//   path_depth_mm, lateral_force_N                            (n,) float64
+//   force_vector_N, torque_about_entry_N_m                    (n, 3) float64, scene frame
 //   phase                                                     (n,) int8: phase_names
 //   layer_state                                               (n, L) int8: state_names
 //   layer_surface_force_N, layer_support_force_N, layer_cutting_force_N,
@@ -46,6 +48,18 @@ py::array_t<T> layer_column(const std::vector<TickResult>& ticks, std::size_t la
   return a;
 }
 
+/// (ticks, 3) array of a per-tick vector.
+template <class Value>
+py::array_t<double> vector_column(const std::vector<TickResult>& ticks, Value value) {
+  py::array_t<double> a({static_cast<py::ssize_t>(ticks.size()), py::ssize_t{3}});
+  auto out = a.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < ticks.size(); ++i) {
+    const Eigen::Vector3d v = value(ticks[i]);
+    for (py::ssize_t c = 0; c < 3; ++c) out(static_cast<py::ssize_t>(i), c) = v[c];
+  }
+  return a;
+}
+
 void add_needle_columns(py::dict& a, const Scene& scene, const std::vector<TickResult>& ticks) {
   a["time_s"] = tick_column<double>(ticks, [](const TickResult& t) { return t.time_s; });
   a["depth_mm"] = tick_column<double>(ticks, [](const TickResult& t) { return t.depth_m / kMm; });
@@ -55,6 +69,10 @@ void add_needle_columns(py::dict& a, const Scene& scene, const std::vector<TickR
   a["surface_force_N"] = tick_column<double>(ticks, [](const TickResult& t) { return t.surface_force_N; });
   a["cutting_force_N"] = tick_column<double>(ticks, [](const TickResult& t) { return t.cutting_force_N; });
   a["friction_force_N"] = tick_column<double>(ticks, [](const TickResult& t) { return t.friction_force_N; });
+  a["path_depth_mm"] = tick_column<double>(ticks, [](const TickResult& t) { return t.path_depth_m / kMm; });
+  a["lateral_force_N"] = tick_column<double>(ticks, [](const TickResult& t) { return t.lateral_force_N; });
+  a["force_vector_N"] = vector_column(ticks, [](const TickResult& t) { return t.force_on_needle_N; });
+  a["torque_about_entry_N_m"] = vector_column(ticks, [](const TickResult& t) { return t.torque_about_entry_N_m; });
   const ScriptedTrajectory trajectory(scene.insertion);
   // The phase as `puncture run` writes it (run_command.cpp curve_csv).
   a["phase"] = tick_column<std::int8_t>(ticks, [&](const TickResult& t) {
@@ -118,6 +136,15 @@ py::dict curve_columns(const RunResult& r) {
                            "friction_force_N"})
     d[name] = r.arrays[name];
   d["phase"] = numpy.attr("asarray")(phase_names())[r.arrays["phase"]];
+  d["path_depth_mm"] = r.arrays["path_depth_mm"];
+  d["lateral_force_N"] = r.arrays["lateral_force_N"];
+  const py::ssize_t rows = py::len(r.arrays["time_s"]);
+  const std::string axes = "xyz";
+  for (py::ssize_t c = 0; c < 3; ++c) {
+    const py::tuple column = py::make_tuple(py::slice(0, rows, 1), c);
+    d[py::str(std::string("force_") + axes[c] + "_N")] = r.arrays["force_vector_N"][column];
+    d[py::str(std::string("torque_") + axes[c] + "_N_m")] = r.arrays["torque_about_entry_N_m"][column];
+  }
   const py::object states = numpy.attr("asarray")(state_names());
   for (std::size_t k = 0; k < r.layer_names.size(); ++k) {
     const py::tuple column = layer_column_index(k);

@@ -122,9 +122,9 @@ void bind_simulator(py::module_& m) {
             return s.tick_depth(depth_mm * kMm, mm_to_m(velocity_mm_per_s), time_s);
           },
           py::arg("depth_mm"), py::arg("velocity_mm_per_s") = py::none(), py::arg("time_s") = py::none(),
-          "One haptic tick, the tip on the insertion axis at depth_mm below the undeformed skin. "
-          "Defaults: time_s = the last tick's + time_step_s (0 first), velocity from the depth change over time_step_s "
-          "(0 first). Returns a Tick (force and its parts, layers, this tick's punctures).")
+          "One haptic tick, the tip on the scene's insertion line (through the origin at insertion.angle_deg to the "
+          "surface normal) at depth_mm below the undeformed skin. Defaults: time_s = the last tick's + time_step_s "
+          "(0 first), velocity along the needle from the depth change over time_step_s (0 first). Returns a Tick (force and its parts, layers, this tick's punctures).")
       .def(
           "tick_pose",
           [](SimulatorHandle& s, const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& direction, double velocity_mm_per_s,

@@ -7,7 +7,10 @@
 namespace puncture::python {
 
 SimulatorHandle::SimulatorHandle(const Scene& scene)
-    : scene_(scene), model_(build_realtime_model(scene)), dt_(1.0 / scene.realtime.haptic_rate_Hz) {
+    : scene_(scene),
+      model_(build_realtime_model(scene)),
+      dt_(1.0 / scene.realtime.haptic_rate_Hz),
+      insertion_direction_(insertion_direction(scene.insertion)) {
   for (const Layer& l : scene.layers) names_->push_back(l.name);
 }
 
@@ -42,10 +45,14 @@ TickRecord SimulatorHandle::tick_depth(double depth_m, std::optional<double> vel
                                        std::optional<double> time_s) {
   if (!std::isfinite(depth_m)) throw std::invalid_argument("tick: depth_mm must be finite");
   NeedleState needle;
-  needle.tip_position_m = Eigen::Vector3d(0.0, 0.0, -depth_m);
+  // On the scene's insertion line (needle.hpp): at depth_m below the skin plane.
+  const Eigen::Vector3d& d = insertion_direction_;
+  needle.direction = d;
+  needle.tip_position_m = Eigen::Vector3d(d.x() == 0.0 ? 0.0 : d.x() * depth_m / -d.z(), 0.0, -depth_m);
   needle.time_s = time_s ? *time_s : (ticks_ == 0 ? 0.0 : last_time_s_ + dt_);
+  // The depth's rate is vertical; the needle moves along its inclined axis, 1 / cos a as fast.
   needle.axial_velocity_m_per_s =
-      velocity_m_per_s ? *velocity_m_per_s : (ticks_ == 0 ? 0.0 : (depth_m - last_depth_m_) / dt_);
+      velocity_m_per_s ? *velocity_m_per_s : (ticks_ == 0 ? 0.0 : (depth_m - last_depth_m_) / dt_ / -d.z());
   return step(needle);
 }
 

@@ -47,6 +47,7 @@ class SimulatorHandle {
   RealtimeModel model_;
   std::shared_ptr<std::vector<std::string>> names_ = std::make_shared<std::vector<std::string>>();
   double dt_ = 0.0;
+  Eigen::Vector3d insertion_direction_ = -Eigen::Vector3d::UnitZ();  ///< the scene's insertion line (needle.hpp)
   long ticks_ = 0;
   double last_time_s_ = 0.0;
   double last_depth_m_ = 0.0;

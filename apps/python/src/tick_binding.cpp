@@ -73,8 +73,15 @@ void bind_tick(py::module_& m) {
       .def_property_readonly("surface_force_N", [](const TickRecord& t) { return t.result.surface_force_N; })
       .def_property_readonly("cutting_force_N", [](const TickRecord& t) { return t.result.cutting_force_N; })
       .def_property_readonly("friction_force_N", [](const TickRecord& t) { return t.result.friction_force_N; })
-      .def_property_readonly("force_vector_N", [](const TickRecord& t) { Eigen::Vector3d f = -t.result.total_force_N * t.direction; return f; },
-                             "the tissue's force on the needle (N, scene frame): against the insertion direction")
+      .def_property_readonly("force_vector_N", [](const TickRecord& t) { return t.result.force_on_needle_N; },
+                             "the tissue's whole force on the needle (N, scene frame): along the axis against the "
+                             "insertion, plus the part across it of a needle inclined to the surface normal")
+      .def_property_readonly("lateral_force_N", [](const TickRecord& t) { return t.result.lateral_force_N; },
+                             "|force across the needle axis| (N; 0 along the surface normal)")
+      .def_property_readonly("torque_about_entry_N_m", [](const TickRecord& t) { return t.result.torque_about_entry_N_m; },
+                             "moment of force_vector_N about the entry point (the axis' crossing with z = 0), N m")
+      .def_property_readonly("path_depth_mm", [](const TickRecord& t) { return t.result.path_depth_m / kMm; },
+                             "tip past the entry point along the needle (mm): depth_mm / cos(angle to the vertical)")
       .def_property_readonly("layers", [](const TickRecord& t) { return t.result.layers; })
       .def_property_readonly("layer_states",
                              [](const TickRecord& t) {

@@ -1,13 +1,19 @@
 // needle.hpp: the rigid straight needle, its scripted insertion and the
 // device interface the haptic loop reads.
 //
-// Geometry convention (scene.hpp): the needle moves along -z on the sample
-// axis; depth = -z_tip. Only insertion along the surface normal is
-// supported (Insertion::angle_deg must be 0).
+// Geometry convention (scene.hpp): the undeformed skin surface is the plane
+// z = 0, tissue below; depth = -z_tip. A scripted insertion enters the skin
+// at the origin along the unit direction
+//   d = (sin a, 0, -cos a),  a = Insertion::angle_deg (0: along the sample
+// axis, the surface normal; the needle tilts towards +x). The tip's path
+// coordinate s (m, along d, 0 at the entry point, < 0 above the skin) runs
+// from -start_height / cos a to target_depth / cos a: start height and target
+// depth are vertical, the speeds are along the needle.
 #pragma once
 
 #include <Eigen/Core>
 
+#include "puncture/insertion_angle.hpp"
 #include "puncture/scene.hpp"
 
 namespace puncture {
@@ -19,16 +25,28 @@ struct NeedleState {
   double time_s = 0.0;
 
   double depth_m() const { return -tip_position_m.z(); }
+  /// Tip position along the needle axis (m): tip . direction (= depth_m() for the axial needle).
+  double axial_position_m() const { return tip_position_m.dot(direction); }
+  /// Cosine of the needle axis to the vertical, -direction.z (1 along the sample axis).
+  double axis_cosine() const { return -direction.z(); }
 };
+
+/// Smallest axis cosine (needle to the vertical) at which depths along the
+/// needle and vertical depths convert into each other; a needle closer to
+/// horizontal counts as horizontal (path depth and shaft lengths use this).
+constexpr double kMinAxisCosine = 1e-3;
+
+/// The unit insertion direction d of a scripted insertion at insertion.angle_deg (see the header).
+Eigen::Vector3d insertion_direction(const Insertion& insertion);
 
 /// Approach from start_height above the skin at `speed`, go on at the same
 /// speed to target_depth, dwell, withdraw at withdrawal_speed to the start
-/// height. Piecewise linear in time; the tip stays on the z axis.
+/// height, all along the straight line through the origin at the insertion
+/// angle (see the header). Piecewise linear in time.
 class ScriptedTrajectory {
  public:
-  /// Throws std::invalid_argument for angle_deg != 0 (only insertion along the
-  /// surface normal is supported), speed <= 0, withdrawal speed <= 0, or a
-  /// target depth not below the start point.
+  /// Throws std::invalid_argument for an angle outside [0, kMaxInsertionAngleDeg],
+  /// speed <= 0, withdrawal speed <= 0, or a target depth not below the start point.
   explicit ScriptedTrajectory(const Insertion& insertion);
 
   /// State at time t (s); t < 0 gives the start, t > duration() the end (at rest).
@@ -36,9 +54,14 @@ class ScriptedTrajectory {
   double duration() const { return insert_end_s_ + insertion_.dwell_s + withdraw_duration_s_; }
   double insertion_end_s() const { return insert_end_s_; }   ///< time the target depth is reached
   double withdrawal_start_s() const { return insert_end_s_ + insertion_.dwell_s; }
+  /// Unit insertion direction d (see the header).
+  const Eigen::Vector3d& direction() const { return direction_; }
 
  private:
   Insertion insertion_;
+  Eigen::Vector3d direction_ = -Eigen::Vector3d::UnitZ();
+  double start_path_m_ = 0.0;   ///< path coordinate of the start (m, <= 0)
+  double target_path_m_ = 0.0;  ///< path coordinate of the target (m)
   double insert_end_s_ = 0.0;
   double withdraw_duration_s_ = 0.0;
 };

@@ -268,7 +268,7 @@ struct Insertion {
   double target_depth_m = 0.03;          ///< deepest tip depth below the skin surface
   double dwell_s = 0.5;                  ///< pause at the target depth
   double withdrawal_speed_m_per_s = 0.01;///< withdrawal speed (> 0), back to the start height
-  double angle_deg = 0.0;                ///< angle between needle and surface normal; only 0 is supported
+  double angle_deg = 0.0;                ///< angle between needle and surface normal (deg; needle.hpp); the FEM takes 0 only
 };
 
 /// Settings of the real-time model.

@@ -3,9 +3,10 @@
 // the comparison harness (validation/comparison, for every compared model)
 // both call.
 //
-// Per punctured layer with h (m) of shaft inside it (shaft_length_in_layer_m)
-// and axial velocity v (m/s, > 0 inserting), forces on the needle in N,
-// positive resisting insertion:
+// Per punctured layer with h (m) of shaft inside it (shaft_length_in_layer_m
+// of the tip depth, divided by the cosine of the needle axis to the vertical
+// for an inclined needle) and axial velocity v (m/s, > 0 inserting), forces
+// on the needle along its axis in N, positive resisting insertion:
 //     friction  phi h_eff  (Effects::friction, shaft_friction.hpp; h_eff = h
 //                          unless the contact pressure relaxes,
 //                          shaft_pressure_relaxation.hpp)

@@ -42,7 +42,10 @@
 //   3. the tip's penetration D past the contact point along the contact
 //      normal drives the chain (displacement-driven: one common force F,
 //      deflections summing to D; without interaction the chain is the needle
-//      layer alone and F its mesh reaction). F >= 0 is the surface force. If
+//      layer alone and F its mesh reaction). F >= 0 is the surface force; it
+//      acts on the needle along the contact normal n (a frictionless tip:
+//      F (-n . d) along the needle, the rest across it; core/README.md, "The
+//      needle at an angle"). If
 //      the needle layer has no contact yet, the chain below is loaded by the
 //      cutting force of the layer above (force-driven) or relaxes;
 //   4. breakthrough of the needle layer by its criterion
@@ -82,8 +85,9 @@
 // (except the broken surface's profile and one matrix-vector product at a
 // break, allocation-free).
 // The force meshes are laid out at construction around the point where the
-// scene's insertion axis (x = y = 0, direction -z) crosses each surface; the
-// mesh step is the fixed haptic step 1 / RealtimeSettings::haptic_rate_Hz.
+// sample axis (x = y = 0, direction -z) crosses each surface, and laid anew
+// where the needle first meets each surface (an inclined or off-axis needle);
+// the mesh step is the fixed haptic step 1 / RealtimeSettings::haptic_rate_Hz.
 #pragma once
 
 #include <Eigen/Core>
@@ -123,11 +127,17 @@ struct LayerTickResult {
 
 struct TickResult {
   double time_s = 0.0;
-  double depth_m = 0.0;           ///< tip depth below the undeformed skin surface
+  double depth_m = 0.0;           ///< tip depth below the undeformed skin surface (vertical)
+  double path_depth_m = 0.0;      ///< tip past the entry point along the needle: depth_m / cos a (a: axis to the vertical)
   double velocity_m_per_s = 0.0;  ///< along the needle axis, > 0 inserting
-  double total_force_N = 0.0;     ///< tip + cutting + friction
-  double tip_force_N = 0.0;       ///< surface force of the needle layer + the open crack's bevel part (cutting.hpp)
-  double surface_force_N = 0.0;   ///< surface force of the needle layer alone
+  double total_force_N = 0.0;     ///< along the needle axis, > 0 resisting insertion: tip + cutting + friction
+  double tip_force_N = 0.0;       ///< axial: surface force of the needle layer (its axial part) + the open crack's bevel part (cutting.hpp)
+  double surface_force_N = 0.0;   ///< surface force of the needle layer alone, along its contact normal (the mesh's load)
+  double lateral_force_N = 0.0;   ///< |force on the needle across its axis| (0 along the surface normal)
+  Eigen::Vector3d force_on_needle_N = Eigen::Vector3d::Zero();  ///< the tissue's whole force on the needle, scene frame
+  /// Moment of force_on_needle_N about the entry point (the axis' crossing with z = 0), N m, scene frame:
+  /// (path_depth_m d) x force, which only the lateral part makes.
+  Eigen::Vector3d torque_about_entry_N_m = Eigen::Vector3d::Zero();
   double cutting_force_N = 0.0;   ///< sum of the layers' cutting forces less the open crack's bevel part (in tip_force_N)
   double friction_force_N = 0.0;  ///< sum of shaft friction and damping d h v
   std::vector<LayerTickResult> layers;  ///< one per layer, sized at construction
@@ -225,8 +235,12 @@ class PunctureSimulator {
     mutable Eigen::Matrix3Xd shifted_positions;
   };
 
+  /// Where a ray along the needle that searches for a surface crossing starts: above every surface.
+  Eigen::Vector3d search_origin(const NeedleState& needle) const;
   /// Sets the contact of the needle layer if the tip has reached its surface.
   bool try_contact(const NeedleState& needle);
+  /// The tick's force as a vector, its lateral part and its moment about the entry point (TickResult).
+  void resolve_force_vector(const NeedleState& needle, double surface_force_N, const Eigen::Vector3d& surface_normal);
   /// Lays the force mesh of layer k where the needle axis crosses its rest
   /// surface, if it is at rest and laid elsewhere.
   void lay_mesh_on_axis(std::size_t k, const NeedleState& needle, const SurfacePoint* hit);

@@ -124,7 +124,10 @@ const BadCase kBadCases[] = {
     {"no_layers", [](json& j) { j["layers"] = json::array(); }, "/layers"},
     {"duplicate_layer_name", [](json& j) { j["layers"][1]["name"] = "skin"; }, "/layers/1/name"},
     {"depth_beyond_tissue", [](json& j) { j["insertion"]["target_depth_mm"] = 60.0; }, "/insertion/target_depth_mm"},
-    {"oblique_needle", [](json& j) { j["insertion"]["angle_deg"] = 30.0; }, "/insertion/angle_deg"},
+    {"angle_beyond_limit", [](json& j) { j["insertion"]["angle_deg"] = 61.0; }, "/insertion/angle_deg"},
+    {"negative_angle", [](json& j) { j["insertion"]["angle_deg"] = -5.0; }, "/insertion/angle_deg"},
+    // 30 mm deep at 45 deg the needle lies 30.6 mm off the axis of a 60 mm sample.
+    {"inclined_path_leaves_the_sample", [](json& j) { j["insertion"]["angle_deg"] = 45.0; }, "/insertion/angle_deg"},
     {"unknown_integrator", [](json& j) { j["realtime"]["integrator"] = "rk4"; }, "/realtime/integrator"},
     {"unknown_spring_kind", [](json& j) { j["comparison"]["mass_spring_springs"] = "hooke"; },
      "/comparison/mass_spring_springs"},

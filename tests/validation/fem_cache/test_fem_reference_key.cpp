@@ -86,7 +86,8 @@ std::vector<json> perturbations(const std::string& pointer, const json& v) {
 }
 
 /// Leaves that no single change can alter while the scene stays valid: the
-/// schema version, the insertion angle (only 0 is supported), and the
+/// schema version, the insertion angle (the FEM takes 0 only; the commands
+/// refuse an inclined scene before a key is made), and the
 /// material model, criterion and law names and the one Ogden term's share,
 /// whose change needs other fields too (their key changes are checked in
 /// tests/apps/test_validate_command.cpp).

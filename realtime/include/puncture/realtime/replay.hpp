@@ -4,7 +4,9 @@
 // compute_tick(): the model tick plus what the app derives from it, shared by
 // the haptic loop and the offline replay so both do exactly the same
 // arithmetic: tissue force F (TickResult::total_force_N, > 0 resisting
-// insertion), force on the needle f_raw = -F * direction (N, scene frame),
+// insertion, along the needle), force on the needle f_raw =
+// TickResult::force_on_needle_N (N, scene frame: -F * direction along the
+// surface normal, plus the part across the axis of an inclined needle),
 // force to the device f_sent = ForceGuard::apply(f_raw), packed layer states.
 //
 // ReplayDevice feeds a recording's NeedleStates verbatim, asks for a fresh

@@ -37,7 +37,9 @@
 //    20    4 u32      layer states, 2 bits per layer (layer k in bits 2k..2k+1):
 //                     0 untouched, 1 pressed, 2 punctured
 //    24    8 f64      model time (s)
-//    32   24 f64[3]   force to render on the device (after the stability guard)
+//    32   24 f64[3]   force to render on the device (after the stability guard): the
+//                     tissue's whole force on the needle, along it and, for a needle
+//                     at an angle to the surface, across it (TickResult::force_on_needle_N)
 //    56    8 f64      tissue force along the needle (> 0 resisting insertion, unguarded)
 //    64    8 f64      tip depth below the skin surface (m)
 // A receiver ignores datagrams of another size, magic, version or type.

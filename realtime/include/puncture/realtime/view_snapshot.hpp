@@ -23,6 +23,7 @@ struct TickSample {
   double depth_m = 0.0;
   double tissue_force_N = 0.0;   ///< model force along the needle (> 0 resisting)
   double sent_axial_N = 0.0;     ///< guarded force along the needle (> 0 resisting)
+  double lateral_force_N = 0.0;  ///< model force across the needle (TickResult::lateral_force_N)
   std::uint32_t layer_states = 0;
   std::uint32_t flags = 0;       ///< ForceOutputFlags
   std::uint64_t model_generation = 0;
@@ -53,6 +54,7 @@ struct ViewSnapshot {
   double tip_force_N = 0.0;       ///< TickResult: tip + cutting + friction = tissue force
   double cutting_force_N = 0.0;
   double friction_force_N = 0.0;  ///< shaft friction and damping
+  double lateral_force_N = 0.0;   ///< TickResult: across the needle (inclined insertion)
   Eigen::Vector3d force_sent_N = Eigen::Vector3d::Zero();
   std::uint32_t flags = 0;
   std::vector<LayerSnapshot> layers;
