@@ -223,6 +223,39 @@ def tuned_sections():
     out.append(table(["effects / phase", "ticks in phase", "punctures", "median us / tick", "CPU us / tick", "ratio",
                       "spread %"], lines))
     out.append("")
+    out.extend(angle_section())
+    return out
+
+
+def angle_section():
+    """The tuned preset with the needle at 0, 15 and 30 deg to the surface normal (BM_tick_angle)."""
+    out = ["## The needle at an angle (tuned preset)", ""]
+    ref, at30 = get("BM_tick_angle/0/in_tissue"), get("BM_tick_angle/30/in_tissue")
+    if ref.get("median_cpu_us") and at30.get("median_cpu_us"):
+        ratio = at30["median_cpu_us"] / ref["median_cpu_us"]
+        verdict = "met" if ratio <= 1.5 else "NOT met"
+        out.append(f"**Target: the tick with contact at 30 deg within 1.5x of 0 deg: {verdict}** "
+                   f"(in_tissue, CPU: {fmt_time(at30['median_cpu_us'])} us against {fmt_time(ref['median_cpu_us'])} us, "
+                   f"ratio {ratio:.2f}).")
+        out.append("")
+    out.append("The tuned preset's scripted insertion along the line through the entry point at the angle "
+               "(core/include/puncture/needle.hpp): each layer is met where the inclined path crosses it, its force "
+               "mesh laid there. Ratio: to 0 deg for the same phase.")
+    out.append("")
+    lines = [time_row(f"{a} deg / {p}", f"BM_tick_angle/{a}/{p}", f"BM_tick_angle/0/{p}", ("phase_ticks",))
+             for a in (0, 15, 30) for p in ("press_skin", "in_tissue", "whole_insertion")]
+    out.append(table(["angle / phase", "ticks in phase", "median us / tick", "CPU us / tick", "ratio", "spread %"],
+                     lines))
+    out.append("")
+    dist = get("BM_tick_distribution/tuned_30deg/whole_insertion")
+    def c(key):
+        v = dist.get("counter:" + key)
+        return fmt_time(v) if v is not None else "n/a"
+    out.append(f"Single ticks at 30 deg (as 'Single-tick distribution, tuned preset'): over the "
+               f"{fmt_count(dist, 'contact_ticks')} ticks with contact mean {c('contact_mean_us')} us, p50 "
+               f"{c('contact_p50_us')} us, p99 {c('contact_p99_us')} us, slowest tick by its own cost "
+               f"{c('contact_worst_tick_us')} us.")
+    out.append("")
     return out
 
 
