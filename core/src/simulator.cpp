@@ -61,10 +61,17 @@ PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique
                                   "\": cutting force must be >= 0, its release distance > 0 and its rupture release >= 0");
     if (scene.effects.stiffening) layer.stiffening = &layer.law.stiffening;
     if (scene.effects.surface_force) {
+      // Laid where the scene's insertion line (needle.hpp: through the origin
+      // at insertion.angle_deg) crosses the surface, so that a scripted
+      // insertion meets every mesh where it lies and no tick lays one anew.
       double s = 0.0;
       SurfacePoint centre;
-      const Eigen::Vector3d origin(0.0, 0.0, contact_search_height_m_);
-      if (!layer.surface->intersect_ray(origin, -Eigen::Vector3d::UnitZ(), s, centre))
+      Eigen::Vector3d origin(0.0, 0.0, contact_search_height_m_), direction = -Eigen::Vector3d::UnitZ();
+      if (scene.insertion.angle_deg != 0.0) {
+        direction = insertion_direction(scene.insertion);
+        origin = -direction * (contact_search_height_m_ / -direction.z());
+      }
+      if (!layer.surface->intersect_ray(origin, direction, s, centre))
         throw std::invalid_argument("layer \"" + in.name + "\": the insertion axis misses its surface");
       layer.mesh.emplace(*layer.surface, centre, in.force_mesh, in.thickness_m, in.density_kg_per_m3, integration);
       layer.shifted_positions = layer.mesh->rest_positions();

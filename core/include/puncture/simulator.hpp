@@ -85,8 +85,9 @@
 // (except the broken surface's profile and one matrix-vector product at a
 // break, allocation-free).
 // The force meshes are laid out at construction around the point where the
-// sample axis (x = y = 0, direction -z) crosses each surface, and laid anew
-// where the needle first meets each surface (an inclined or off-axis needle);
+// scene's insertion line (x = y = 0, direction -z; inclined at
+// insertion.angle_deg, needle.hpp) crosses each surface, and laid anew where
+// the needle first meets a surface elsewhere (a needle off that line);
 // the mesh step is the fixed haptic step 1 / RealtimeSettings::haptic_rate_Hz.
 #pragma once
 
