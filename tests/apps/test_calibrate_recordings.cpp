@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <cmath>
@@ -337,6 +338,51 @@ TEST(ObliqueRecordings, TheInclinedTruthFollowsItsRecordingAndCalibrationRecover
   const Scene tuned = load_scene(work / "calibrated" / "rate_truth_tuned.json");
   EXPECT_EQ(tuned.insertion.angle_deg, 30.0);
   EXPECT_NEAR(tuned.layers[0].force_law.breakthrough.critical_force_N, 2.0, 0.06);
+  if (!::testing::Test::HasFailure()) fs::remove_all(work);
+}
+
+}  // namespace puncture::apps
+
+namespace puncture::apps {
+
+// The FEM reference and the comparison models insert along the sample axis
+// only: every command that would run them refuses an inclined scene before any
+// FEM run, naming the field, with exit code 2 and no output.
+TEST(ObliqueRecordings, TheFemCommandsRefuseAnInclinedSceneNamingTheField) {
+  const fs::path work = fresh_dir("oblique_fem");
+  Scene scene = truth_scene();
+  scene.insertion.angle_deg = 30.0;
+  const fs::path path = work / "inclined.json";
+  std::ofstream(path) << scene_to_json_text(scene);
+  auto refused = [&](const char* what, const std::function<int(std::ostream&, std::ostream&)>& command) {
+    std::ostringstream out, err;
+    EXPECT_EQ(command(out, err), 2) << what;
+    EXPECT_NE(err.str().find(path.string() + ": /insertion/angle_deg: 30 deg"), std::string::npos)
+        << what << ": " << err.str();
+    EXPECT_FALSE(fs::exists(work / "out")) << what;
+  };
+  refused("fem", [&](std::ostream& out, std::ostream& err) {
+    FemOptions o;
+    o.scene = path;
+    o.output_dir = work / "out";
+    return fem_command(o, out, err);
+  });
+  refused("validate", [&](std::ostream& out, std::ostream& err) {
+    ValidateOptions o;
+    o.scene = path;
+    o.output_dir = work / "out";
+    return validate_command(o, out, err);
+  });
+  refused("calibrate", [&](std::ostream& out, std::ostream& err) {
+    CalibrateOptions o = skin_options(path, work / "out");
+    return calibrate_command(o, out, err);
+  });
+  refused("compare", [&](std::ostream& out, std::ostream& err) {
+    CompareOptions o;
+    o.scene = path;
+    o.output_dir = work / "out";
+    return compare_command(o, out, err);
+  });
   if (!::testing::Test::HasFailure()) fs::remove_all(work);
 }
 
