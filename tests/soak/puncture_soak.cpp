@@ -56,8 +56,9 @@ int main(int argc, char** argv) {
      << "implicit; segments to random depths from the start height to 2 mm above the sample base at random speeds "
      << "(log-uniform " << options.min_speed_mm_per_s << "-" << options.max_speed_mm_per_s << " mm/s), random dwells "
      << "(probability " << options.dwell_probability << " after a segment, up to " << options.max_dwell_s
-     << " s), reversals, and a random lateral offset of the needle axis up to " << options.max_lateral_offset_mm
-     << " mm. Seed " << options.seed << ".\n\n"
+     << " s), reversals, a random lateral offset of the needle's entry point up to " << options.max_lateral_offset_mm
+     << " mm and a random inclination of the needle up to " << options.max_angle_deg
+     << " deg to the surface normal at any azimuth (the tip on the inclined line). Seed " << options.seed << ".\n\n"
      << "| quantity | value |\n|---|---|\n"
      << "| haptic ticks | " << r.ticks << " |\n"
      << "| episodes (models built) | " << r.episodes << " |\n"
@@ -68,6 +69,7 @@ int main(int argc, char** argv) {
      << "| direction reversals | " << r.reversals << " |\n"
      << "| dwell ticks | " << r.dwell_ticks << " |\n"
      << "| fastest needle | " << std::setprecision(4) << r.max_speed_mm_per_s << " mm/s |\n"
+     << "| largest inclination | " << r.max_angle_deg << " deg |\n"
      << "| largest needle force | " << r.max_abs_force_N << " N |\n"
      << "| largest force-mesh energy | " << r.max_energy_J << " J |\n"
      << "| largest energy / work done on the meshes | " << r.max_energy_to_work << " (bound: 1 + "

@@ -30,16 +30,25 @@ std::string read_file(const std::string& path) {
   return s.str();
 }
 
-/// The needle of one episode: piecewise-linear random motion along the axis.
+/// The needle of one episode: piecewise-linear random motion along its
+/// inclined axis (z_ is the tip's height, the needle's own speed is the
+/// vertical one / cos a).
 class RandomTrajectory {
  public:
   RandomTrajectory(std::mt19937_64& rng, const SoakOptions& o, double top_m, double bottom_m, double dt_s)
       : rng_(rng), o_(o), top_m_(top_m), bottom_m_(bottom_m), dt_s_(dt_s) {
     std::uniform_real_distribution<double> offset(-o.max_lateral_offset_mm * kMm, o.max_lateral_offset_mm * kMm);
     x_ = offset(rng_), y_ = offset(rng_);
+    std::uniform_real_distribution<double> angle(0.0, o.max_angle_deg * M_PI / 180.0), azimuth(0.0, 2.0 * M_PI);
+    angle_rad_ = angle(rng_);
+    const double phi = azimuth(rng_);
+    direction_ = Eigen::Vector3d(std::sin(angle_rad_) * std::cos(phi), std::sin(angle_rad_) * std::sin(phi),
+                                 -std::cos(angle_rad_));
     z_ = top_m_;
     next_segment();
   }
+
+  double angle_deg() const { return angle_rad_ * 180.0 / M_PI; }
 
   /// Advances one tick; returns the needle state at the end of it.
   NeedleState step(SoakReport& report) {
@@ -71,9 +80,11 @@ class RandomTrajectory {
       if (last_dir_ != 0 && dir != last_dir_) ++report.reversals;
       last_dir_ = dir;
     }
-    s.tip_position_m = Eigen::Vector3d(x_, y_, z_);
-    s.direction = -Eigen::Vector3d::UnitZ();
-    s.axial_velocity_m_per_s = v;
+    // On the inclined line through the entry point (x_, y_, 0), at height z_.
+    const double path = z_ / direction_.z();
+    s.tip_position_m = Eigen::Vector3d(x_ + path * direction_.x(), y_ + path * direction_.y(), z_);
+    s.direction = direction_;
+    s.axial_velocity_m_per_s = v / -direction_.z();
     return s;
   }
 
@@ -90,7 +101,8 @@ class RandomTrajectory {
   std::mt19937_64& rng_;
   const SoakOptions& o_;
   double top_m_, bottom_m_, dt_s_;
-  double x_ = 0, y_ = 0, z_ = 0, target_z_ = 0, speed_ = 0;
+  double x_ = 0, y_ = 0, z_ = 0, target_z_ = 0, speed_ = 0, angle_rad_ = 0;
+  Eigen::Vector3d direction_ = -Eigen::Vector3d::UnitZ();
   long long dwell_left_ = 0;
   long long tick_ = 0;
   int last_dir_ = 0;
@@ -179,6 +191,7 @@ SoakReport run_soak(const SoakOptions& o, const std::function<void(double)>& pro
     const double dt = 1.0 / scene.realtime.haptic_rate_Hz;
     // From the start height down to 2 mm above the sample base.
     RandomTrajectory needle(rng, o, scene.insertion.start_height_m, -(scene.total_thickness_m() - 2e-3), dt);
+    report.max_angle_deg = std::max(report.max_angle_deg, needle.angle_deg());
     const std::size_t n_layers = sim.layer_count();
     std::vector<double> force_prev(n_layers, 0.0), deflection_prev(n_layers, 0.0);
     double work = 0.0;

@@ -12,8 +12,11 @@
 // and drives it with a random trajectory: segments to random depths between
 // the start height and near the sample base (so some pass every layer and
 // most reverse), each at a random speed (log-uniform in [min, max]), with
-// random dwells in between and a random lateral offset of the needle axis
-// (x, y in [-max_offset, max_offset]). Ticks are 1 / haptic_rate_Hz apart.
+// random dwells in between, a random lateral offset of the needle's entry
+// point (x, y in [-max_offset, max_offset]) and a random inclination of the
+// needle (angle to the surface normal in [0, max_angle], any azimuth: the
+// tip moves on the inclined line through the entry point, as a device may
+// hold it). Ticks are 1 / haptic_rate_Hz apart.
 //
 // Checks per tick (violations are counted, the first few described):
 //   * every force (total, per layer surface and damping) is finite; tick()
@@ -42,6 +45,7 @@ struct SoakOptions {
   double min_speed_mm_per_s = 0.5;
   double max_speed_mm_per_s = 200.0;
   double max_lateral_offset_mm = 1.0;
+  double max_angle_deg = 30.0;        ///< inclination of the needle to the surface normal (uniform in [0, max])
   double dwell_probability = 0.3;     ///< after each segment
   double max_dwell_s = 1.0;
   double energy_rel_tolerance = 0.02;
@@ -60,6 +64,7 @@ struct SoakReport {
   long long reversals = 0;               ///< insertion <-> withdrawal changes of direction
   long long dwell_ticks = 0;
   double max_speed_mm_per_s = 0.0;
+  double max_angle_deg = 0.0;            ///< largest inclination an episode used
   double max_abs_force_N = 0.0;
   double max_energy_J = 0.0;
   double max_energy_to_work = 0.0;       ///< max over ticks of E / (W + 1e-9 J)

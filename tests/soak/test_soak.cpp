@@ -22,8 +22,9 @@ TEST(Soak, RandomTrajectoriesEveryEffectAllIntegrators) {
   EXPECT_EQ(r.allocations, 0);
   // The random trajectories did what a soak needs: every integrator ran,
   // layers broke (and some episodes went through all of them), the needle
-  // reversed and dwelt, and the meshes stored energy.
+  // reversed and dwelt, the needle came in inclined, and the meshes stored energy.
   for (long long n : r.ticks_per_integrator) EXPECT_GT(n, 10000);
+  EXPECT_GT(r.max_angle_deg, 10.0);
   EXPECT_GT(r.punctures, 10);
   EXPECT_GT(r.episodes_all_punctured, 0);
   EXPECT_GT(r.reversals, 20);
