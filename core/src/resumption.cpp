@@ -24,6 +24,14 @@ void SurfaceResumption::set_rest_positions(const Eigen::Matrix3Xd& rest_position
   eta_ = 1.0;
 }
 
+void SurfaceResumption::move_goals(const Eigen::Matrix3Xd& rest_positions) {
+  if (rest_positions.cols() != rest_.cols())
+    throw std::invalid_argument("resumption: rest positions must keep one column per node");
+  broken_ += rest_positions - rest_;
+  rest_ = rest_positions;
+  current_ = rest_ + eta_ * (broken_ - rest_);
+}
+
 void SurfaceResumption::start(const Eigen::Matrix3Xd& broken_positions, double time_s) {
   if (broken_positions.cols() != rest_.cols())
     throw std::invalid_argument("resumption: broken positions must have one column per node");

@@ -340,11 +340,13 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
     if (layer.stiffening) event.tip_stiffening_force_N = stiffening_force_N(*layer.stiffening, layer.deflection_m);
   }
   events_.push_back(event);               // capacity reserved at construction
-  if (layer.mesh && layer.mesh->layout_pending()) {
-    // The drawn surface must be complete before it recovers (a break within
-    // a few ticks of the contact: rare).
-    layer.mesh->refine_layout(layer.mesh->node_count());
-    if (layer.resumption) layer.resumption->set_rest_positions(layer.mesh->rest_positions());
+  if (layer.mesh && layer.mesh->layout_pending() && layer.resumption) {
+    // A break within a few ticks of the contact (a layer met at the tip by a
+    // needle off the scene's insertion line): the recovery starts towards the
+    // layout as far as it is projected, and refine_pending_layouts() moves its
+    // goals as the remaining nodes reach the surface (projecting them all in
+    // this tick would cost up to ~100 us).
+    layer.resumption->set_rest_positions(layer.mesh->rest_positions());
   }
   if (coupling_) freeze_coupled_break(active_, surface_force_N, needle.depth_m());
   if (layer.resumption) layer.resumption->start(layer.mesh->positions(), needle.time_s);
@@ -494,7 +496,9 @@ void PunctureSimulator::refine_pending_layouts() {
     const int nodes = std::min(budget, layer.mesh->pending_nodes());
     layer.mesh->refine_layout(nodes);
     budget -= nodes;
-    if (!layer.mesh->layout_pending() && layer.resumption && !layer.resumption->active())
+    if (layer.resumption && layer.resumption->active())
+      layer.resumption->move_goals(layer.mesh->rest_positions());  // a broken layer recovering
+    else if (!layer.mesh->layout_pending() && layer.resumption)
       layer.resumption->set_rest_positions(layer.mesh->rest_positions());
   }
 }

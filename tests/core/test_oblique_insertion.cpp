@@ -323,3 +323,50 @@ TEST(ObliqueInsertion, EntryNearTheEdgeOfAMeshLaidElsewhere) {
   EXPECT_GT(fresh_force, 0.0);
   EXPECT_NEAR(first_force, fresh_force, 1e-9 * fresh_force);
 }
+
+// A layer that breaks within a few ticks of a contact off the scene's line
+// (its force mesh laid anew in the tangent plane, kLayoutNodesPerTick nodes
+// projected per tick) does not project the rest of its layout in the break's
+// tick: its recovery starts towards the layout projected so far and its goals
+// follow the projection until the layout is complete.
+TEST(ObliqueInsertion, ABreakBeforeTheLayoutIsCompleteRecoversTowardsTheProjectedLayout) {
+  Scene scene = table2_at(0.0, 0.01);  // meshes laid on the sample axis at construction
+  scene.effects.resumption = true;
+  scene.layers[1].force_law.breakthrough.kind = BreakthroughCriterion::Kind::CriticalForce;
+  scene.layers[1].force_law.breakthrough.critical_force_N = 0.02;  // the fat breaks within ticks of its contact
+  scene.layers[1].force_mesh.rings_w = 8;                          // 169 nodes: 42 ticks to project them
+  PunctureSimulator sim(scene, test::plane_surfaces(scene));
+  const double angle = 30.0 * kDeg;
+  const Eigen::Vector3d d(std::sin(angle), 0.0, -std::cos(angle));
+  const int fat_nodes = sim.force_mesh(1)->node_count();
+  double time = 0.0, path = -1e-3;
+  int break_tick = -1;
+  for (int i = 0; i < 20000 && break_tick < 0; ++i, path += 1e-5, time += 1e-3) {
+    NeedleState n;
+    n.tip_position_m = path * d;
+    n.direction = d;
+    n.axial_velocity_m_per_s = 0.01;
+    n.time_s = time;
+    sim.tick(n);
+    if (sim.layer_state(1) == LayerState::Punctured) break_tick = i;
+  }
+  ASSERT_GE(break_tick, 0) << "the fat did not break";
+  const ForceMesh& fat = *sim.force_mesh(1);
+  const SurfaceResumption& recovery = *sim.resumption(1);
+  ASSERT_TRUE(fat.layout_pending()) << "the fat's layout was completed at its break";
+  EXPECT_LT(fat.pending_nodes(), fat_nodes);
+  EXPECT_TRUE(recovery.active());
+  EXPECT_NEAR((recovery.goals() - fat.rest_positions()).cwiseAbs().maxCoeff(), 0.0, 1e-15);
+  // Hold the needle; the projection goes on at kLayoutNodesPerTick nodes per tick.
+  NeedleState hold;
+  hold.tip_position_m = path * d;
+  hold.direction = d;
+  for (int i = 0; i < fat_nodes / kLayoutNodesPerTick + 10; ++i, time += 1e-3) {
+    hold.time_s = time;
+    sim.tick(hold);
+  }
+  EXPECT_FALSE(fat.layout_pending());
+  EXPECT_TRUE(recovery.active());  // not reset by the completed layout
+  EXPECT_NEAR((recovery.goals() - fat.rest_positions()).cwiseAbs().maxCoeff(), 0.0, 1e-15);
+  EXPECT_TRUE(recovery.positions().allFinite());
+}

@@ -182,3 +182,27 @@ TEST(Resumption, SingleNodeReturnsToRest) {
   EXPECT_TRUE(res.positions().allFinite());
   EXPECT_LT((res.positions() - rest).norm(), 1e-15);
 }
+
+TEST(SurfaceResumption, MovedGoalsCarryTheBrokenShapeAlong) {
+  // Halfway through the recovery the goals move by t: the nodes, their broken
+  // positions and their goals all move by t, so the current positions move by t
+  // and the recovery goes on (eta unchanged).
+  Eigen::Matrix3Xd rest(3, 2), broken(3, 2);
+  rest << 0.0, 1.0, 0.0, 0.0, 0.0, 0.0;
+  broken << 0.0, 1.0, 0.0, 0.0, -2.0, -1.0;
+  SurfaceResumption r(rest, 1.0);
+  r.start(broken, 0.0);
+  r.step(0.5);
+  const Eigen::Matrix3Xd before = r.positions();
+  const Eigen::Vector3d t(0.1, -0.2, 0.3);
+  Eigen::Matrix3Xd moved = rest;
+  moved.colwise() += t;
+  r.move_goals(moved);
+  EXPECT_TRUE(r.active());
+  EXPECT_DOUBLE_EQ(r.recovery_factor(), 0.5);
+  Eigen::Matrix3Xd expected = before;
+  expected.colwise() += t;
+  EXPECT_NEAR((r.positions() - expected).cwiseAbs().maxCoeff(), 0.0, 1e-15);
+  r.step(1.0);
+  EXPECT_NEAR((r.positions() - moved).cwiseAbs().maxCoeff(), 0.0, 1e-15);
+}

@@ -43,6 +43,11 @@ class SurfaceResumption {
   void step(double time_s);
   /// The rest positions changed (the mesh was laid out elsewhere); stops any recovery.
   void set_rest_positions(const Eigen::Matrix3Xd& rest_positions);
+  /// The goals moved during a recovery (the mesh's nodes projected onto the
+  /// curved surface after a break, see simulator.hpp): each node's broken
+  /// position moves with its goal, so the recovery goes on from the same
+  /// deformation towards the new goals. No allocation.
+  void move_goals(const Eigen::Matrix3Xd& rest_positions);
 
   bool active() const { return active_; }
   bool recovered() const { return active_ && eta_ == 0.0; }

@@ -75,7 +75,9 @@
 //      contact point (exact force at once: the mechanics are deflections
 //      along the normals) and gets its nodes projected onto the curved
 //      surface kLayoutNodesPerTick per tick (a few us each on an SH surface),
-//      so an off-axis contact costs no spike in one tick.
+//      so an off-axis contact costs no spike in one tick; a layer that breaks
+//      before its layout is complete recovers towards the layout projected so
+//      far, its goals moving with the projection (SurfaceResumption::move_goals).
 // Effects::coupled_surfaces (without layer interaction) draws the layers'
 // surfaces as one deformed slab (coupled_surfaces.hpp): the layers below the
 // needle layer follow its surface through the half-space transmission, a
