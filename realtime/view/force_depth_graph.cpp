@@ -98,8 +98,8 @@ void ForceDepthGraph::build(vtkRenderer* renderer, double x0, double y0, double 
     titles_.push_back(t);
   };
   text("tissue force (N)", x0_ + 0.01, y1_ + 0.012, 0.8, 0.1, 0.1, 14);
-  text("force to device (N)", x0_ + 0.16, y1_ + 0.012, 0.15, 0.35, 0.85, 14);
-  text("across (N)", x0_ + 0.33, y1_ + 0.012, 0.10, 0.55, 0.20, 14);
+  text("force to device (N)", x0_ + 0.13, y1_ + 0.012, 0.15, 0.35, 0.85, 14);
+  text("across (N)", x0_ + 0.265, y1_ + 0.012, 0.10, 0.55, 0.20, 14);
   text("depth (mm)", x1_, y0 + 0.005, 0.2, 0.2, 0.2, 13, true);
   rebuild_axes();
 }
