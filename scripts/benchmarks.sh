@@ -62,6 +62,7 @@ fi
 python3 - "$out" <<'PY'
 """Turns the Google Benchmark JSON files into results/benchmarks/tick_benchmarks.md."""
 import datetime
+import functools
 import json
 import os
 import re
@@ -134,6 +135,11 @@ def fmt_time(us):
     return f"{us:.4f}"
 
 
+def counter_text(result, key):
+    """A benchmark's counter `key` as a time in us (n/a when it has none)."""
+    return fmt_time(result.get("counter:" + key))
+
+
 def fmt_ratio(value, ref):
     if value is None or ref is None or ref == 0:
         return "n/a"
@@ -170,9 +176,7 @@ def tuned_sections():
     """The tuned preset's target, phases, single-tick distribution and effects (the page leads with them)."""
     out = []
     dist = get("BM_tick_distribution/tuned/whole_insertion")
-    def c(key):
-        v = dist.get("counter:" + key)
-        return fmt_time(v) if v is not None else "n/a"
+    c = functools.partial(counter_text, dist)
     p99, worst = dist.get("counter:contact_p99_us"), dist.get("counter:contact_worst_tick_us")
     if p99 is not None and worst is not None:
         verdict = "met" if p99 <= 10.0 and worst <= 50.0 else "NOT met"
@@ -248,9 +252,7 @@ def angle_section():
                      lines))
     out.append("")
     dist = get("BM_tick_distribution/tuned_30deg/whole_insertion")
-    def c(key):
-        v = dist.get("counter:" + key)
-        return fmt_time(v) if v is not None else "n/a"
+    c = functools.partial(counter_text, dist)
     out.append(f"Single ticks at 30 deg (as 'Single-tick distribution, tuned preset'): over the "
                f"{fmt_count(dist, 'contact_ticks')} ticks with contact mean {c('contact_mean_us')} us, p50 "
                f"{c('contact_p50_us')} us, p99 {c('contact_p99_us')} us, slowest tick by its own cost "
@@ -354,9 +356,7 @@ md.append("BM_tick_distribution: every tick of whole insertions timed one by one
           "loop must absorb.")
 md.append("")
 r = get("BM_tick_distribution/whole_insertion")
-def counter(key):
-    v = r.get("counter:" + key)
-    return fmt_time(v) if v is not None else "n/a"
+counter = functools.partial(counter_text, r)
 md.append(table(["ticks", "p50 us", "p90 us", "p99 us", "max us"],
                 [["all ticks of the insertion", counter("p50_us"), counter("p90_us"), counter("p99_us"),
                   counter("max_us")],

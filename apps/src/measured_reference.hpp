@@ -15,13 +15,13 @@
 //     is refused before any FEM run (SceneError naming /insertion/angle_deg).
 #pragma once
 
-#include <cmath>
 #include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "command_errors.hpp"
+#include "puncture/needle.hpp"
 #include "puncture/validation/calibration.hpp"
 #include "puncture/validation/recording.hpp"
 
@@ -35,7 +35,7 @@ inline validation::ReferenceCurve read_measured_reference(const std::filesystem:
   reference.kind = "measured";
   auto& meta = reference.curve.metadata;
   if (insertion.angle_deg != 0.0 && meta.count("recording_format")) {
-    const double cos_a = std::cos(insertion.angle_deg * (M_PI / 180.0));
+    const double cos_a = -insertion_direction(insertion).z();
     for (double& d : reference.curve.depth_m) d *= cos_a;
     std::ostringstream angle;
     angle << insertion.angle_deg;

@@ -7,6 +7,15 @@
 
 namespace puncture {
 
+double NeedleState::along_axis_m(double vertical_m) const {
+  return vertical_m / std::max(axis_cosine(), kMinAxisCosine);
+}
+
+Eigen::Vector3d point_on_insertion_line(const Eigen::Vector3d& d, double path_m) {
+  auto along = [path_m](double component) { return component == 0.0 ? 0.0 : component * path_m; };
+  return Eigen::Vector3d(along(d.x()), along(d.y()), along(d.z()));
+}
+
 Eigen::Vector3d insertion_direction(const Insertion& insertion) {
   const double angle_rad = insertion.angle_deg * (M_PI / 180.0);
   return Eigen::Vector3d(std::sin(angle_rad), 0.0, -std::cos(angle_rad));
@@ -48,8 +57,7 @@ NeedleState ScriptedTrajectory::sample(double t) const {
     path = target_path_m_ - insertion_.withdrawal_speed_m_per_s * (t - withdrawal_start_s());
     v = -insertion_.withdrawal_speed_m_per_s;
   }
-  // Along the sample axis x is exactly 0 (not -0 from 0 * a negative path).
-  s.tip_position_m = Eigen::Vector3d(direction_.x() == 0.0 ? 0.0 : direction_.x() * path, 0.0, -path * -direction_.z());
+  s.tip_position_m = point_on_insertion_line(direction_, path);
   s.direction = direction_;
   s.axial_velocity_m_per_s = v;
   return s;

@@ -23,8 +23,7 @@ LayerShaftForce punctured_layer_shaft_force(double top_depth_m, double thickness
   if (!damping_on && !friction) return out;
   // The layer's depth range [top, top + thickness] holds its vertical extent
   // of the shaft; along an inclined needle that is 1 / cos a as long.
-  const double cos_axis = std::max(needle.axis_cosine(), kMinAxisCosine);
-  out.shaft_length_m = shaft_length_in_layer_m(needle.depth_m(), top_depth_m, thickness_m) / cos_axis;
+  out.shaft_length_m = needle.along_axis_m(shaft_length_in_layer_m(needle.depth_m(), top_depth_m, thickness_m));
   if (friction)
     out.friction_N = friction->stick_slip.update(needle.axial_velocity_m_per_s, needle.axial_position_m()) *
                      friction->contact_pressure.update(out.shaft_length_m, needle.time_s);

@@ -16,6 +16,14 @@
 
 namespace puncture {
 
+namespace {
+/// The share of a load along the surface normal n that acts along the needle:
+/// -n . d, the cosine of the angle between them (1 along the sample axis).
+double along_needle(const Eigen::Vector3d& normal, const NeedleState& needle) {
+  return -normal.dot(needle.direction);
+}
+}  // namespace
+
 PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique_ptr<ContactSurface>> layer_surfaces)
     : empty_positions_(3, 0) {
   if (scene.layers.empty()) throw std::invalid_argument("scene has no layers");
@@ -66,12 +74,9 @@ PunctureSimulator::PunctureSimulator(const Scene& scene, std::vector<std::unique
       // insertion meets every mesh where it lies and no tick lays one anew.
       double s = 0.0;
       SurfacePoint centre;
-      Eigen::Vector3d origin(0.0, 0.0, contact_search_height_m_), direction = -Eigen::Vector3d::UnitZ();
-      if (scene.insertion.angle_deg != 0.0) {
-        direction = insertion_direction(scene.insertion);
-        origin = -direction * (contact_search_height_m_ / -direction.z());
-      }
-      if (!layer.surface->intersect_ray(origin, direction, s, centre))
+      NeedleState line;  // the tip at the entry point
+      line.direction = insertion_direction(scene.insertion);
+      if (!layer.surface->intersect_ray(search_origin(line), line.direction, s, centre))
         throw std::invalid_argument("layer \"" + in.name + "\": the insertion axis misses its surface");
       layer.mesh.emplace(*layer.surface, centre, in.force_mesh, in.thickness_m, in.density_kg_per_m3, integration);
       layer.shifted_positions = layer.mesh->rest_positions();
@@ -199,9 +204,8 @@ void PunctureSimulator::lay_mesh_on_axis(std::size_t k, const NeedleState& needl
 }
 
 Eigen::Vector3d PunctureSimulator::search_origin(const NeedleState& needle) const {
-  const double cos_axis = std::max(needle.axis_cosine(), kMinAxisCosine);
   return needle.tip_position_m -
-         needle.direction * ((contact_search_height_m_ + std::abs(needle.tip_position_m.z())) / cos_axis);
+         needle.direction * needle.along_axis_m(contact_search_height_m_ + std::abs(needle.tip_position_m.z()));
 }
 
 bool PunctureSimulator::try_contact(const NeedleState& needle) {
@@ -298,7 +302,7 @@ bool PunctureSimulator::breakthrough(std::size_t k, double surface_force_N, cons
   if (layer.state != LayerState::Pressed) return false;
   const BreakthroughCriterion& c = layer.law.breakthrough;
   // The surface is loaded at the tip's speed along its normal (v cos a for a needle at a to it).
-  const double normal_share = -layer.contact.normal.dot(needle.direction);
+  const double normal_share = along_needle(layer.contact.normal, needle);
   const double rate = breakthrough_rate_factor(
       c, mean_pressing_speed_m_per_s(layer.contact_axial_m * normal_share, layer.contact_time_s,
                                      needle.axial_position_m() * normal_share, needle.time_s,
@@ -332,7 +336,7 @@ void PunctureSimulator::record_puncture(const NeedleState& needle, double surfac
   event.cutting_force_N = cutting_force_N;
   // Along the needle axis (tick() adds the shaft forces of the layers above):
   // the surface force acts along the contact normal (see the header).
-  const double axial_share = -layer.contact.normal.dot(needle.direction);
+  const double axial_share = along_needle(layer.contact.normal, needle);
   event.total_force_N = surface_force_N * axial_share + cutting_force_N;
   if (layer.mesh) {
     event.eq5_force_N = layer.mesh->eq5_force_N();
@@ -503,19 +507,11 @@ void PunctureSimulator::refine_pending_layouts() {
   }
 }
 
-void PunctureSimulator::resolve_force_vector(const NeedleState& needle, double surface_force_N,
-                                             const Eigen::Vector3d& surface_normal) {
+void PunctureSimulator::resolve_force_vector(const NeedleState& needle, const Eigen::Vector3d& lateral_N) {
   const Eigen::Vector3d& d = needle.direction;
-  // The axial parts act along -d; the surface force's part across the axis
-  // is F (n - (n . d) d). Along the sample axis it is zero and is not added
-  // (the vector stays bit for bit -F d).
-  result_.force_on_needle_N = -result_.total_force_N * d;
-  result_.lateral_force_N = 0.0;
-  if (surface_force_N != 0.0) {
-    const Eigen::Vector3d lateral = surface_force_N * (surface_normal - surface_normal.dot(d) * d);
-    result_.lateral_force_N = lateral.norm();
-    if (result_.lateral_force_N > 0.0) result_.force_on_needle_N += lateral;
-  }
+  // The axial parts act along -d; the surface force's part across the needle is lateral_N.
+  result_.force_on_needle_N = -result_.total_force_N * d + lateral_N;
+  result_.lateral_force_N = lateral_N.norm();
   // The entry point: where the needle axis crosses the skin's undeformed plane z = 0.
   const double cos_axis = needle.axis_cosine();
   result_.path_depth_m = cos_axis >= kMinAxisCosine ? needle.depth_m() / cos_axis : needle.depth_m();
@@ -558,13 +554,15 @@ const TickResult& PunctureSimulator::tick(const NeedleState& needle) {
   // 5. Shaft friction and damping of the punctured layers.
   const double friction_total = shaft_friction_and_damping(needle);
   // The crack's viscous part (cutting.hpp) is the tissue the bevel wedges apart: tip force.
-  const double surface_axial = surface_force * -surface_normal.dot(needle.direction);
+  // The surface force acts along the contact normal n: F (-n . d) along the needle, the rest across it.
+  const double surface_share = along_needle(surface_normal, needle);
+  const double surface_axial = surface_force * surface_share;
   result_.surface_force_N = surface_force;
   result_.tip_force_N = surface_axial + crack.bevel_N;
   result_.cutting_force_N = cut - crack.bevel_N;
   result_.friction_force_N = friction_total;
   result_.total_force_N = surface_axial + cut + friction_total;
-  resolve_force_vector(needle, surface_force, surface_normal);
+  resolve_force_vector(needle, surface_force * (surface_normal + surface_share * needle.direction));
   if (broke) add_shaft_forces_to_events(needle.time_s);
   // 6. Meshes laid at a new contact point get their nodes projected onto the
   // surface a few per tick.

@@ -20,10 +20,7 @@ void ScriptedDevice::read(std::int64_t, double time_s, DeviceInput& input) noexc
   input.fresh_tissue = waiting_;
   input.pose.position_m = s.tip_position_m;
   // The needle axis orientation * (0, 0, -1) is the trajectory's direction (the identity along the sample axis).
-  if (s.direction == Eigen::Vector3d(0.0, 0.0, -1.0))
-    input.pose.orientation.setIdentity();
-  else
-    input.pose.orientation = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d(0.0, 0.0, -1.0), s.direction);
+  input.pose.orientation = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d(0.0, 0.0, -1.0), s.direction);
   input.pose.velocity_m_per_s = s.direction * s.axial_velocity_m_per_s;
   input.pose.has_velocity = true;
   input.has_exact_needle = false;

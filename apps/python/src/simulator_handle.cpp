@@ -48,7 +48,7 @@ TickRecord SimulatorHandle::tick_depth(double depth_m, std::optional<double> vel
   // On the scene's insertion line (needle.hpp): at depth_m below the skin plane.
   const Eigen::Vector3d& d = insertion_direction_;
   needle.direction = d;
-  needle.tip_position_m = Eigen::Vector3d(d.x() == 0.0 ? 0.0 : d.x() * depth_m / -d.z(), 0.0, -depth_m);
+  needle.tip_position_m = point_on_insertion_line(d, depth_m / -d.z());
   needle.time_s = time_s ? *time_s : (ticks_ == 0 ? 0.0 : last_time_s_ + dt_);
   // The depth's rate is vertical; the needle moves along its inclined axis, 1 / cos a as fast.
   needle.axial_velocity_m_per_s =

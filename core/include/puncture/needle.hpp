@@ -18,6 +18,11 @@
 
 namespace puncture {
 
+/// Smallest axis cosine (needle to the vertical) at which depths along the
+/// needle and vertical depths convert into each other; a needle closer to
+/// horizontal counts as horizontal (path depth and shaft lengths use this).
+constexpr double kMinAxisCosine = 1e-3;
+
 struct NeedleState {
   Eigen::Vector3d tip_position_m = Eigen::Vector3d::Zero();  ///< m, scene frame
   Eigen::Vector3d direction = -Eigen::Vector3d::UnitZ();      ///< unit, pointing from the shaft to the tip (insertion direction)
@@ -29,15 +34,17 @@ struct NeedleState {
   double axial_position_m() const { return tip_position_m.dot(direction); }
   /// Cosine of the needle axis to the vertical, -direction.z (1 along the sample axis).
   double axis_cosine() const { return -direction.z(); }
+  /// A vertical extent (m) as a length along the needle: vertical / cos a, the
+  /// cosine at least kMinAxisCosine.
+  double along_axis_m(double vertical_m) const;
 };
-
-/// Smallest axis cosine (needle to the vertical) at which depths along the
-/// needle and vertical depths convert into each other; a needle closer to
-/// horizontal counts as horizontal (path depth and shaft lengths use this).
-constexpr double kMinAxisCosine = 1e-3;
 
 /// The unit insertion direction d of a scripted insertion at insertion.angle_deg (see the header).
 Eigen::Vector3d insertion_direction(const Insertion& insertion);
+
+/// The point path_m (m) along the unit direction d from the origin (the entry
+/// point); a component d has none of is exactly 0 (not -0).
+Eigen::Vector3d point_on_insertion_line(const Eigen::Vector3d& direction, double path_m);
 
 /// Approach from start_height above the skin at `speed`, go on at the same
 /// speed to target_depth, dwell, withdraw at withdrawal_speed to the start

@@ -242,8 +242,9 @@ class PunctureSimulator {
   Eigen::Vector3d search_origin(const NeedleState& needle) const;
   /// Sets the contact of the needle layer if the tip has reached its surface.
   bool try_contact(const NeedleState& needle);
-  /// The tick's force as a vector, its lateral part and its moment about the entry point (TickResult).
-  void resolve_force_vector(const NeedleState& needle, double surface_force_N, const Eigen::Vector3d& surface_normal);
+  /// The tick's force as a vector, its part across the needle (lateral_N, N, scene frame: the surface
+  /// force's) and its moment about the entry point (TickResult), from total_force_N along the needle.
+  void resolve_force_vector(const NeedleState& needle, const Eigen::Vector3d& lateral_N);
   /// Lays the force mesh of layer k where the needle axis crosses its rest
   /// surface, if it is at rest and laid elsewhere.
   void lay_mesh_on_axis(std::size_t k, const NeedleState& needle, const SurfacePoint* hit);
