@@ -79,7 +79,7 @@ def current_record(out, scene, digests):
     if rec is None:
         return None
     geometry, digest = fsd.scene_geometry(scene), record_digest(rec, scene)
-    if digest != digests[geometry]:
+    if not fsd.same_runs(geometry, digest, digests[geometry]):
         return None
     rec.setdefault("fem_digest", digest)
     rec.setdefault("geometry", geometry)
@@ -152,6 +152,18 @@ def released_share(out, scene):
     return s["crack_energy_released_J"] / total
 
 
+def current_sources_note(records):
+    """What the page's runs are to the tree's FEM sources: the same digests, or runs that the
+    sources' recorded moves of code (scripts/fem_source_digest.py, SAME_RUNS) make the same."""
+    moved = sorted({(r.get("geometry"), r.get("fem_digest"), fsd.digest(None, r.get("geometry"))) for r in records
+                    if r.get("geometry") in fsd.GEOMETRIES and r.get("fem_digest") != fsd.digest(None, r.get("geometry"))})
+    if not moved:
+        return "the tree's FEM sources"
+    return "the tree's FEM sources compute the same (" + ", ".join(
+        f"{g} {new} moved code of {old} without changing its runs" for g, old, new in moved) + \
+        "; SAME_RUNS in scripts/fem_source_digest.py)"
+
+
 def page_header(records, args, command):
     """Records, options and command -> the page's title, provenance, scene count and partial-study notice."""
     missing = getattr(args, "missing", [])
@@ -163,7 +175,8 @@ def page_header(records, args, command):
         f"the runs from programs of git {', '.join(sorted({r.get('fem_source', 'unknown') for r in records}))}, "
         "FEM sources per geometry (scripts/fem_source_digest.py) "
         f"{', '.join(sorted({r.get('geometry', '?') + ' ' + str(r.get('fem_digest')) for r in records}))}"
-        + (f", finished between {min(times)} and {max(times)} UTC." if times else "."),
+        + (f", finished between {min(times)} and {max(times)} UTC" if times else "") + "; "
+        + current_sources_note(records) + ".",
         f"Scenes: {len(records) + len(missing)} drawn with seed {args.seed}, family `{args.family}` "
         "(scripts/fem_robustness.py: the ranges are `RANGES` there), "
         f"{args.jobs} run(s) side by side with one assembly thread each.",

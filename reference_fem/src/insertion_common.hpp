@@ -1,5 +1,5 @@
 // insertion_common.hpp: what the two insertion drivers share
-// (axisymmetric_insertion.cc, needle_insertion.cc): the state of a layer (the
+// (axisymmetric_insertion.cc, slab_insertion_run.cc): the state of a layer (the
 // core's LayerState), the number format of the CSV files, the rows of the surface and recovery
 // profiles, the force-depth CSV's layer-state columns, the checks of the
 // scene both drivers make, the text outputs and the puncture events of the

@@ -1,6 +1,6 @@
 // slab_insertion_output.cc: what the 3D reference's insertion run records (each load step,
 // the punctures, the surface profiles) and writes (force-depth CSV, summary JSON, VTU frames);
-// the algorithm is in needle_insertion.cc.
+// the algorithm is in slab_insertion_run.cc.
 #include "slab_insertion_run.hpp"
 
 namespace puncture::fem::slab_insertion {

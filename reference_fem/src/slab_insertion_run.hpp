@@ -1,5 +1,5 @@
 // slab_insertion_run.hpp (internal to puncture_fem): the 3D reference's insertion run
-// (SlabInsertionRun, needle_insertion.cc: the algorithm; slab_insertion_output.cc: what it
+// (SlabInsertionRun, slab_insertion_run.cc: the algorithm; slab_insertion_output.cc: what it
 // records and writes), with the node sets and rows it keeps.
 #pragma once
 
@@ -32,6 +32,9 @@ using namespace dealii;
 using insertion::format_double;
 using insertion::LayerState;
 using Tria = parallel::distributed::Triangulation<3>;
+
+/// The boundary ids build_slab_triangulation gives the slab's faces (needle_insertion.hpp).
+constexpr types::boundary_id kTop = 0, kBase = 1, kLateral = 2;
 
 /// A node (support point) with its three displacement dofs.
 struct Node {

@@ -8,6 +8,7 @@
   at namespace level only members of FiniteStrainSolver and SlabInsertionRun (or functions local
   to their file), and each geometry's own files exist.
 - A file of one geometry changes that geometry's digest only; a shared file changes both.
+- Recorded moves of code (SAME_RUNS) make two digests of one geometry the same runs, no others.
 
 Runs under pytest and on its own without pytest (ctest scripts.fem_source_digest).
 """
@@ -108,6 +109,26 @@ def test_a_geometrys_own_file_changes_its_digest_only():
         assert "unknown geometry '2d'" in str(e)
     else:
         raise AssertionError("an unknown geometry must raise")
+
+
+def test_same_runs_follows_the_recorded_moves_of_code_only():
+    for (geometry, newer), older in fsd.SAME_RUNS.items():
+        assert geometry in fsd.GEOMETRIES and newer != older
+        assert fsd.same_runs(geometry, newer, older) and fsd.same_runs(geometry, older, newer)
+        other = next(g for g in fsd.GEOMETRIES if g != geometry)
+        assert not fsd.same_runs(other, newer, older), "a move recorded for one geometry says nothing of the other"
+    assert fsd.same_runs("3d", "0123456789abcdef", "0123456789abcdef")
+    assert not fsd.same_runs("3d", "0123456789abcdef", "fedcba9876543210")
+    assert not fsd.same_runs("3d", None, None)
+    saved = dict(fsd.SAME_RUNS)
+    try:  # a chain of moves is followed back; a cycle ends
+        fsd.SAME_RUNS.clear()
+        fsd.SAME_RUNS.update({("3d", "c"): "b", ("3d", "b"): "a", ("axisymmetric", "x"): "y", ("axisymmetric", "y"): "x"})
+        assert fsd.same_runs("3d", "c", "a") and not fsd.same_runs("3d", "c", "d")
+        assert fsd.oldest_same("axisymmetric", "x") in ("x", "y")
+    finally:
+        fsd.SAME_RUNS.clear()
+        fsd.SAME_RUNS.update(saved)
 
 
 def test_scene_geometry_follows_the_tip_for_auto():
