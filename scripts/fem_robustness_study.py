@@ -118,6 +118,7 @@ def run_one(scene, out, binary, threads, sources):
                     "punctures": [(e["name"], round(e["depth_mm"], 3), round(e["force_N"], 4))
                                   for e in s.get("punctures", [])]})
         rec["problems"] = fr.check_run(run_dir)
+        rec["crack_released_share"] = released_share(out, name)
     results_io.write_text(os.path.join(out, "results", name + ".json"), json.dumps(rec, indent=1))
     return rec
 
@@ -137,10 +138,13 @@ def median(v):
     return float("nan") if n == 0 else (v[n // 2] if n % 2 else 0.5 * (v[n // 2 - 1] + v[n // 2]))
 
 
-def released_share(out, scene):
+def released_share(out, scene, rec=None):
     """The share of a run's crack dissipation that came from energy the
     tissue had stored (crack_energy_released_J / cohesive_dissipation_J of
-    OUT/runs/<scene>/fem_summary.json), or None."""
+    OUT/runs/<scene>/fem_summary.json; the record REC keeps it, since the
+    run directories are not committed), or None."""
+    if rec is not None and rec.get("crack_released_share") is not None:
+        return rec["crack_released_share"]
     path = os.path.join(out, "runs", scene, "fem_summary.json")
     if not os.path.exists(path):
         return None
@@ -234,7 +238,7 @@ def failures_section(failed, wrong):
 def crack_energy_section(records, out):
     """Records and OUT -> the section on the share of crack dissipation from stored energy (empty without runs)."""
     lines = []
-    shares = [q for r in records if (q := released_share(out, r["scene"])) is not None]
+    shares = [q for r in records if (q := released_share(out, r["scene"], r)) is not None]
     if shares:
         lines += ["## The cutting part and crack runs", "",
                   "The cutting part of the force is the crack's dissipation per unit advance, at most the force "
