@@ -159,8 +159,9 @@ def released_share(out, scene, rec=None):
 def current_sources_note(records):
     """What the page's runs are to the tree's FEM sources: the same digests, or runs that the
     sources' recorded moves of code (scripts/fem_source_digest.py, SAME_RUNS) make the same."""
-    moved = sorted({(r.get("geometry"), r.get("fem_digest"), fsd.digest(None, r.get("geometry"))) for r in records
-                    if r.get("geometry") in fsd.GEOMETRIES and r.get("fem_digest") != fsd.digest(None, r.get("geometry"))})
+    current = {g: fsd.digest(None, g) for g in fsd.GEOMETRIES}
+    moved = sorted({(r["geometry"], r.get("fem_digest"), current[r["geometry"]]) for r in records
+                    if r.get("geometry") in current and r.get("fem_digest") != current[r["geometry"]]})
     if not moved:
         return "the tree's FEM sources"
     return "the tree's FEM sources compute the same (" + ", ".join(
