@@ -3,7 +3,10 @@
 // run_needle_insertion). Prints one Markdown table row per run on rank 0.
 //
 //   fem_study run SCENE OUT_DIR [REFINEMENT] [DEGREE]
-//       full insertion of the scene, files in OUT_DIR
+//       full insertion of the scene, files in OUT_DIR; the environment may
+//       set the linear solver (PUNCTURE_FEM_LINEAR_SOLVER=auto|direct|iterative)
+//       and the 3D slab's mesh (PUNCTURE_FEM_SECTORS: cells around the
+//       circumference, a multiple of 4; PUNCTURE_FEM_RADIAL_GRADING: >= 1)
 //   fem_study indent SCENE DEPTH_MM SECTORS REFINEMENT DEGREE [FORMULATION]
 //       indentation without puncture to DEPTH_MM; row:
 //       | sectors | refinement | Q | formulation | dofs | force at depth (N) | wall (s) |
@@ -36,6 +39,8 @@ int main(int argc, char** argv) {
       if (argc > 4) o.refinement_override = std::atoi(argv[4]);
       if (argc > 5) o.degree_override = std::atoi(argv[5]);
       if (const char* ls = std::getenv("PUNCTURE_FEM_LINEAR_SOLVER")) o.linear_solver = ls;
+      if (const char* sec = std::getenv("PUNCTURE_FEM_SECTORS")) o.mesh.sectors = std::atoi(sec);
+      if (const char* g = std::getenv("PUNCTURE_FEM_RADIAL_GRADING")) o.mesh.radial_grading = std::atof(g);
       const auto s = fem::run_needle_insertion(scene, o, MPI_COMM_WORLD);
       if (root)
         std::cout << "dofs " << s.n_dofs << ", wall " << s.wall_time_s << " s, punctures " << s.punctures.size()
