@@ -424,8 +424,10 @@ FiniteStrainSolver::Failure FiniteStrainSolver::newton_direction(Step& step, Ite
   return std::nullopt;
 }
 
-FiniteStrainSolver::Failure FiniteStrainSolver::line_search(Step& step, const Iterate& x, double& alpha) {
+FiniteStrainSolver::Failure FiniteStrainSolver::line_search(Step& step, Iterate& x, double& alpha) {
   // Any admissible step while a prescribed displacement is still being reached.
+  std::ostringstream trials;
+  trials << std::defaultfloat;
   const LineSearchResult search = backtracking_line_search(
       x.free, x.gap > step.gap_tolerance_m, settings_.absolute_residual_floor_N, settings_.max_line_search_halvings,
       [&](double a, int halvings) -> std::optional<double> {
@@ -436,10 +438,17 @@ FiniteStrainSolver::Failure FiniteStrainSolver::line_search(Step& step, const It
         // common case) the next iteration needs no assembly of its own.
         const bool full_step = halvings == 0;
         if (full_step) increment_constraints(step.trial_ghosted, step.trial_constraints);
-        if (!assemble(step.trial_ghosted, full_step, full_step ? &step.trial_constraints : nullptr).valid)
+        if (!assemble(step.trial_ghosted, full_step, full_step ? &step.trial_constraints : nullptr).valid) {
+          trials << ' ' << a << ":inverted";
           return std::nullopt;
-        return free_residual_norm();
+        }
+        const double free_N = free_residual_norm();
+        trials << ' ' << a << ':' << std::setprecision(3) << free_N / x.free;
+        return free_N;
       });
+  // Why a step was cut: each rejected trial's alpha and its residual relative
+  // to the iterate's (or "inverted" for an inadmissible state).
+  if (search.halvings > 0 || !search.accepted) x.line << "  trials" << trials.str();
   alpha = search.alpha;
   if (search.accepted) {
     step.assembled_here = search.halvings == 0;

@@ -227,7 +227,7 @@ class FiniteStrainSolver {
   /// Newton direction: K du = -R with the increment constraints (solve_linear).
   Failure newton_direction(Step& step, Iterate& x);
   /// Backtracking line search along du from solution_: the step length alpha and step.trial.
-  Failure line_search(Step& step, const Iterate& x, double& alpha);
+  Failure line_search(Step& step, Iterate& x, double& alpha);
   /// A converged step: its log line and the last increment.
   NewtonReport accept_step(Step& step, const Iterate& x);
   /// A failed step: the state at its start restored, the reason reported.
