@@ -5,6 +5,7 @@
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -106,6 +107,25 @@ ForceMesh::ForceMesh(const ContactSurface& surface, const SurfacePoint& contact,
   for (int i = 0; i < n; ++i) ring_size_[lattice_.ring[i] - 1] += 1.0;
 
   setup_cells();
+  // Each ring's nodes in node order and its distinct cells (the ring means of a stiffening mesh).
+  ring_node_start_.assign(params.rings_w + 1, 0);
+  for (int i = 0; i < n; ++i) ++ring_node_start_[lattice_.ring[i]];
+  for (int j = 0; j < params.rings_w; ++j) ring_node_start_[j + 1] += ring_node_start_[j];
+  ring_nodes_.resize(n);
+  {
+    std::vector<int> next(ring_node_start_.begin(), ring_node_start_.end() - 1);
+    for (int i = 0; i < n; ++i) ring_nodes_[next[lattice_.ring[i] - 1]++] = i;
+  }
+  ring_cell_start_.assign(1, 0);
+  ring_cells_.clear();
+  for (int j = 0; j < params.rings_w; ++j) {
+    for (int k = ring_node_start_[j]; k < ring_node_start_[j + 1]; ++k) {
+      const int c = cell_of_[ring_nodes_[k]];
+      if (std::find(ring_cells_.begin() + ring_cell_start_[j], ring_cells_.end(), c) == ring_cells_.end())
+        ring_cells_.push_back(c);
+    }
+    ring_cell_start_.push_back(static_cast<int>(ring_cells_.size()));
+  }
   compute_static_influence();
   choose_integration();
   if (nonlinear_) {
@@ -236,6 +256,7 @@ void ForceMesh::project_node(int i) {
                                 " onto the layer surface gave a non-finite point");
   rest_.col(i) = sp.position;
   normals_.col(i) = sp.normal.normalized();
+  update_nodes();
   positions_.col(i) = rest_.col(i) - z_[i] * normals_.col(i);
 }
 
@@ -254,6 +275,7 @@ void ForceMesh::layout(const ContactSurface& surface, const SurfacePoint& contac
 
 const Eigen::Matrix3Xd& ForceMesh::positions() const {
   if (positions_stale_) {
+    update_nodes();
     for (int i = 0; i < lattice_.node_count(); ++i) positions_.col(i) = rest_.col(i) - z_[i] * normals_.col(i);
     positions_stale_ = false;
   }
@@ -288,6 +310,11 @@ bool ForceMesh::laid_at(const SurfacePoint& contact, double tolerance_m) const {
 void ForceMesh::reset() {
   z_.setZero();
   v_.setZero();
+  nodes_stale_ = false;
+  if (nonlinear_) {
+    cell_state_z_.setZero();
+    cell_state_v_.setZero();
+  }
   predicted_ = false;
   predicted_z0_ = 0.0;
   update_derived();
@@ -361,7 +388,7 @@ void ForceMesh::step_free_nodes(double z0_old, double z0_new) {
 
 void ForceMesh::predict() {
   if (nonlinear_) {
-    predict_nonlinear(z_[0]);
+    predict_nonlinear(cell_state_z_[0]);
     return;
   }
   predict_linear();
@@ -389,18 +416,34 @@ void ForceMesh::commit(double contact_deflection_m) {
   if (!std::isfinite(contact_deflection_m)) throw std::runtime_error("force mesh: non-finite contact deflection");
   if (!predicted_) predict();
   const double z0 = std::max(0.0, contact_deflection_m);
-  const double z0_old = z_[0];
-  const int n = lattice_.node_count();
   const double dz0 = z0 - predicted_z0_;  // predicted_z0_ = 0 for a linear mesh
-  for (int i = 1; i < n; ++i) {
-    z_[i] = pz_[i] + dz0 * qz_[i];
-    v_[i] = pv_[i] + dz0 * qv_[i];
+  bool finite = true;
+  if (nonlinear_) {
+    // The state on the cells; the nodes follow when asked (update_nodes).
+    const double z0_old = cell_state_z_[0];
+    const int nc = static_cast<int>(cell_size_.size());
+    for (int a = 1; a < nc; ++a) {
+      cell_state_z_[a] = cell_pz_[a] + dz0 * cell_qz_[a];
+      cell_state_v_[a] = cell_pv_[a] + dz0 * cell_qv_[a];
+    }
+    cell_state_z_[0] = z0;
+    cell_state_v_[0] = (z0 - z0_old) / settings_.time_step_s;
+    nodes_stale_ = true;
+    finite = cell_state_z_.allFinite() && cell_state_v_.allFinite();
+  } else {
+    const double z0_old = z_[0];
+    const int n = lattice_.node_count();
+    for (int i = 1; i < n; ++i) {
+      z_[i] = pz_[i] + dz0 * qz_[i];
+      v_[i] = pv_[i] + dz0 * qv_[i];
+    }
+    z_[0] = z0;
+    v_[0] = (z0 - z0_old) / settings_.time_step_s;
   }
-  z_[0] = z0;
-  v_[0] = (z0 - z0_old) / settings_.time_step_s;
   predicted_ = false;
   update_derived();
-  if (!std::isfinite(ring_mean_m_.sum()) || !std::isfinite(v_.sum()))
+  if (!nonlinear_) finite = std::isfinite(ring_mean_m_.sum()) && std::isfinite(v_.sum());
+  if (!finite)
     throw std::runtime_error("force mesh: deflections became non-finite (integrator " +
                              std::string(to_string(settings_.integrator)) + ")");
 }
@@ -413,16 +456,48 @@ void ForceMesh::advance(double contact_deflection_m) {
 }
 
 void ForceMesh::update_derived() {
+  positions_stale_ = true;
+  if (nonlinear_) {
+    // The nodes' values are their cells': the same extremes; the ring means when asked.
+    ring_means_stale_ = true;
+    max_abs_deflection_m_ = cell_state_z_.cwiseAbs().maxCoeff();
+    max_abs_velocity_m_per_s_ = cell_state_v_.cwiseAbs().maxCoeff();
+    return;
+  }
   const int n = lattice_.node_count();
   ring_mean_m_.setZero();
   for (int i = 0; i < n; ++i) ring_mean_m_[lattice_.ring[i] - 1] += z_[i];
-  positions_stale_ = true;
   ring_mean_m_.array() /= ring_size_.array();
   max_abs_deflection_m_ = z_.cwiseAbs().maxCoeff();
   max_abs_velocity_m_per_s_ = v_.cwiseAbs().maxCoeff();
 }
 
+void ForceMesh::update_nodes() const {
+  if (!nodes_stale_) return;
+  const int n = lattice_.node_count();
+  for (int i = 0; i < n; ++i) {
+    const int a = cell_of_[i];
+    z_[i] = cell_state_z_[a];
+    v_[i] = cell_state_v_[a];
+  }
+  nodes_stale_ = false;
+}
+
+double ForceMesh::ring_mean_from_cells(int j) const {
+  // The sum in node order, as update_derived() forms it for a linear mesh.
+  double sum = 0.0;
+  for (int k = ring_node_start_[j]; k < ring_node_start_[j + 1]; ++k) sum += cell_state_z_[cell_of_[ring_nodes_[k]]];
+  return sum / ring_size_[j];
+}
+
+void ForceMesh::update_ring_means() const {
+  if (!ring_means_stale_) return;
+  for (int j = 0; j < params_.rings_w; ++j) ring_mean_m_[j] = ring_mean_from_cells(j);
+  ring_means_stale_ = false;
+}
+
 double ForceMesh::contact_reaction_N() const {
+  update_nodes();
   if (nonlinear_) {
     double f = virtual_spring_force_N(params_, z_[0]);
     for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k)
@@ -436,6 +511,8 @@ double ForceMesh::contact_reaction_N() const {
 }
 
 double ForceMesh::eq5_force_N() const {
+  update_nodes();
+  update_ring_means();
   if (params_.virtual_stiffening_m > 0.0) {
     double f = 0.0;
     for (int i = 0; i < lattice_.node_count(); ++i) f += virtual_spring_force_N(params_, z_[i]);
@@ -447,17 +524,36 @@ double ForceMesh::eq5_force_N() const {
 }
 
 int ForceMesh::deformed_rings() const {
+  const double threshold = params_.deformed_threshold_m;
   int j = 0;
-  while (j < params_.rings_w && ring_mean_m_[j] > params_.deformed_threshold_m) ++j;
+  if (nonlinear_ && ring_means_stale_) {
+    // Per tick: a ring whose cells all lie clearly on one side of the threshold
+    // needs no sum (the rounded mean of values in [lo, hi] lies within
+    // 1e-10 max(|lo|, |hi|) of that range); the others are summed exactly.
+    for (; j < params_.rings_w; ++j) {
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (int k = ring_cell_start_[j]; k < ring_cell_start_[j + 1]; ++k) {
+        lo = std::min(lo, cell_state_z_[ring_cells_[k]]);
+        hi = std::max(hi, cell_state_z_[ring_cells_[k]]);
+      }
+      const double margin = 1e-10 * std::max(std::abs(lo), std::abs(hi));
+      if (lo > threshold + margin) continue;
+      if (hi < threshold - margin || !(ring_mean_from_cells(j) > threshold)) break;
+    }
+    return j;
+  }
+  while (j < params_.rings_w && ring_mean_m_[j] > threshold) ++j;
   return j;
 }
 
 double ForceMesh::kinetic_energy_J() const {
   // Free nodes only: the contact node moves with the needle.
+  update_nodes();
   return 0.5 * mass_kg_ * v_.tail(v_.size() - 1).squaredNorm();
 }
 
 double ForceMesh::virtual_spring_energy_J() const {
+  update_nodes();
   if (params_.virtual_stiffening_m > 0.0) {
     double e = 0.0;
     for (int i = 0; i < lattice_.node_count(); ++i) e += puncture::virtual_spring_energy_J(params_, z_[i]);
@@ -467,6 +563,7 @@ double ForceMesh::virtual_spring_energy_J() const {
 }
 
 double ForceMesh::surface_spring_energy_J() const {
+  update_nodes();
   double e = 0.0;
   if (params_.surface_axial_stiffness_N_per_m > 0.0) {
     for (int i = 0; i < lattice_.node_count(); ++i)

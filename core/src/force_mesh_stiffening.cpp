@@ -115,7 +115,6 @@ void ForceMesh::setup_nonlinear() {
   // The step is solved on the lattice's cells: one unknown per free cell
   // a = cell - 1, the tangent weighted by the cells' sizes (symmetric:
   // |A| n_AB = |B| n_BA springs between A and B).
-  const int n = lattice_.node_count();
   const double dt = settings_.time_step_s;
   step_mass_term_ = use_implicit_ ? mass_kg_ / (dt * dt) + params_.node_damping_N_s_per_m / dt : 0.0;
   const int nc = static_cast<int>(cell_size_.size());
@@ -123,8 +122,15 @@ void ForceMesh::setup_nonlinear() {
   std::vector<std::pair<int, int>> lower;  // free-cell indices a = cell - 1
   for (int a = 0; a < mf; ++a) lower.push_back({a, a});
   for (const CellPair& p : pairs_) lower.push_back({p.b - 1, p.a - 1});
-  qz_.setZero(n);
-  qv_.setZero(n);
+  cell_state_z_.setZero(nc);
+  cell_state_v_.setZero(nc);
+  cell_pz_.setZero(nc);
+  cell_pv_.setZero(nc);
+  cell_qz_.setZero(nc);
+  cell_qv_.setZero(nc);
+  pair_stiffness_.assign(pairs_.size(), 0.0);
+  contact_pair_stiffness_.assign(contact_pairs_.size(), 0.0);
+  cell_virtual_stiffness_.assign(nc, 0.0);
   cell_z_.setZero(nc);
   trial_cell_z_.setZero(nc);
   const int m = std::max(mf, 1);
@@ -141,48 +147,47 @@ void ForceMesh::setup_nonlinear() {
 
 double ForceMesh::nonlinear_residual(double z0) {
   // Every free node's residual, one per cell (cell_z_[0] = z0): node terms,
-  // then the springs between cells, each pair once.
+  // then the springs between cells, each pair once. The springs' tangent at
+  // this state is kept for factorize_tangent.
   const int nc = static_cast<int>(cell_size_.size());
   const SurfaceSpringLaw law{params_.surface_stiffness_N_per_m, params_.surface_axial_stiffness_N_per_m,
                              params_.spacing_L_m};
   cell_z_[0] = z0;
-  for (int a = 1; a < nc; ++a)
+  for (int a = 1; a < nc; ++a) {
     cell_residual_[a - 1] =
         step_mass_term_ * (cell_z_[a] - inertial_target_[a - 1]) + virtual_spring_force_N(params_, cell_z_[a]);
-  double f = 0.0, k = 0.0;
-  for (const CellPair& p : pairs_) {
-    law.evaluate(cell_z_[p.a] - cell_z_[p.b], f, k);
+    cell_virtual_stiffness_[a] = virtual_spring_stiffness_N_per_m(params_, cell_z_[a]);
+  }
+  double f = 0.0;
+  for (std::size_t e = 0; e < pairs_.size(); ++e) {
+    const CellPair& p = pairs_[e];
+    law.evaluate(cell_z_[p.a] - cell_z_[p.b], f, pair_stiffness_[e]);
     cell_residual_[p.a - 1] += p.per_node_a * f;
     cell_residual_[p.b - 1] -= p.per_node_b * f;
   }
-  for (const CellPair& p : contact_pairs_) {
-    law.evaluate(cell_z_[p.b] - z0, f, k);
+  for (std::size_t e = 0; e < contact_pairs_.size(); ++e) {
+    const CellPair& p = contact_pairs_[e];
+    law.evaluate(cell_z_[p.b] - z0, f, contact_pair_stiffness_[e]);
     cell_residual_[p.b - 1] += p.per_node_b * f;
   }
   return nc > 1 ? cell_residual_.cwiseAbs().maxCoeff() : 0.0;
 }
 
-void ForceMesh::factorize_tangent(double z0) {
-  // The tangent of the cells' residuals, each row times the cell's size.
+void ForceMesh::factorize_tangent() {
+  // The tangent of the cells' residuals, each row times the cell's size, from
+  // the springs' tangent the last nonlinear_residual() kept (at cell_z_).
   const int nc = static_cast<int>(cell_size_.size());
-  const SurfaceSpringLaw law{params_.surface_stiffness_N_per_m, params_.surface_axial_stiffness_N_per_m,
-                             params_.spacing_L_m};
-  cell_z_[0] = z0;
-  for (int a = 1; a < nc; ++a)
-    tangent_values_[a - 1] = cell_size_[a] * (step_mass_term_ + virtual_spring_stiffness_N_per_m(params_, cell_z_[a]));
+  for (int a = 1; a < nc; ++a) tangent_values_[a - 1] = cell_size_[a] * (step_mass_term_ + cell_virtual_stiffness_[a]);
   const std::size_t diagonal = static_cast<std::size_t>(nc - 1);
-  double f = 0.0, k = 0.0;
   for (std::size_t e = 0; e < pairs_.size(); ++e) {
     const CellPair& p = pairs_[e];
-    law.evaluate(cell_z_[p.a] - cell_z_[p.b], f, k);
+    const double k = pair_stiffness_[e];
     tangent_values_[p.a - 1] += p.edges * k;
     tangent_values_[p.b - 1] += p.edges * k;
     tangent_values_[diagonal + e] = -p.edges * k;
   }
-  for (const CellPair& p : contact_pairs_) {
-    law.evaluate(cell_z_[p.b] - z0, f, k);
-    tangent_values_[p.b - 1] += p.edges * k;
-  }
+  for (std::size_t e = 0; e < contact_pairs_.size(); ++e)
+    tangent_values_[contact_pairs_[e].b - 1] += contact_pairs_[e].edges * contact_pair_stiffness_[e];
   if (!tangent_->factorize(tangent_values_.data()))
     throw std::runtime_error("force mesh: the stiffening mesh's tangent is not positive definite (non-finite deflections?)");
   tangent_ready_ = true;
@@ -208,7 +213,7 @@ double ForceMesh::newton_solve_cells(double z0, double scale) {
       throw std::runtime_error("force mesh: the stiffening mesh's step did not converge in " +
                                std::to_string(kMaxNewton) + " Newton iterations (contact deflection " +
                                std::to_string(z0 * 1e3) + " mm)");
-    factorize_tangent(z0);
+    factorize_tangent();
     for (int a = 0; a < mf; ++a) cell_residual_[a] *= -cell_size_[a + 1];
     tangent_->solve(cell_residual_, newton_step_);
     ++newton_iterations_;
@@ -235,24 +240,23 @@ double ForceMesh::newton_solve_cells(double z0, double scale) {
 }
 
 void ForceMesh::solve_nonlinear_step(double z0) {
-  const int n = lattice_.node_count();
   const int nc = static_cast<int>(cell_size_.size());
   const double dt = settings_.time_step_s;
   newton_iterations_ = 0;
-  if (n == 1) {
-    pz_[0] = z0;
-    pv_.setZero();
-    return;
-  }
-  // The committed state is constant on the cells: its cells' values are their first nodes'.
+  cell_pz_[0] = z0;
+  cell_pv_[0] = 0.0;
+  cell_qz_[0] = 1.0;
+  cell_qv_[0] = 0.0;
+  if (nc == 1) return;
+  // The committed state is constant on the cells (cell_state_z_, cell_state_v_).
   double scale = std::max(std::abs(z0), params_.deformed_threshold_m);
   for (int a = 1; a < nc; ++a) {
-    const int i = cell_rep_[a];
-    cell_z_[a] = z_[i];
-    scale = std::max(scale, std::abs(z_[i]));
+    const double z = cell_state_z_[a];
+    cell_z_[a] = z;
+    scale = std::max(scale, std::abs(z));
     if (use_implicit_) {
       const double m_dt2 = mass_kg_ / (dt * dt), c_dt = params_.node_damping_N_s_per_m / dt;
-      inertial_target_[a - 1] = (m_dt2 * (z_[i] + dt * v_[i]) + c_dt * z_[i]) / step_mass_term_;
+      inertial_target_[a - 1] = (m_dt2 * (z + dt * cell_state_v_[a]) + c_dt * z) / step_mass_term_;
     }
   }
   const double last_step = newton_solve_cells(z0, scale);
@@ -261,21 +265,16 @@ void ForceMesh::solve_nonlinear_step(double z0) {
   // deflections) away: it is kept then; the predicted slope is then off by
   // about that fraction of the tangent's change over the step (a tick of
   // needle travel), and the next predict() solves the true step.
-  if (!tangent_ready_ || last_step > 1e-3 * scale) factorize_tangent(z0);
+  if (!tangent_ready_ || last_step > 1e-3 * scale) factorize_tangent();
   cell_residual_.setZero();
-  for (const CellPair& p : contact_pairs_)
-    cell_residual_[p.b - 1] = p.edges * surface_spring_stiffness_N_per_m(params_, cell_z_[p.b] - z0);
+  for (std::size_t e = 0; e < contact_pairs_.size(); ++e)
+    cell_residual_[contact_pairs_[e].b - 1] = contact_pairs_[e].edges * contact_pair_stiffness_[e];
   tangent_->solve(cell_residual_, newton_step_);
-  pz_[0] = z0;
-  pv_[0] = 0.0;
-  qz_[0] = 1.0;
-  qv_[0] = 0.0;
-  for (int i = 1; i < n; ++i) {
-    const int a = cell_of_[i];
-    pz_[i] = cell_z_[a];
-    qz_[i] = newton_step_[a - 1];
-    qv_[i] = use_implicit_ ? qz_[i] / dt : 0.0;
-    pv_[i] = use_implicit_ ? (pz_[i] - z_[i]) / dt : 0.0;
+  for (int a = 1; a < nc; ++a) {
+    cell_pz_[a] = cell_z_[a];
+    cell_qz_[a] = newton_step_[a - 1];
+    cell_qv_[a] = use_implicit_ ? cell_qz_[a] / dt : 0.0;
+    cell_pv_[a] = use_implicit_ ? (cell_pz_[a] - cell_state_z_[a]) / dt : 0.0;
   }
 }
 
@@ -286,9 +285,9 @@ void ForceMesh::predict_nonlinear(double z0_star) {
   double reaction = virtual_spring_force_N(params_, predicted_z0_);
   double slope = virtual_spring_stiffness_N_per_m(params_, predicted_z0_);
   for (int k = lattice_.neighbour_offsets[0]; k < lattice_.neighbour_offsets[1]; ++k) {
-    const int j = lattice_.neighbours[k];
-    reaction += surface_spring_force_N(params_, predicted_z0_ - pz_[j]);
-    slope += surface_spring_stiffness_N_per_m(params_, predicted_z0_ - pz_[j]) * (1.0 - qz_[j]);
+    const int c = cell_of_[lattice_.neighbours[k]];
+    reaction += surface_spring_force_N(params_, predicted_z0_ - cell_pz_[c]);
+    slope += surface_spring_stiffness_N_per_m(params_, predicted_z0_ - cell_pz_[c]) * (1.0 - cell_qz_[c]);
   }
   reaction_slope_N_per_m_ = slope;
   predicted_intercept_N_ = reaction - slope * predicted_z0_;

@@ -268,6 +268,8 @@ TEST(ForceMeshStiffening, AStepAllocatesNothing) {
     m.predict();
     sum += m.predicted_reaction_N(5e-5 * i);
     m.commit(5e-5 * i);
+    // The per-node state and the ring means are expanded from the cells when asked: no allocation either.
+    sum += m.deformed_rings() + m.ring_mean_deflection_m(3) + m.deflections_m()[5] + m.contact_reaction_N();
   }
   EXPECT_EQ(test::stop_counting_allocations(), 0);
   EXPECT_TRUE(std::isfinite(sum));
@@ -285,4 +287,66 @@ TEST(ForceMeshStiffening, ACopyIsIndependent) {
   again.advance(2.1e-3);
   EXPECT_EQ(original.contact_reaction_N(), again.contact_reaction_N());
   EXPECT_GT(copy.contact_reaction_N(), original.contact_reaction_N());
+}
+
+namespace {
+
+// Ring means of a mesh's node deflections, summed in node order.
+Eigen::VectorXd ring_means_of_nodes(const ForceMesh& m) {
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(m.rings()), count = Eigen::VectorXd::Zero(m.rings());
+  const Eigen::VectorXd& z = m.deflections_m();
+  for (int i = 0; i < m.node_count(); ++i) {
+    sum[m.node_rings()[i] - 1] += z[i];
+    count[m.node_rings()[i] - 1] += 1.0;
+  }
+  return sum.cwiseQuotient(count);
+}
+
+int deformed_rings_of(const Eigen::VectorXd& means, double threshold_m) {
+  int j = 0;
+  while (j < means.size() && means[j] > threshold_m) ++j;
+  return j;
+}
+
+}  // namespace
+
+TEST(ForceMeshStiffening, RingMeansAndDeformedRingsAreThoseOfTheNodes) {
+  // A stiffening mesh keeps its state on the lattice's cells and expands it to
+  // the nodes when asked; the ring means, the deformed rings (checked per tick
+  // from the cells' range) and the velocities must be exactly those of the
+  // nodes, over a press, a fast withdrawal that lifts rings above the surface
+  // (negative deflections) and the rebound.
+  ForceMeshParams light = stiffening_params(9);
+  light.node_damping_N_s_per_m = 1e-4;  // little damping: the released rings overshoot
+  ForceMesh m = make_mesh(light, MeshIntegrator::Implicit);
+  std::vector<double> path;
+  for (int i = 1; i <= 120; ++i) path.push_back(4e-3 * i / 120.0);
+  for (int i = 0; i < 300; ++i) path.push_back(0.0);
+  int checked = 0, negative = 0;
+  double ring4_at_mid = 0.0;
+  for (std::size_t t = 0; t < path.size(); ++t) {
+    m.advance(path[t]);
+    const int rings = m.deformed_rings();  // before anything expands the nodes
+    const Eigen::VectorXd means = ring_means_of_nodes(m);
+    ASSERT_EQ(rings, deformed_rings_of(means, m.params().deformed_threshold_m)) << "tick " << t;
+    for (int j = 1; j <= m.rings(); ++j) ASSERT_EQ(m.ring_mean_deflection_m(j), means[j - 1]) << "tick " << t;
+    negative += means.minCoeff() < 0.0;
+    if (t == 60) ring4_at_mid = means[3];
+    ++checked;
+  }
+  EXPECT_EQ(checked, static_cast<int>(path.size()));
+  EXPECT_GT(negative, 0);  // the withdrawal did lift some ring
+  // A threshold exactly at a ring's mean: that ring is not deformed (mean > threshold is false),
+  // the case the cells' range cannot decide.
+  ForceMeshParams p = light;
+  ForceMesh a = make_mesh(p, MeshIntegrator::Implicit);
+  for (int t = 0; t <= 60; ++t) a.advance(path[t]);
+  p.deformed_threshold_m = a.ring_mean_deflection_m(4);
+  ASSERT_EQ(p.deformed_threshold_m, ring4_at_mid);
+  ForceMesh b = make_mesh(p, MeshIntegrator::Implicit);
+  for (int t = 0; t <= 60; ++t) b.advance(path[t]);
+  const Eigen::VectorXd means_b = ring_means_of_nodes(b);
+  ASSERT_EQ(means_b[3], p.deformed_threshold_m);  // the same path: the threshold does not set its scale here
+  ASSERT_GT(means_b.head(3).minCoeff(), p.deformed_threshold_m);
+  EXPECT_EQ(b.deformed_rings(), 3);
 }

@@ -216,7 +216,10 @@ class ForceMesh {
   // --- deformation ---
   int rings() const { return params_.rings_w; }
   int node_count() const { return lattice_.node_count(); }
-  double ring_mean_deflection_m(int ring) const { return ring_mean_m_[ring - 1]; }  ///< ring in 1..w
+  double ring_mean_deflection_m(int ring) const {  ///< ring in 1..w
+    update_ring_means();
+    return ring_mean_m_[ring - 1];
+  }
   int deformed_rings() const;
   /// True when every node's deflection is below tolerance_m and its speed
   /// below tolerance_m per time step (nothing left to integrate).
@@ -224,8 +227,14 @@ class ForceMesh {
     return max_abs_deflection_m_ <= tolerance_m && max_abs_velocity_m_per_s_ * settings_.time_step_s <= tolerance_m;
   }
   bool broken() const { return deformed_rings() >= params_.rings_w; }
-  const Eigen::VectorXd& deflections_m() const { return z_; }       ///< size N, [0] = contact node
-  const Eigen::VectorXd& velocities_m_per_s() const { return v_; }  ///< size N, [0] = contact node rate
+  const Eigen::VectorXd& deflections_m() const {  ///< size N, [0] = contact node
+    update_nodes();
+    return z_;
+  }
+  const Eigen::VectorXd& velocities_m_per_s() const {  ///< size N, [0] = contact node rate
+    update_nodes();
+    return v_;
+  }
   /// Equilibrium deflection of every node per metre of contact deflection (u_0 = 1).
   const Eigen::VectorXd& unit_influence() const { return influence_; }
 
@@ -260,6 +269,12 @@ class ForceMesh {
   /// Backward-Euler solve of the free nodes for rhs_ (+ b z0 added by the caller) into work_.
   void implicit_solve();
   void update_derived();
+  /// A stiffening mesh keeps its state on the cells (cell_state_z_, cell_state_v_);
+  /// the per-node vectors and the ring means are expanded from them when asked.
+  void update_nodes() const;
+  void update_ring_means() const;
+  /// Mean deflection of ring j (0-based) summed over its nodes in node order (m).
+  double ring_mean_from_cells(int j) const;
   void layout(const ContactSurface& surface, const SurfacePoint& contact);
   void set_frame(const SurfacePoint& contact);
   void project_node(int i);
@@ -283,12 +298,14 @@ class ForceMesh {
   /// Residual of the free nodes' step equations at (cell_z_, contact z0), one per free cell, into
   /// cell_residual_; returns its max norm.
   double nonlinear_residual(double z0);
-  /// Tangent of the cells' step equations at cell_z_ factorised; throws std::runtime_error if not SPD.
-  void factorize_tangent(double z0);
+  /// Tangent of the cells' step equations at the state of the last nonlinear_residual() (the
+  /// springs' tangent it kept) factorised; throws std::runtime_error if not SPD.
+  void factorize_tangent();
   /// Newton from cell_z_ to the step's solution at contact deflection z0 (scale: the deflections'
   /// magnitude, m); returns the last full Newton step (m).
   double newton_solve_cells(double z0, double scale);
-  /// Solves the step to contact deflection z0 from (z_, v_) into (pz_, pv_), with its sensitivity in (qz_, qv_).
+  /// Solves the step to contact deflection z0 from the committed cell state into
+  /// (cell_pz_, cell_pv_), with its sensitivity in (cell_qz_, cell_qv_).
   void solve_nonlinear_step(double z0);
 
   ForceMeshParams params_;
@@ -311,7 +328,11 @@ class ForceMesh {
   Eigen::Vector3d frame_origin_ = Eigen::Vector3d::Zero(), frame_normal_ = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d frame_e1_ = Eigen::Vector3d::UnitX(), frame_e2_ = Eigen::Vector3d::UnitY();
   int next_projection_ = 0;
-  Eigen::VectorXd z_, v_, influence_, rhs_, work_;
+  // Node state. A stiffening mesh's own state is on the cells (below); z_ and v_
+  // are then its expansion to the nodes, made when asked (nodes_stale_).
+  mutable Eigen::VectorXd z_, v_;
+  mutable bool nodes_stale_ = false;
+  Eigen::VectorXd influence_, rhs_, work_;
   Eigen::VectorXd pz_, pv_;  ///< predicted free-node state for z0 = 0 (index 0 unused)
   Eigen::VectorXd qz_, qv_;  ///< unit response of the free nodes to z0 = 1 at the end of a step
   double max_abs_deflection_m_ = 0.0;
@@ -338,13 +359,21 @@ class ForceMesh {
   std::vector<CellPair> pairs_;                ///< adjacent free cells
   std::vector<CellPair> contact_pairs_;        ///< cells adjacent to the contact node (a = 0)
   double step_mass_term_ = 0.0;                ///< m/dt^2 + c/dt (implicit), 0 (quasi-static)
-  Eigen::VectorXd cell_z_, trial_cell_z_;      ///< deflection per cell ([0] = contact)
+  Eigen::VectorXd cell_state_z_, cell_state_v_;  ///< committed deflection and rate per cell ([0] = contact)
+  Eigen::VectorXd cell_pz_, cell_pv_;          ///< predicted state per cell at the linearisation point
+  Eigen::VectorXd cell_qz_, cell_qv_;          ///< its sensitivity to the contact deflection per cell
+  Eigen::VectorXd cell_z_, trial_cell_z_;      ///< Newton iterate per cell ([0] = contact)
+  std::vector<double> pair_stiffness_, contact_pair_stiffness_;  ///< springs' tangent at the last residual
+  std::vector<double> cell_virtual_stiffness_;                   ///< virtual springs' tangent there, per cell
   Eigen::VectorXd inertial_target_;            ///< z_hat of the step equations per free cell
   Eigen::VectorXd cell_residual_, newton_step_;
   int newton_iterations_ = 0;
   bool tangent_ready_ = false;  ///< the tangent has been factorised at least once
-  Eigen::VectorXd ring_mean_m_;
+  mutable Eigen::VectorXd ring_mean_m_;
+  mutable bool ring_means_stale_ = false;
   Eigen::VectorXd ring_size_;
+  std::vector<int> ring_node_start_, ring_nodes_;  ///< each ring's nodes in node order (CSR)
+  std::vector<int> ring_cell_start_, ring_cells_;  ///< each ring's distinct cells (CSR)
 
   // LDLT factors of the implicit system over the free cells (index a = cell - 1; linear mesh):
   // P A P^T = L D L^T, L unit lower, stored column-wise (CSC, strictly lower part).
