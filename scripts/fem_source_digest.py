@@ -45,7 +45,7 @@ CORE_HEADERS = ("core/include/puncture/scene.hpp", "core/include/puncture/punctu
 # (the same filter as validation/fem_cache/CMakeLists.txt).
 NOT_FEM = re.compile(r"tet_slab_mesh|tet_mesh")
 ONLY = {
-    "3d": re.compile(r"^reference_fem/(src/(finite_strain_solver\.cc|finite_strain_assembly\.cc|"
+    "3d": re.compile(r"^reference_fem/(src/(finite_strain_solver\.cc|finite_strain_assembly\.cc|energy_line_search\.hpp|"
                      r"slab_insertion_output\.cc|slab_insertion_run\.(cc|hpp))|"
                      r"include/puncture/fem/finite_strain_solver\.hpp)$"),
     "axisymmetric": re.compile(r"^(reference_fem/src/axisymmetric_[a-z_]+\.(cc|hpp)|"

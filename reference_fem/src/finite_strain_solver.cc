@@ -3,6 +3,7 @@
 #include <puncture/fem/kinematics.hpp>
 
 #include "backtracking_line_search.hpp"
+#include "energy_line_search.hpp"
 #include "solver_timing.hpp"
 
 #include <deal.II/base/mpi.h>
@@ -188,6 +189,14 @@ double FiniteStrainSolver::free_residual_norm() const {
     if (locally_owned_.is_element(dof)) r[dof] = 0.0;
   r.compress(VectorOperation::insert);
   return r.l2_norm();
+}
+
+double FiniteStrainSolver::free_residual_dot(const TrilinosWrappers::MPI::Vector& du) const {
+  TrilinosWrappers::MPI::Vector r(residual_);
+  for (const auto& [dof, target] : targets_)
+    if (locally_owned_.is_element(dof)) r[dof] = 0.0;
+  r.compress(VectorOperation::insert);
+  return r * du;
 }
 
 double FiniteStrainSolver::reaction_norm() const {
@@ -428,6 +437,7 @@ FiniteStrainSolver::Failure FiniteStrainSolver::line_search(Step& step, Iterate&
   // Any admissible step while a prescribed displacement is still being reached.
   std::ostringstream trials;
   trials << std::defaultfloat;
+  const double slope0 = free_residual_dot(step.du);  // residual_ is the iterate's here
   const LineSearchResult search = backtracking_line_search(
       x.free, x.gap > step.gap_tolerance_m, settings_.absolute_residual_floor_N, settings_.max_line_search_halvings,
       [&](double a, int halvings) -> std::optional<double> {
@@ -446,10 +456,40 @@ FiniteStrainSolver::Failure FiniteStrainSolver::line_search(Step& step, Iterate&
         trials << ' ' << a << ':' << std::setprecision(3) << free_N / x.free;
         return free_N;
       });
-  // Why a step was cut: each rejected trial's alpha and its residual relative
-  // to the iterate's (or "inverted" for an inadmissible state).
-  if (search.halvings > 0 || !search.accepted) x.line << "  trials" << trials.str();
   alpha = search.alpha;
+  // The log says why a step was cut: each rejected trial's alpha and its
+  // residual relative to the iterate's (or "inverted" for an inadmissible
+  // state); after "energy", the fallback's trials and their slope over |slope0|.
+  const bool prescribing = x.gap > step.gap_tolerance_m;
+  if (settings_.energy_line_search_fallback && !prescribing && alpha <= 0.125 && slope0 < 0.0) {
+    trials << "  energy";
+    const std::optional<double> a =
+        energy_line_search(slope0, 8, [&](double a_trial) -> std::optional<double> {
+          step.trial = solution_;
+          step.trial.add(a_trial, step.du);
+          step.trial_ghosted = step.trial;
+          if (!assemble(step.trial_ghosted, false, nullptr).valid) {
+            trials << ' ' << a_trial << ":inverted";
+            return std::nullopt;
+          }
+          const double g = free_residual_dot(step.du);
+          trials << ' ' << a_trial << ':' << std::setprecision(3) << g / -slope0;
+          return g;
+        });
+    if (a && *a > alpha) {
+      x.line << "  trials" << trials.str();
+      alpha = *a;
+      step.assembled_here = false;
+      step.trial = solution_;
+      step.trial.add(alpha, step.du);
+      return std::nullopt;
+    }
+    if (alpha >= 0.0) {  // the fallback's trials overwrote the trial state: the backtracking's step again
+      step.trial = solution_;
+      step.trial.add(alpha, step.du);
+    }
+  }
+  if (search.halvings > 0 || !search.accepted) x.line << "  trials" << trials.str();
   if (search.accepted) {
     step.assembled_here = search.halvings == 0;
     return std::nullopt;
