@@ -81,8 +81,10 @@ peak = max(abs(float(r[a[0].index("force_N")])) for r in a[1:])
 print(f"\n## `{scene}`\n")
 print(f"- Command: `bash scripts/tick_ab.sh BEFORE AFTER` (RUNS={runs}: `puncture run {scene} --no-frames -q` "
       "with each binary in turn, interleaved)")
-print(f"- Machine: {cpu_model()}, {os.cpu_count()} cores, host `{socket.gethostname()}`; shared with other builds "
-      f"and FEM runs during the measurement (load average {load_before} before, {load_after} after)")
+busy = max(float(load_before.split()[0]), float(load_after.split()[0])) > 1.0
+print(f"- Machine: {cpu_model()}, {os.cpu_count()} cores, host `{socket.gethostname()}`; "
+      + ("shared with other work during the measurement" if busy else "otherwise idle")
+      + f" (load average {load_before} before, {load_after} after)")
 print(f"- Date: {started}")
 print(f"- Before: {rev_before}; after: {rev_after}")
 print("- Times: wall time of tick() measured inside each run (summary.json `tick_timing_us`), over the "
