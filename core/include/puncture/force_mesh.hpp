@@ -333,8 +333,8 @@ class ForceMesh {
   mutable Eigen::VectorXd z_, v_;
   mutable bool nodes_stale_ = false;
   Eigen::VectorXd influence_, rhs_, work_;
-  Eigen::VectorXd pz_, pv_;  ///< predicted free-node state for z0 = 0 (index 0 unused)
-  Eigen::VectorXd qz_, qv_;  ///< unit response of the free nodes to z0 = 1 at the end of a step
+  Eigen::VectorXd pz_, pv_;  ///< linear mesh: predicted free-node state for z0 = 0 (index 0 unused)
+  Eigen::VectorXd qz_, qv_;  ///< linear mesh: unit response of the free nodes to z0 = 1 at the end of a step
   double max_abs_deflection_m_ = 0.0;
   double max_abs_velocity_m_per_s_ = 0.0;
   double predicted_intercept_N_ = 0.0;
