@@ -256,8 +256,8 @@ void ForceMesh::project_node(int i) {
                                 " onto the layer surface gave a non-finite point");
   rest_.col(i) = sp.position;
   normals_.col(i) = sp.normal.normalized();
-  update_nodes();
-  positions_.col(i) = rest_.col(i) - z_[i] * normals_.col(i);
+  // Stale positions are all recomputed when asked (positions()); fresh ones imply fresh nodes.
+  if (!positions_stale_) positions_.col(i) = rest_.col(i) - z_[i] * normals_.col(i);
 }
 
 void ForceMesh::layout(const ContactSurface& surface, const SurfacePoint& contact) {
@@ -412,37 +412,40 @@ void ForceMesh::predict_linear() {
   predicted_ = true;
 }
 
+namespace {
+
+/// One step's state (z, v) from its prediction: entries 1.. at contact
+/// deflection z0 = predicted + dz0 (p + dz0 q), entry 0 the contact itself.
+/// Per node for a linear mesh, per lattice cell for a stiffening one.
+void commit_predicted(Eigen::VectorXd& z, Eigen::VectorXd& v, const Eigen::VectorXd& pz, const Eigen::VectorXd& pv,
+                      const Eigen::VectorXd& qz, const Eigen::VectorXd& qv, double dz0, double z0, double dt) {
+  const double z0_old = z[0];
+  for (Eigen::Index i = 1; i < z.size(); ++i) {
+    z[i] = pz[i] + dz0 * qz[i];
+    v[i] = pv[i] + dz0 * qv[i];
+  }
+  z[0] = z0;
+  v[0] = (z0 - z0_old) / dt;
+}
+
+}  // namespace
+
 void ForceMesh::commit(double contact_deflection_m) {
   if (!std::isfinite(contact_deflection_m)) throw std::runtime_error("force mesh: non-finite contact deflection");
   if (!predicted_) predict();
   const double z0 = std::max(0.0, contact_deflection_m);
   const double dz0 = z0 - predicted_z0_;  // predicted_z0_ = 0 for a linear mesh
-  bool finite = true;
-  if (nonlinear_) {
-    // The state on the cells; the nodes follow when asked (update_nodes).
-    const double z0_old = cell_state_z_[0];
-    const int nc = static_cast<int>(cell_size_.size());
-    for (int a = 1; a < nc; ++a) {
-      cell_state_z_[a] = cell_pz_[a] + dz0 * cell_qz_[a];
-      cell_state_v_[a] = cell_pv_[a] + dz0 * cell_qv_[a];
-    }
-    cell_state_z_[0] = z0;
-    cell_state_v_[0] = (z0 - z0_old) / settings_.time_step_s;
+  const double dt = settings_.time_step_s;
+  if (nonlinear_) {  // the state on the cells; the nodes follow when asked (update_nodes)
+    commit_predicted(cell_state_z_, cell_state_v_, cell_pz_, cell_pv_, cell_qz_, cell_qv_, dz0, z0, dt);
     nodes_stale_ = true;
-    finite = cell_state_z_.allFinite() && cell_state_v_.allFinite();
   } else {
-    const double z0_old = z_[0];
-    const int n = lattice_.node_count();
-    for (int i = 1; i < n; ++i) {
-      z_[i] = pz_[i] + dz0 * qz_[i];
-      v_[i] = pv_[i] + dz0 * qv_[i];
-    }
-    z_[0] = z0;
-    v_[0] = (z0 - z0_old) / settings_.time_step_s;
+    commit_predicted(z_, v_, pz_, pv_, qz_, qv_, dz0, z0, dt);
   }
   predicted_ = false;
   update_derived();
-  if (!nonlinear_) finite = std::isfinite(ring_mean_m_.sum()) && std::isfinite(v_.sum());
+  const bool finite = nonlinear_ ? cell_state_z_.allFinite() && cell_state_v_.allFinite()
+                                 : std::isfinite(ring_mean_m_.sum()) && std::isfinite(v_.sum());
   if (!finite)
     throw std::runtime_error("force mesh: deflections became non-finite (integrator " +
                              std::string(to_string(settings_.integrator)) + ")");
