@@ -343,9 +343,19 @@ TEST(CompareCommand, ModelsBreakWhereTheFemDoesAndAreJudgedOnHeldOutCases) {
     phases.insert(e["phase"].get<std::string>());
   }
   EXPECT_NEAR(sum_s, total_s, 1e-6 * total_s);
-  for (const char* p : {"FEM reference, calibration trajectory", "FEM references, 2 cases", "mass_tensor: identification",
-                        "mass_tensor: calibration-trajectory run", "held-out phase", "the rest"})
+  for (const char* p : {"FEM reference, calibration trajectory", "FEM references, 2 cases",
+                        "identifications against the FEM", "mass_tensor: calibration-trajectory run", "held-out phase",
+                        "the rest"})
     EXPECT_EQ(phases.count(p), 1u) << p;
+  // The identifications ran side by side: each model's own time is in the
+  // phase's note, and none exceeds the phase.
+  for (const nlohmann::json& e : summary["time_budget"])
+    if (e["phase"] == "identifications against the FEM") {
+      for (const char* model : {"shf", "bem", "mass_tensor"})
+        EXPECT_NE(e["note"].get<std::string>().find(std::string(" ") + model + " "), std::string::npos) << e.dump();
+      for (const auto& [model, id] : summary["model_identification"].items())
+        EXPECT_LE(id["wall_time_s"].get<double>(), e["wall_time_s"].get<double>() + 1e-9) << model;
+    }
   if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 

@@ -236,6 +236,40 @@ TEST(ModelIdentification, AForceDropAtOneDepthIsLeftOutOfTheWindow) {
   EXPECT_NEAR(id.layers[1].stiffness_scale, clean.layers[1].stiffness_scale, 1e-3 * clean.layers[1].stiffness_scale);
 }
 
+TEST(ModelIdentification, ALayerBrokenOnTheStepThatBreaksTheLayerAboveEndsItBeforeAnyRunBelow) {
+  // The fat punctured on the sample that punctures the skin (the default
+  // slab's FEM does this): the reference never presses the fat, so it has no
+  // critical force to identify and the muscle below would be fitted for
+  // nothing. No run reaches below the skin's puncture, the skin is identified
+  // as with the muscle unfitted, and the fat's note gives the reason.
+  const Reference reference = reference_of({2.0, 0.5, 1.5}, {4e-3, 3e-3, 5e-3});
+  validation::ReferenceData same_step = reference.data;
+  validation::InsertionCurve& c = same_step.curve;
+  const auto skin = static_cast<std::size_t>(c.layer_index("skin"));
+  const auto fat = static_cast<std::size_t>(c.layer_index("fat"));
+  std::size_t i = 0;
+  while (i < c.size() && c.layer_states[skin][i] != LayerState::Punctured) ++i;
+  ASSERT_LT(i, c.size());
+  for (std::size_t j = i; j < c.size(); ++j) c.layer_states[fat][j] = LayerState::Punctured;
+  const Scene scene = default_scene();
+  std::vector<std::string> lines;
+  const validation::ModelIdentification id = validation::identify_comparison_model(
+      "bem", scene, nullptr, same_step, true, [&](const std::string& line) { lines.push_back(line); });
+  ASSERT_EQ(id.layers.size(), 2u);
+  EXPECT_TRUE(id.layers[0].identified) << id.layers[0].note;
+  EXPECT_FALSE(id.layers[1].identified);
+  EXPECT_NE(id.layers[1].note.find("on the haptic step that punctures skin"), std::string::npos) << id.layers[1].note;
+  EXPECT_TRUE(id.joint_note.empty()) << id.joint_note;  // one factor fitted: no joint step
+  for (const std::string& line : lines)
+    EXPECT_EQ(line.rfind("skin", 0), 0u) << "a run for another layer: " << line;
+  // The skin's window and force are those of the reference: its factor is
+  // fitted with the layers below at factor 1, as the identified scene has them.
+  const Scene identified = validation::with_identified_parameters(scene, id);
+  EXPECT_EQ(identified.comparison.stiffness_scale[1], 1.0);
+  EXPECT_EQ(identified.comparison.stiffness_scale[2], 1.0);
+  EXPECT_LT(id.layers[0].window_rmse_after_N, 0.5 * id.layers[0].window_rmse_before_N);
+}
+
 /// The two window costs in a "not needed" joint-fit note ("... cost A together, B in their own fits ...").
 std::pair<double, double> uncoupled_costs(const std::string& note) {
   const std::size_t cost = note.find(" cost ");

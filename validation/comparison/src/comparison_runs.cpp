@@ -2,11 +2,13 @@
 #include "comparison_runs.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <thread>
 
 #include "comparison_tables.hpp"
 #include "puncture/comparison/model_factory.hpp"
@@ -21,6 +23,8 @@ namespace {
 
 constexpr double kMm = 1e-3;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// Identifications run side by side (one per core of the reference machine).
+constexpr std::size_t kIdentificationsAtOnce = 2;
 
 bool has_column(const std::filesystem::path& csv, const std::string& column) {
   std::ifstream in(csv);
@@ -189,12 +193,17 @@ nlohmann::json ComparisonRunner::identify(const std::string& method) {
 }
 
 Scene ComparisonRunner::identify_model(const std::string& key) {
-  if (!options_.quiet) out_ << "[compare] " << key << ": identifying against the FEM ...\n" << std::flush;
+  if (!options_.quiet) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    out_ << "[compare] " << key << ": identifying against the FEM ...\n" << std::flush;
+  }
   const ModelIdentification id = identify_comparison_model(
       key, scene_, comparison::is_volumetric_model(key) ? mesh_ : nullptr, reference_.data,
       options_.identify_stiffness, [&](const std::string& line) {
         if (options_.check_interrupt) options_.check_interrupt();
-        if (!options_.quiet) out_ << "[compare] " << key << ": " << line << "\n" << std::flush;
+        if (options_.quiet) return;
+        const std::lock_guard<std::mutex> lock(mutex_);
+        out_ << "[compare] " << key << ": " << line << "\n" << std::flush;
       });
   nlohmann::json layers = nlohmann::json::array();
   for (const LayerIdentification& l : id.layers) {
@@ -212,17 +221,54 @@ Scene ComparisonRunner::identify_model(const std::string& key) {
     if (!l.note.empty()) j["note"] = l.note;
     layers.push_back(j);
   }
-  identification_records_[key] = {{"layers", layers},
-                                  {"stiffness_identified", id.stiffness_identified},
-                                  {"model_runs", id.model_runs},
-                                  {"wall_time_s", id.wall_time_s}};
-  if (!id.joint_note.empty()) identification_records_[key]["joint_fit"] = id.joint_note;
+  nlohmann::json record = {{"layers", layers},
+                           {"stiffness_identified", id.stiffness_identified},
+                           {"model_runs", id.model_runs},
+                           {"wall_time_s", id.wall_time_s}};
+  if (!id.joint_note.empty()) record["joint_fit"] = id.joint_note;
   Scene identified = with_identified_parameters(scene_, id);
   identified.name = scene_.name + "_" + key + "_identified";
   identified.description = "The scene of `puncture compare` with model " + key +
                            "'s layer stiffness factors and critical contact forces identified against the FEM "
                            "reference on this scene's trajectory (model_identification.hpp).";
+  const std::lock_guard<std::mutex> lock(mutex_);
+  identification_records_[key] = std::move(record);
   session_.write_text("identified/" + key + ".json", scene_to_json_text(identified));
+  return identified;
+}
+
+std::map<std::string, Scene> ComparisonRunner::identify_models(const std::vector<std::string>& keys,
+                                                               double& wall_time_s) {
+  const auto start = std::chrono::steady_clock::now();
+  // The volumetric models first: they take nearly all the time, so they
+  // start together and the cheap ones fill in beside the longer one.
+  std::vector<std::string> order;
+  for (const std::string& key : keys)
+    if (comparison::is_volumetric_model(key)) order.push_back(key);
+  for (const std::string& key : keys)
+    if (!comparison::is_volumetric_model(key)) order.push_back(key);
+  std::map<std::string, Scene> identified;
+  std::exception_ptr failure;
+  std::atomic<std::size_t> next{0};
+  const auto worker = [&]() {
+    for (std::size_t i = next++; i < order.size(); i = next++) {
+      try {
+        Scene s = identify_model(order[i]);
+        const std::lock_guard<std::mutex> lock(mutex_);
+        identified.insert_or_assign(order[i], std::move(s));
+      } catch (...) {  // e.g. interrupted: the others stop at their next check
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (!failure) failure = std::current_exception();
+        next = order.size();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (std::size_t t = 0; t < std::min<std::size_t>(kIdentificationsAtOnce, order.size()); ++t)
+    threads.emplace_back(worker);
+  for (std::thread& t : threads) t.join();
+  wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (failure) std::rethrow_exception(failure);
   return identified;
 }
 

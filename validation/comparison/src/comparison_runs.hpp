@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -69,6 +70,12 @@ class ComparisonRunner {
   /// (model_identification.hpp), also written to identified/<key>.json; the
   /// record goes to identification_records().
   Scene identify_model(const std::string& key);
+  /// identify_model of each of `keys`, two models at a time (each
+  /// identification's optimiser runs its own model runs two at a time too:
+  /// side by side they keep both cores busy while one optimiser waits for
+  /// its slower run). Returns key -> identified scene; wall_time_s gets the
+  /// phase's wall time. The identified values do not depend on the order.
+  std::map<std::string, Scene> identify_models(const std::vector<std::string>& keys, double& wall_time_s);
   const nlohmann::json& identification_records() const { return identification_records_; }
   /// The scene each run model was built on (key -> scene).
   const std::map<std::string, Scene>& model_scenes() const { return model_scenes_; }
@@ -93,6 +100,7 @@ class ComparisonRunner {
   std::vector<std::unique_ptr<ModelRun>> runs_;
   nlohmann::json identification_records_ = nlohmann::json::object();
   std::map<std::string, Scene> model_scenes_;
+  std::mutex mutex_;  ///< out_, session_ and the records while identifications run side by side
 };
 
 /// Haptic steps of the scene's whole scripted trajectory (the denominator of

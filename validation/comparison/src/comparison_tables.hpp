@@ -56,8 +56,9 @@ struct ComparisonContent {
   const std::vector<HeldOutRow>& heldout;  ///< empty without held-out cases
   const ComparisonOutcome& outcome;        ///< heldout_metrics, heldout_grade
   const DelphiWeights& weights;
-  double wall_time_s;          ///< the whole command, s
-  double heldout_wall_time_s;  ///< the held-out phase (its runs two at a time), s
+  double wall_time_s;                 ///< the whole command, s
+  double identification_wall_time_s;  ///< the models' identifications (two models at a time), s
+  double heldout_wall_time_s;         ///< the held-out phase (its runs two at a time), s
 };
 
 /// Where the command's wall time went: one entry per phase (FEM references,

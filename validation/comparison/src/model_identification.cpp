@@ -378,6 +378,17 @@ ModelIdentification identify_comparison_model(const std::string& model, const Sc
                                           : "the reference does not puncture this layer";
       break;  // the layers below are not reached either
     }
+    if (!until_s.empty() && until == until_s.back()) {
+      // Broken on the haptic step that breaks the layer above: the reference
+      // never presses it, the model cannot either (its contact force there is
+      // the first touch, not a strength), and the layers below would be
+      // fitted for nothing.
+      std::ostringstream note;
+      note << "the reference punctures it on the haptic step that punctures " << scene.layers[k - 1].name << " ("
+           << depths_m.back() * 1e3 << " mm): it is never pressed, so its critical force cannot be identified";
+      result.layers.back().note = note.str();
+      break;
+    }
     depths_m.push_back(p.depth_m);
     until_s.push_back(until);
   }

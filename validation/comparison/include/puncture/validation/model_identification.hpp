@@ -47,9 +47,12 @@
 //      contact force on the step at d_k, so the model, breaking each layer by
 //      its critical force, breaks it where the reference does.
 //   Without stiffness identification step 1 is skipped (s_k = 1).
-// A layer the reference does not puncture, or at whose puncture depth the
-// model's force is not positive, ends the identification there (identified
-// = false, with the reason); the layers below keep the scene's values.
+// A layer the reference does not puncture, or punctures on the haptic step
+// that punctures the layer above (never pressed: no strength to identify),
+// ends the identification there before any run, so no factor below it is
+// fitted for nothing; so does a layer at whose puncture depth the model's
+// force is not positive (step 2). Either way identified = false, with the
+// reason, and the layers below keep the scene's values.
 // Out: ModelIdentification; with_identified_parameters(scene, id) gives the
 // model's scene (stiffness_scale, each identified layer's rule CriticalForce
 // F_k). The identified values are model properties: held-out cases (other
