@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -79,7 +80,7 @@ double mean_of_finite(const std::vector<double>& values) {
 
 std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std::string, Scene>& model_scenes,
                                           const ComparisonReportOptions& options, std::ostream& out,
-                                          std::ostream& err) {
+                                          std::ostream& err, const std::vector<std::function<void()>>& first_jobs) {
   // Every (held-out case, model) pair is one independent run; they share
   // nothing but the case's mesh and reference (read only), so they run two
   // at a time (one per core of the reference machine). A case that is not
@@ -95,8 +96,20 @@ std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std
   std::vector<HeldOutRow> rows(jobs.size());
   std::atomic<std::size_t> next{0};
   std::mutex report_mutex;
+  std::exception_ptr first_job_failure;
   const auto worker = [&]() {
-    for (std::size_t j = next++; j < jobs.size(); j = next++) {
+    for (std::size_t i = next++; i < first_jobs.size() + jobs.size(); i = next++) {
+      if (i < first_jobs.size()) {
+        try {
+          first_jobs[i]();
+        } catch (...) {
+          const std::lock_guard<std::mutex> lock(report_mutex);
+          if (!first_job_failure) first_job_failure = std::current_exception();
+          next = first_jobs.size() + jobs.size();  // the other worker stops after its run
+        }
+        continue;
+      }
+      const std::size_t j = i - first_jobs.size();
       const ComparisonCase& c = options.cases[jobs[j].first];
       const std::string& key = jobs[j].second;
       if (!options.quiet) {
@@ -118,8 +131,10 @@ std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std
     }
   };
   std::vector<std::thread> threads;
-  for (int t = 0; t < std::min<int>(kHeldOutThreads, static_cast<int>(jobs.size())); ++t) threads.emplace_back(worker);
+  for (int t = 0; t < std::min<int>(kHeldOutThreads, static_cast<int>(first_jobs.size() + jobs.size())); ++t)
+    threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
+  if (first_job_failure) std::rethrow_exception(first_job_failure);
   return rows;
 }
 

@@ -24,6 +24,7 @@
 //   fraction), in the order of `models`: what the Sec. 3.3 ranking reads.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <ostream>
 #include <string>
@@ -43,9 +44,13 @@ struct HeldOutRow {
   double wall_time_s = 0.0;  ///< the model's build and run on the case, s
 };
 
+/// first_jobs: other independent runs (the volumetric models' runs on the
+/// calibration trajectory) that the same two workers take first, before the
+/// held-out runs; an exception of one is rethrown after every worker stopped.
 std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std::string, Scene>& model_scenes,
                                           const ComparisonReportOptions& options, std::ostream& out,
-                                          std::ostream& err);
+                                          std::ostream& err,
+                                          const std::vector<std::function<void()>>& first_jobs = {});
 
 std::string heldout_csv(const Scene& scene, const std::vector<HeldOutRow>& rows);
 

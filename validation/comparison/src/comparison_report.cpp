@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 
 #include "comparison_heldout.hpp"
 #include "comparison_runs.hpp"
 #include "comparison_tables.hpp"
+#include "puncture/comparison/model_factory.hpp"
 #include "puncture/io/provenance.hpp"
 #include "puncture/io/provenance_json.hpp"
 #include "puncture/io/pvd.hpp"
@@ -33,13 +35,30 @@ ComparisonOutcome write_model_comparison(const Scene& scene, const DelphiWeights
     if (options.identify_models && key != "realtime" && key != "fem") to_identify.push_back(key);
   double identification_wall_time_s = 0.0;
   const std::map<std::string, Scene> identified = runner.identify_models(to_identify, identification_wall_time_s);
-  // Then each model's run on the calibration trajectory, one at a time (its
-  // time per step is a column of the tables).
+  // Then each model's run on the calibration trajectory: the light ones now,
+  // one at a time; the volumetric ones (minutes each) side by side with each
+  // other and with the held-out runs, two at a time (one per core; their
+  // time per step, a column of the tables, is that of a run beside one other,
+  // as the held-out runs' always was).
+  std::vector<std::function<void()>> volumetric_runs;
+  std::vector<std::string> run_beside_others;
   for (const std::string& key : options.models) {
     if (key == "fem") continue;
     const auto it = identified.find(key);
-    runner.run(key, it != identified.end() ? it->second : scene, key);
+    const Scene& model_scene = it != identified.end() ? it->second : scene;
+    const std::size_t slot = runner.add_slot(key, model_scene, key);
+    if (comparison::is_volumetric_model(key)) {
+      volumetric_runs.push_back([&runner, slot, key, &model_scene]() { runner.run_in_slot(slot, key, model_scene, key); });
+      run_beside_others.push_back(key);
+    } else {
+      runner.run_in_slot(slot, key, model_scene, key);
+    }
   }
+  // Held out: every model as identified above, on the cases' trajectories and slabs.
+  const auto pool_start = std::chrono::steady_clock::now();
+  const std::vector<HeldOutRow> heldout =
+      run_heldout_cases(scene, runner.model_scenes(), options, out, err, volumetric_runs);
+  const double pool_wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - pool_start).count();
   nlohmann::json identification = nlohmann::json::array();
   for (const std::string& method : options.identify) identification.push_back(runner.identify(method));
 
@@ -54,11 +73,6 @@ ComparisonOutcome write_model_comparison(const Scene& scene, const DelphiWeights
   outcome.grade = grade_models(rows.metrics, weights);
   outcome.has_shaft_forces = reference.data.has_shaft_forces;
   session.write_text("ranking.csv", ranking_csv(outcome.grade));
-
-  // Held out: every model as identified above, on the cases' trajectories and slabs.
-  const auto heldout_start = std::chrono::steady_clock::now();
-  const std::vector<HeldOutRow> heldout = run_heldout_cases(scene, runner.model_scenes(), options, out, err);
-  const double heldout_wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - heldout_start).count();
   if (!heldout.empty()) {
     session.write_text("heldout.csv", heldout_csv(scene, heldout));
     outcome.heldout_metrics = aggregate_heldout(heldout, options.models);
@@ -71,9 +85,16 @@ ComparisonOutcome write_model_comparison(const Scene& scene, const DelphiWeights
   const ComparisonContent content{scene,         options, fem,     reference,      mesh,
                                   provenance,    runs,    identification, runner.identification_records(),
                                   rows,          outcome.grade, heldout, outcome,  weights,
-                                  wall_time_s,   identification_wall_time_s, heldout_wall_time_s};
+                                  wall_time_s,   identification_wall_time_s, pool_wall_time_s,
+                                  run_beside_others};
   session.write_text("comparison_summary.json", summary_json(content).dump(2) + "\n");
-  if (!runner.pvd().empty()) io::write_pvd(session, "comparison.pvd", runner.pvd());
+  if (!runner.pvd().empty()) {
+    std::vector<io::PvdEntry> pvd = runner.pvd();  // in the order the frames were written: sorted by part and time
+    std::stable_sort(pvd.begin(), pvd.end(), [](const io::PvdEntry& a, const io::PvdEntry& b) {
+      return a.part != b.part ? a.part < b.part : a.time_s < b.time_s;
+    });
+    io::write_pvd(session, "comparison.pvd", pvd);
+  }
   session.commit();
 
   const std::vector<std::string> plots = run_plot_script("plot_comparison.py", options.output_dir, out, err);

@@ -111,20 +111,32 @@ ComparisonRunner::ComparisonRunner(const Scene& scene, const ComparisonReportOpt
   frame_interval_s_ = options.frames > 0 ? trajectory.duration() / options.frames : 0.0;
 }
 
-ModelRunOptions ComparisonRunner::run_options(const std::string& key, const comparison::ComparisonModel& model,
-                                              int& last_tenth) {
+std::size_t ComparisonRunner::add_slot(const std::string& key, const Scene& model_scene,
+                                      const std::string& factory_name) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  Slot slot;
+  slot.first_part = next_part_;
+  if (options_.write_vtk && frame_interval_s_ > 0.0)
+    next_part_ += static_cast<int>(scene_.layers.size()) + (comparison::is_volumetric_model(factory_name) ? 1 : 0);
+  slots_.push_back(slot);
+  runs_.push_back(nullptr);
+  if (key == factory_name) model_scenes_.insert_or_assign(key, model_scene);
+  return runs_.size() - 1;
+}
+
+ModelRunOptions ComparisonRunner::run_options(const std::string& key, std::size_t slot, int& last_tenth) {
   ModelRunOptions o;
   o.profile_depths_m = reference_.profile_depths_m;
   o.profile_radii_m = reference_.profile_radii_m;
   o.measure_inversion = true;
-  const double x_offset = 1.25 * scene_.sample.diameter_m * (static_cast<int>(runs_.size()) + 1);
+  const double x_offset = 1.25 * scene_.sample.diameter_m * (static_cast<int>(slot) + 1);
   if (options_.write_vtk && frame_interval_s_ > 0.0) {
     o.frame_interval_s = frame_interval_s_;
-    const int first_part = next_part_;
-    next_part_ += static_cast<int>(scene_.layers.size()) + (model.has_volume() ? 1 : 0);
+    const int first_part = slots_[slot].first_part;
     o.on_frame = [this, key, x_offset, first_part](const comparison::ComparisonModel& m, double t, int frame) {
       char index[16];
       std::snprintf(index, sizeof index, "%04d", frame);
+      const std::lock_guard<std::mutex> lock(mutex_);
       for (std::size_t k = 0; k < scene_.layers.size(); ++k) {
         const std::string name = "frames/" + key + "/" + scene_.layers[k].name + "_surface_" + index + ".vtp";
         discs_.write(session_, name, m, k, x_offset);
@@ -144,6 +156,7 @@ ModelRunOptions ComparisonRunner::run_options(const std::string& key, const comp
       const int tenth = static_cast<int>(fraction * 10.0);
       if (tenth != last_tenth) {
         last_tenth = tenth;
+        const std::lock_guard<std::mutex> lock(mutex_);
         out_ << "[compare] " << key << ": " << tenth * 10 << " %\n" << std::flush;
       }
     };
@@ -151,23 +164,31 @@ ModelRunOptions ComparisonRunner::run_options(const std::string& key, const comp
 }
 
 void ComparisonRunner::run(const std::string& key, const Scene& model_scene, const std::string& factory_name) {
+  run_in_slot(add_slot(key, model_scene, factory_name), key, model_scene, factory_name);
+}
+
+void ComparisonRunner::run_in_slot(std::size_t slot, const std::string& key, const Scene& model_scene,
+                                   const std::string& factory_name) {
   const auto build_start = std::chrono::steady_clock::now();
-  if (!options_.quiet) out_ << "[compare] " << key << ": building ...\n" << std::flush;
+  if (!options_.quiet) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    out_ << "[compare] " << key << ": building ...\n" << std::flush;
+  }
   std::unique_ptr<comparison::ComparisonModel> model = comparison::make_comparison_model(
       factory_name, model_scene, comparison::is_volumetric_model(factory_name) ? mesh_ : nullptr);
   const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
   int last_tenth = -1;
-  const ModelRunOptions options = run_options(key, *model, last_tenth);
+  const ModelRunOptions options = run_options(key, slot, last_tenth);
   auto run = std::make_unique<ModelRun>(run_comparison_model(*model, model_scene, options));
   run->model = key;
   run->build_wall_time_s = build_s;
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (run->failed()) err_ << "warning: " << key << " failed " << run->failure << "\n";
   if (!options_.quiet)
     out_ << "[compare] " << key << ": " << run->steps() << " steps in " << shown(run->run_wall_time_s) << " s"
          << (run->integrator_report.empty() ? "" : "; " + run->integrator_report) << "\n";
   session_.write_text("curves/" + key + ".csv", curve_csv(model_scene, *run, reference_.data.has_shaft_forces));
-  runs_.push_back(std::move(run));
-  if (key == factory_name) model_scenes_.insert_or_assign(key, model_scene);
+  runs_[slot] = std::move(run);
 }
 
 nlohmann::json ComparisonRunner::identify(const std::string& method) {

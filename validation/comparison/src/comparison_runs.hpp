@@ -63,6 +63,13 @@ class ComparisonRunner {
                    std::ostream& err);
   /// Builds the model `factory_name` on model_scene and runs it as row `key`.
   void run(const std::string& key, const Scene& model_scene, const std::string& factory_name);
+  /// run() in two steps, so that runs can go side by side: add_slot books
+  /// row `key` (its place among the rows and the .pvd parts, its scene in
+  /// model_scenes()) and returns its index; run_in_slot (from any thread)
+  /// fills it.
+  std::size_t add_slot(const std::string& key, const Scene& model_scene, const std::string& factory_name);
+  void run_in_slot(std::size_t slot, const std::string& key, const Scene& model_scene,
+                   const std::string& factory_name);
   /// One identification (method: simulated_annealing or isres) and the run of its result.
   nlohmann::json identify(const std::string& method);
   /// The scene of model `key` with its layers' stiffness factors and
@@ -84,7 +91,11 @@ class ComparisonRunner {
   const std::vector<io::PvdEntry>& pvd() const { return pvd_; }
 
  private:
-  ModelRunOptions run_options(const std::string& key, const comparison::ComparisonModel& model, int& last_tenth);
+  ModelRunOptions run_options(const std::string& key, std::size_t slot, int& last_tenth);
+
+  struct Slot {
+    int first_part = 0;  ///< .pvd part index of the row's first dataset
+  };
 
   const Scene& scene_;
   const ComparisonReportOptions& options_;
@@ -97,7 +108,8 @@ class ComparisonRunner {
   double frame_interval_s_ = 0.0;
   int next_part_ = 0;  ///< .pvd part index of the next model's first dataset
   std::vector<io::PvdEntry> pvd_;
-  std::vector<std::unique_ptr<ModelRun>> runs_;
+  std::vector<Slot> slots_;
+  std::vector<std::unique_ptr<ModelRun>> runs_;  ///< one per slot (null until its run is done)
   nlohmann::json identification_records_ = nlohmann::json::object();
   std::map<std::string, Scene> model_scenes_;
   std::mutex mutex_;  ///< out_, session_ and the records while identifications run side by side

@@ -58,12 +58,15 @@ struct ComparisonContent {
   const DelphiWeights& weights;
   double wall_time_s;                 ///< the whole command, s
   double identification_wall_time_s;  ///< the models' identifications (two models at a time), s
-  double heldout_wall_time_s;         ///< the held-out phase (its runs two at a time), s
+  /// The runs two at a time: the volumetric models' on the calibration
+  /// trajectory (run_beside_others) and the held-out runs, s.
+  double heldout_wall_time_s;
+  const std::vector<std::string>& run_beside_others;  ///< models whose calibration-trajectory run was in that phase
 };
 
 /// Where the command's wall time went: one entry per phase (FEM references,
 /// mesh, each model's identification and calibration-trajectory run, the
-/// held-out phase, the rest), in seconds; they add up to the total.
+/// volumetric runs and held-out phase, the rest), in seconds; they add up to the total.
 struct TimeBudgetEntry {
   std::string phase;
   double wall_time_s;
