@@ -38,19 +38,41 @@ OPENBLAS_DIRS = ["/usr/lib/x86_64-linux-gnu/openblas-serial", "/usr/lib/aarch64-
 TOLERANCE = 0.01
 
 
+BLAS_ALTERNATIVES = ["libblas.so.3-x86_64-linux-gnu", "liblapack.so.3-x86_64-linux-gnu",
+                     "libblas.so.3-aarch64-linux-gnu", "liblapack.so.3-aarch64-linux-gnu"]
+
+
+def alternative_selections():
+    """Debian's BLAS and LAPACK alternatives as the machine selects them now: name -> library path."""
+    selected = {}
+    for name in BLAS_ALTERNATIVES:
+        q = subprocess.run(["update-alternatives", "--query", name], capture_output=True, text=True, check=False)
+        for line in q.stdout.splitlines():
+            if line.startswith("Value: "):
+                selected[name] = line[len("Value: "):].strip()
+    return selected
+
+
 def openblas_dir():
     """The serial OpenBLAS's folder, installed if missing (Debian's package;
     the runs put it first on LD_LIBRARY_PATH, whatever BLAS the machine
-    selects)."""
+    selects). Installing it makes Debian's alternatives select it for every
+    program; the machine's selection is put back, as the serial OpenBLAS is
+    not safe to call from two threads of one process (results/comparison/README.md)."""
     for attempt in range(2):
         for d in OPENBLAS_DIRS:
             if os.path.exists(os.path.join(d, "libblas.so.3")):
                 return d
         if attempt == 0:
             sudo = [] if os.geteuid() == 0 else ["sudo"]
+            before = alternative_selections()
             print(f"fem_reproducibility: installing {OPENBLAS_PACKAGE}", flush=True)
             subprocess.run(sudo + ["apt-get", "install", "-y", "-qq", "--no-install-recommends", OPENBLAS_PACKAGE],
                            env=dict(os.environ, DEBIAN_FRONTEND="noninteractive"), check=False)
+            for name, path in before.items():
+                if alternative_selections().get(name) != path:
+                    print(f"fem_reproducibility: {name} back to {path}", flush=True)
+                    subprocess.run(sudo + ["update-alternatives", "--set", name, path], check=False)
     sys.exit(f"fem_reproducibility: OpenBLAS is not installed (apt-get install {OPENBLAS_PACKAGE})")
 
 

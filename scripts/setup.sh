@@ -26,7 +26,11 @@ PACKAGES=(
 # The BLAS is left as the machine selects it: the FEM reference's committed
 # scenes give the same curves under Debian's reference BLAS and the serial
 # OpenBLAS to 1e-10 of the peak force (results/fem_reproducibility/), and
-# every output's machine line names the BLAS it ran with.
+# every output's machine line names the BLAS it ran with. Under the serial
+# OpenBLAS (libopenblas0-serial: not safe to call from two threads of one
+# process) `puncture compare` runs its models one at a time and says so; the
+# threaded libopenblas0-pthread, or the reference BLAS, lets them run two at a
+# time (results/comparison/README.md).
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi

@@ -11,6 +11,8 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCholesky>
 
+#include "puncture/io/provenance.hpp"
+
 namespace puncture::comparison {
 
 namespace {
@@ -36,6 +38,21 @@ class SerialOpenMpRegions {
 };
 
 }  // namespace
+
+std::string concurrent_solver_limit_for(const std::string& blas_library) {
+  return blas_library == "openblas-serial"
+             ? "the BLAS is Debian's serial OpenBLAS (openblas-serial), which is not safe to call from two threads at "
+               "once: the comparison models run one at a time (the threaded libopenblas0-pthread or the reference "
+               "BLAS lets them run two at a time)"
+             : "";
+}
+
+std::string concurrent_solver_limit() {
+  static const std::string reason = concurrent_solver_limit_for(io::blas_library());
+  return reason;
+}
+
+int concurrent_solver_threads(int wanted) { return concurrent_solver_limit().empty() ? wanted : 1; }
 
 struct SparseSpdFactor::Impl {
   cholmod_common common;

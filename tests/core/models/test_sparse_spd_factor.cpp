@@ -10,6 +10,7 @@
 #include <omp.h>
 
 #include <cstdlib>
+#include <string>
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
@@ -98,6 +99,15 @@ TEST(SparseSpdFactor, SolvesA3dGridWhoseFactorHasLargeSupernodes) {
       EXPECT_LT((A * x - b).norm() / b.norm(), 1e-12) << "shift " << shift << ", seed " << seed;
     }
   }
+}
+
+TEST(SparseSpdFactor, ModelRunsGoOneAtATimeOnlyOnABlasThatIsNotSafeFromTwoThreads) {
+  EXPECT_NE(concurrent_solver_limit_for("openblas-serial").find("not safe to call from two threads"), std::string::npos);
+  EXPECT_EQ(concurrent_solver_limit_for("reference BLAS"), "");
+  EXPECT_EQ(concurrent_solver_limit_for("openblas-pthread"), "");
+  EXPECT_EQ(concurrent_solver_limit_for(""), "");
+  // This process's BLAS decides: two threads unless it is the serial OpenBLAS.
+  EXPECT_EQ(concurrent_solver_threads(2), concurrent_solver_limit().empty() ? 2 : 1);
 }
 
 TEST(SparseSpdFactor, IndefiniteSystemsFallBackToLdlt) {

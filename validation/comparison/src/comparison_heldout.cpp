@@ -16,6 +16,7 @@
 #include "comparison_runs.hpp"
 #include "comparison_tables.hpp"
 #include "puncture/comparison/model_factory.hpp"
+#include "puncture/comparison/sparse_spd_factor.hpp"
 #include "puncture/meshing/comparison_tet_slab_mesh.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/validation_cases.hpp"
@@ -131,7 +132,8 @@ std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std
     }
   };
   std::vector<std::thread> threads;
-  for (int t = 0; t < std::min<int>(kHeldOutThreads, static_cast<int>(first_jobs.size() + jobs.size())); ++t)
+  const int at_once = comparison::concurrent_solver_threads(kHeldOutThreads);
+  for (int t = 0; t < std::min<int>(at_once, static_cast<int>(first_jobs.size() + jobs.size())); ++t)
     threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
   if (first_job_failure) std::rethrow_exception(first_job_failure);

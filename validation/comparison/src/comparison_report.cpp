@@ -11,6 +11,7 @@
 #include "comparison_runs.hpp"
 #include "comparison_tables.hpp"
 #include "puncture/comparison/model_factory.hpp"
+#include "puncture/comparison/sparse_spd_factor.hpp"
 #include "puncture/io/provenance.hpp"
 #include "puncture/io/provenance_json.hpp"
 #include "puncture/io/pvd.hpp"
@@ -27,6 +28,7 @@ ComparisonOutcome write_model_comparison(const Scene& scene, const DelphiWeights
   const nlohmann::json provenance = io::provenance_json(io::make_provenance(options.command_line));
   const ComparisonMesh mesh = build_comparison_mesh(scene, options, session, out);
 
+  if (const std::string limit = comparison::concurrent_solver_limit(); !limit.empty()) err << "warning: " << limit << "\n";
   ComparisonRunner runner(scene, options, reference, mesh.mesh, session, out, err);
   // The real-time model is the scene's (`puncture calibrate` tunes it);
   // every other model is identified against the FEM first, two at a time.

@@ -12,6 +12,7 @@
 
 #include "comparison_tables.hpp"
 #include "puncture/comparison/model_factory.hpp"
+#include "puncture/comparison/sparse_spd_factor.hpp"
 #include "puncture/needle.hpp"
 #include "puncture/scene_io.hpp"
 #include "puncture/validation/model_identification.hpp"
@@ -24,7 +25,7 @@ namespace {
 constexpr double kMm = 1e-3;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// Identifications run side by side (one per core of the reference machine).
-constexpr std::size_t kIdentificationsAtOnce = 2;
+constexpr int kIdentificationsAtOnce = 2;
 
 bool has_column(const std::filesystem::path& csv, const std::string& column) {
   std::ifstream in(csv);
@@ -285,7 +286,8 @@ std::map<std::string, Scene> ComparisonRunner::identify_models(const std::vector
     }
   };
   std::vector<std::thread> threads;
-  for (std::size_t t = 0; t < std::min<std::size_t>(kIdentificationsAtOnce, order.size()); ++t)
+  const auto at_once = static_cast<std::size_t>(comparison::concurrent_solver_threads(kIdentificationsAtOnce));
+  for (std::size_t t = 0; t < std::min(at_once, order.size()); ++t)
     threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
   wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "puncture/comparison/sparse_spd_factor.hpp"
 #include "puncture/meshing/tet_mesh.hpp"
 #include "puncture/validation/number_format.hpp"
 
@@ -179,10 +180,13 @@ void markdown_identification(std::ostringstream& md, const nlohmann::json& ident
 
 /// comparison.md: where the wall time went (time_budget).
 void markdown_time_budget(std::ostringstream& md, const ComparisonContent& c) {
-  md << "## Where the time goes\n\nWall time of this command by phase (the identifications two models at a time, "
-        "each optimiser's runs two at a time; the volumetric models' calibration-trajectory runs and the held-out "
-        "runs two at a time; everything else on one core).\n\n| phase | wall time s | share | note |\n"
-        "|---|---|---|---|\n";
+  const std::string limit = comparison::concurrent_solver_limit();
+  md << "## Where the time goes\n\nWall time of this command by phase ("
+     << (limit.empty() ? "the identifications two models at a time, each optimiser's runs two at a time; the "
+                         "volumetric models' calibration-trajectory runs and the held-out runs two at a time; "
+                         "everything else on one core"
+                       : "every model run one at a time, though the notes say two at a time: " + limit)
+     << ").\n\n| phase | wall time s | share | note |\n|---|---|---|---|\n";
   for (const TimeBudgetEntry& e : time_budget(c))
     md << "| " << e.phase << " | " << shown(e.wall_time_s, 4) << " | " << shown(100.0 * e.wall_time_s / c.wall_time_s, 2)
        << " % | " << e.note << " |\n";

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "puncture/comparison/model_factory.hpp"
+#include "puncture/comparison/sparse_spd_factor.hpp"
 #include "puncture/needle.hpp"
 #include "puncture/validation/levenberg_marquardt.hpp"
 #include "puncture/validation/puncture_events.hpp"
@@ -153,7 +154,7 @@ LevenbergMarquardtOptions factor_fit_options(int max_evaluations) {
   options.fd_step = options.fd_step_min = 0.02;
   options.cost_tolerance = 1e-3;
   options.step_tolerance = 1e-3;  // a factor to 0.1 %: finer steps move no table (the runs to confirm them did)
-  options.threads = 2;
+  options.threads = comparison::concurrent_solver_threads(2);
   return options;
 }
 

@@ -26,12 +26,25 @@
 
 #include <cstddef>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
 namespace puncture::comparison {
+
+/// Threads of this process that may factorise and solve at the same time
+/// (the comparison's model runs side by side): `wanted`, or 1 when the BLAS
+/// loaded is Debian's serial OpenBLAS (openblas-serial), built without locks
+/// around its work buffers: with two threads calling it the volumetric
+/// joint-identification test gave a different fit in 3 of 27 runs, never
+/// with the reference BLAS or the threaded OpenBLAS (results/comparison/README.md).
+int concurrent_solver_threads(int wanted);
+/// Why concurrent_solver_threads limits to 1 (empty when it does not): that
+/// of the loaded BLAS, and that of a BLAS named as io::blas_library() names it.
+std::string concurrent_solver_limit();
+std::string concurrent_solver_limit_for(const std::string& blas_library);
 
 class SparseSpdFactor {
  public:
