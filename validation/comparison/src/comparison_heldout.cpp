@@ -49,7 +49,7 @@ CaseSetup setup_case(const ComparisonCase& c, const Scene& scene, const std::map
 
 /// One model on one case: its row.
 HeldOutRow run_model_on_case(const ComparisonCase& c, const CaseSetup& setup, const std::string& key,
-                             const Scene& identified_scene) {
+                             const Scene& identified_scene, const std::function<void()>& check_interrupt) {
   const auto start = std::chrono::steady_clock::now();
   const Scene model_scene = case_scene(scene_to_json_text(identified_scene), key + " model scene", c.validation_case).scene;
   std::unique_ptr<comparison::ComparisonModel> model =
@@ -58,6 +58,7 @@ HeldOutRow run_model_on_case(const ComparisonCase& c, const CaseSetup& setup, co
   run_options.profile_depths_m = setup.reference.profile_depths_m;
   run_options.profile_radii_m = setup.reference.profile_radii_m;
   run_options.measure_inversion = true;
+  if (check_interrupt) run_options.on_progress = [&check_interrupt](double) { check_interrupt(); };
   ModelRun run = run_comparison_model(*model, model_scene, run_options);
   run.model = key;
   HeldOutRow row;
@@ -97,7 +98,7 @@ std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std
   std::vector<HeldOutRow> rows(jobs.size());
   std::atomic<std::size_t> next{0};
   std::mutex report_mutex;
-  std::exception_ptr first_job_failure;
+  std::exception_ptr first_job_failure;  ///< or an interrupt of a held-out run
   const auto worker = [&]() {
     for (std::size_t i = next++; i < first_jobs.size() + jobs.size(); i = next++) {
       if (i < first_jobs.size()) {
@@ -118,12 +119,22 @@ std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std
         out << "[compare] case " << c.validation_case.name << ": " << key << " ...\n" << std::flush;
       }
       try {
-        rows[j] = run_model_on_case(c, setups[jobs[j].first], key, model_scenes.at(key));
-      } catch (const std::exception& e) {  // the model could not be built on this case
+        rows[j] = run_model_on_case(c, setups[jobs[j].first], key, model_scenes.at(key), options.check_interrupt);
+      } catch (const std::exception& e) {  // the model could not be built on this case, or an interrupt
         rows[j].case_name = c.validation_case.name;
         rows[j].held_out = c.validation_case.held_out;
         rows[j].metrics.model = key;
         rows[j].failure = e.what();
+      }
+      if (options.check_interrupt) {
+        try {  // an interrupt (which throws again at every check once raised) ends the phase
+          options.check_interrupt();
+        } catch (...) {
+          const std::lock_guard<std::mutex> lock(report_mutex);
+          if (!first_job_failure) first_job_failure = std::current_exception();
+          next = first_jobs.size() + jobs.size();
+          return;
+        }
       }
       if (!rows[j].failure.empty()) {
         const std::lock_guard<std::mutex> lock(report_mutex);
@@ -131,10 +142,14 @@ std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std
       }
     }
   };
+  // The calling thread is one of the workers: an interrupt check that acts
+  // on the main thread only (Python's) is then made there too, and the other
+  // worker's next check throws as well.
   std::vector<std::thread> threads;
   const int at_once = comparison::concurrent_solver_threads(kHeldOutThreads);
-  for (int t = 0; t < std::min<int>(at_once, static_cast<int>(first_jobs.size() + jobs.size())); ++t)
+  for (int t = 1; t < std::min<int>(at_once, static_cast<int>(first_jobs.size() + jobs.size())); ++t)
     threads.emplace_back(worker);
+  worker();
   for (std::thread& t : threads) t.join();
   if (first_job_failure) std::rethrow_exception(first_job_failure);
   return rows;

@@ -285,10 +285,12 @@ std::map<std::string, Scene> ComparisonRunner::identify_models(const std::vector
       }
     }
   };
+  // The calling thread is one of the workers: an interrupt check that acts
+  // on the main thread only (Python's) is then made there too.
   std::vector<std::thread> threads;
   const auto at_once = static_cast<std::size_t>(comparison::concurrent_solver_threads(kIdentificationsAtOnce));
-  for (std::size_t t = 0; t < std::min(at_once, order.size()); ++t)
-    threads.emplace_back(worker);
+  for (std::size_t t = 1; t < std::min(at_once, order.size()); ++t) threads.emplace_back(worker);
+  worker();
   for (std::thread& t : threads) t.join();
   wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (failure) std::rethrow_exception(failure);
