@@ -61,8 +61,8 @@ TEST(SparseSpdFactor, SolvesPositiveDefiniteSystemsByCholesky) {
 TEST(SparseSpdFactor, SolvesA3dGridWhoseFactorHasLargeSupernodes) {
   // The 7-point Laplacian of a 14^3 grid, 3 dofs per node, plus 0.01 I: its
   // nested-dissection factor has dense separator blocks (the supernodal
-  // factorisation's BLAS kernels); the residual of several right-hand sides,
-  // and again after new values.
+  // factorisation's), solved in the factor's simplicial form; the residual
+  // of several right-hand sides, and again after new values.
   const int n = 14;
   auto node = [n](int i, int j, int k) { return (i * n + j) * n + k; };
   auto grid = [&](double shift) {

@@ -12,6 +12,10 @@
 // ordering: the best of AMD and METIS nested dissection): on the
 // comparison meshes, whose plan levels couple through the whole disc, a
 // factorisation takes about a third of the time of Eigen's simplicial LDL^T.
+// L is then turned into CHOLMOD's simplicial form for the solves (one
+// right-hand side each: the integrator's preconditioner), which sweep L's
+// columns instead of calling a dense triangular solve and matrix-vector
+// product (BLAS level 2) per supernode.
 // CHOLMOD's own OpenMP regions (4 threads as Debian builds it) are switched
 // off on the calling thread while it factorises and solves (measured faster
 // on 2 cores; see sparse_spd_factor.cpp).
