@@ -94,8 +94,9 @@ bool SparseSpdFactor::factorize(const Eigen::SparseMatrix<double>& A) {
   // The supernodal factorisation (dense BLAS kernels on the supernodes), then
   // the same L in simplicial form: a solve with one right-hand side is then
   // two sweeps over L's columns instead of a dense triangular solve and
-  // matrix-vector product per supernode (BLAS level 2), about twice as fast
-  // with the reference BLAS on the comparison meshes (results/comparison/README.md).
+  // matrix-vector product per supernode (BLAS level 2). A small gain on the
+  // default slab with two runs side by side, a loss on the small slab alone
+  // (results/comparison/README.md, "Solves in simplicial form").
   cholmod_free_factor(&s.factor, &s.common);
   s.factor = s.symbolic ? cholmod_copy_factor(s.symbolic, &s.common) : nullptr;
   s.use_ldlt = !s.factor || !cholmod_factorize(&view, s.factor, &s.common) || s.common.status != CHOLMOD_OK ||

@@ -3,18 +3,16 @@
 #include "comparison_heldout.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <sstream>
-#include <thread>
 
 #include "comparison_runs.hpp"
 #include "comparison_tables.hpp"
+#include "side_by_side.hpp"
 #include "puncture/comparison/model_factory.hpp"
 #include "puncture/comparison/sparse_spd_factor.hpp"
 #include "puncture/meshing/comparison_tet_slab_mesh.hpp"
@@ -96,62 +94,32 @@ std::vector<HeldOutRow> run_heldout_cases(const Scene& scene, const std::map<std
       if (model_scenes.count(key)) jobs.emplace_back(i, key);  // not "fem"
   }
   std::vector<HeldOutRow> rows(jobs.size());
-  std::atomic<std::size_t> next{0};
   std::mutex report_mutex;
-  std::exception_ptr first_job_failure;  ///< or an interrupt of a held-out run
-  const auto worker = [&]() {
-    for (std::size_t i = next++; i < first_jobs.size() + jobs.size(); i = next++) {
-      if (i < first_jobs.size()) {
-        try {
-          first_jobs[i]();
-        } catch (...) {
-          const std::lock_guard<std::mutex> lock(report_mutex);
-          if (!first_job_failure) first_job_failure = std::current_exception();
-          next = first_jobs.size() + jobs.size();  // the other worker stops after its run
-        }
-        continue;
-      }
-      const std::size_t j = i - first_jobs.size();
-      const ComparisonCase& c = options.cases[jobs[j].first];
-      const std::string& key = jobs[j].second;
-      if (!options.quiet) {
-        const std::lock_guard<std::mutex> lock(report_mutex);
-        out << "[compare] case " << c.validation_case.name << ": " << key << " ...\n" << std::flush;
-      }
-      try {
-        rows[j] = run_model_on_case(c, setups[jobs[j].first], key, model_scenes.at(key), options.check_interrupt);
-      } catch (const std::exception& e) {  // the model could not be built on this case, or an interrupt
-        rows[j].case_name = c.validation_case.name;
-        rows[j].held_out = c.validation_case.held_out;
-        rows[j].metrics.model = key;
-        rows[j].failure = e.what();
-      }
-      if (options.check_interrupt) {
-        try {  // an interrupt (which throws again at every check once raised) ends the phase
-          options.check_interrupt();
-        } catch (...) {
-          const std::lock_guard<std::mutex> lock(report_mutex);
-          if (!first_job_failure) first_job_failure = std::current_exception();
-          next = first_jobs.size() + jobs.size();
-          return;
-        }
-      }
-      if (!rows[j].failure.empty()) {
-        const std::lock_guard<std::mutex> lock(report_mutex);
-        err << "warning: " << key << " failed on case " << c.validation_case.name << " " << rows[j].failure << "\n";
-      }
+  const std::size_t first = first_jobs.size();
+  run_side_by_side(first + jobs.size(), comparison::concurrent_solver_threads(kHeldOutThreads), [&](std::size_t i) {
+    if (i < first) return first_jobs[i]();
+    const std::size_t j = i - first;
+    const ComparisonCase& c = options.cases[jobs[j].first];
+    const std::string& key = jobs[j].second;
+    if (!options.quiet) {
+      const std::lock_guard<std::mutex> lock(report_mutex);
+      out << "[compare] case " << c.validation_case.name << ": " << key << " ...\n" << std::flush;
     }
-  };
-  // The calling thread is one of the workers: an interrupt check that acts
-  // on the main thread only (Python's) is then made there too, and the other
-  // worker's next check throws as well.
-  std::vector<std::thread> threads;
-  const int at_once = comparison::concurrent_solver_threads(kHeldOutThreads);
-  for (int t = 1; t < std::min<int>(at_once, static_cast<int>(first_jobs.size() + jobs.size())); ++t)
-    threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
-  if (first_job_failure) std::rethrow_exception(first_job_failure);
+    try {
+      rows[j] = run_model_on_case(c, setups[jobs[j].first], key, model_scenes.at(key), options.check_interrupt);
+    } catch (const std::exception& e) {  // the model could not be built on this case, or an interrupt
+      rows[j].case_name = c.validation_case.name;
+      rows[j].held_out = c.validation_case.held_out;
+      rows[j].metrics.model = key;
+      rows[j].failure = e.what();
+    }
+    // An interrupt (which throws again at every check once raised) ends the phase here.
+    if (options.check_interrupt) options.check_interrupt();
+    if (!rows[j].failure.empty()) {
+      const std::lock_guard<std::mutex> lock(report_mutex);
+      err << "warning: " << key << " failed on case " << c.validation_case.name << " " << rows[j].failure << "\n";
+    }
+  });
   return rows;
 }
 

@@ -2,15 +2,14 @@
 #include "comparison_runs.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <limits>
-#include <thread>
 
 #include "comparison_tables.hpp"
+#include "side_by_side.hpp"
 #include "puncture/comparison/model_factory.hpp"
 #include "puncture/comparison/sparse_spd_factor.hpp"
 #include "puncture/needle.hpp"
@@ -270,30 +269,12 @@ std::map<std::string, Scene> ComparisonRunner::identify_models(const std::vector
   for (const std::string& key : keys)
     if (!comparison::is_volumetric_model(key)) order.push_back(key);
   std::map<std::string, Scene> identified;
-  std::exception_ptr failure;
-  std::atomic<std::size_t> next{0};
-  const auto worker = [&]() {
-    for (std::size_t i = next++; i < order.size(); i = next++) {
-      try {
-        Scene s = identify_model(order[i]);
-        const std::lock_guard<std::mutex> lock(mutex_);
-        identified.insert_or_assign(order[i], std::move(s));
-      } catch (...) {  // e.g. interrupted: the others stop at their next check
-        const std::lock_guard<std::mutex> lock(mutex_);
-        if (!failure) failure = std::current_exception();
-        next = order.size();
-      }
-    }
-  };
-  // The calling thread is one of the workers: an interrupt check that acts
-  // on the main thread only (Python's) is then made there too.
-  std::vector<std::thread> threads;
-  const auto at_once = static_cast<std::size_t>(comparison::concurrent_solver_threads(kIdentificationsAtOnce));
-  for (std::size_t t = 1; t < std::min(at_once, order.size()); ++t) threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
+  run_side_by_side(order.size(), comparison::concurrent_solver_threads(kIdentificationsAtOnce), [&](std::size_t i) {
+    Scene s = identify_model(order[i]);  // an exception (e.g. an interrupt): the others stop at their next check
+    const std::lock_guard<std::mutex> lock(mutex_);
+    identified.insert_or_assign(order[i], std::move(s));
+  });
   wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (failure) std::rethrow_exception(failure);
   return identified;
 }
 

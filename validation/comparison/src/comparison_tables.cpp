@@ -185,7 +185,7 @@ void markdown_time_budget(std::ostringstream& md, const ComparisonContent& c) {
      << (limit.empty() ? "the identifications two models at a time, each optimiser's runs two at a time; the "
                          "volumetric models' calibration-trajectory runs and the held-out runs two at a time; "
                          "everything else on one core"
-                       : "every model run one at a time, though the notes say two at a time: " + limit)
+                       : "every model run one at a time: " + limit)
      << ").\n\n| phase | wall time s | share | note |\n|---|---|---|---|\n";
   for (const TimeBudgetEntry& e : time_budget(c))
     md << "| " << e.phase << " | " << shown(e.wall_time_s, 4) << " | " << shown(100.0 * e.wall_time_s / c.wall_time_s, 2)
@@ -319,8 +319,10 @@ std::vector<TimeBudgetEntry> time_budget(const ComparisonContent& c) {
                       std::to_string(solved) + " solved, the others from the cache"});
   }
   if (c.mesh.mesh) budget.push_back({"tetrahedral mesh", c.mesh.report.wall_time_s, c.mesh.report.kind});
+  const bool two_at_a_time = comparison::concurrent_solver_threads(2) == 2;
   if (!c.model_identification.empty()) {
-    std::string note = "two models at a time, each optimiser's runs two at a time; per model:";
+    std::string note = two_at_a_time ? "two models at a time, each optimiser's runs two at a time; per model:"
+                                     : "one model run at a time; per model:";
     for (const auto& run : c.runs)
       if (c.model_identification.contains(run->model)) {
         const nlohmann::json& id = c.model_identification[run->model];
@@ -344,14 +346,14 @@ std::vector<TimeBudgetEntry> time_budget(const ComparisonContent& c) {
   if (!c.heldout.empty() || !beside.empty()) {
     std::map<std::string, double> per_model;
     for (const HeldOutRow& r : c.heldout) per_model[r.metrics.model] += r.wall_time_s;
-    std::string note = "two at a time:";
+    std::string note = two_at_a_time ? "two at a time:" : "one at a time:";
     if (!beside.empty()) note += " the calibration-trajectory runs of" + beside;
     if (!c.heldout.empty()) {
       note += " " + std::to_string(c.heldout.size()) + " held-out runs, run time per model:";
       for (const auto& [model, seconds] : per_model) note += " " + model + " " + shown(seconds, 4) + " s,";
     }
     note.pop_back();
-    budget.push_back({c.heldout.empty() ? "volumetric runs" : "volumetric runs and held-out phase", c.heldout_wall_time_s,
+    budget.push_back({c.heldout.empty() ? "volumetric runs" : "volumetric runs and held-out phase", c.pool_wall_time_s,
                       note});
   }
   double accounted = 0.0;

@@ -60,7 +60,7 @@ struct ComparisonContent {
   double identification_wall_time_s;  ///< the models' identifications (two models at a time), s
   /// The runs two at a time: the volumetric models' on the calibration
   /// trajectory (run_beside_others) and the held-out runs, s.
-  double heldout_wall_time_s;
+  double pool_wall_time_s;
   const std::vector<std::string>& run_beside_others;  ///< models whose calibration-trajectory run was in that phase
 };
 
