@@ -90,10 +90,14 @@ TEST(LevenbergMarquardt, StopsAtTheBoundWhenTheMinimumLiesOutside) {
   EXPECT_NEAR(res.cost, 1.0, 1e-9);
 }
 
-TEST(LevenbergMarquardt, WithoutACoarserDifferenceStepTheFirstStallEndsTheFit) {
+namespace {
+
+/// Runs the fit of the tests below with stalls_to_stop and checks that it
+/// ends at its first stall: stalls_to_stop small decreases in a row.
+void expect_the_fit_to_end_at_its_first_stall(int stalls_to_stop) {
   // r = (x - 3)^2 + 0.01 from x = 0 on one thread: the cost falls by orders
-  // of magnitude, then, near its floor 1e-4, by under 5 % a step. Two such
-  // steps in a row are a stall. With fd_step == fd_step_min there is no
+  // of magnitude, then, near its floor 1e-4, by under 5 % a step.
+  // stalls_to_stop such steps in a row are a stall. With fd_step == fd_step_min there is no
   // coarser step to start a new cycle from, so the fit ends at the first
   // stall (each further iteration would cost a Jacobian and a trial, i.e.
   // simulation runs, for a few 1e-5 of the cost). The runs are read back
@@ -110,6 +114,7 @@ TEST(LevenbergMarquardt, WithoutACoarserDifferenceStepTheFirstStallEndsTheFit) {
   o.fd_step = o.fd_step_min = 0.02;
   o.cost_tolerance = 0.05;
   o.threads = 1;
+  o.stalls_to_stop = stalls_to_stop;
   const pv::LevenbergMarquardtResult res = pv::levenberg_marquardt(r, {0.0}, {-1e3}, {1e3}, o);
   EXPECT_LT(res.cost, 1.5e-4);  // near the minimum, cost 1e-4 at x = 3
   EXPECT_EQ(res.status, "cost_tolerance");
@@ -127,12 +132,25 @@ TEST(LevenbergMarquardt, WithoutACoarserDifferenceStepTheFirstStallEndsTheFit) {
       stalls = (current - costs[i]) / current < o.cost_tolerance ? stalls + 1 : 0;
       current = costs[i];
       jacobian_next = true;
-      if (stalls == 2 && first_stall_end == 0) first_stall_end = i;
+      if (stalls == stalls_to_stop && first_stall_end == 0) first_stall_end = i;
     }
   }
   ASSERT_GT(first_stall_end, 0u) << "the fit never stalled";
   EXPECT_EQ(costs.size(), first_stall_end + 1) << "the fit went on after its first stall";
   EXPECT_DOUBLE_EQ(res.cost, current);
+}
+
+}  // namespace
+
+TEST(LevenbergMarquardt, WithoutACoarserDifferenceStepTheFirstStallEndsTheFit) {
+  expect_the_fit_to_end_at_its_first_stall(2);
+}
+
+TEST(LevenbergMarquardt, OneSmallDecreaseIsAStallWhenTheCallerSaysSo) {
+  // As above with stalls_to_stop = 1 (the comparison's factor fits, whose
+  // evaluations are model runs): the first accepted step that lowers the cost
+  // by under cost_tolerance ends the fit, one Jacobian and trial earlier.
+  expect_the_fit_to_end_at_its_first_stall(1);
 }
 
 TEST(LevenbergMarquardt, NeverAcceptsAPointThatCannotBeEvaluated) {

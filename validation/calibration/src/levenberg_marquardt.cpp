@@ -272,7 +272,7 @@ LevenbergMarquardtResult levenberg_marquardt(const ResidualFunction& r, const st
     need_jacobian = true;
     lambda = std::max(1e-9, trial.lambda / 3.0);
     stalls = decrease < o.cost_tolerance ? stalls + 1 : 0;
-    if ((stalls >= 2 && !refine("cost_tolerance")) || (step < o.step_tolerance && !refine("step_tolerance"))) {
+    if ((stalls >= std::max(1, o.stalls_to_stop) && !refine("cost_tolerance")) || (step < o.step_tolerance && !refine("step_tolerance"))) {
       ++res.iterations;
       break;
     }

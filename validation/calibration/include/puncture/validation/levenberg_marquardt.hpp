@@ -24,7 +24,7 @@
 // the better one kept. A trial that lowers the cost is accepted and lambda
 // shrinks; otherwise lambda grows and the same Jacobian is reused.
 // Stalls when the relative cost decrease of an accepted step is below
-// cost_tolerance twice in a row, the step is below step_tolerance (max
+// cost_tolerance stalls_to_stop times in a row (twice by default), the step is below step_tolerance (max
 // |dx|), or lambda exceeds 1e12 (no descent direction: a kink or a flat
 // valley). On a stall the difference step is divided by 10 (the Jacobian of
 // a piecewise smooth objective across a kink misleads at a coarse step) and
@@ -53,6 +53,11 @@ struct LevenbergMarquardtOptions {
   double initial_lambda = 1e-2;    ///< relative to diag(J^T J)
   double cost_tolerance = 1e-4;    ///< relative decrease of an accepted step counted as stalling
   double step_tolerance = 1e-6;    ///< max |dx| below which the iteration stops
+  /// Accepted steps in a row below cost_tolerance that make a stall. Two by
+  /// default (one small decrease may be a step along a flat stretch); one
+  /// where each evaluation is a long simulation and a fit converged within
+  /// cost_tolerance is all the caller needs (the comparison's factor fits).
+  int stalls_to_stop = 2;
   int threads = 0;                 ///< 0: std::thread::hardware_concurrency()
   /// When >= 0 and the cost at x0 is at most this, x0 is returned after its
   /// one evaluation (status "start_accepted"): a caller that knows what cost
