@@ -92,6 +92,14 @@ TEST(LevenbergMarquardt, StopsAtTheBoundWhenTheMinimumLiesOutside) {
 
 namespace {
 
+double sum_of_squares_at(const pv::ResidualFunction& r, const std::vector<double>& x) {
+  std::vector<double> out;
+  r(x, out);
+  double sum = 0.0;
+  for (double v : out) sum += v * v;
+  return sum;
+}
+
 /// Runs the fit of the tests below with stalls_to_stop and checks that it
 /// ends at its first stall: stalls_to_stop small decreases in a row.
 void expect_the_fit_to_end_at_its_first_stall(int stalls_to_stop) {
@@ -151,6 +159,46 @@ TEST(LevenbergMarquardt, OneSmallDecreaseIsAStallWhenTheCallerSaysSo) {
   // evaluations are model runs): the first accepted step that lowers the cost
   // by under cost_tolerance ends the fit, one Jacobian and trial earlier.
   expect_the_fit_to_end_at_its_first_stall(1);
+}
+
+TEST(LevenbergMarquardt, ASecantThroughTheTwoTrialsSavesTheDifferenceRunsOfAOneFactorFit) {
+  // A factor fit as the comparison runs it: r_i = t_i e^x - y_i (a force
+  // proportional to a stiffness factor e^x) from e^x = 6.5, two lanes, the
+  // factor fits' options. The least-squares factor in closed form is
+  // sum t y / sum t^2. With the secant through each iteration's two trials
+  // as the next Jacobian the fit reaches it as closely as with a difference
+  // Jacobian after every accepted step, in fewer evaluations.
+  std::vector<double> t, y;
+  for (int i = 0; i < 12; ++i) {
+    t.push_back(0.1 + 0.05 * i);
+    y.push_back(21.0 * t.back() * (1.0 + 0.04 * std::sin(1.7 * i)));
+  }
+  double ty = 0.0, tt = 0.0;
+  for (std::size_t i = 0; i < t.size(); ++i) ty += t[i] * y[i], tt += t[i] * t[i];
+  const double best = ty / tt;
+  const pv::ResidualFunction r = [&](const std::vector<double>& x, std::vector<double>& out) {
+    out.resize(t.size());
+    for (std::size_t i = 0; i < t.size(); ++i) out[i] = t[i] * std::exp(x[0]) - y[i];
+    return true;
+  };
+  auto fit = [&](bool secant) {
+    pv::LevenbergMarquardtOptions o;
+    o.max_iterations = 6;
+    o.max_evaluations = 14;
+    o.fd_step = o.fd_step_min = 0.02;
+    o.cost_tolerance = 1e-3;
+    o.step_tolerance = 1e-3;
+    o.stalls_to_stop = 1;
+    o.threads = 2;
+    o.secant_jacobian = secant;
+    return pv::levenberg_marquardt(r, {std::log(6.5)}, {-std::log(1000.0)}, {std::log(1000.0)}, o);
+  };
+  const pv::LevenbergMarquardtResult difference = fit(false), secant = fit(true);
+  EXPECT_NEAR(std::exp(difference.x[0]) / best, 1.0, 0.01);
+  EXPECT_NEAR(std::exp(secant.x[0]) / best, 1.0, 0.01);
+  EXPECT_LT(secant.cost, 1.01 * sum_of_squares_at(r, {std::log(best)}));
+  EXPECT_EQ(secant.status, "cost_tolerance");  // converged within the budget of 14
+  EXPECT_LT(secant.evaluations, difference.evaluations);
 }
 
 TEST(LevenbergMarquardt, NeverAcceptsAPointThatCannotBeEvaluated) {

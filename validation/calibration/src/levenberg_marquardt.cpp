@@ -181,6 +181,8 @@ struct Trial {
   double lambda = 0.0;          ///< the accepted trial's, else the largest tried
   double cost = 0.0;
   std::vector<double> x, residuals;
+  /// The other lane's point and residuals when both were evaluated (for a secant).
+  std::vector<double> other_x, other_residuals;
 };
 
 Trial try_steps(const ResidualFunction& r, LevenbergMarquardtResult& res, const Eigen::VectorXd& rv,
@@ -199,10 +201,30 @@ Trial try_steps(const ResidualFunction& r, LevenbergMarquardtResult& res, const 
   t.cost = res.cost;
   t.lambda = lambdas.back();
   t.x = points.back();
+  std::size_t accepted = points.size();
   for (std::size_t i = 0; i < points.size(); ++i)
-    if (ok[i] && rs[i].size() == res.residuals.size() && sum_sq(rs[i]) < t.cost)
-      t = Trial{true, lambdas[i], sum_sq(rs[i]), points[i], rs[i]};
+    if (ok[i] && rs[i].size() == res.residuals.size() && sum_sq(rs[i]) < t.cost) {
+      t = Trial{true, lambdas[i], sum_sq(rs[i]), points[i], rs[i], {}, {}};
+      accepted = i;
+    }
+  if (t.accepted && points.size() == 2) {
+    const std::size_t other = 1 - accepted;
+    if (ok[other] && rs[other].size() == res.residuals.size()) {
+      t.other_x = points[other];
+      t.other_residuals = rs[other];
+    }
+  }
   return t;
+}
+
+/// The secant through the accepted trial and the other lane's (one
+/// parameter): false when there is no other point or it is the same.
+bool secant_jacobian(const Trial& t, Eigen::MatrixXd& J) {
+  if (t.x.size() != 1 || t.other_x.size() != 1) return false;
+  const double dx = t.other_x[0] - t.x[0];
+  if (!(std::abs(dx) > 1e-12)) return false;
+  J = (as_vector(t.other_residuals) - as_vector(t.residuals)) / dx;
+  return true;
 }
 
 }  // namespace
@@ -227,6 +249,7 @@ LevenbergMarquardtResult levenberg_marquardt(const ResidualFunction& r, const st
   // A stall with a coarse difference step may be the Jacobian's error across
   // a kink: refine the step and go on from the same point.
   bool need_jacobian = !jacobian_with_start;
+  bool secant = false;  // the Jacobian in use is a secant (options.secant_jacobian)
   double cycle_start_cost = res.cost;
   auto refine = [&](const char* why) {
     if (fd_step / 10.0 < 0.999 * o.fd_step_min) {
@@ -251,6 +274,7 @@ LevenbergMarquardtResult levenberg_marquardt(const ResidualFunction& r, const st
       if (res.evaluations + static_cast<int>(x0.size()) > o.max_evaluations) { res.status = "max_evaluations"; break; }
       res.jacobian = finite_difference_jacobian(r, res.x, res.residuals, lower, upper, fd_step, o.threads, &res.evaluations);
       need_jacobian = false;
+      secant = false;
     }
     const Eigen::VectorXd rv = as_vector(res.residuals);
     const Eigen::VectorXd g = res.jacobian.transpose() * rv;
@@ -260,16 +284,22 @@ LevenbergMarquardtResult levenberg_marquardt(const ResidualFunction& r, const st
     Trial trial = try_steps(r, res, rv, free, lambda, lanes, lower, upper);
     if (!trial.accepted) {
       lambda = 8.0 * trial.lambda;
+      if (secant) {  // the secant may have misled: a difference Jacobian before any verdict
+        secant = false;
+        need_jacobian = true;
+        continue;
+      }
       const bool stalled = lambda > 1e12 || max_abs_difference(trial.x, res.x) < o.step_tolerance;
       if (stalled && !refine(lambda > 1e12 ? "no_descent" : "step_tolerance")) break;
       continue;
     }
     const double step = max_abs_difference(trial.x, res.x);
     const double decrease = (res.cost - trial.cost) / std::max(res.cost, 1e-300);
+    secant = o.secant_jacobian && secant_jacobian(trial, res.jacobian);
+    need_jacobian = !secant;
     res.x = std::move(trial.x);
     res.residuals = std::move(trial.residuals);
     res.cost = trial.cost;
-    need_jacobian = true;
     lambda = std::max(1e-9, trial.lambda / 3.0);
     stalls = decrease < o.cost_tolerance ? stalls + 1 : 0;
     if ((stalls >= std::max(1, o.stalls_to_stop) && !refine("cost_tolerance")) || (step < o.step_tolerance && !refine("step_tolerance"))) {
@@ -278,7 +308,7 @@ LevenbergMarquardtResult levenberg_marquardt(const ResidualFunction& r, const st
     }
     if (res.evaluations >= o.max_evaluations) { res.status = "max_evaluations"; ++res.iterations; break; }
   }
-  res.jacobian_at_x = !need_jacobian;
+  res.jacobian_at_x = !need_jacobian && !secant;
   return res;
 }
 

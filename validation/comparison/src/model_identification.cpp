@@ -158,6 +158,10 @@ LevenbergMarquardtOptions factor_fit_options(int max_evaluations) {
   // second one, to confirm, cost a Jacobian and a trial (3 model runs of
   // 10-20 s each on the default slab) and moved the factor by 0.001 %.
   options.stalls_to_stop = 1;
+  // The one-factor fits take the secant through their two trial runs as the
+  // next Jacobian instead of a difference run alone (the joint fit, with
+  // more factors, does not: secant_jacobian needs one parameter).
+  options.secant_jacobian = true;
   options.threads = comparison::concurrent_solver_threads(2);
   return options;
 }

@@ -22,10 +22,12 @@
 // active set); the trial point is projected into the box. With two or more
 // threads two trial points (lambda and 8 lambda) are evaluated together and
 // the better one kept. A trial that lowers the cost is accepted and lambda
-// shrinks; otherwise lambda grows and the same Jacobian is reused.
+// shrinks; otherwise lambda grows and the same Jacobian is reused (with
+// secant_jacobian, one parameter: the next Jacobian is the secant through the
+// two trial points, and a failed trial on it gets a forward difference).
 // Stalls when the relative cost decrease of an accepted step is below
-// cost_tolerance stalls_to_stop times in a row (twice by default), the step is below step_tolerance (max
-// |dx|), or lambda exceeds 1e12 (no descent direction: a kink or a flat
+// cost_tolerance stalls_to_stop times in a row (twice by default), the step
+// is below step_tolerance (max |dx|), or lambda exceeds 1e12 (no descent direction: a kink or a flat
 // valley). On a stall the difference step is divided by 10 (the Jacobian of
 // a piecewise smooth objective across a kink misleads at a coarse step) and
 // the iteration goes on from the same point, while the step stays at or
@@ -58,6 +60,13 @@ struct LevenbergMarquardtOptions {
   /// where each evaluation is a long simulation and a fit converged within
   /// cost_tolerance is all the caller needs (the comparison's factor fits).
   int stalls_to_stop = 2;
+  /// One parameter, two lanes: after an accepted trial the Jacobian is the
+  /// secant through the iteration's two trial points (evaluated together)
+  /// instead of a forward difference at the new point (one evaluation alone,
+  /// the other lane idle); a trial that fails on a secant gets a forward
+  /// difference before lambda is judged. For fits whose evaluations are long
+  /// simulations (the comparison's factor fits).
+  bool secant_jacobian = false;
   int threads = 0;                 ///< 0: std::thread::hardware_concurrency()
   /// When >= 0 and the cost at x0 is at most this, x0 is returned after its
   /// one evaluation (status "start_accepted"): a caller that knows what cost
