@@ -2,8 +2,10 @@
 // solutions, and its finite-difference Jacobian against analytic derivatives.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 
@@ -88,6 +90,28 @@ TEST(LevenbergMarquardt, StopsAtTheBoundWhenTheMinimumLiesOutside) {
   EXPECT_DOUBLE_EQ(res.x[0], 2.0);
   EXPECT_NEAR(res.x[1], 1.0, 1e-6);
   EXPECT_NEAR(res.cost, 1.0, 1e-9);
+}
+
+TEST(LevenbergMarquardt, TwoTrialStepsProjectedOntoOneBoundPointAreEvaluatedOnce) {
+  // r = x - 3 with x <= 2 from 0 on two lanes: both trial steps (lambda and
+  // 8 lambda) overshoot past the bound and are projected onto x = 2, which is
+  // evaluated once (a model run is not repeated for nothing); the fit ends
+  // there (the gradient pushes out of the box).
+  std::mutex mutex;
+  std::vector<double> evaluated;
+  const pv::ResidualFunction r = [&](const std::vector<double>& x, std::vector<double>& out) {
+    const std::lock_guard<std::mutex> lock(mutex);
+    evaluated.push_back(x[0]);
+    out = {x[0] - 3.0};
+    return true;
+  };
+  pv::LevenbergMarquardtOptions o;
+  o.threads = 2;
+  o.initial_lambda = 1e-6;
+  const pv::LevenbergMarquardtResult res = pv::levenberg_marquardt(r, {0.0}, {-10.0}, {2.0}, o);
+  EXPECT_DOUBLE_EQ(res.x[0], 2.0);
+  EXPECT_EQ(std::count(evaluated.begin(), evaluated.end(), 2.0), 1);
+  EXPECT_EQ(res.evaluations, static_cast<int>(evaluated.size()));
 }
 
 namespace {

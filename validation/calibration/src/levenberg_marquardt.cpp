@@ -193,9 +193,14 @@ Trial try_steps(const ResidualFunction& r, LevenbergMarquardtResult& res, const 
   for (int lane = 0; lane < lanes; ++lane) {
     lambdas.push_back(lane == 0 ? lambda : 8.0 * lambda);
     points.push_back(trial_point(res.x, res.jacobian, rv, free, lambdas.back(), lower, upper));
+    // Both steps projected onto the same point of the box's boundary: one evaluation.
+    if (lane > 0 && points.back() == points.front()) {
+      points.pop_back();
+      lambdas.pop_back();
+    }
   }
   std::vector<char> ok;
-  evaluate_residuals_parallel(r, points, rs, ok, lanes);
+  evaluate_residuals_parallel(r, points, rs, ok, static_cast<int>(points.size()));
   res.evaluations += static_cast<int>(points.size());
   Trial t;
   t.cost = res.cost;
