@@ -165,15 +165,21 @@ int VolumetricNeedleModel::preconditioner_solve(double, const double* yp, const 
     if (extra_ > 0) work_a_ += gamma * q_force;
     b = work_a_.cwiseQuotient(diagonal_);
   } else {
-    work_b_.setZero(n3);
-    for (int d = 0; d < n3; ++d)
-      if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) work_b_[d] = rv[d];
     // The prescribed dofs' values enter the free rows through the Newton
-    // matrix of this gamma (the factorisation may have been made with another).
-    work_a_ = mass_.cwiseProduct(rv) - gamma * (K * rx) - (gamma * gamma) * (K * work_b_) -
-              (1.0 + gamma * settings_.mass_damping_per_s) * mass_.cwiseProduct(work_b_);
-    if (settings_.stiffness_damping_s > 0.0)
-      work_a_.noalias() -= (gamma * settings_.stiffness_damping_s) * (rest_tangent_.matrix() * work_b_);
+    // matrix of this gamma (the factorisation may have been made with another):
+    // their columns of it only (a few hundred of the mesh's dofs, where a
+    // product with a vector zero elsewhere swept every column).
+    work_a_ = mass_.cwiseProduct(rv) - gamma * (K * rx);
+    const Eigen::SparseMatrix<double>& K0 = rest_tangent_.matrix();
+    const double damping = gamma * settings_.stiffness_damping_s;
+    for (int d = 0; d < n3; ++d) {
+      if (dof_[static_cast<std::size_t>(d / 3)] == Dof::Free || rv[d] == 0.0) continue;
+      const double v = rv[d];
+      work_a_[d] -= (1.0 + gamma * settings_.mass_damping_per_s) * mass_[d] * v;
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, d); it; ++it) work_a_[it.row()] -= gamma * gamma * it.value() * v;
+      if (damping > 0.0)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(K0, d); it; ++it) work_a_[it.row()] -= damping * it.value() * v;
+    }
     if (extra_ > 0) work_a_ += gamma * q_force;
     for (int d = 0; d < n3; ++d)
       if (dof_[static_cast<std::size_t>(d / 3)] != Dof::Free) work_a_[d] = rv[d];

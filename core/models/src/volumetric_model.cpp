@@ -102,12 +102,16 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
   checked_force_N_ = std::numeric_limits<double>::quiet_NaN();
   double snap = 0.0;
   if (withdrawing && active_ < layers_.size()) {
-    compute_forces(y_, work_f_);
-    for (int a = 0; a < nodes_; ++a)
-      if (dof_[static_cast<std::size_t>(a)] == Dof::Contact && work_f_[3 * a + 2] < 0.0) {
+    // A contact node in tension lets go (a linear law's force from K0's
+    // columns, not a sweep over every element at every haptic step).
+    if (!law_->is_linear()) compute_forces(y_, work_f_);
+    for (int a = 0; a < nodes_; ++a) {
+      if (dof_[static_cast<std::size_t>(a)] != Dof::Contact) continue;
+      if ((law_->is_linear() ? linear_force_z_N(a) : work_f_[3 * a + 2]) < 0.0) {
         dof_[static_cast<std::size_t>(a)] = Dof::Free;
         changed = true;
       }
+    }
   }
   // No node joins the contact set while the needle is withdrawn: a released
   // surface that recovers behind the retreating tip would otherwise be put
@@ -296,25 +300,27 @@ void VolumetricNeedleModel::puncture_active_layer(double load_at_break_N) {
   ++events_;
 }
 
+double VolumetricNeedleModel::linear_force_z_N(int a) const {
+  // f = -K0 (x - X) - beta K0 v (the law's forces and the stiffness damping).
+  const Eigen::SparseMatrix<double>& K0 = rest_tangent_.matrix();
+  const double beta = settings_.stiffness_damping_s;
+  const int n3 = 3 * nodes_;
+  double force = 0.0;
+  for (Eigen::SparseMatrix<double>::InnerIterator it(K0, 3 * a + 2); it; ++it) {
+    const Eigen::Index i = it.row();
+    force -= it.value() * (y_[i] - rest_[i] + beta * y_[n3 + i]);
+  }
+  return force;
+}
+
 double VolumetricNeedleModel::contact_force_N() {
   // Without contact nodes the force is zero: no internal force evaluation
   // (a sweep over every element) on the steps before and between contacts.
   if (std::none_of(dof_.begin(), dof_.end(), [](Dof d) { return d == Dof::Contact; })) return 0.0;
   double force = 0.0;
-  if (law_->is_linear()) {
-    // f = -K0 (x - X) - beta K0 v: the contact nodes' z rows of K0 (its
-    // columns, K0 being symmetric) against x - X + beta v; a few hundred
-    // products instead of a sweep over every element at every haptic step.
-    const Eigen::SparseMatrix<double>& K0 = rest_tangent_.matrix();
-    const double beta = settings_.stiffness_damping_s;
-    const int n3 = 3 * nodes_;
-    for (int a = 0; a < nodes_; ++a) {
-      if (dof_[static_cast<std::size_t>(a)] != Dof::Contact) continue;
-      for (Eigen::SparseMatrix<double>::InnerIterator it(K0, 3 * a + 2); it; ++it) {
-        const Eigen::Index i = it.row();
-        force -= it.value() * (y_[i] - rest_[i] + beta * y_[n3 + i]);
-      }
-    }
+  if (law_->is_linear()) {  // a few hundred products instead of a sweep over every element at every haptic step
+    for (int a = 0; a < nodes_; ++a)
+      if (dof_[static_cast<std::size_t>(a)] == Dof::Contact) force += linear_force_z_N(a);
   } else {
     compute_forces(y_, work_f_);
     for (int a = 0; a < nodes_; ++a)

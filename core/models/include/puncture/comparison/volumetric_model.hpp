@@ -173,6 +173,10 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   /// Drops every kept factorisation of the Newton matrix (a new tangent or mesh).
   void drop_factors();
   void compute_forces(const Eigen::VectorXd& y, Eigen::VectorXd& f) const;
+  /// A linear law's force on node a along z (N) in the current state:
+  /// -(K0 (x - X + beta v)) at that row, from K0's column (K0 symmetric): a
+  /// few dozen products where compute_forces sweeps every element.
+  double linear_force_z_N(int a) const;
   bool update_contacts(double z_tip_m, double velocity_z_m_per_s, bool withdrawing);
   /// After a relaxation to equilibrium with the tip at z_tip_m: the needle's
   /// layer, if its rule reads the contact force, is checked on this state and
@@ -253,7 +257,7 @@ class VolumetricNeedleModel final : public ComparisonModel, private OdeSystem {
   long mass_only_setups_ = 0;
   double factorisation_seconds_ = 0.0;
   std::vector<double> decay_rates_;
-  mutable Eigen::VectorXd work_f_, work_a_, work_b_;
+  mutable Eigen::VectorXd work_f_, work_a_;
   const double* yp_current_ = nullptr;  ///< the state preconditioner_solve was called at
 };
 
