@@ -193,15 +193,19 @@ Trial try_steps(const ResidualFunction& r, LevenbergMarquardtResult& res, const 
   for (int lane = 0; lane < lanes; ++lane) {
     lambdas.push_back(lane == 0 ? lambda : 8.0 * lambda);
     points.push_back(trial_point(res.x, res.jacobian, rv, free, lambdas.back(), lower, upper));
-    // Both steps projected onto the same point of the box's boundary: one evaluation.
-    if (lane > 0 && points.back() == points.front()) {
-      points.pop_back();
-      lambdas.pop_back();
-    }
   }
+  // Both steps projected onto the same point of the box's boundary: evaluated
+  // once, the second lane given the first's result (the iteration goes on as
+  // if both had run: a failure counts as 8 lambda tried).
+  const bool same = points.size() == 2 && points[1] == points[0];
+  const std::vector<std::vector<double>> run(points.begin(), same ? points.begin() + 1 : points.end());
   std::vector<char> ok;
-  evaluate_residuals_parallel(r, points, rs, ok, static_cast<int>(points.size()));
-  res.evaluations += static_cast<int>(points.size());
+  evaluate_residuals_parallel(r, run, rs, ok, static_cast<int>(run.size()));
+  res.evaluations += static_cast<int>(run.size());
+  if (same) {
+    rs.push_back(rs.front());
+    ok.push_back(ok.front());
+  }
   Trial t;
   t.cost = res.cost;
   t.lambda = lambdas.back();
