@@ -104,10 +104,11 @@ bool VolumetricNeedleModel::update_contacts(double z_tip, double velocity_z, boo
   if (withdrawing && active_ < layers_.size()) {
     // A contact node in tension lets go (a linear law's force from K0's
     // columns, not a sweep over every element at every haptic step).
-    if (!law_->is_linear()) compute_forces(y_, work_f_);
+    const bool linear = law_->is_linear();
+    if (!linear) compute_forces(y_, work_f_);
     for (int a = 0; a < nodes_; ++a) {
       if (dof_[static_cast<std::size_t>(a)] != Dof::Contact) continue;
-      if ((law_->is_linear() ? linear_force_z_N(a) : work_f_[3 * a + 2]) < 0.0) {
+      if ((linear ? linear_force_z_N(a) : work_f_[3 * a + 2]) < 0.0) {
         dof_[static_cast<std::size_t>(a)] = Dof::Free;
         changed = true;
       }
