@@ -12,7 +12,9 @@ scripts/fem_axisymmetric_convergence.sh) and writes two tables:
      attempts given up and cut, steps accepted at a stall) and the median
      time of one tangent assembly and one sparse direct solve.
 A run given as LABEL=DIR is shown under LABEL (e.g. the same scene before and
-after a solver change); the table says nothing about a run it was not given.
+after a solver change); runs given under one label more than once are repeats
+of one run (e.g. by scripts/fem_timing_ab.sh): one row, the median wall time
+and each run's. The table says nothing about a run it was not given.
 Each --note TEXT is printed under the tables as given (what a run changed).
 
 Usage: scripts/fem_axisymmetric_timing.py OUT_MD [--note TEXT]... [LABEL=]RUN_DIR...
@@ -67,12 +69,12 @@ def main():
             notes.append(rest.pop(0))
         else:
             args.append(a)
-    runs = []
+    runs = {}  # label (or the directory) -> its run directories, in the order given
     for a in args:
         label, path = a.split("=", 1) if "=" in a and not os.path.exists(a) else (None, a)
         if os.path.isfile(path):
             path = os.path.dirname(path)
-        runs.append((label, path))
+        runs.setdefault(label or path, []).append((label, path))
     rev = provenance.git_revision()
     L = ["# Axisymmetric FEM: time per run, per load step and per Newton iteration\n",
          f"Command: `scripts/fem_axisymmetric_timing.py {out} "
@@ -86,15 +88,20 @@ def main():
          "wall (s) | s per Newton iteration |",
          "|---|---|---|---|---|---|---|---|---|---|"]
     stats = []
-    for label, path in runs:
+    for group in runs.values():
+        label, path = group[0]
         j = json.load(open(os.path.join(path, "fem_summary.json")))
         steps = j.get("load_steps", 0)
         its = j.get("newton_iterations", 0)
-        wall = j.get("wall_time_s", float("nan"))
+        walls = [json.load(open(os.path.join(p, "fem_summary.json"))).get("wall_time_s", float("nan"))
+                 for _, p in group]
+        wall = statistics.median(walls)
+        wall_text = f"{wall:.0f}" if len(walls) == 1 else \
+            f"{wall:.1f} (median of {len(walls)}: {', '.join(f'{w:.1f}' for w in walls)})"
         name = label or j.get("scene", os.path.basename(path))
         L.append(f"| {name} | Q{j.get('element_degree', 1)} | "
                  f"{j.get('n_cells', '')} | {j.get('n_dofs', '')} | {steps} | "
-                 f"{j.get('step_cuts', '')} | {its} | {its / steps if steps else float('nan'):.1f} | {wall:.0f} | "
+                 f"{j.get('step_cuts', '')} | {its} | {its / steps if steps else float('nan'):.1f} | {wall_text} | "
                  f"{wall / its if its else float('nan'):.3f} |")
         stats.append((name, newton_stats(os.path.join(path, "fem_newton_log.txt"))))
     L += ["", "## Where the Newton iterations and their time go (from each run's fem_newton_log.txt)\n",

@@ -3,8 +3,10 @@
 // its output (axisymmetric_solver_output.cc). Internal to reference_fem/src
 // (not part of the public headers).
 //
-// In:  a cell's FEValues<2> (values, gradients, quadrature points, JxW) and a
-//      nodal displacement vector (u_R, u_Z in m); the layer's LayerMaterial
+// In:  a cell's undeformed geometry (AxisymmetricCellGeometry: values,
+//      gradients, quadrature points, JxW; made from its FEValues<2> by
+//      cell_geometry) and a nodal displacement vector (u_R, u_Z in m); the
+//      layer's LayerMaterial
 //      and, for a viscoelastic layer, its law, the points' committed Prony
 //      histories and the time step (s).
 // Out: per quadrature point F, J, the ring volume dV = 2 pi R JxW (m^3), the
@@ -16,13 +18,15 @@
 #include <deal.II/base/point.h>
 #include <deal.II/base/tensor.h>
 #include <deal.II/fe/fe_values.h>
-#include <deal.II/fe/fe_values_extractors.h>
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/vector.h>
 
+#include <array>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
+#include <puncture/fem/axisymmetric_solver.hpp>
 #include <puncture/fem/hyperelastic_materials.hpp>
 #include <puncture/fem/kinematics.hpp>
 #include <puncture/fem/viscoelastic_material.hpp>
@@ -45,7 +49,40 @@ struct CellState {
   std::vector<SymTensor4> CC;
   dealii::FullMatrix<double> M_inv, K_JJ;
   std::vector<std::vector<double>> Np;
+  dealii::FullMatrix<double> M;  ///< scratch: the pressure modes' mass matrix
 };
+
+/// Most quadrature points of a cell (QGauss(3) on Q2: 9).
+constexpr unsigned kMaxQuadraturePoints = 9;
+/// Most pressure modes of a cell (Q2-P1: 3).
+constexpr unsigned kMaxPressureModes = 3;
+
+/// The geometry of the cell fev was last reinitialised on (dofs: its dofs;
+/// unit_points: the quadrature's points, which must outlive the result).
+inline AxisymmetricCellGeometry cell_geometry(const dealii::FEValues<2>& fev,
+                                              const std::vector<dealii::types::global_dof_index>& dofs,
+                                              const std::vector<dealii::Point<2>>& unit_points) {
+  AxisymmetricCellGeometry g;
+  g.n_q = fev.n_quadrature_points;
+  g.dofs_per_cell = fev.dofs_per_cell;
+  if (g.n_q > kMaxQuadraturePoints)
+    throw std::logic_error("axisymmetric cell: more quadrature points than kMaxQuadraturePoints");
+  g.dofs = dofs;
+  g.unit_points = &unit_points;
+  g.R_m.resize(g.n_q);
+  g.JxW_m2.resize(g.n_q);
+  g.shape_value.resize(g.n_q * g.dofs_per_cell);
+  g.shape_grad.resize(g.n_q * g.dofs_per_cell);
+  for (unsigned q = 0; q < g.n_q; ++q) {
+    g.R_m[q] = fev.quadrature_point(q)[0];
+    g.JxW_m2[q] = fev.JxW(q);
+    for (unsigned i = 0; i < g.dofs_per_cell; ++i) {
+      g.shape_value[q * g.dofs_per_cell + i] = fev.shape_value(i, q);
+      g.shape_grad[q * g.dofs_per_cell + i] = fev.shape_grad(i, q);
+    }
+  }
+  return g;
+}
 
 /// A viscoelastic cell's law, its points' committed histories and the step
 /// (law nullptr: elastic).
@@ -55,13 +92,13 @@ struct ViscousCell {
   double dt_s = 0.0;
 };
 
-/// Evaluates st at the cell of fev from the displacement gradients H at its
-/// points (with_tangent: also CC and K_JJ); false if a point is inverted or
-/// its stress non-finite.
-inline bool evaluate_cell(const LayerMaterial& material, unsigned degree, const dealii::FEValues<2>& fev,
+/// Evaluates st at the cell of geometry g from the displacement gradients H at
+/// its points (with_tangent: also CC and K_JJ); false if a point is inverted
+/// or its stress non-finite. st keeps its storage from one cell to the next.
+inline bool evaluate_cell(const LayerMaterial& material, unsigned degree, const AxisymmetricCellGeometry& g,
                           const std::vector<dealii::Tensor<2, 3>>& H, CellState& st, bool with_tangent = true,
                           const ViscousCell& viscous = {}) {
-  const unsigned nq = fev.n_quadrature_points, np = n_pressure_modes(degree);
+  const unsigned nq = g.n_q, np = n_pressure_modes(degree);
   st.F.resize(nq);
   st.J.resize(nq);
   st.dV.resize(nq);
@@ -69,16 +106,18 @@ inline bool evaluate_cell(const LayerMaterial& material, unsigned degree, const 
   st.CC.resize(nq);
   st.M_inv.reinit(np, np);
   st.K_JJ.reinit(np, np);
-  st.Np.assign(nq, std::vector<double>(np, 0.0));
+  st.M.reinit(np, np);
+  st.Np.resize(nq);
+  for (std::vector<double>& modes : st.Np) modes.resize(np);
   const dealii::Tensor<2, 3> I = dealii::unit_symmetric_tensor<3>();
-  const auto& unit_points = fev.get_quadrature().get_points();
-  dealii::FullMatrix<double> M(np, np);
-  std::vector<double> bJ(np, 0.0), bp(np, 0.0), cJ(np, 0.0), cp(np, 0.0);
+  const std::vector<dealii::Point<2>>& unit_points = *g.unit_points;
+  dealii::FullMatrix<double>& M = st.M;
+  std::array<double, kMaxPressureModes> bJ{}, bp{}, cJ{}, cp{};
   for (unsigned q = 0; q < nq; ++q) {
     st.F[q] = I + H[q];
     st.J[q] = dealii::determinant(st.F[q]);
     if (!(st.J[q] > 0.0) || !std::isfinite(st.J[q])) return false;
-    st.dV[q] = kTwoPi * fev.quadrature_point(q)[0] * fev.JxW(q);
+    st.dV[q] = kTwoPi * g.R_m[q] * g.JxW_m2[q];
     for (unsigned a = 0; a < np; ++a) st.Np[q][a] = pressure_mode(a, unit_points[q]);
     for (unsigned a = 0; a < np; ++a) {
       bJ[a] += st.Np[q][a] * st.J[q] * st.dV[q];
@@ -89,7 +128,7 @@ inline bool evaluate_cell(const LayerMaterial& material, unsigned degree, const 
   for (unsigned a = 0; a < np; ++a)
     for (unsigned b = 0; b < np; ++b) cJ[a] += st.M_inv(a, b) * bJ[b];
   const VolumetricLaw& vol = material.volumetric();
-  std::vector<double> J_tilde(nq, 0.0), pressure(nq, 0.0);
+  std::array<double, kMaxQuadraturePoints> J_tilde{}, pressure{};
   for (unsigned q = 0; q < nq; ++q) {
     for (unsigned a = 0; a < np; ++a) J_tilde[q] += cJ[a] * st.Np[q][a];
     if (!(J_tilde[q] > 0.0) || !std::isfinite(J_tilde[q])) return false;
@@ -125,23 +164,42 @@ inline bool evaluate_cell(const LayerMaterial& material, unsigned degree, const 
 }
 
 /// Displacement gradients H (3x3, R Z theta) at the quadrature points of a
-/// cell from a nodal vector u (scratch for one cell at a time).
+/// cell from a nodal vector u (scratch for one cell at a time; component: per
+/// shape function, 0 for u_R and 1 for u_Z). The sums run over the shape
+/// functions in the element's order, as FEValuesViews::Scalar's
+/// get_function_gradients and get_function_values do.
 class DisplacementGradients {
  public:
-  explicit DisplacementGradients(unsigned nq) : g_ur_(nq), g_uz_(nq), v_ur_(nq) {}
-  void compute(const dealii::FEValues<2>& fev, const dealii::Vector<double>& u,
+  DisplacementGradients(unsigned nq, const std::vector<unsigned>& component)
+      : component_(component), g_ur_(nq), g_uz_(nq), v_ur_(nq), dof_values_(component.size()) {}
+  void compute(const AxisymmetricCellGeometry& g, const dealii::Vector<double>& u,
                std::vector<dealii::Tensor<2, 3>>& H) {
-    fev[ur_].get_function_gradients(u, g_ur_);
-    fev[uz_].get_function_gradients(u, g_uz_);
-    fev[ur_].get_function_values(u, v_ur_);
-    for (unsigned q = 0; q < H.size(); ++q)
-      H[q] = axisymmetric_displacement_gradient(g_ur_[q], g_uz_[q], v_ur_[q], fev.quadrature_point(q)[0]);
+    const unsigned nq = g.n_q, n = g.dofs_per_cell;
+    for (unsigned i = 0; i < n; ++i) dof_values_[i] = u(g.dofs[i]);
+    for (unsigned q = 0; q < nq; ++q) {
+      g_ur_[q] = dealii::Tensor<1, 2>();
+      g_uz_[q] = dealii::Tensor<1, 2>();
+      v_ur_[q] = 0.0;
+    }
+    for (unsigned i = 0; i < n; ++i) {
+      const double value = dof_values_[i];
+      if (value == 0.0) continue;
+      if (component_[i] == 0) {
+        for (unsigned q = 0; q < nq; ++q) g_ur_[q] += value * g.grad(i, q);
+        for (unsigned q = 0; q < nq; ++q) v_ur_[q] += value * g.value(i, q);
+      } else {
+        for (unsigned q = 0; q < nq; ++q) g_uz_[q] += value * g.grad(i, q);
+      }
+    }
+    for (unsigned q = 0; q < nq; ++q)
+      H[q] = axisymmetric_displacement_gradient(g_ur_[q], g_uz_[q], v_ur_[q], g.R_m[q]);
   }
 
  private:
-  const dealii::FEValuesExtractors::Scalar ur_{0}, uz_{1};
+  std::vector<unsigned> component_;
   std::vector<dealii::Tensor<1, 2>> g_ur_, g_uz_;
   std::vector<double> v_ur_;
+  std::vector<double> dof_values_;
 };
 
 }  // namespace puncture::fem::axisymmetric_cell

@@ -60,6 +60,11 @@ struct AxisymmetricSolver::Step {
   int contact_changes = 0;                ///< changes of the punch contact set so far
   std::vector<double> history;            ///< free residual per iteration of one Newton solve (stall detection)
   bool strict = false;                    ///< converged to the Newton tolerance (not only at a stall)
+  /// The line search's accepted trial was assembled with its tangent (the first
+  /// trial, alpha = 1, is): the next iterate is that state, already assembled.
+  bool assembled_at_solution = false;
+  bool trial_has_tangent = false;         ///< the last trial state was assembled with its tangent
+  double trial_assemble_s = 0.0;          ///< wall time of that assembly (s)
 };
 
 /// One Newton iterate (the state solution_).
@@ -85,6 +90,7 @@ AxisymmetricSolver::Failure AxisymmetricSolver::newton(Step& step, int max_itera
   step.history.clear();
   step.max_free = 0.0;
   step.contact_changes = 0;
+  step.assembled_at_solution = false;
   for (int it = 0;; ++it) {
     Iterate x;
     if (const Failure why = evaluate_iterate(step, it, x)) return why;
@@ -208,10 +214,17 @@ void AxisymmetricSolver::start_step(Step& step, double predictor_scale) {
 AxisymmetricSolver::Failure AxisymmetricSolver::evaluate_iterate(Step& step, int it, Iterate& x) {
   debug_contacts_ = settings_.verbose && std::getenv("PUNCTURE_FEM_DEBUG_CONTACT") != nullptr;
   make_constraints(solution_, step.constraints);
-  const double assemble_before_s = section_wall_seconds(timer_, "assemble");
-  if (!assemble(solution_, true)) return "inverted or non-finite state";
+  if (step.assembled_at_solution && !debug_contacts_) {
+    // The line search's first trial, accepted, is this state with its tangent:
+    // residual, tangent and trial histories are those an assembly here gives.
+    x.assemble_s = step.trial_assemble_s;
+  } else {
+    const double assemble_before_s = section_wall_seconds(timer_, "assemble");
+    if (!assemble(solution_, true)) return "inverted or non-finite state";
+    x.assemble_s = section_wall_seconds(timer_, "assemble") - assemble_before_s;
+  }
+  step.assembled_at_solution = false;
   debug_contacts_ = false;
-  x.assemble_s = section_wall_seconds(timer_, "assemble") - assemble_before_s;
   const AffineConstraints<double>& constraints = step.constraints;
   x.free = free_residual_norm(constraints);
   for (std::size_t i = 0; i < solution_.size(); ++i)
@@ -422,18 +435,26 @@ std::string AxisymmetricSolver::tangent_check(const Step& step, const Vector<dou
 }
 
 AxisymmetricSolver::Failure AxisymmetricSolver::line_search(Step& step, const Iterate& x, double& alpha) {
-  // Any admissible step while the punch gap closes.
+  // Any admissible step while the punch gap closes. The first trial (the full
+  // step, accepted in most iterations) is assembled with its tangent: accepted,
+  // it is the next iterate's assembly; the shorter trials need the residual only.
   const LineSearchResult search = backtracking_line_search(
       x.free, x.gap > 0.0, settings_.absolute_residual_floor_N, settings_.max_line_search_halvings,
-      [&](double a, int) -> std::optional<double> {
+      [&](double a, int halvings) -> std::optional<double> {
         step.trial = solution_;
         step.trial.add(a, step.du);
-        if (!assemble(step.trial, false)) return std::nullopt;
+        const bool with_matrix = halvings == 0;
+        const double before_s = section_wall_seconds(timer_, "assemble");
+        step.trial_has_tangent = false;
+        if (!assemble(step.trial, with_matrix)) return std::nullopt;
+        step.trial_has_tangent = with_matrix;
+        if (with_matrix) step.trial_assemble_s = section_wall_seconds(timer_, "assemble") - before_s;
         AffineConstraints<double> tc;
         make_constraints(step.trial, tc);
         return free_residual_norm(tc);
       });
   alpha = search.alpha;
+  step.assembled_at_solution = search.accepted && step.trial_has_tangent;
   if (search.accepted) return std::nullopt;
   if (alpha < 0.0) return "line search: every trial state is inverted or non-finite";
   // No decrease found: the least bad admissible step, unless it would throw

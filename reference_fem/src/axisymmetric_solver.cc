@@ -90,16 +90,14 @@ const ViscoelasticMaterial<LayerMaterial>* AxisymmetricSolver::viscoelastic_of(
 }
 
 void AxisymmetricSolver::commit_viscous_history() {
-  const QGauss<2> quadrature(settings_.degree + 1);
-  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points);
-  const unsigned nq = quadrature.size();
-  DisplacementGradients gradients(nq);
+  const unsigned nq = unit_points_.size();
+  DisplacementGradients gradients(nq, shape_component_);
   std::vector<Tensor<2, 3>> H(nq);
-  for (const auto& cell : cells_) {
+  for (std::size_t k = 0; k < cells_.size(); ++k) {
+    const auto& cell = cells_[k];
     const ViscoelasticMaterial<LayerMaterial>* law = viscoelastic_of(cell);
     if (!law) continue;
-    fev.reinit(cell);
-    gradients.compute(fev, solution_, H);
+    gradients.compute(geometry_[k], solution_, H);
     std::vector<ViscoelasticHistory>& history = viscous_history_[cell->active_cell_index()];
     for (unsigned q = 0; q < nq; ++q) {
       const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) + H[q];
@@ -174,15 +172,12 @@ void AxisymmetricSolver::make_constraints(const Vector<double>& u, AffineConstra
 
 bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, const Vector<double>& u, bool with_matrix) {
   const unsigned degree = settings_.degree;
-  const QGauss<2> quadrature(degree + 1);
-  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_JxW_values | update_quadrature_points);
-  const unsigned dpc = fe_.n_dofs_per_cell(), nq = quadrature.size(), np = n_pressure_modes(degree);
+  const unsigned dpc = fe_.n_dofs_per_cell(), nq = unit_points_.size(), np = n_pressure_modes(degree);
   FullMatrix<double> B(np, dpc);
   std::vector<Tensor<2, 3>> H(nq), H0(nq), gradN(dpc);
   std::vector<SymTensor2> dE(dpc), CC_dE(dpc);
-  std::vector<unsigned> comp(dpc);
-  for (unsigned i = 0; i < dpc; ++i) comp[i] = fe_.system_to_component_index(i).first;
-  DisplacementGradients gradients(nq);
+  const std::vector<unsigned>& comp = shape_component_;
+  DisplacementGradients gradients(nq, comp);
   CellState st;
   // Viscous stabilisation (Kelvin-Voigt on the step's strain increment):
   // sigma_v = (tau / dt) 2 mu_0 sym(H - H_step_start), mu_0 the layer's
@@ -200,27 +195,27 @@ bool AxisymmetricSolver::assemble_cells(std::size_t begin, std::size_t end, cons
     FullMatrix<double>& Ke = out.Ke;
     Vector<double>& Re = out.Re;
     out.stabilization_J = 0.0;
-    fev.reinit(cell);
-    gradients.compute(fev, u, H);
+    const AxisymmetricCellGeometry& g = geometry_[k];
+    gradients.compute(g, u, H);
     const ViscousCell viscous{viscoelastic_of(cell), &viscous_history_[cell->active_cell_index()], dt_s_};
-    if (!evaluate_cell(material_of(cell), degree, fev, H, st, with_matrix, viscous)) return false;
+    if (!evaluate_cell(material_of(cell), degree, g, H, st, with_matrix, viscous)) return false;
     Ke = 0.0;
     Re = 0.0;
     B = 0.0;
     double two_mu_v = 0.0, two_mu_c = 0.0;
     const LayerMaterial& m = material_of(cell);
     if (stabilize) {
-      gradients.compute(fev, step_start_, H0);
+      gradients.compute(g, step_start_, H0);
       two_mu_v = stab_ratio * m.youngs_modulus_Pa() / (1.0 + m.poisson_ratio());
     }
     if (continuing) {
-      gradients.compute(fev, continuation_reference_, Hk);
+      gradients.compute(g, continuation_reference_, Hk);
       two_mu_c = continuation_ratio_ * m.youngs_modulus_Pa() / (1.0 + m.poisson_ratio());
     }
     for (unsigned q = 0; q < nq; ++q) {
-      const double R = fev.quadrature_point(q)[0];
+      const double R = g.R_m[q];
       for (unsigned i = 0; i < dpc; ++i) {
-        gradN[i] = axisymmetric_shape_gradient(comp[i], fev.shape_value(i, q), fev.shape_grad(i, q), R);
+        gradN[i] = axisymmetric_shape_gradient(comp[i], g.value(i, q), g.grad(i, q), R);
         dE[i] = strain_variation(st.F[q], gradN[i]);
         Re(i) += scalar_product(st.S[q], dE[i]) * st.dV[q];
       }
@@ -296,10 +291,9 @@ void AxisymmetricSolver::add_cell_contributions(bool with_matrix) {
     bulk_diagonal_ = 0.0;
   }
   residual_ = 0.0;
-  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
   for (std::size_t k = 0; k < cells_.size(); ++k) {
     const CellContribution& c = cell_work_[k];
-    cells_[k]->get_dof_indices(dofs);
+    const std::vector<types::global_dof_index>& dofs = geometry_[k].dofs;
     stabilization_trial_J_ += c.stabilization_J;
     for (unsigned i = 0; i < dofs.size(); ++i) {
       residual_(dofs[i]) += c.Re(i);

@@ -66,18 +66,17 @@ std::vector<std::pair<double, double>> AxisymmetricSolver::vertical_displacement
 }
 
 double AxisymmetricSolver::max_principal_stretch(int layer, double r_max_m, double z_lo_m, double z_hi_m) const {
-  const QGauss<2> quadrature(settings_.degree + 1);
-  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points);
-  DisplacementGradients gradients(quadrature.size());
-  std::vector<Tensor<2, 3>> H(quadrature.size());
+  const unsigned nq = unit_points_.size();
+  std::vector<Tensor<2, 3>> H(nq);
+  DisplacementGradients gradients(nq, shape_component_);
   double stretch = 1.0;
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
+  for (std::size_t k = 0; k < cells_.size(); ++k) {
+    const auto& cell = cells_[k];
     if (static_cast<int>(cell->material_id()) != layer) continue;
     const Point<2> c = cell->center();
     if (c[0] > r_max_m || c[1] < z_lo_m || c[1] > z_hi_m) continue;
-    fev.reinit(cell);
-    gradients.compute(fev, solution_, H);
-    for (unsigned q = 0; q < quadrature.size(); ++q) {
+    gradients.compute(geometry_[k], solution_, H);
+    for (unsigned q = 0; q < nq; ++q) {
       const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) + H[q];
       const auto ev = eigenvalues(right_cauchy_green(F));
       stretch = std::max(stretch, std::sqrt(std::max(ev[0], 0.0)));
@@ -110,20 +109,18 @@ std::array<double, 2> AxisymmetricSolver::displacement_at(double R_m, double Z_m
 void AxisymmetricSolver::write_vtu(const std::string& path) const {
   const unsigned n = triangulation_.n_active_cells();
   Vector<double> layer(n), J(n), von_mises(n), stretch(n), damage(n);
-  const QGauss<2> quadrature(settings_.degree + 1);
-  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_quadrature_points | update_JxW_values);
-  const unsigned nq = quadrature.size();
-  DisplacementGradients gradients(nq);
+  const unsigned nq = unit_points_.size();
+  DisplacementGradients gradients(nq, shape_component_);
   std::vector<Tensor<2, 3>> H(nq);
   CellState st;
-  for (const auto& cell : dof_handler_.active_cell_iterators()) {
+  for (std::size_t k = 0; k < cells_.size(); ++k) {
+    const auto& cell = cells_[k];
     const unsigned c = cell->active_cell_index();
-    fev.reinit(cell);
-    gradients.compute(fev, solution_, H);
+    gradients.compute(geometry_[k], solution_, H);
     layer(c) = cell->material_id();
     // dt = 0 with the committed history: the committed (converged) stress.
     const ViscousCell viscous{viscoelastic_of(cell), &viscous_history_[c], 0.0};
-    const bool ok = evaluate_cell(material_of(cell), settings_.degree, fev, H, st, true, viscous);
+    const bool ok = evaluate_cell(material_of(cell), settings_.degree, geometry_[k], H, st, true, viscous);
     double j_sum = 0.0, vm_sum = 0.0, s_max = 1.0;
     for (unsigned q = 0; q < nq; ++q) {
       const Tensor<2, 3> F = Tensor<2, 3>(unit_symmetric_tensor<3>()) + H[q];

@@ -158,6 +158,20 @@ void AxisymmetricSolver::distribute_dofs_and_constraints() {
   for (const auto& cell : dof_handler_.active_cell_iterators()) cells_.push_back(cell);
   cell_work_.assign(cells_.size(), CellContribution{FullMatrix<double>(fe_.n_dofs_per_cell(), fe_.n_dofs_per_cell()),
                                                     Vector<double>(fe_.n_dofs_per_cell()), 0.0});
+  // The cells' undeformed geometry, once: every assembly reads it.
+  const QGauss<2> quadrature(settings_.degree + 1);
+  unit_points_ = quadrature.get_points();
+  shape_component_.resize(fe_.n_dofs_per_cell());
+  for (unsigned i = 0; i < fe_.n_dofs_per_cell(); ++i) shape_component_[i] = fe_.system_to_component_index(i).first;
+  FEValues<2> fev(fe_, quadrature, update_values | update_gradients | update_JxW_values | update_quadrature_points);
+  std::vector<types::global_dof_index> dofs(fe_.n_dofs_per_cell());
+  geometry_.clear();
+  geometry_.reserve(cells_.size());
+  for (const auto& cell : cells_) {
+    fev.reinit(cell);
+    cell->get_dof_indices(dofs);
+    geometry_.push_back(cell_geometry(fev, dofs, unit_points_));
+  }
   // Homogeneous Dirichlet conditions.
   dirichlet_.clear();
   VectorTools::interpolate_boundary_values(dof_handler_, kBase, Functions::ZeroFunction<2>(2), dirichlet_);

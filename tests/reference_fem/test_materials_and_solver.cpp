@@ -159,6 +159,28 @@ TEST(Materials, VolumetricPressureIsDerivativeOfEnergy) {
   EXPECT_DOUBLE_EQ(vol.pressure(1.0), 0.0);
 }
 
+TEST(Materials, TensorProductsOnTheIndependentComponentsAreDealiisBitForBit) {
+  // outer and symmetric_product write the 6 x 6 independent components
+  // directly; they must give exactly what deal.II's outer_product and the
+  // index-quadruple definition of (A (.) A) give (the FEM's references do not
+  // move with them).
+  SymTensor2 a, b;
+  for (unsigned i = 0; i < 3; ++i)
+    for (unsigned j = i; j < 3; ++j) {
+      a[i][j] = std::sin(1.0 + 3 * i + j) * 1.7 + (i == j ? 2.0 : 0.0);
+      b[i][j] = std::cos(0.3 + 5 * i + 2 * j) / 3.0;
+    }
+  const SymTensor4 ab = outer(a, b), ab_dealii = outer_product(a, b), aa = symmetric_product(a);
+  for (unsigned i = 0; i < 3; ++i)
+    for (unsigned j = 0; j < 3; ++j)
+      for (unsigned k = 0; k < 3; ++k)
+        for (unsigned l = 0; l < 3; ++l) {
+          EXPECT_EQ(ab[i][j][k][l], ab_dealii[i][j][k][l]);
+          EXPECT_EQ(ab[i][j][k][l], a[i][j] * b[k][l]);
+          EXPECT_EQ(aa[i][j][k][l], 0.5 * (a[i][k] * a[j][l] + a[i][l] * a[j][k]));
+        }
+}
+
 TEST(Materials, RejectsInvalidParameters) {
   EXPECT_THROW(LayerMaterial(make_material("neo_hookean", 1e4, 0.5, 0.0)), std::invalid_argument);
   EXPECT_THROW(LayerMaterial(make_material("neo_hookean", -1.0, 0.3, 0.0)), std::invalid_argument);

@@ -43,6 +43,8 @@
 #pragma once
 
 #include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
+#include <deal.II/base/types.h>
 #include <deal.II/base/timer.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
@@ -185,6 +187,22 @@ struct NeedleForce {
   double normal_N = 0.0;    ///< from the normal contact pressure (tip flank, punch face)
   double friction_N = 0.0;  ///< from the tangential (friction) tractions
   int nodes_in_contact = 0;
+};
+
+/// The undeformed geometry of one cell at its quadrature points: what the
+/// total-Lagrangian assembly reads of a cell's FEValues<2>, kept once per cell
+/// (the reference configuration never moves). Shape data are indexed
+/// [q * dofs_per_cell + i] for shape function i at quadrature point q.
+struct AxisymmetricCellGeometry {
+  std::vector<dealii::types::global_dof_index> dofs;  ///< the cell's dofs, in the element's order
+  std::vector<double> R_m;                            ///< radius of each quadrature point (m)
+  std::vector<double> JxW_m2;                         ///< quadrature weight x Jacobian determinant (m^2)
+  std::vector<double> shape_value;                    ///< N_i at point q
+  std::vector<dealii::Tensor<1, 2>> shape_grad;       ///< grad N_i at point q (1/m)
+  const std::vector<dealii::Point<2>>* unit_points = nullptr;  ///< the quadrature's points on the unit cell
+  unsigned n_q = 0, dofs_per_cell = 0;
+  double value(unsigned i, unsigned q) const { return shape_value[q * dofs_per_cell + i]; }
+  const dealii::Tensor<1, 2>& grad(unsigned i, unsigned q) const { return shape_grad[q * dofs_per_cell + i]; }
 };
 
 class AxisymmetricSolver {
@@ -422,6 +440,11 @@ class AxisymmetricSolver {
   };
   std::vector<dealii::DoFHandler<2>::active_cell_iterator> cells_;
   std::vector<CellContribution> cell_work_;
+  /// Per cell of cells_: its undeformed geometry (made once with the dofs), and
+  /// the quadrature's unit points it refers to.
+  std::vector<AxisymmetricCellGeometry> geometry_;
+  std::vector<dealii::Point<2>> unit_points_;
+  std::vector<unsigned> shape_component_;  ///< per shape function: 0 (u_R) or 1 (u_Z)
   /// Cells [begin, end) of cells_ into cell_work_; false on an inverted or
   /// non-finite state.
   bool assemble_cells(std::size_t begin, std::size_t end, const dealii::Vector<double>& u, bool with_matrix);

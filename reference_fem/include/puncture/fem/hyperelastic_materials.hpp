@@ -43,15 +43,38 @@ namespace puncture::fem {
 using SymTensor2 = dealii::SymmetricTensor<2, 3>;
 using SymTensor4 = dealii::SymmetricTensor<4, 3>;
 
+/// Storage of the independent components of a symmetric 3x3 tensor (deal.II's
+/// order: 00, 11, 22, 01, 02, 12): the index of component (i, j).
+constexpr unsigned kSymIndex[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+/// The index pair (i, j), i <= j, of independent component I.
+constexpr unsigned kSymPair[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+
+/// (a x b)_{ABCD} = a_AB b_CD, written on the 6 x 6 independent components
+/// (the products dealii::outer_product forms one index quadruple at a time).
+inline SymTensor4 outer(const SymTensor2& a, const SymTensor2& b) {
+  SymTensor4 out;
+  const double* pa = a.begin_raw();
+  const double* pb = b.begin_raw();
+  double* po = out.begin_raw();
+  for (unsigned I = 0; I < 6; ++I)
+    for (unsigned K = 0; K < 6; ++K) po[6 * I + K] = pa[I] * pb[K];
+  return out;
+}
+
 /// (A (.) A)_{ABCD} = 1/2 (A_AC A_BD + A_AD A_BC): the symmetrised product
-/// that appears in d(C^{-1})/dC = -(C^{-1} (.) C^{-1}).
+/// that appears in d(C^{-1})/dC = -(C^{-1} (.) C^{-1}) (on the 6 x 6
+/// independent components).
 inline SymTensor4 symmetric_product(const SymTensor2& A) {
   SymTensor4 out;
-  for (unsigned a = 0; a < 3; ++a)
-    for (unsigned b = a; b < 3; ++b)
-      for (unsigned c = 0; c < 3; ++c)
-        for (unsigned d = c; d < 3; ++d)
-          out[a][b][c][d] = 0.5 * (A[a][c] * A[b][d] + A[a][d] * A[b][c]);
+  const double* pa = A.begin_raw();
+  double* po = out.begin_raw();
+  for (unsigned I = 0; I < 6; ++I) {
+    const unsigned a = kSymPair[I][0], b = kSymPair[I][1];
+    for (unsigned K = 0; K < 6; ++K) {
+      const unsigned c = kSymPair[K][0], d = kSymPair[K][1];
+      po[6 * I + K] = 0.5 * (pa[kSymIndex[a][c]] * pa[kSymIndex[b][d]] + pa[kSymIndex[a][d]] * pa[kSymIndex[b][c]]);
+    }
+  }
   return out;
 }
 
@@ -81,14 +104,14 @@ inline void isochoric_push(const SymTensor2& C, const SymTensor2& Sbar, const Sy
   const double J_m23 = std::pow(J, -2.0 / 3.0);
   const double Sbar_C = dealii::scalar_product(Sbar, C);  // Tr(Sbar)
   S_iso = J_m23 * (Sbar - (Sbar_C / 3.0) * C_inv);
-  const SymTensor4 Cinv_x_Cinv = dealii::outer_product(C_inv, C_inv);
+  const SymTensor4 Cinv_x_Cinv = outer(C_inv, C_inv);
   const SymTensor4 P_tilde = symmetric_product(C_inv) - (1.0 / 3.0) * Cinv_x_Cinv;
   CC_iso = (2.0 / 3.0) * J_m23 * Sbar_C * P_tilde -
-           (2.0 / 3.0) * (dealii::outer_product(C_inv, S_iso) + dealii::outer_product(S_iso, C_inv));
+           (2.0 / 3.0) * (outer(C_inv, S_iso) + outer(S_iso, C_inv));
   if (CC_hat != nullptr) {
     const SymTensor4 identity = dealii::identity_tensor<3>();
-    const SymTensor4 P = identity - (1.0 / 3.0) * dealii::outer_product(C_inv, C);
-    const SymTensor4 P_T = identity - (1.0 / 3.0) * dealii::outer_product(C, C_inv);
+    const SymTensor4 P = identity - (1.0 / 3.0) * outer(C_inv, C);
+    const SymTensor4 P_T = identity - (1.0 / 3.0) * outer(C, C_inv);
     CC_iso += std::pow(J, -4.0 / 3.0) * (P * (*CC_hat) * P_T);
   }
 }
@@ -428,7 +451,7 @@ class LayerMaterial {
 inline void add_volumetric_at_fixed_pressure(const SymTensor2& C_inv, double J, double p,
                                              SymTensor2& S, SymTensor4& CC) {
   S += (p * J) * C_inv;
-  CC += (p * J) * (dealii::outer_product(C_inv, C_inv) - 2.0 * symmetric_product(C_inv));
+  CC += (p * J) * (outer(C_inv, C_inv) - 2.0 * symmetric_product(C_inv));
 }
 
 }  // namespace puncture::fem

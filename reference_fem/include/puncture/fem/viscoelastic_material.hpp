@@ -231,7 +231,7 @@ class ViscoelasticMaterial {
     const double J = std::sqrt(dealii::determinant(C));
     const SymTensor2 C_inv = dealii::invert(C);
     add_volumetric_at_fixed_pressure(C_inv, J, vol_.pressure(J), S, CC);
-    CC += (J * J * vol_.dpressure_dJ(J)) * dealii::outer_product(C_inv, C_inv);
+    CC += (J * J * vol_.dpressure_dJ(J)) * outer(C_inv, C_inv);
   }
   SymTensor2 stress(const SymTensor2& C, double dt_s, const ViscoelasticHistory& history) const {
     SymTensor2 S = isochoric_stress(C, dt_s, history);
