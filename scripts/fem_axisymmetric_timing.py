@@ -120,7 +120,8 @@ def main():
     L += ["",
           "Each Newton iteration assembles the tangent (finite-strain three-field cells, cohesive points, contact "
           "and friction nodes), solves it with UMFPACK (nonsymmetric because of friction) and line-searches on "
-          "the residual (residual-only assemblies). Iterations per converged step measure the tangent's "
+          "the residual (from 8b34964 the full step is assembled with its tangent, which the next iteration takes "
+          "over when the step is accepted; the shorter trials are residual-only assemblies). Iterations per converged step measure the tangent's "
           "consistency; iterations in cut attempts measure the work thrown away where Newton fails (the skin's "
           "snap-through, kinks of contact and full damage) before the step is cut; the median assembly and "
           "solve times measure the cost of one iteration."]
