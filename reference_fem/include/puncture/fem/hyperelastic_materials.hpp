@@ -43,12 +43,6 @@ namespace puncture::fem {
 using SymTensor2 = dealii::SymmetricTensor<2, 3>;
 using SymTensor4 = dealii::SymmetricTensor<4, 3>;
 
-/// Storage of the independent components of a symmetric 3x3 tensor (deal.II's
-/// order: 00, 11, 22, 01, 02, 12): the index of component (i, j).
-constexpr unsigned kSymIndex[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
-/// The index pair (i, j), i <= j, of independent component I.
-constexpr unsigned kSymPair[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
-
 /// (a x b)_{ABCD} = a_AB b_CD, written on the 6 x 6 independent components
 /// (the products dealii::outer_product forms one index quadruple at a time).
 inline SymTensor4 outer(const SymTensor2& a, const SymTensor2& b) {
@@ -56,8 +50,9 @@ inline SymTensor4 outer(const SymTensor2& a, const SymTensor2& b) {
   const double* pa = a.begin_raw();
   const double* pb = b.begin_raw();
   double* po = out.begin_raw();
-  for (unsigned I = 0; I < 6; ++I)
-    for (unsigned K = 0; K < 6; ++K) po[6 * I + K] = pa[I] * pb[K];
+  constexpr unsigned n = SymTensor2::n_independent_components;
+  for (unsigned I = 0; I < n; ++I)
+    for (unsigned K = 0; K < n; ++K) po[n * I + K] = pa[I] * pb[K];
   return out;
 }
 
@@ -68,11 +63,16 @@ inline SymTensor4 symmetric_product(const SymTensor2& A) {
   SymTensor4 out;
   const double* pa = A.begin_raw();
   double* po = out.begin_raw();
-  for (unsigned I = 0; I < 6; ++I) {
-    const unsigned a = kSymPair[I][0], b = kSymPair[I][1];
-    for (unsigned K = 0; K < 6; ++K) {
-      const unsigned c = kSymPair[K][0], d = kSymPair[K][1];
-      po[6 * I + K] = 0.5 * (pa[kSymIndex[a][c]] * pa[kSymIndex[b][d]] + pa[kSymIndex[a][d]] * pa[kSymIndex[b][c]]);
+  // The storage order of the independent components is deal.II's (00, 11, 22, 01, 02, 12 in 3D).
+  const auto at = [pa](unsigned i, unsigned j) {
+    return pa[SymTensor2::component_to_unrolled_index(dealii::TableIndices<2>(i, j))];
+  };
+  constexpr unsigned n = SymTensor2::n_independent_components;
+  for (unsigned I = 0; I < n; ++I) {
+    const dealii::TableIndices<2> ab = SymTensor2::unrolled_to_component_indices(I);
+    for (unsigned K = 0; K < n; ++K) {
+      const dealii::TableIndices<2> cd = SymTensor2::unrolled_to_component_indices(K);
+      po[n * I + K] = 0.5 * (at(ab[0], cd[0]) * at(ab[1], cd[1]) + at(ab[0], cd[1]) * at(ab[1], cd[0]));
     }
   }
   return out;
