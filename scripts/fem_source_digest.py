@@ -46,9 +46,10 @@ CORE_HEADERS = ("core/include/puncture/scene.hpp", "core/include/puncture/punctu
 # (the same filter as validation/fem_cache/CMakeLists.txt).
 NOT_FEM = re.compile(r"tet_slab_mesh|tet_mesh")
 ONLY = {
-    "3d": re.compile(r"^reference_fem/(src/(finite_strain_solver\.cc|finite_strain_assembly\.cc|energy_line_search\.hpp|"
+    "3d": re.compile(r"^(reference_fem/(src/(finite_strain_solver\.cc|finite_strain_assembly\.cc|energy_line_search\.hpp|"
                      r"slab_insertion_output\.cc|slab_insertion_run\.(cc|hpp))|"
-                     r"include/puncture/fem/finite_strain_solver\.hpp)$"),
+                     r"include/puncture/fem/finite_strain_solver\.hpp)|"
+                     r"meshing/(src|include/puncture/meshing)/inclined_path_mesh\.(cpp|hpp))$"),
     "axisymmetric": re.compile(r"^(reference_fem/src/axisymmetric_[a-z_]+\.(cc|hpp)|"
                                r"reference_fem/include/puncture/fem/axisymmetric_solver\.hpp|"
                                r"meshing/(src|include/puncture/meshing)/axisymmetric_slab_mesh\.(cpp|hpp))$"),
