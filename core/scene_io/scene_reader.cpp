@@ -407,6 +407,7 @@ Insertion read_insertion(ObjectReader o) {
   in.dwell_s = o.number("dwell_s", in.dwell_s);
   in.withdrawal_speed_m_per_s = o.number("withdrawal_speed_mm_per_s", in.speed_m_per_s / kMm) * kMm;
   in.angle_deg = o.number("angle_deg", in.angle_deg);
+  in.azimuth_deg = o.number("azimuth_deg", in.azimuth_deg);
   o.reject_unknown_keys();
   return in;
 }

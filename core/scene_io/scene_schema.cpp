@@ -134,6 +134,7 @@ std::vector<SceneField> insertion_and_realtime_fields() {
       {"/insertion/dwell_s", T::Number, "s", kOptional, within(0, scene_limits::kMaxDurationS), kFem, kWritten},
       {"/insertion/withdrawal_speed_mm_per_s", T::Number, "mm/s", kOptional, above(0), kFem, kWritten},
       {"/insertion/angle_deg", T::Number, "deg", kOptional, within(0, kMaxInsertionAngleDeg), kFem, kWritten},
+      {"/insertion/azimuth_deg", T::Number, "deg", kOptional, within(0, 360, false, true), kFem, kWritten},
 
       {"/realtime/sh_degree", T::Integer, "", kOptional, within(2, 64), kRealtime, kWritten},
       {"/realtime/haptic_rate_Hz", T::Number, "Hz", kOptional, within(0, scene_limits::kMaxHapticRateHz, true),

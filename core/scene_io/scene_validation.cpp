@@ -254,6 +254,8 @@ void validate_insertion(const Scene& s, const std::string& file) {
           "in [0, " + std::to_string(static_cast<int>(kMaxInsertionAngleDeg)) +
               "] deg (the angle between the needle and the surface normal)",
           in.angle_deg);
+  require(in.azimuth_deg >= 0.0 && in.azimuth_deg < 360.0, file, "/insertion/azimuth_deg",
+          "in [0, 360) deg (the direction the needle tilts towards, from +x towards +y)", in.azimuth_deg);
   if (in.angle_deg > 0.0) validate_inclined_path(s, file);
 }
 

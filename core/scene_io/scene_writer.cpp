@@ -197,7 +197,8 @@ std::string scene_to_json_text(const Scene& s) {
                        {"target_depth_mm", in.target_depth_m / kMm},
                        {"dwell_s", in.dwell_s},
                        {"withdrawal_speed_mm_per_s", in.withdrawal_speed_m_per_s / kMm},
-                       {"angle_deg", in.angle_deg}};
+                       {"angle_deg", in.angle_deg},
+                       {"azimuth_deg", in.azimuth_deg}};
   root["realtime"] = {{"sh_degree", s.realtime.sh_degree},
                       {"haptic_rate_Hz", s.realtime.haptic_rate_Hz},
                       {"integrator", s.realtime.integrator},

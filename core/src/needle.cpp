@@ -18,13 +18,18 @@ Eigen::Vector3d point_on_insertion_line(const Eigen::Vector3d& d, double path_m)
 
 Eigen::Vector3d insertion_direction(const Insertion& insertion) {
   const double angle_rad = insertion.angle_deg * (M_PI / 180.0);
-  return Eigen::Vector3d(std::sin(angle_rad), 0.0, -std::cos(angle_rad));
+  const double azimuth_rad = insertion.azimuth_deg * (M_PI / 180.0);
+  return Eigen::Vector3d(std::sin(angle_rad) * std::cos(azimuth_rad), std::sin(angle_rad) * std::sin(azimuth_rad),
+                         -std::cos(angle_rad));
 }
 
 ScriptedTrajectory::ScriptedTrajectory(const Insertion& insertion) : insertion_(insertion) {
   if (!(insertion.angle_deg >= 0.0 && insertion.angle_deg <= kMaxInsertionAngleDeg))
     throw std::invalid_argument("insertion.angle_deg = " + std::to_string(insertion.angle_deg) + ": must lie in [0, " +
                                 std::to_string(kMaxInsertionAngleDeg) + "] deg");
+  if (!(insertion.azimuth_deg >= 0.0 && insertion.azimuth_deg < 360.0))
+    throw std::invalid_argument("insertion.azimuth_deg = " + std::to_string(insertion.azimuth_deg) +
+                                ": must lie in [0, 360) deg");
   if (!(insertion.speed_m_per_s > 0.0) || !std::isfinite(insertion.speed_m_per_s))
     throw std::invalid_argument("insertion.speed_m_per_s must be positive for a scripted trajectory");
   if (!(insertion.withdrawal_speed_m_per_s > 0.0) || !std::isfinite(insertion.withdrawal_speed_m_per_s))

@@ -4,8 +4,9 @@
 // Geometry convention (scene.hpp): the undeformed skin surface is the plane
 // z = 0, tissue below; depth = -z_tip. A scripted insertion enters the skin
 // at the origin along the unit direction
-//   d = (sin a, 0, -cos a),  a = Insertion::angle_deg (0: along the sample
-// axis, the surface normal; the needle tilts towards +x). The tip's path
+//   d = (sin a cos b, sin a sin b, -cos a),  a = Insertion::angle_deg (0: along
+// the sample axis, the surface normal), b = Insertion::azimuth_deg (the
+// needle tilts towards +x at b = 0, towards +y at b = 90). The tip's path
 // coordinate s (m, along d, 0 at the entry point, < 0 above the skin) runs
 // from -start_height / cos a to target_depth / cos a: start height and target
 // depth are vertical, the speeds are along the needle.

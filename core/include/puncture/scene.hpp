@@ -269,6 +269,7 @@ struct Insertion {
   double dwell_s = 0.5;                  ///< pause at the target depth
   double withdrawal_speed_m_per_s = 0.01;///< withdrawal speed (> 0), back to the start height
   double angle_deg = 0.0;                ///< angle between needle and surface normal (deg; needle.hpp); the FEM takes 0 only
+  double azimuth_deg = 0.0;              ///< direction the needle tilts towards, from +x towards +y (deg, [0, 360); needle.hpp)
 };
 
 /// Settings of the real-time model.

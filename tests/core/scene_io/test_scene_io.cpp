@@ -71,6 +71,16 @@ TEST(SceneIo, RoundTripThroughJsonText) {
   EXPECT_EQ(a.realtime.integrator, b.realtime.integrator);
 }
 
+TEST(SceneIo, InclinationAndAzimuthRoundTripAndDefaultToTheNormal) {
+  Scene a = load_scene(kDefaultScene);
+  EXPECT_EQ(a.insertion.azimuth_deg, 0.0);  // the default scene names no azimuth
+  a.insertion.angle_deg = 20.0;
+  a.insertion.azimuth_deg = 247.5;
+  const Scene b = parse_scene(scene_to_json_text(a), "roundtrip");
+  EXPECT_EQ(b.insertion.angle_deg, 20.0);
+  EXPECT_EQ(b.insertion.azimuth_deg, 247.5);
+}
+
 TEST(SceneIo, MalformedJsonNamesTheFile) {
   try {
     parse_scene("{ \"schema_version\": 1, ", "broken.json");
@@ -126,6 +136,9 @@ const BadCase kBadCases[] = {
     {"depth_beyond_tissue", [](json& j) { j["insertion"]["target_depth_mm"] = 60.0; }, "/insertion/target_depth_mm"},
     {"angle_beyond_limit", [](json& j) { j["insertion"]["angle_deg"] = 61.0; }, "/insertion/angle_deg"},
     {"negative_angle", [](json& j) { j["insertion"]["angle_deg"] = -5.0; }, "/insertion/angle_deg"},
+    {"azimuth_full_turn", [](json& j) { j["insertion"]["azimuth_deg"] = 360.0; }, "/insertion/azimuth_deg"},
+    {"negative_azimuth", [](json& j) { j["insertion"]["azimuth_deg"] = -90.0; }, "/insertion/azimuth_deg"},
+    {"azimuth_not_a_number", [](json& j) { j["insertion"]["azimuth_deg"] = "north"; }, "/insertion/azimuth_deg"},
     // 30 mm deep at 45 deg the needle lies 30.6 mm off the axis of a 60 mm sample.
     {"inclined_path_leaves_the_sample", [](json& j) { j["insertion"]["angle_deg"] = 45.0; }, "/insertion/angle_deg"},
     {"unknown_integrator", [](json& j) { j["realtime"]["integrator"] = "rk4"; }, "/realtime/integrator"},
