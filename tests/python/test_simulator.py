@@ -150,6 +150,21 @@ def test_tick_by_depth_follows_the_scenes_inclined_line(oblique_scene):
     assert a.path_depth_mm == pytest.approx(2.99 / np.cos(np.radians(30.0)))
 
 
+def test_the_azimuth_turns_the_force_vector_about_the_sample_axis(oblique_scene):
+    # The flat slab is rotationally symmetric: at azimuth 120 deg the run is the one at 0 deg turned by 120 deg.
+    turned = puncture.Simulator(oblique_scene.updated({"insertion/azimuth_deg": 120.0})).run()
+    r = puncture.Simulator(oblique_scene).run()
+    b = np.radians(120.0)
+    turn = np.array([[np.cos(b), -np.sin(b), 0.0], [np.sin(b), np.cos(b), 0.0], [0.0, 0.0, 1.0]])
+    scale = 1e-12 * (1.0 + np.abs(r.force_vector_N).max())
+    np.testing.assert_allclose(turned.force_vector_N, r.force_vector_N @ turn.T, atol=scale)
+    np.testing.assert_allclose(turned.torque_about_entry_N_m, r.torque_about_entry_N_m @ turn.T, atol=scale)
+    np.testing.assert_allclose(turned.force_N, r.force_N, atol=scale)
+    assert np.abs(turned.force_vector_N[:, 1]).max() > 0.01  # the needle now tilts out of the x-z plane
+    with pytest.raises(ValueError, match="azimuth_deg"):
+        oblique_scene.updated({"insertion/azimuth_deg": 360.0})
+
+
 def test_bad_ticks_raise(short_scene):
     sim = puncture.Simulator(short_scene)
     with pytest.raises(ValueError, match="finite"):
