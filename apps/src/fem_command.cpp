@@ -11,10 +11,40 @@
 #ifdef PUNCTURE_HAVE_FEM
 #include <deal.II/base/mpi.h>
 
+#include <sstream>
+
 #include "puncture/fem/needle_insertion.hpp"
+#include "puncture/meshing/inclined_path_mesh.hpp"
 #endif
 
 namespace puncture::apps {
+
+#ifdef PUNCTURE_HAVE_FEM
+namespace {
+
+/// `puncture fem` at an angle: the 3D reference (a blunt tip) takes one, on a
+/// mesh whose needle column follows the path (meshing/inclined_path_mesh.hpp),
+/// while that mesh stays valid; the axisymmetric reference does not.
+inline void require_fem_takes_the_angle(const Scene& scene, const std::string& file) {
+  if (scene.insertion.angle_deg == 0.0) return;
+  const std::string geometry =
+      scene.fem.geometry == "auto" ? (scene.needle.tip == "blunt" ? "3d" : "axisymmetric") : scene.fem.geometry;
+  if (geometry != "3d")
+    require_axial_for_fem(scene, file, "the axisymmetric FEM reference (a '" + scene.needle.tip +
+                                           "' tip; the 3d reference, a blunt tip, takes an angle)");
+  const double bound = meshing::inclined_path_jacobian_bound(meshing::inclined_path_of(scene));
+  if (!(bound >= meshing::kMinInclinedPathJacobian)) {
+    std::ostringstream msg;
+    msg << scene.insertion.angle_deg << " deg to " << scene.insertion.target_depth_m * 1e3
+        << " mm: the 3D reference's mesh cannot follow the needle's path in a sample of diameter "
+        << scene.sample.diameter_m * 1e3 << " mm (its Jacobian bound " << bound << " < "
+        << meshing::kMinInclinedPathJacobian << "; reduce the angle or the target depth, or widen /sample/diameter_mm)";
+    throw SceneError(file, "/insertion/angle_deg", msg.str());
+  }
+}
+
+}  // namespace
+#endif
 
 int fem_command(const FemOptions& options, std::ostream& stdout_stream, std::ostream& err) {
   NullStream quiet;
@@ -26,7 +56,7 @@ int fem_command(const FemOptions& options, std::ostream& stdout_stream, std::ost
   NullStream silent;
   return report_errors(root ? err : silent, scene_path.string(), [&]() -> int {
     const Scene scene = load_scene(scene_path);
-    require_axial_for_fem(scene, scene_path.string(), "the FEM reference");
+    require_fem_takes_the_angle(scene, scene_path.string());
     fem::FemRunOptions fem_options;
     fem_options.output_dir =
         (options.output_dir.empty() ? std::filesystem::path("out") / (scene.name + "_fem") : options.output_dir).string();

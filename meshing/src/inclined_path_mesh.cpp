@@ -35,6 +35,16 @@ void check_path(const InclinedPath& p) {
 
 }  // namespace
 
+InclinedPath inclined_path_of(const Scene& scene) {
+  InclinedPath path;
+  path.angle_rad = scene.insertion.angle_deg * (kHalfPi / 90.0);
+  path.azimuth_rad = scene.insertion.azimuth_deg * (kHalfPi / 90.0);
+  path.end_depth_m = std::min(scene.insertion.target_depth_m, scene.total_thickness_m());
+  path.needle_radius_m = scene.needle.radius_m;
+  path.sample_radius_m = 0.5 * scene.sample.diameter_m;
+  return path;
+}
+
 Eigen::Vector3d path_direction(const InclinedPath& path) {
   const double s = std::sin(path.angle_rad);
   return Eigen::Vector3d(s * std::cos(path.azimuth_rad), s * std::sin(path.azimuth_rad), -std::cos(path.angle_rad));

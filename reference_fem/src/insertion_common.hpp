@@ -79,13 +79,19 @@ inline void append_layer_states(std::ostream& csv, const std::vector<LayerState>
   for (const auto s : states) csv << "," << to_string(s);
 }
 
-/// The checks of the scene both references make (layers, an axial insertion
-/// at positive speed); throws std::invalid_argument.
-inline void check_axial_insertion(const Scene& scene) {
+/// The checks of the scene both references make (layers, an insertion at
+/// positive speed); throws std::invalid_argument.
+inline void check_insertion(const Scene& scene) {
   if (scene.layers.empty()) throw std::invalid_argument("fem: the scene has no layers");
-  if (scene.insertion.angle_deg != 0.0)
-    throw std::invalid_argument("fem: only insertions along the sample axis (angle_deg = 0) are modelled");
   if (!(scene.insertion.speed_m_per_s > 0.0)) throw std::invalid_argument("fem: insertion speed must be > 0");
+}
+
+/// check_insertion, and an insertion along the sample axis (the axisymmetric reference).
+inline void check_axial_insertion(const Scene& scene) {
+  check_insertion(scene);
+  if (scene.insertion.angle_deg != 0.0)
+    throw std::invalid_argument("fem: the axisymmetric reference inserts along the sample axis only (angle_deg = 0); "
+                                "the 3d reference (a blunt tip) takes an angle");
 }
 
 /// Element degree: the option's override, else the scene's.

@@ -8,6 +8,8 @@
 #include <deal.II/grid/manifold_lib.h>
 #include <deal.II/grid/tria.h>
 
+#include <puncture/meshing/inclined_path_mesh.hpp>
+
 #include <algorithm>
 #include <string>
 #include <vector>
@@ -20,7 +22,8 @@ using namespace dealii;
 
 void build_slab_triangulation(const Scene& scene, const meshing::SlabMeshOptions& options,
                               int refinement, parallel::distributed::Triangulation<3>& tria) {
-  const meshing::HexMesh mesh = meshing::build_layered_cylinder_mesh(scene, options);
+  meshing::HexMesh mesh = meshing::build_layered_cylinder_mesh(scene, options);
+  if (scene.insertion.angle_deg != 0.0) meshing::incline_needle_path(mesh, meshing::inclined_path_of(scene));
   std::vector<Point<3>> vertices;
   vertices.reserve(mesh.vertices.size());
   for (const auto& v : mesh.vertices) vertices.emplace_back(v.x(), v.y(), v.z());

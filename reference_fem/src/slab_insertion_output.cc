@@ -13,7 +13,7 @@ PunctureEvent SlabInsertionRun::record_before_puncture(std::size_t layer, double
   event.depth_m = depth_;
   event.force_N = force;
   event.max_stretch = stretch;
-  event.time_s = (depth_ + start_height_) / speed_;
+  event.time_s = (depth_ + start_height_) / (speed_ * path_.axis_cosine);
   record_row(depth_, force, stretch);
   records_.add_recovery_profile(layer, "before", depth_, surface_profile(layer));
   return event;
@@ -38,11 +38,14 @@ void SlabInsertionRun::record_after_puncture(std::size_t layer, PunctureEvent ev
 // vtu_stride steps (and the last), a progress line.
 void SlabInsertionRun::record_load_step(int step) {
   const bool touching = any_contact();
-  const double force = touching ? needle_force() : 0.0;
+  const NeedleForce force_vector = touching ? needle_force_vector() : NeedleForce{};
+  const double force = force_vector.axial_N;
   const double stretch = touching && current_layer_ < n_layers_ ? tip_stretch(current_layer_) : 1.0;
-  if (!std::isfinite(force)) throw std::runtime_error("fem: non-finite needle force");
+  if (!std::isfinite(force) || !std::isfinite(force_vector.lateral_N))
+    throw std::runtime_error("fem: non-finite needle force");
   // (A puncture at the end of the step already recorded this depth.)
-  if (!(rows_.back().depth_m == depth_ && rows_.back().force_N == force)) record_row(depth_, force, stretch);
+  if (!(rows_.back().depth_m == depth_ && rows_.back().force_N == force))
+    record_row(depth_, force, stretch, force_vector.lateral_N);
   ++record_index_;
   if (current_layer_ < n_layers_)
     records_.add_surface_profile(record_index_, depth_, surface_profile(current_layer_),
@@ -79,9 +82,9 @@ insertion::SurfaceProfile SlabInsertionRun::surface_profile(std::size_t layer) c
 }
 
 // One row of the force-depth curve (CSV and summary).
-void SlabInsertionRun::record_row(double depth, double force, double stretch) {
-  const double time = (depth + start_height_) / speed_;
-  rows_.push_back({time, depth, speed_, force, stretch, states_});
+void SlabInsertionRun::record_row(double depth, double force, double stretch, double lateral_force) {
+  const double time = (depth + start_height_) / (speed_ * path_.axis_cosine);  // vertical depth at v cos a
+  rows_.push_back({time, depth, speed_, force, stretch, states_, lateral_force});
   summary_.time_s.push_back(time);
   summary_.depth_m.push_back(depth);
   summary_.force_N.push_back(force);
@@ -94,7 +97,7 @@ void SlabInsertionRun::record_row(double depth, double force, double stretch) {
 // Writes one frame of the fields (collective; if VTU output is asked for).
 void SlabInsertionRun::write_frame(double depth) {
   if (!fields_) return;
-  const auto names = fields_->write_frame(solver_, (depth + start_height_) / speed_);
+  const auto names = fields_->write_frame(solver_, (depth + start_height_) / (speed_ * path_.axis_cosine));
   if (root_) summary_.files_written.insert(summary_.files_written.end(), names.begin(), names.end());
 }
 
@@ -111,14 +114,21 @@ void SlabInsertionRun::write_outputs(const std::string& status, const std::strin
   io::write_file_atomically(out_dir_ / "fem_summary.json", summary_json(status, error).dump(2) + "\n");
 }
 
-// fem_force_depth.csv: one line per recorded row.
+// fem_force_depth.csv: one line per recorded row; an inclined needle's run
+// adds the tip's depth along the needle and the force across it. (The time
+// runs with the vertical depth, which the tip covers at v cos a.)
 std::string SlabInsertionRun::force_depth_csv() const {
+  const bool inclined = scene_.insertion.angle_deg != 0.0;
   std::ostringstream csv;
-  csv << insertion::force_depth_header("time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch", scene_);
+  csv << insertion::force_depth_header(inclined ? "time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch,path_depth_mm,"
+                                                  "lateral_force_N"
+                                                : "time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch",
+                                       scene_);
   for (const auto& r : rows_) {
     csv << format_double(r.time_s) << "," << format_double(r.depth_m * 1e3) << ","
         << format_double(r.velocity_m_per_s * 1e3) << "," << format_double(r.force_N) << ","
         << format_double(r.tip_stretch, 6);
+    if (inclined) csv << "," << format_double(r.depth_m / path_.axis_cosine * 1e3) << "," << format_double(r.lateral_force_N);
     insertion::append_layer_states(csv, r.states);
     csv << "\n";
   }

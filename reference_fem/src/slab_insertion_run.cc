@@ -77,7 +77,7 @@ SlabDiscretisation checked_discretisation(const Scene& scene, const FemRunOption
     else if (l.material.viscoelastic.enabled())
       throw std::invalid_argument("fem: the 3d reference has no viscoelastic layers (layer '" + l.name +
                                   "', material.viscoelastic); use geometry axisymmetric");
-  insertion::check_axial_insertion(scene);
+  insertion::check_insertion(scene);
   if (!(scene.fem.load_step_m > 0.0)) throw std::invalid_argument("fem: load_step_m must be > 0");
   if (options.spring_back_stages < 1) throw std::invalid_argument("fem: spring_back_stages must be >= 1");
   const SlabDiscretisation d{insertion::element_degree(scene, options), insertion::refinement_level(scene, options)};
@@ -144,6 +144,15 @@ SolverSettings solver_settings(const Scene& scene, const FemRunOptions& options,
 
 namespace slab_insertion {
 
+NeedlePath::NeedlePath(const Insertion& insertion) {
+  const double a = insertion.angle_deg * (M_PI / 180.0), b = insertion.azimuth_deg * (M_PI / 180.0);
+  axis_cosine = std::cos(a);
+  const double sin_a = std::sin(a), cos_b = std::cos(b), sin_b = std::sin(b);
+  d[0] = sin_a * cos_b, d[1] = sin_a * sin_b, d[2] = -axis_cosine;
+  e1[0] = axis_cosine * cos_b, e1[1] = axis_cosine * sin_b, e1[2] = sin_a;
+  e2[0] = -sin_b, e2[1] = cos_b, e2[2] = 0.0;
+}
+
 SlabInsertionRun::SlabInsertionRun(const Scene& scene, const FemRunOptions& options, MPI_Comm comm)
     : scene_(scene),
       options_(options),
@@ -152,6 +161,7 @@ SlabInsertionRun::SlabInsertionRun(const Scene& scene, const FemRunOptions& opti
       disc_(checked_discretisation(scene, options)),
       n_layers_(scene.layers.size()),
       needle_radius_(scene.needle.radius_m),
+      path_(scene.insertion),
       thickness_(scene.total_thickness_m()),
       tol_(1e-9 * std::max(thickness_, scene.sample.diameter_m)),
       speed_(scene.insertion.speed_m_per_s),
@@ -214,7 +224,7 @@ void SlabInsertionRun::find_node_sets() {
     for (std::size_t i = 0; i < n_layers_; ++i)
       if (std::abs(nodes_[n].X[2] - interface_z_[i]) < tol_) {
         interface_nodes_[i].push_back(n);
-        if (nodes_[n].r() <= needle_radius_ * (1.0 + 1e-6)) tip_nodes_[i].push_back(n);
+        if (path_.distance(nodes_[n].X) <= needle_radius_ * (1.0 + 1e-6)) tip_nodes_[i].push_back(n);
       }
 }
 
@@ -363,7 +373,7 @@ void SlabInsertionRun::open_hole(std::size_t layer) {
   solver_.remove_cells(
       [&](const FiniteStrainSolver::CellIterator& cell) {
         const Point<3> c = cell->center();
-        return cell->material_id() == layer && std::hypot(c[0], c[1]) < needle_radius_;
+        return cell->material_id() == layer && path_.distance(c) < needle_radius_;
       },
       /*release_gradually=*/true);
   states_[layer] = LayerState::Punctured;
@@ -413,14 +423,14 @@ void SlabInsertionRun::spring_back(const std::string& layer_name) {
   solver_.set_anchor_springs({});
 }
 
-// Solves at tip depth `depth`, joining reached nodes until none is left.
-// predictor_scale: start the first pass from u + scale x the last increment.
+// Solves at (vertical) tip depth `depth`, joining reached nodes until none
+// is left. predictor_scale: start the first pass from u + scale x the last increment.
 bool SlabInsertionRun::solve_at(double depth, NewtonReport& report, double predictor_scale) {
-  const double z_tip = -depth;
+  const double path_tip = depth / path_.axis_cosine;  // the tip's coordinate along the path
   for (int pass = 0; pass < 8; ++pass) {
-    const bool joined = join_reached_nodes(z_tip);
+    const bool joined = join_reached_nodes(path_tip);
     if (!joined && !solution_is_stale_ && !any_contact()) return true;  // nothing to do
-    apply_targets(z_tip);
+    apply_targets(path_tip);
     const Timer solve_timer;
     report = solver_.solve_step(pass == 0 && !joined ? predictor_scale : 0.0);
     summary_.solve_time_s += solve_timer.wall_time();
@@ -438,7 +448,7 @@ bool SlabInsertionRun::solve_at(double depth, NewtonReport& report, double predi
     bool more = false;
     if (current_layer_ < n_layers_)
       for (const std::size_t n : tip_nodes_[current_layer_])
-        if (!contact_.count(n) && nodes_[n].X[2] + u_of(nodes_[n], 2) >= z_tip - tol_) more = true;
+        if (!contact_.count(n) && along_path(nodes_[n]) <= path_tip + tol_) more = true;
     if (Utilities::MPI::max(more ? 1 : 0, comm_) == 0) return true;
   }
   return true;
@@ -447,40 +457,54 @@ bool SlabInsertionRun::solve_at(double depth, NewtonReport& report, double predi
 // Collective: does any rank hold contact nodes? (A rank may own none of them.)
 bool SlabInsertionRun::any_contact() const { return Utilities::MPI::max(contact_.empty() ? 0 : 1, comm_) == 1; }
 
-// Prescribes the held boundary and the contact nodes: on the tip in z, held laterally.
-void SlabInsertionRun::apply_targets(double z_tip) {
+// A node's current position along the path (m; the tip is at path_tip).
+double SlabInsertionRun::along_path(const Node& n) const {
+  Tensor<1, 3> x;
+  for (unsigned c = 0; c < 3; ++c) x[c] = n.X[c] + u_of(n, c);
+  return x * path_.d;
+}
+
+// Prescribes the held boundary and the contact nodes: on the punch face
+// (their coordinate along the path that of the tip), held across the needle.
+void SlabInsertionRun::apply_targets(double path_tip) {
   std::map<types::global_dof_index, double> targets = fixed_;
   for (const auto& [n, hold] : contact_) {
-    targets[nodes_[n].dof[0]] = hold[0];
-    targets[nodes_[n].dof[1]] = hold[1];
-    targets[nodes_[n].dof[2]] = z_tip - nodes_[n].X[2];
+    const Tensor<1, 3> u = hold + (path_tip - Tensor<1, 3>(nodes_[n].X) * path_.d) * path_.d;
+    for (unsigned c = 0; c < 3; ++c) targets[nodes_[n].dof[c]] = u[c];
   }
   solver_.set_prescribed_displacements(std::move(targets));
 }
 
-// Nodes of the current interface the tip has reached (current z >= z_tip)
-// join the contact set; collective: did any join?
-bool SlabInsertionRun::join_reached_nodes(double z_tip) {
+// Nodes of the current interface the tip has reached (their coordinate
+// along the path <= the tip's) join the contact set; collective: did any join?
+bool SlabInsertionRun::join_reached_nodes(double path_tip) {
   bool joined = false;
   if (current_layer_ >= n_layers_) return false;
   for (const std::size_t n : tip_nodes_[current_layer_]) {
     if (contact_.count(n)) continue;
-    if (nodes_[n].X[2] + u_of(nodes_[n], 2) >= z_tip - tol_) {
-      contact_[n] = {u_of(nodes_[n], 0), u_of(nodes_[n], 1)};
+    if (along_path(nodes_[n]) <= path_tip + tol_) {
+      Tensor<1, 3> u;
+      for (unsigned c = 0; c < 3; ++c) u[c] = u_of(nodes_[n], c);
+      contact_[n] = u - (u * path_.d) * path_.d;
       joined = true;
     }
   }
   return Utilities::MPI::max(joined ? 1 : 0, comm_) == 1;
 }
 
-// The needle force (N, > 0 resisting the insertion).
-double SlabInsertionRun::needle_force() const {
-  std::vector<types::global_dof_index> dofs;
-  for (const auto& [n, hold] : contact_) dofs.push_back(nodes_[n].dof[2]);
-  // The z reaction is what the needle applies to the tissue; the tissue
-  // pushes back on the needle with the opposite force (upward, > 0).
-  const double force = -solver_.sum_of_residual(dofs);
-  return force == 0.0 ? 0.0 : force;  // no "-0" in the CSV
+// The tissue's force on the needle: the reactions at the contact nodes are
+// what the needle applies to the tissue; the tissue pushes back with the
+// opposite force, whose part along -d resists the insertion (> 0).
+NeedleForce SlabInsertionRun::needle_force_vector() const {
+  Tensor<1, 3> reaction;
+  for (unsigned c = 0; c < 3; ++c) {
+    std::vector<types::global_dof_index> dofs;
+    for (const auto& [n, hold] : contact_) dofs.push_back(nodes_[n].dof[c]);
+    reaction[c] = solver_.sum_of_residual(dofs);
+  }
+  const double axial = reaction * path_.d;
+  const Tensor<1, 3> across = reaction - (reaction * path_.d) * path_.d;
+  return {axial == 0.0 ? 0.0 : axial, across.norm()};  // no "-0" in the CSV
 }
 
 // Maximum principal stretch in the layer's cells touching the needle's patch of its top.
@@ -489,7 +513,7 @@ double SlabInsertionRun::tip_stretch(std::size_t layer) const {
     if (cell->material_id() != layer) return false;
     for (unsigned v = 0; v < 8; ++v) {
       const Point<3>& p = cell->vertex(v);
-      if (std::abs(p[2] - interface_z_[layer]) < tol_ && std::hypot(p[0], p[1]) <= needle_radius_ * (1.0 + 1e-6))
+      if (std::abs(p[2] - interface_z_[layer]) < tol_ && path_.distance(p) <= needle_radius_ * (1.0 + 1e-6))
         return true;
     }
     return false;

@@ -43,10 +43,33 @@ struct Node {
   double r() const { return std::hypot(X[0], X[1]); }
 };
 
+/// The needle's straight path through the entry point (the origin) at the
+/// scene's angle a and azimuth b (core/include/puncture/needle.hpp): its unit
+/// direction d into the tissue and two unit vectors across it, e1 in the
+/// plane of d and the sample axis, e2 horizontal. Along the sample axis
+/// d = (0, 0, -1), e1 = (1, 0, 0), e2 = (0, 1, 0), so that every quantity
+/// below is computed with the same floating-point operations as the axial
+/// punch's (z, x, y).
+struct NeedlePath {
+  Tensor<1, 3> d, e1, e2;
+  double axis_cosine = 1.0;  ///< cos a: a vertical depth is axis_cosine x the length along d
+  explicit NeedlePath(const Insertion& insertion);
+  /// Distance (m) of point p from the path line.
+  double distance(const Point<3>& p) const { return std::hypot(p * e1, p * e2); }
+};
+
 struct Row {
   double time_s, depth_m, velocity_m_per_s, force_N;
   double tip_stretch;  ///< max principal stretch at the tip in the pressed layer (1: no contact)
   std::vector<LayerState> states;
+  double lateral_force_N = 0.0;  ///< |force on the needle across its axis| (inclined needle)
+};
+
+/// The tissue's force on the needle: along the needle (> 0 resisting the
+/// insertion) and across it.
+struct NeedleForce {
+  double axial_N = 0.0;
+  double lateral_N = 0.0;
 };
 
 /// Element degree and global refinements of the 3D reference.
@@ -61,7 +84,7 @@ struct SubStepStart {
   double depth_m;
   double last_advance_m;
   bool predictor_valid;
-  std::map<std::size_t, std::array<double, 2>> contact;
+  std::map<std::size_t, Tensor<1, 3>> contact;
   std::vector<LayerState> states;
   FiniteStrainSolver::Snapshot snapshot;
 };
@@ -73,7 +96,9 @@ struct PunctureCheck {
   bool breaks;
 };
 
-/// The 3D insertion (flat punch, removal of a layer column at puncture): the
+/// The 3D insertion (flat punch moving along the needle's path, at an angle
+/// on a mesh whose needle column follows the path; removal of a layer column
+/// at puncture): the
 /// slab and the solver, the contact set and the layer states, what is
 /// recorded, and the steps of the algorithm. Every rank runs it.
 class SlabInsertionRun {
@@ -104,12 +129,14 @@ class SlabInsertionRun {
   void describe_model();
   double u_of(const Node& n, unsigned c) const { return solver_.displacement(n.dof[c]); }
   bool any_contact() const;
-  void apply_targets(double z_tip);
-  bool join_reached_nodes(double z_tip);
-  double needle_force() const;
+  double along_path(const Node& n) const;
+  void apply_targets(double path_tip);
+  bool join_reached_nodes(double path_tip);
+  NeedleForce needle_force_vector() const;
+  double needle_force() const { return needle_force_vector().axial_N; }
   double tip_stretch(std::size_t layer) const;
   insertion::SurfaceProfile surface_profile(std::size_t layer) const;
-  void record_row(double depth, double force, double stretch);
+  void record_row(double depth, double force, double stretch, double lateral_force = 0.0);
   void write_frame(double depth);
   void write_outputs(const std::string& status, const std::string& error);
   std::string force_depth_csv() const;
@@ -127,6 +154,7 @@ class SlabInsertionRun {
   const SlabDiscretisation disc_;
   const std::size_t n_layers_;
   const double needle_radius_;
+  const NeedlePath path_;
   const double thickness_;
   const double tol_;  // position tolerance (m)
   const double speed_;
@@ -145,7 +173,7 @@ class SlabInsertionRun {
   // Per layer: every node of its top interface (profiles) and those under the needle.
   std::vector<std::vector<std::size_t>> interface_nodes_, tip_nodes_;
   // Contact and layer state.
-  std::map<std::size_t, std::array<double, 2>> contact_;  // joined node -> held lateral displacement
+  std::map<std::size_t, Tensor<1, 3>> contact_;  // joined node -> its displacement across the needle, held
   std::vector<LayerState> states_;
   std::size_t current_layer_ = 0;  // first layer not punctured
   bool solution_is_stale_ = true;  // the state differs from the last solved one

@@ -345,28 +345,50 @@ TEST(ObliqueRecordings, TheInclinedTruthFollowsItsRecordingAndCalibrationRecover
 
 namespace puncture::apps {
 
-// The FEM reference and the comparison models insert along the sample axis
-// only: every command that would run them refuses an inclined scene before any
-// FEM run, naming the field, with exit code 2 and no output.
+// The axisymmetric FEM reference, the comparison models and the comparisons
+// against the FEM insert along the sample axis only; the 3D reference (a blunt
+// tip) takes an angle while its mesh can follow the path. Every command that
+// cannot run a scene refuses it before any FEM run, naming the field, with
+// exit code 2 and no output.
 TEST(ObliqueRecordings, TheFemCommandsRefuseAnInclinedSceneNamingTheField) {
   const fs::path work = fresh_dir("oblique_fem");
-  Scene scene = truth_scene();
+  Scene scene = truth_scene();  // a blunt tip: the 3D reference
   scene.insertion.angle_deg = 30.0;
   const fs::path path = work / "inclined.json";
   std::ofstream(path) << scene_to_json_text(scene);
-  auto refused = [&](const char* what, const std::function<int(std::ostream&, std::ostream&)>& command) {
+  auto refused_scene = [&](const fs::path& scene_path, const char* what, const std::string& because,
+                           const std::function<int(std::ostream&, std::ostream&)>& command) {
     std::ostringstream out, err;
     EXPECT_EQ(command(out, err), 2) << what;
-    EXPECT_NE(err.str().find(path.string() + ": /insertion/angle_deg: 30 deg"), std::string::npos)
+    EXPECT_NE(err.str().find(scene_path.string() + ": /insertion/angle_deg: "), std::string::npos)
         << what << ": " << err.str();
+    EXPECT_NE(err.str().find(because), std::string::npos) << what << ": " << err.str();
     EXPECT_FALSE(fs::exists(work / "out")) << what;
   };
-  refused("fem", [&](std::ostream& out, std::ostream& err) {
-    FemOptions o;
-    o.scene = path;
-    o.output_dir = work / "out";
-    return fem_command(o, out, err);
-  });
+  auto refused = [&](const char* what, const std::function<int(std::ostream&, std::ostream&)>& command) {
+    refused_scene(path, what, "30 deg", command);
+  };
+  auto fem_on = [&](const fs::path& scene_path) {
+    return [&work, scene_path](std::ostream& out, std::ostream& err) {
+      FemOptions o;
+      o.scene = scene_path;
+      o.output_dir = work / "out";
+      return fem_command(o, out, err);
+    };
+  };
+  // `fem`: a bevel tip (the axisymmetric reference) at an angle, and a blunt one too steep for its mesh.
+  Scene bevel = scene;
+  bevel.needle.tip = "bevel";
+  bevel.needle.tip_angle_deg = 12.0;
+  const fs::path bevel_path = work / "inclined_bevel.json";
+  std::ofstream(bevel_path) << scene_to_json_text(bevel);
+  refused_scene(bevel_path, "fem, bevel", "axisymmetric FEM reference", fem_on(bevel_path));
+  Scene steep = scene;
+  steep.insertion.angle_deg = 45.0;
+  steep.insertion.target_depth_m = 0.020;  // 20 mm off the axis of the 30 mm radius: in the sample, but the mesh would fold
+  const fs::path steep_path = work / "inclined_steep.json";
+  std::ofstream(steep_path) << scene_to_json_text(steep);
+  refused_scene(steep_path, "fem, steep", "widen /sample/diameter_mm", fem_on(steep_path));
   refused("validate", [&](std::ostream& out, std::ostream& err) {
     ValidateOptions o;
     o.scene = path;
@@ -383,6 +405,45 @@ TEST(ObliqueRecordings, TheFemCommandsRefuseAnInclinedSceneNamingTheField) {
     o.output_dir = work / "out";
     return compare_command(o, out, err);
   });
+  if (!::testing::Test::HasFailure()) fs::remove_all(work);
+}
+
+// `puncture fem` on the blunt scene at 30 deg: the 3D reference runs the
+// first 0.2 mm and writes the inclined needle's columns.
+TEST(ObliqueRecordings, TheFemCommandRunsTheBluntNeedleAtAnAngle) {
+  const fs::path work = fresh_dir("oblique_fem_run");
+  Scene scene = truth_scene();
+  scene.insertion.angle_deg = 30.0;
+  scene.insertion.start_height_m = 0.5e-3;
+  const fs::path path = work / "inclined.json";
+  std::ofstream(path) << scene_to_json_text(scene);
+  FemOptions o;
+  o.scene = path;
+  o.output_dir = work / "out";
+  o.write_vtu = false;
+  o.stop_depth_mm = 0.2;
+  o.quiet = true;
+  std::ostringstream out, err;
+  ASSERT_EQ(fem_command(o, out, err), 0) << err.str();
+  std::ifstream csv(work / "out" / "fem_force_depth.csv");
+  std::string line, header;
+  double last_depth = 0.0, last_path = 0.0, last_force = 0.0;
+  while (std::getline(csv, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (header.empty()) {
+      header = line;
+      continue;
+    }
+    std::stringstream fields(line);
+    std::vector<double> v;
+    for (std::string f; std::getline(fields, f, ',') && v.size() < 7;) v.push_back(std::stod(f));
+    last_depth = v[1], last_force = v[3], last_path = v[5];
+  }
+  EXPECT_EQ(header.rfind("time_s,depth_mm,velocity_mm_per_s,force_N,tip_stretch,path_depth_mm,lateral_force_N", 0), 0u)
+      << header;
+  EXPECT_NEAR(last_depth, 0.2, 1e-9);
+  EXPECT_NEAR(last_path, 0.2 / std::cos(30.0 * M_PI / 180.0), 1e-8);
+  EXPECT_GT(last_force, 0.0);
   if (!::testing::Test::HasFailure()) fs::remove_all(work);
 }
 

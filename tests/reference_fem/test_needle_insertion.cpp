@@ -6,6 +6,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <vector>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -178,10 +180,115 @@ TEST(NeedleInsertion, HardCaseThinSkinNearlyIncompressibleDeepIndentationStaysFi
   EXPECT_TRUE(r.punctures.empty());
 }
 
-TEST(NeedleInsertion, RejectsObliqueInsertion) {
+TEST(NeedleInsertion, TheAxisymmetricReferenceRefusesAnInclinedNeedle) {
   Scene s = small_three_layer_scene();
+  s.needle.tip = "bevel";
+  s.fem.geometry = "axisymmetric";
   s.insertion.angle_deg = 10.0;
-  EXPECT_THROW(run_needle_insertion(s, quiet_options(""), MPI_COMM_WORLD), std::invalid_argument);
+  try {
+    run_needle_insertion(s, quiet_options(""), MPI_COMM_WORLD);
+    FAIL() << "an inclined needle was accepted by the axisymmetric reference";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("angle_deg"), std::string::npos) << e.what();
+  }
+}
+
+namespace {
+
+/// The rows of a fem_force_depth.csv: column name -> values.
+std::map<std::string, std::vector<double>> read_force_depth_csv(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::vector<std::string> names;
+  std::map<std::string, std::vector<double>> columns;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::stringstream fields(line);
+    std::string field;
+    if (names.empty()) {
+      while (std::getline(fields, field, ',')) names.push_back(field);
+      continue;
+    }
+    for (std::size_t i = 0; std::getline(fields, field, ',') && i < names.size(); ++i)
+      if (!field.empty() && (std::isdigit(static_cast<unsigned char>(field[0])) || field[0] == '-'))
+        columns[names[i]].push_back(std::stod(field));
+  }
+  return columns;
+}
+
+/// A blunt punch pressed along its path at `angle_deg` and `azimuth_deg` into
+/// one thick nearly incompressible layer, from a start where its face (square
+/// to the needle, reaching a sin a below its centre) is 0.05 a above the
+/// surface, to a vertical depth of 0.3 a: the force-depth CSV's columns.
+std::map<std::string, std::vector<double>> inclined_punch(double angle_deg, double azimuth_deg, const std::string& name) {
+  Scene s;
+  s.name = name;
+  const double a = 0.635e-3, E = 1e4, nu = 0.499, h = 20 * a;
+  s.sample.diameter_m = 32 * a;
+  s.layers = {make_layer("top", 0.5e-3, E, nu, 1e9), make_layer("bulk", h - 0.5e-3, E, nu, 1e9)};
+  s.needle.radius_m = a;
+  s.insertion.angle_deg = angle_deg;
+  s.insertion.azimuth_deg = azimuth_deg;
+  const double angle = angle_deg * M_PI / 180.0;
+  s.insertion.start_height_m = a * std::sin(angle) + 0.05 * a;
+  s.insertion.target_depth_m = 0.3 * a;
+  s.fem.load_step_m = 0.05 * a;
+  const auto dir = fresh_dir(name);
+  FemRunOptions o = quiet_options(dir.string());
+  o.mesh.sectors = 12;
+  o.mesh.radial_grading = 1.3;
+  o.mesh.elements_through_skin = 2;
+  o.mesh.thickness_grading = 1.3;
+  const FemRunSummary r = run_needle_insertion(s, o, MPI_COMM_WORLD);
+  EXPECT_TRUE(r.punctures.empty());
+  return read_force_depth_csv(dir / "fem_force_depth.csv");
+}
+
+}  // namespace
+
+// The blunt punch along an inclined path (meshing/inclined_path_mesh.hpp:
+// the needle column follows it). Its face, square to the needle, meets the
+// level surface with its lowest point first: the point of the column's rim
+// at horizontal distance a / cos a behind the entry point along the tilt,
+// whose coordinate along the needle is -a tan a, so the needle feels force
+// from a path depth of -a tan a (a vertical depth of -a sin a) on, where
+// along the sample axis it feels none before 0. The force then has a part
+// across the needle. The run turned by 90 deg about the sample axis (whose
+// O-grid mesh the turn maps onto itself) gives the same forces.
+TEST(NeedleInsertion, InclinedBluntPunchMeetsTheSurfaceWithItsLowestPointFirst) {
+  const double a = 0.635e-3, angle = 30.0, c = std::cos(angle * M_PI / 180.0), t = std::tan(angle * M_PI / 180.0);
+  auto axial = inclined_punch(0.0, 0.0, "punch_0deg");
+  auto inclined = inclined_punch(angle, 0.0, "punch_30deg");
+  auto turned = inclined_punch(angle, 90.0, "punch_30deg_turned");
+  ASSERT_FALSE(axial.count("lateral_force_N")) << "the axial run's CSV has no columns of an inclined needle";
+  ASSERT_TRUE(inclined.count("lateral_force_N") && inclined.count("path_depth_mm"));
+  const std::vector<double>& depth = inclined.at("depth_mm");
+  const std::vector<double>& path = inclined.at("path_depth_mm");
+  const std::vector<double>& force = inclined.at("force_N");
+  const std::vector<double>& lateral = inclined.at("lateral_force_N");
+  ASSERT_GT(depth.size(), 5u);
+  // The first row with a force lies within a load step (0.05 a vertical) past -a tan a along the needle.
+  std::size_t first = 0;
+  while (first < force.size() && force[first] == 0.0) ++first;
+  ASSERT_LT(first, force.size());
+  ASSERT_GT(first, 0u) << "the start touched the surface";
+  EXPECT_GE(path[first] * 1e-3, -a * t - 1e-9);
+  EXPECT_LE(path[first - 1] * 1e-3, -a * t + 1e-9);
+  EXPECT_LE(path[first] * 1e-3, -a * t + 0.05 * a / c + 1e-9);
+  for (std::size_t i = 0; i < depth.size(); ++i) EXPECT_NEAR(path[i], depth[i] / c, 1e-9);
+  for (std::size_t i = 0; i < axial.at("depth_mm").size(); ++i)
+    if (axial.at("depth_mm")[i] < 0.0) EXPECT_EQ(axial.at("force_N")[i], 0.0);
+  // Pressed: axial and lateral forces positive, the lateral one a fraction of the axial.
+  EXPECT_GT(force.back(), 0.0);
+  EXPECT_GT(lateral.back(), 0.0);
+  EXPECT_LT(lateral.back(), force.back());
+  // Turned by 90 deg: the same forces.
+  ASSERT_EQ(turned.at("force_N").size(), force.size());
+  for (std::size_t i = 0; i < force.size(); ++i) {
+    EXPECT_NEAR(turned.at("force_N")[i], force[i], 1e-6 * force.back()) << "row " << i;
+    EXPECT_NEAR(turned.at("lateral_force_N")[i], lateral[i], 1e-6 * force.back()) << "row " << i;
+  }
+  RecordProperty("lateral_over_axial", ::testing::PrintToString(lateral.back() / force.back()));
 }
 
 TEST(NeedleInsertion, CriticalStretchCriterionPuncturesWhenTheTipStretchIsReached) {

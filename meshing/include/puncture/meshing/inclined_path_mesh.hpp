@@ -30,6 +30,7 @@
 #include <Eigen/Core>
 
 #include <puncture/meshing/hex_mesh.hpp>
+#include <puncture/scene.hpp>
 
 namespace puncture::meshing {
 
@@ -45,6 +46,11 @@ struct InclinedPath {
   double sample_radius_m = 0.0;  ///< R: the mesh's outer radius, > core radius
   double core_radius_m = 0.0;    ///< r_c: the map is a shift and stretch inside it; 0 = 4 rho
 };
+
+/// The path of a scene's insertion: its angle and azimuth, the target depth
+/// (at most the slab's thickness), the needle radius, the sample radius, the
+/// default core radius.
+InclinedPath inclined_path_of(const Scene& scene);
 
 /// The unit direction d of the path (from the entry point into the tissue).
 Eigen::Vector3d path_direction(const InclinedPath& path);
