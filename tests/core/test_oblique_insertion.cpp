@@ -47,6 +47,16 @@ void expect_vector_consistent(const TickResult& r, const Eigen::Vector3d& d) {
   EXPECT_NEAR((r.torque_about_entry_N_m - arm.cross(f)).norm(), 0.0, scale * (1.0 + std::abs(r.path_depth_m)));
 }
 
+/// A scripted trajectory of `in` is refused with an error naming `key` (whose bad value is `value`).
+void expect_refused(const Insertion& in, const std::string& key, double value) {
+  try {
+    ScriptedTrajectory tr(in);
+    ADD_FAILURE() << key << " = " << value << " was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 
 TEST(ObliqueTrajectory, FollowsTheInclinedLineThroughTheOrigin) {
@@ -95,12 +105,7 @@ TEST(ObliqueTrajectory, AnglesBeyondTheLimitAreRefusedNamingTheKey) {
   EXPECT_NO_THROW(ScriptedTrajectory{in});
   for (double bad : {kMaxInsertionAngleDeg + 1.0, -1.0, std::nan("")}) {
     in.angle_deg = bad;
-    try {
-      ScriptedTrajectory tr(in);
-      FAIL() << "angle " << bad << " was accepted";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("insertion.angle_deg"), std::string::npos) << e.what();
-    }
+    expect_refused(in, "insertion.angle_deg", bad);
   }
 }
 
@@ -129,12 +134,7 @@ TEST(ObliqueTrajectory, TheAzimuthTurnsTheLineAboutTheSampleAxis) {
   EXPECT_EQ(ScriptedTrajectory(in).direction(), Eigen::Vector3d(0.0, 0.0, -1.0));
   for (double bad : {360.0, -1.0, std::nan("")}) {
     in.azimuth_deg = bad;
-    try {
-      ScriptedTrajectory tr(in);
-      FAIL() << "azimuth " << bad << " was accepted";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("insertion.azimuth_deg"), std::string::npos) << e.what();
-    }
+    expect_refused(in, "insertion.azimuth_deg", bad);
   }
 }
 

@@ -7,9 +7,9 @@
 #include <puncture/meshing/inclined_path_mesh.hpp>
 #include <puncture/meshing/layered_cylinder_mesh.hpp>
 
-#include <gtest/gtest.h>
+#include "hex_test_geometry.hpp"
 
-#include <Eigen/LU>
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <ostream>
@@ -27,21 +27,8 @@ using puncture::meshing::incline_needle_path;
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
-/// Skin 0.8 mm, fat 8.4 mm, muscle 39 mm (the paper's Table 2), 18 G needle, `diameter_m` wide.
-Scene slab(double diameter_m) {
-  Scene s;
-  s.sample.diameter_m = diameter_m;
-  s.needle.radius_m = 0.635e-3;
-  const char* names[] = {"skin", "fat", "muscle"};
-  const double thickness[] = {0.8e-3, 8.4e-3, 39e-3};
-  for (int i = 0; i < 3; ++i) {
-    puncture::Layer l;
-    l.name = names[i];
-    l.thickness_m = thickness[i];
-    s.layers.push_back(l);
-  }
-  return s;
-}
+using puncture::meshing::test::hex_jacobian;
+using puncture::meshing::test::table2_slab;
 
 struct Case {
   double angle_deg, azimuth_deg, end_depth_mm, diameter_mm;
@@ -62,32 +49,17 @@ InclinedPath path_of(const Case& c) {
   return p;
 }
 
-/// det J of a trilinear hex at reference point (x, y, z) in [0, 1]^3.
-double jacobian(const HexMesh& mesh, std::size_t c, double x, double y, double z) {
-  Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
-  for (int k = 0; k < 8; ++k) {
-    const int i = k & 1, j = (k >> 1) & 1, l = (k >> 2) & 1;
-    const double wx = i ? x : 1 - x, wy = j ? y : 1 - y, wz = l ? z : 1 - z;
-    const double dx = i ? 1 : -1, dy = j ? 1 : -1, dz = l ? 1 : -1;
-    const Eigen::Vector3d& v = mesh.vertices[mesh.cells[c][k]];
-    J.col(0) += v * dx * wy * wz;
-    J.col(1) += v * wx * dy * wz;
-    J.col(2) += v * wx * wy * dz;
-  }
-  return J.determinant();
-}
-
 /// Per layer: volume by 2x2x2 Gauss quadrature of det J (exact for trilinear
 /// hexes) and the smallest det J at those points over the mesh.
 std::vector<double> layer_volumes(const HexMesh& mesh, double& min_det) {
-  const double g[2] = {0.5 - 0.5 / std::sqrt(3.0), 0.5 + 0.5 / std::sqrt(3.0)};
+  const double* g = puncture::meshing::test::gauss_points_01();
   std::vector<double> volume(3, 0.0);
   min_det = INFINITY;
   for (std::size_t c = 0; c < mesh.cells.size(); ++c)
-    for (double x : g)
-      for (double y : g)
-        for (double z : g) {
-          const double det = jacobian(mesh, c, x, y, z);
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j)
+        for (int k = 0; k < 2; ++k) {
+          const double det = hex_jacobian(mesh, c, g[i], g[j], g[k]);
           min_det = std::min(min_det, det);
           volume[mesh.material_id[c]] += det / 8.0;
         }
@@ -100,7 +72,7 @@ double distance_from_line(const Eigen::Vector3d& p, const Eigen::Vector3d& d) { 
 }  // namespace
 
 TEST(InclinedPathMesh, LeavesTheMeshAsItIsAlongTheNormal) {
-  const HexMesh original = build_layered_cylinder_mesh(slab(0.06), {});
+  const HexMesh original = build_layered_cylinder_mesh(table2_slab(0.06), {});
   HexMesh mesh = original;
   incline_needle_path(mesh, path_of({0.0, 30.0, 20.0, 60.0}));
   ASSERT_EQ(mesh.vertices.size(), original.vertices.size());
@@ -112,7 +84,7 @@ class InclinedPathMeshCases : public ::testing::TestWithParam<Case> {};
 TEST_P(InclinedPathMeshCases, KeepsTheLayersAndTheWallAndPutsTheColumnOnThePath) {
   const Case c = GetParam();
   const InclinedPath path = path_of(c);
-  const Scene scene = slab(c.diameter_mm * 1e-3);
+  const Scene scene = table2_slab(c.diameter_mm * 1e-3);
   const HexMesh original = build_layered_cylinder_mesh(scene, {});
   HexMesh mesh = original;
   incline_needle_path(mesh, path);
@@ -174,7 +146,7 @@ INSTANTIATE_TEST_SUITE_P(Paths, InclinedPathMeshCases,
                                            Case{45.0, 250.0, 12.0, 100.0}, Case{60.0, 90.0, 10.0, 100.0}));
 
 TEST(InclinedPathMesh, RefusesAPathThatWouldFoldTheMeshNamingWhatToChange) {
-  HexMesh mesh = build_layered_cylinder_mesh(slab(0.06), {});
+  HexMesh mesh = build_layered_cylinder_mesh(table2_slab(0.06), {});
   const InclinedPath steep = path_of({45.0, 0.0, 25.0, 60.0});
   EXPECT_LT(puncture::meshing::inclined_path_jacobian_bound(steep), puncture::meshing::kMinInclinedPathJacobian);
   try {

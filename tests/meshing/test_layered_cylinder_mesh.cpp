@@ -6,6 +6,8 @@
 #include <puncture/meshing/hex_mesh_quality.hpp>
 #include <puncture/scene_io.hpp>
 
+#include "hex_test_geometry.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -31,43 +33,9 @@ constexpr double kPi = 3.14159265358979323846;
 
 /// The paper's default sample (Table 2: skin 0.8 mm, fat 8.4 mm, muscle 39 mm),
 /// 60 mm diameter, 18 G needle.
-Scene default_scene() {
-  Scene s;
-  s.sample.diameter_m = 0.06;
-  s.needle.radius_m = 0.635e-3;
-  const char* names[] = {"skin", "fat", "muscle"};
-  const double thickness[] = {0.8e-3, 8.4e-3, 39e-3};
-  for (int i = 0; i < 3; ++i) {
-    puncture::Layer l;
-    l.name = names[i];
-    l.thickness_m = thickness[i];
-    s.layers.push_back(l);
-  }
-  return s;
-}
+Scene default_scene() { return puncture::meshing::test::table2_slab(0.06); }
 
-/// Volume of a trilinear hex by 2x2x2 Gauss quadrature of det J (exact: det J
-/// is at most quadratic in each reference coordinate).
-double hex_volume(const HexMesh& mesh, std::size_t c) {
-  const double g[2] = {0.5 - 0.5 / std::sqrt(3.0), 0.5 + 0.5 / std::sqrt(3.0)};
-  double volume = 0.0;
-  for (double x : g)
-    for (double y : g)
-      for (double z : g) {
-        Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
-        for (int k = 0; k < 8; ++k) {
-          const int i = k & 1, j = (k >> 1) & 1, l = (k >> 2) & 1;
-          const double wx = i ? x : 1 - x, wy = j ? y : 1 - y, wz = l ? z : 1 - z;
-          const double dx = i ? 1 : -1, dy = j ? 1 : -1, dz = l ? 1 : -1;
-          const Eigen::Vector3d& v = mesh.vertices[mesh.cells[c][k]];
-          J.col(0) += v * dx * wy * wz;
-          J.col(1) += v * wx * dy * wz;
-          J.col(2) += v * wx * wy * dz;
-        }
-        volume += J.determinant() / 8.0;
-      }
-  return volume;
-}
+using puncture::meshing::test::hex_volume;
 
 Eigen::Vector3d cell_centre(const HexMesh& mesh, std::size_t c) {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
