@@ -14,7 +14,7 @@ PunctureEvent SlabInsertionRun::record_before_puncture(std::size_t layer, double
   event.force_N = force;
   event.max_stretch = stretch;
   event.time_s = (depth_ + start_height_) / (speed_ * path_.axis_cosine);
-  record_row(depth_, force, stretch);
+  record_row(depth_, force, stretch, needle_force_vector().lateral_N);
   records_.add_recovery_profile(layer, "before", depth_, surface_profile(layer));
   return event;
 }
@@ -23,14 +23,15 @@ PunctureEvent SlabInsertionRun::record_before_puncture(std::size_t layer, double
 // surface after breakthrough, the event, its row and a frame.
 void SlabInsertionRun::record_after_puncture(std::size_t layer, PunctureEvent event) {
   const bool touching = any_contact();
-  event.force_after_N = touching ? needle_force() : 0.0;
+  const NeedleForce after = touching ? needle_force_vector() : NeedleForce{};
+  event.force_after_N = after.axial_N;
   if (current_layer_ < n_layers_ && touching) states_[current_layer_] = LayerState::Pressed;
   records_.add_recovery_profile(layer, "after", depth_, surface_profile(layer));
   summary_.punctures.push_back(event);
   log("  PUNCTURE of " + event.layer_name + " at depth " + format_double(depth_ * 1e3, 5) + " mm, force " +
       format_double(event.force_N, 5) + " N -> " + format_double(event.force_after_N, 5) + " N");
   const double stretch_after = current_layer_ < n_layers_ && touching ? tip_stretch(current_layer_) : 1.0;
-  record_row(depth_, event.force_after_N, stretch_after);
+  record_row(depth_, event.force_after_N, stretch_after, after.lateral_N);
   write_frame(depth_);
 }
 

@@ -232,7 +232,7 @@ void SlabInsertionRun::find_node_sets() {
 // step, advance the tip (with punctures on the way), then record the step.
 // The outputs are written also when the run fails.
 FemRunSummary SlabInsertionRun::run() {
-  record_row(depth_, 0.0, 1.0);
+  record_row(depth_, 0.0, 1.0, 0.0);
   write_frame(depth_);
   try {
     for (int step = 1; step <= n_steps_; ++step) {

@@ -136,7 +136,7 @@ class SlabInsertionRun {
   double needle_force() const { return needle_force_vector().axial_N; }
   double tip_stretch(std::size_t layer) const;
   insertion::SurfaceProfile surface_profile(std::size_t layer) const;
-  void record_row(double depth, double force, double stretch, double lateral_force = 0.0);
+  void record_row(double depth, double force, double stretch, double lateral_force);
   void write_frame(double depth);
   void write_outputs(const std::string& status, const std::string& error);
   std::string force_depth_csv() const;
