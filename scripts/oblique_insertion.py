@@ -14,8 +14,9 @@ along the needle.
 What the numbers can be checked against: the frictionless tip (core/README.md,
 "The needle at an angle") predicts, on the flat slab, the same normal load and
 vertical depth at every break, the axial tip force F cos a and the lateral
-F sin a; the page prints these ratios. The 3D FEM reference at an angle is not
-built (issue 50), so no figure here is validated against a reference.
+F sin a; the page prints these ratios. The 3D FEM reference at an angle is so
+far a blunt flat punch (results/fem_oblique_blunt/), so no figure here is
+validated against a reference.
 
 Usage: oblique_insertion.py PRESET OUT_DIR PUNCTURE_BIN [--width-mm 100] [--depth-mm 25]
 Writes OUT_DIR/README.md, OUT_DIR/oblique_insertion.csv, OUT_DIR/oblique_insertion.png.
