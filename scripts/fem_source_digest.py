@@ -99,6 +99,11 @@ SAME_RUNS = {
     # A puncture's rows record the force across the needle too (an inclined run's CSV): the 3D run
     # of robustness_full_028 identical in every CSV and the Newton log (less its timings).
     ("3d", "96fb5d8e8afa74db"): "444f7039ee057ce5",
+    # One resolution of fem.geometry "auto" (resolved_geometry) and the 3D path's direction from
+    # the mesh's (meshing::path_direction): the 3D run of robustness_full_028 (and the same scene
+    # at 30 deg) identical, the default slab's reference identical in its CSVs.
+    ("axisymmetric", "b0c330198cd37219"): "641eaa216fd8c8de",
+    ("3d", "84b12ebdef9e7c41"): "96fb5d8e8afa74db",
 }
 
 

@@ -25,11 +25,9 @@ namespace {
 /// `puncture fem` at an angle: the 3D reference (a blunt tip) takes one, on a
 /// mesh whose needle column follows the path (meshing/inclined_path_mesh.hpp),
 /// while that mesh stays valid; the axisymmetric reference does not.
-inline void require_fem_takes_the_angle(const Scene& scene, const std::string& file) {
+void require_fem_takes_the_angle(const Scene& scene, const std::string& file) {
   if (scene.insertion.angle_deg == 0.0) return;
-  const std::string geometry =
-      scene.fem.geometry == "auto" ? (scene.needle.tip == "blunt" ? "3d" : "axisymmetric") : scene.fem.geometry;
-  if (geometry != "3d")
+  if (fem::resolved_geometry(scene) != "3d")
     require_axial_for_fem(scene, file, "the axisymmetric FEM reference (a '" + scene.needle.tip +
                                            "' tip; the 3d reference, a blunt tip, takes an angle)");
   const double bound = meshing::inclined_path_jacobian_bound(meshing::inclined_path_of(scene));

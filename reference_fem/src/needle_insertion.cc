@@ -54,10 +54,13 @@ void build_slab_triangulation(const Scene& scene, const meshing::SlabMeshOptions
   if (refinement > 0) tria.refine_global(refinement);
 }
 
+std::string resolved_geometry(const Scene& scene) {
+  if (scene.fem.geometry != "auto") return scene.fem.geometry;
+  return scene.needle.tip == "blunt" ? "3d" : "axisymmetric";
+}
+
 FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& options, MPI_Comm comm) {
-  std::string geometry = scene.fem.geometry;
-  if (geometry == "auto") geometry = scene.needle.tip == "blunt" ? "3d" : "axisymmetric";
-  if (geometry == "axisymmetric") return run_axisymmetric_insertion(scene, options, comm);
+  if (resolved_geometry(scene) == "axisymmetric") return run_axisymmetric_insertion(scene, options, comm);
   slab_insertion::SlabInsertionRun run(scene, options, comm);  // checks the scene; slab, solver, node sets
   return run.run();  // per load step: advance, detect puncture, open the hole, release, record; write
 }

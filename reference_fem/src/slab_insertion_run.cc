@@ -144,11 +144,12 @@ SolverSettings solver_settings(const Scene& scene, const FemRunOptions& options,
 
 namespace slab_insertion {
 
-NeedlePath::NeedlePath(const Insertion& insertion) {
-  const double a = insertion.angle_deg * (M_PI / 180.0), b = insertion.azimuth_deg * (M_PI / 180.0);
+NeedlePath::NeedlePath(const meshing::InclinedPath& path) {
+  const Eigen::Vector3d direction = meshing::path_direction(path);
+  for (unsigned c = 0; c < 3; ++c) d[c] = direction[c];
+  const double a = path.angle_rad, b = path.azimuth_rad;
   axis_cosine = std::cos(a);
   const double sin_a = std::sin(a), cos_b = std::cos(b), sin_b = std::sin(b);
-  d[0] = sin_a * cos_b, d[1] = sin_a * sin_b, d[2] = -axis_cosine;
   e1[0] = axis_cosine * cos_b, e1[1] = axis_cosine * sin_b, e1[2] = sin_a;
   e2[0] = -sin_b, e2[1] = cos_b, e2[2] = 0.0;
 }
@@ -161,7 +162,7 @@ SlabInsertionRun::SlabInsertionRun(const Scene& scene, const FemRunOptions& opti
       disc_(checked_discretisation(scene, options)),
       n_layers_(scene.layers.size()),
       needle_radius_(scene.needle.radius_m),
-      path_(scene.insertion),
+      path_(meshing::inclined_path_of(scene)),
       thickness_(scene.total_thickness_m()),
       tol_(1e-9 * std::max(thickness_, scene.sample.diameter_m)),
       speed_(scene.insertion.speed_m_per_s),

@@ -24,6 +24,7 @@
 #include <stdexcept>
 #include <puncture/fem/field_output.hpp>
 #include <puncture/fem/finite_strain_solver.hpp>
+#include <puncture/meshing/inclined_path_mesh.hpp>
 #include "insertion_common.hpp"
 
 namespace puncture::fem::slab_insertion {
@@ -44,8 +45,9 @@ struct Node {
 };
 
 /// The needle's straight path through the entry point (the origin) at the
-/// scene's angle a and azimuth b (core/include/puncture/needle.hpp): its unit
-/// direction d into the tissue and two unit vectors across it, e1 in the
+/// scene's angle a and azimuth b (meshing::inclined_path_of, the path the
+/// mesh follows): its unit direction d into the tissue
+/// (meshing::path_direction) and two unit vectors across it, e1 in the
 /// plane of d and the sample axis, e2 horizontal. Along the sample axis
 /// d = (0, 0, -1), e1 = (1, 0, 0), e2 = (0, 1, 0), so that every quantity
 /// below is computed with the same floating-point operations as the axial
@@ -53,7 +55,7 @@ struct Node {
 struct NeedlePath {
   Tensor<1, 3> d, e1, e2;
   double axis_cosine = 1.0;  ///< cos a: a vertical depth is axis_cosine x the length along d
-  explicit NeedlePath(const Insertion& insertion);
+  explicit NeedlePath(const meshing::InclinedPath& path);
   /// Distance (m) of point p from the path line.
   double distance(const Point<3>& p) const { return std::hypot(p * e1, p * e2); }
 };

@@ -174,10 +174,15 @@ void build_slab_triangulation(const Scene& scene, const meshing::SlabMeshOptions
 /// problem); the other ranks wait and receive the summary.
 FemRunSummary run_axisymmetric_insertion(const Scene& scene, const FemRunOptions& options, MPI_Comm comm);
 
-/// Runs the insertion (see the file comment). Throws std::runtime_error with a
-/// clear message if the solver cannot continue (after writing the rows
-/// computed so far, with "status": "failed" in the summary), and
-/// std::invalid_argument for scenes it cannot model (e.g. angle != 0).
+/// The reference a scene runs with: scene.fem.geometry, or for "auto" "3d"
+/// with a blunt tip and "axisymmetric" with a cutting one.
+std::string resolved_geometry(const Scene& scene);
+
+/// Runs the insertion (see the file comment) on resolved_geometry(scene).
+/// Throws std::runtime_error with a clear message if the solver cannot
+/// continue (after writing the rows computed so far, with "status": "failed"
+/// in the summary), and std::invalid_argument for scenes it cannot model
+/// (e.g. an inclined needle in the axisymmetric reference).
 FemRunSummary run_needle_insertion(const Scene& scene, const FemRunOptions& options, MPI_Comm comm);
 
 }  // namespace puncture::fem
