@@ -108,30 +108,13 @@ std::vector<TrajectoryPoint> trajectory(const Scene& scene, double stop_depth_m)
   return out;
 }
 
-/// The layer's long-term law: its material, scaled by the relaxed fraction
-/// g_inf when the scene's modulus is the instantaneous one (nu kept, so the
-/// bulk modulus scales with it).
-LayerMaterial long_term_material(const ContinuumMaterial& m) {
-  const Viscoelasticity& v = m.viscoelastic;
-  if (!v.enabled() || v.modulus_basis == Viscoelasticity::ModulusBasis::LongTerm) return LayerMaterial(m);
-  ContinuumMaterial relaxed = m;
-  relaxed.youngs_modulus_Pa *= v.relaxed_fraction();
-  return LayerMaterial(relaxed);
-}
-
-std::vector<PronyTerm> prony_terms(const Viscoelasticity& v) {
-  std::vector<NormalisedPronyTerm> normalised;
-  for (const PronyRelaxationTerm& t : v.terms) normalised.push_back({t.g, t.tau_s});
-  return prony_terms_from_normalised(normalised);
-}
-
 LayerLaws layer_laws(const Scene& scene, double crack_radius_m) {
   LayerLaws laws;
   const bool bevel = scene.needle.tip == "bevel";
   const double a = scene.needle.radius_m;
   for (const Layer& l : scene.layers) {
-    laws.materials.push_back(long_term_material(l.material));
-    laws.prony.push_back(prony_terms(l.material.viscoelastic));
+    laws.materials.push_back(insertion::long_term_material(l.material));
+    laws.prony.push_back(insertion::prony_terms(l.material.viscoelastic));
     LayerCrack c;
     if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy) {
       c.kind = LayerCrack::Kind::Cohesive;

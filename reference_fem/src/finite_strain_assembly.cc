@@ -67,10 +67,18 @@ struct CellState {
   }
 };
 
+/// A viscoelastic cell's law, its points' committed history and the time step.
+struct ViscousCell {
+  const ViscoelasticMaterial<LayerMaterial>* law = nullptr;  ///< nullptr: elastic
+  const std::vector<ViscoelasticHistory>* history = nullptr;  ///< per quadrature point
+  double dt_s = 0.0;
+};
+
 /// Evaluates the constitutive state of a not-removed cell from the
-/// displacement gradients. Returns false if any point is inverted or
-/// non-finite (the caller then rejects the state).
-bool evaluate_cell(const LayerMaterial& material, VolumetricFormulation formulation,
+/// displacement gradients (the isochoric part viscoelastic if `viscous` has a
+/// law). Returns false if any point is inverted or non-finite (the caller
+/// then rejects the state).
+bool evaluate_cell(const LayerMaterial& material, const ViscousCell& viscous, VolumetricFormulation formulation,
                    unsigned int degree, const FEValues<3>& fev,
                    const std::vector<Tensor<2, 3>>& grad_u, CellState& st) {
   const unsigned nq = fev.n_quadrature_points;
@@ -121,7 +129,10 @@ bool evaluate_cell(const LayerMaterial& material, VolumetricFormulation formulat
   for (unsigned q = 0; q < nq; ++q) {
     const SymTensor2 C = right_cauchy_green(st.F[q]);
     st.C_inv[q] = invert(C);
-    material.isochoric_stress_and_tangent(C, st.S[q], st.CC[q]);
+    if (viscous.law != nullptr)
+      viscous.law->isochoric_stress_and_tangent(C, viscous.dt_s, (*viscous.history)[q], st.S[q], st.CC[q]);
+    else
+      material.isochoric_stress_and_tangent(C, st.S[q], st.CC[q]);
     add_volumetric_at_fixed_pressure(st.C_inv[q], st.J[q], pressure[q], st.S[q], st.CC[q]);
     if (formulation == VolumetricFormulation::one_field)
       st.CC[q] += (st.J[q] * st.J[q] * vol.dpressure_dJ(st.J[q])) *
@@ -210,9 +221,9 @@ void add_condensed_volumetric_tangent(CellScratch& s) {
 /// Hyperelastic cell: residual int S : dE dV and (with_matrix) the material
 /// and geometric tangent, condensed for the three-field formulation. Returns
 /// false if a quadrature point is inverted or non-finite.
-bool add_solid_cell(const LayerMaterial& material, VolumetricFormulation formulation, unsigned degree,
-                    bool with_matrix, CellScratch& s) {
-  if (!evaluate_cell(material, formulation, degree, s.fev, s.grad_u, s.st)) return false;
+bool add_solid_cell(const LayerMaterial& material, const ViscousCell& viscous, VolumetricFormulation formulation,
+                    unsigned degree, bool with_matrix, CellScratch& s) {
+  if (!evaluate_cell(material, viscous, formulation, degree, s.fev, s.grad_u, s.st)) return false;
   const bool three_field = formulation == VolumetricFormulation::three_field;
   if (three_field) s.B = 0.0;
   for (unsigned q = 0; q < s.nq; ++q) {
@@ -295,7 +306,8 @@ FiniteStrainSolver::AssemblyResult FiniteStrainSolver::assemble(
     const LayerMaterial& material = materials_[cell->material_id()];
     if (removed_[cell->active_cell_index()]) {
       add_void_cell(material, settings_.void_stiffness_fraction, with_matrix, s);
-    } else if (!add_solid_cell(material, settings_.formulation, settings_.degree, with_matrix, s)) {
+    } else if (!add_solid_cell(material, {viscoelastic_of(cell), viscous_history_of(cell), time_step_s_},
+                               settings_.formulation, settings_.degree, with_matrix, s)) {
       valid = false;
       continue;
     }
@@ -360,8 +372,9 @@ CellFields FiniteStrainSolver::cell_fields() const {
     out.removed[c] = removed_[c] ? 1.0 : 0.0;
     double J_sum = 0.0, vm_sum = 0.0, stretch = 0.0;
     const bool have_state =
-        !removed_[c] && evaluate_cell(materials_[cell->material_id()], settings_.formulation,
-                                      settings_.degree, fev, grad_u, st);
+        !removed_[c] && evaluate_cell(materials_[cell->material_id()],
+                                      {viscoelastic_of(cell), viscous_history_of(cell), time_step_s_},
+                                      settings_.formulation, settings_.degree, fev, grad_u, st);
     for (unsigned q = 0; q < grad_u.size(); ++q) {
       const Tensor<2, 3> F = unit_symmetric_tensor<3>() + grad_u[q];
       const double J = determinant(F);

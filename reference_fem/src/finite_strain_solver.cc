@@ -82,6 +82,7 @@ void FiniteStrainSolver::setup() {
   anchor_scale_ = 1.0;
   amg_.reset();
   removed_.assign(triangulation_.n_active_cells(), 0);
+  allocate_viscous_history();
   owned_support_.clear();
   for (const auto& p : locally_relevant_dof_points())
     if (locally_owned_.is_element(p.dof)) owned_support_[p.dof] = {p.component, p.X};
@@ -138,9 +139,77 @@ void FiniteStrainSolver::remove_cells(const std::function<bool(const CellIterato
   }
 }
 
+void FiniteStrainSolver::set_viscoelastic_layers(const std::vector<std::vector<PronyTerm>>& prony_per_material) {
+  if (dof_handler_.has_active_dofs())
+    throw std::logic_error("FiniteStrainSolver: set_viscoelastic_layers must come before setup()");
+  if (prony_per_material.size() != materials_.size())
+    throw std::invalid_argument("FiniteStrainSolver: one Prony series (possibly empty) per material, got " +
+                                std::to_string(prony_per_material.size()) + " for " +
+                                std::to_string(materials_.size()) + " materials");
+  std::vector<std::optional<ViscoelasticMaterial<LayerMaterial>>> laws(materials_.size());
+  bool any = false;
+  for (std::size_t l = 0; l < materials_.size(); ++l)
+    if (!prony_per_material[l].empty()) {
+      laws[l] = make_viscoelastic_layer(materials_[l], prony_per_material[l]);
+      any = true;
+    }
+  if (any) viscoelastic_ = std::move(laws);
+  else viscoelastic_.clear();
+}
+
+const ViscoelasticMaterial<LayerMaterial>* FiniteStrainSolver::viscoelastic_of(const CellIterator& cell) const {
+  if (viscoelastic_.empty() || removed_[cell->active_cell_index()]) return nullptr;
+  const auto& law = viscoelastic_[cell->material_id()];
+  return law ? &*law : nullptr;
+}
+
+const std::vector<ViscoelasticHistory>* FiniteStrainSolver::viscous_history_of(const CellIterator& cell) const {
+  return viscoelastic_of(cell) ? &viscous_history_[cell->active_cell_index()] : nullptr;
+}
+
+void FiniteStrainSolver::allocate_viscous_history() {
+  viscous_history_.clear();
+  time_step_s_ = 0.0;
+  if (viscoelastic_.empty()) return;
+  const unsigned nq = QGauss<3>(settings_.degree + 1).size();
+  viscous_history_.resize(triangulation_.n_active_cells());
+  for (const auto& cell : dof_handler_.active_cell_iterators())
+    if (cell->is_locally_owned())
+      if (const auto* law = viscoelastic_of(cell))
+        viscous_history_[cell->active_cell_index()].assign(nq, law->initial_history());
+}
+
+void FiniteStrainSolver::set_time_step(double dt_s) {
+  if (!std::isfinite(dt_s) || !(dt_s >= 0.0))
+    throw std::invalid_argument("FiniteStrainSolver: time step must be finite and >= 0 s");
+  time_step_s_ = dt_s;
+}
+
+void FiniteStrainSolver::commit_time_step() {
+  if (!viscoelastic_.empty()) {
+    const QGauss<3> quadrature(settings_.degree + 1);
+    FEValues<3> fev(fe_, quadrature, update_gradients);
+    const FEValuesExtractors::Vector displacement(0);
+    std::vector<Tensor<2, 3>> grad_u(quadrature.size());
+    for (const auto& cell : dof_handler_.active_cell_iterators()) {
+      if (!cell->is_locally_owned()) continue;
+      const auto* law = viscoelastic_of(cell);
+      if (law == nullptr) continue;
+      fev.reinit(cell);
+      fev[displacement].get_function_gradients(solution_ghosted_, grad_u);
+      auto& history = viscous_history_[cell->active_cell_index()];
+      for (unsigned q = 0; q < grad_u.size(); ++q)
+        law->commit(right_cauchy_green(unit_symmetric_tensor<3>() + grad_u[q]), time_step_s_, history[q]);
+    }
+  }
+  time_step_s_ = 0.0;
+}
+
 void FiniteStrainSolver::restore(const Snapshot& snapshot) {
   solution_ = snapshot.solution;
   last_increment_ = snapshot.last_increment;
+  viscous_history_ = snapshot.viscous_history;
+  time_step_s_ = snapshot.time_step_s;
   solution_ghosted_ = solution_;
   assemble(solution_ghosted_, false, nullptr);
 }

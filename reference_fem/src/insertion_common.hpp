@@ -2,8 +2,8 @@
 // (axisymmetric_insertion.cc, slab_insertion_run.cc): the state of a layer (the
 // core's LayerState), the number format of the CSV files, the rows of the surface and recovery
 // profiles, the force-depth CSV's layer-state columns, the checks of the
-// scene both drivers make, the text outputs and the puncture events of the
-// summary. Internal to reference_fem/src (not part of the public headers).
+// scene both drivers make, a layer's long-term law and Prony series, the text
+// outputs and the puncture events of the summary. Internal to reference_fem/src (not part of the public headers).
 //
 // Units: depths, radii and displacements in m in, mm in the CSV files;
 // forces in N; times in s.
@@ -20,7 +20,9 @@
 #include <utility>
 #include <vector>
 
+#include <puncture/fem/hyperelastic_materials.hpp>
 #include <puncture/fem/needle_insertion.hpp>
+#include <puncture/fem/viscoelastic_material.hpp>
 #include <puncture/io/atomic_file.hpp>
 #include <puncture/puncture_force.hpp>
 #include <puncture/scene.hpp>
@@ -30,6 +32,24 @@ namespace puncture::fem::insertion {
 /// What the needle has done to a layer so far: the real-time model's
 /// LayerState (puncture_force.hpp), written with its to_string.
 using puncture::LayerState;
+
+/// The layer's long-term law: its material, scaled by the relaxed fraction
+/// g_inf when the scene's modulus is the instantaneous one (nu kept, so the
+/// bulk modulus scales with it).
+inline LayerMaterial long_term_material(const ContinuumMaterial& m) {
+  const Viscoelasticity& v = m.viscoelastic;
+  if (!v.enabled() || v.modulus_basis == Viscoelasticity::ModulusBasis::LongTerm) return LayerMaterial(m);
+  ContinuumMaterial relaxed = m;
+  relaxed.youngs_modulus_Pa *= v.relaxed_fraction();
+  return LayerMaterial(relaxed);
+}
+
+/// The layer's Prony series in the solvers' form (beta_i relative to the long-term law).
+inline std::vector<PronyTerm> prony_terms(const Viscoelasticity& v) {
+  std::vector<NormalisedPronyTerm> normalised;
+  for (const PronyRelaxationTerm& t : v.terms) normalised.push_back({t.g, t.tau_s});
+  return prony_terms_from_normalised(normalised);
+}
 
 /// `v` with `precision` significant digits (the number format of every CSV).
 inline std::string format_double(double v, int precision = 9) {

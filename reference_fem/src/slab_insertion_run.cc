@@ -74,9 +74,6 @@ SlabDiscretisation checked_discretisation(const Scene& scene, const FemRunOption
     if (l.puncture.kind == PunctureCriterion::Kind::FractureEnergy)
       throw std::invalid_argument("fem: the 3d reference has no fracture_energy criterion (layer '" + l.name +
                                   "'); use geometry axisymmetric");
-    else if (l.material.viscoelastic.enabled())
-      throw std::invalid_argument("fem: the 3d reference has no viscoelastic layers (layer '" + l.name +
-                                  "', material.viscoelastic); use geometry axisymmetric");
   insertion::check_insertion(scene);
   if (!(scene.fem.load_step_m > 0.0)) throw std::invalid_argument("fem: load_step_m must be > 0");
   if (options.spring_back_stages < 1) throw std::invalid_argument("fem: spring_back_stages must be >= 1");
@@ -112,9 +109,11 @@ std::unique_ptr<Tria> slab_triangulation(const Scene& scene, const FemRunOptions
   return tria;
 }
 
+/// Per layer its (long-term) law: a viscoelastic layer's modulus relaxed by g_inf when the
+/// scene gives the instantaneous one (insertion_common.hpp); its Prony series goes to the solver.
 std::vector<LayerMaterial> layer_materials(const Scene& scene) {
   std::vector<LayerMaterial> materials;
-  for (const auto& layer : scene.layers) materials.emplace_back(layer.material);
+  for (const auto& layer : scene.layers) materials.push_back(insertion::long_term_material(layer.material));
   return materials;
 }
 
@@ -179,6 +178,9 @@ SlabInsertionRun::SlabInsertionRun(const Scene& scene, const FemRunOptions& opti
       n_steps_(std::max(1, int(std::ceil((final_depth_ + start_height_) / load_step_ - 1e-9)))),
       vtu_stride_(std::max(1, n_steps_ / std::max(1, options.max_vtu_frames))),
       depth_(-start_height_) {
+  std::vector<std::vector<PronyTerm>> prony;
+  for (const auto& layer : scene.layers) prony.push_back(insertion::prony_terms(layer.material.viscoelastic));
+  solver_.set_viscoelastic_layers(prony);
   solver_.setup();
   describe_model();
   find_node_sets();
@@ -315,9 +317,10 @@ double SlabInsertionRun::cut_sub_step(const SubStepStart& start, double trial_de
   return increment;
 }
 
-// A converged sub-step: the tip is at `trial_depth`; the layer it touches is
-// pressed. Returns whether the needle touches the tissue.
+// A converged sub-step: the tip is at `trial_depth` (the viscoelastic layers'
+// history committed there); the layer it touches is pressed. Returns whether the needle touches the tissue.
 bool SlabInsertionRun::accept_sub_step(double trial_depth, double advance) {
+  solver_.commit_time_step();
   depth_ = trial_depth;
   ++summary_.load_steps;
   if (trial_depth == crossing_upper_) crossing_upper_ = std::numeric_limits<double>::infinity();
@@ -419,6 +422,7 @@ void SlabInsertionRun::spring_back(const std::string& layer_name) {
                                  " did not converge: " + report.failure);
       continue;
     }
+    solver_.commit_time_step();  // the stage's state (same instant) is the viscoelastic layers' history
     lambda = next;
   }
   solver_.set_anchor_springs({});
@@ -428,9 +432,13 @@ void SlabInsertionRun::spring_back(const std::string& layer_name) {
 // is left. predictor_scale: start the first pass from u + scale x the last increment.
 bool SlabInsertionRun::solve_at(double depth, NewtonReport& report, double predictor_scale) {
   const double path_tip = depth / path_.axis_cosine;  // the tip's coordinate along the path
+  // The time this solve advances the viscoelastic layers: the vertical depth moves at v cos a
+  // (0 for a spring-back stage, at the same depth).
+  solver_.set_time_step((depth - depth_) / (speed_ * path_.axis_cosine));
   for (int pass = 0; pass < 8; ++pass) {
     const bool joined = join_reached_nodes(path_tip);
-    if (!joined && !solution_is_stale_ && !any_contact()) return true;  // nothing to do
+    // Nothing to do, unless viscoelastic layers relax while the tip moves.
+    if (!joined && !solution_is_stale_ && !any_contact() && !solver_.has_viscoelastic_layers()) return true;
     apply_targets(path_tip);
     const Timer solve_timer;
     report = solver_.solve_step(pass == 0 && !joined ? predictor_scale : 0.0);

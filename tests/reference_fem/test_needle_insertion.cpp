@@ -329,3 +329,62 @@ TEST(NeedleInsertion, TheUnrefinedQ1MeshWarnsThatItIsTooStiff) {
   EXPECT_TRUE(run_needle_insertion(s, o, MPI_COMM_WORLD).warnings.empty());
   std::filesystem::remove_all(dir);
 }
+
+namespace {
+
+/// The small slab, no punctures, every layer with one Prony term g = 0.5, tau = 0.05 s
+/// on its long-term law (the scene's E and nu): instantaneously twice as stiff in shear.
+Scene viscoelastic_slab(double speed_m_per_s) {
+  Scene s = small_three_layer_scene();
+  for (Layer& l : s.layers) {
+    l.puncture.critical_force_N = 1e9;
+    l.material.viscoelastic.terms = {{0.5, 0.05}};
+    l.material.viscoelastic.modulus_basis = Viscoelasticity::ModulusBasis::LongTerm;
+  }
+  s.insertion.speed_m_per_s = speed_m_per_s;
+  return s;
+}
+
+/// The same slab elastic, with the shear modulus times `shear_factor` and the bulk
+/// modulus kept: E' = 9 K mu' / (3 K + mu'), nu' = (3 K - 2 mu') / (2 (3 K + mu')).
+Scene elastic_slab(double shear_factor) {
+  Scene s = viscoelastic_slab(0.01);
+  for (Layer& l : s.layers) {
+    const double E = l.material.youngs_modulus_Pa, nu = l.material.poisson_ratio;
+    const double K = E / (3.0 * (1.0 - 2.0 * nu)), mu = shear_factor * E / (2.0 * (1.0 + nu));
+    l.material.youngs_modulus_Pa = 9.0 * K * mu / (3.0 * K + mu);
+    l.material.poisson_ratio = (3.0 * K - 2.0 * mu) / (2.0 * (3.0 * K + mu));
+    l.material.viscoelastic.terms.clear();
+  }
+  return s;
+}
+
+double force_at_stop(const Scene& s) {
+  FemRunOptions o = quiet_options("");
+  o.stop_depth_m = 1.0e-3;
+  const FemRunSummary r = run_needle_insertion(s, o, MPI_COMM_WORLD);
+  EXPECT_NEAR(r.depth_m.back(), 1.0e-3, 1e-12);
+  return r.force_N.back();
+}
+
+}  // namespace
+
+TEST(NeedleInsertion, ViscoelasticLayersGoFromTheInstantaneousToTheLongTermLawWithTheSpeed) {
+  // The 3D reference's Prony layers against two elastic runs that bound them: the
+  // long-term law (the scene's) and the instantaneous one (shear modulus 1 / g_inf = 2
+  // times, bulk kept). An insertion far faster than tau (1 mm in 0.1 ms) meets the
+  // instantaneous law, one far slower (1 mm in 100 s = 2000 tau) the long-term law;
+  // at 10 mm/s (1 mm in 2 tau) the force lies strictly between.
+  const double long_term = force_at_stop(elastic_slab(1.0));
+  const double instantaneous = force_at_stop(elastic_slab(2.0));
+  ASSERT_GT(instantaneous, 1.5 * long_term);
+  const double fast = force_at_stop(viscoelastic_slab(10.0)), slow = force_at_stop(viscoelastic_slab(1e-5));
+  EXPECT_NEAR(fast / instantaneous, 1.0, 3e-3);
+  EXPECT_NEAR(slow / long_term, 1.0, 1e-3);
+  const double mid = force_at_stop(viscoelastic_slab(0.01));
+  RecordProperty("fast_over_instantaneous", ::testing::PrintToString(fast / instantaneous));
+  RecordProperty("slow_over_long_term", ::testing::PrintToString(slow / long_term));
+  RecordProperty("mid_over_long_term", ::testing::PrintToString(mid / long_term));
+  EXPECT_GT(mid, 1.05 * long_term);
+  EXPECT_LT(mid, 0.95 * instantaneous);
+}

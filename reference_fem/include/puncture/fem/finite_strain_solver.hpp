@@ -51,6 +51,19 @@
 //  * anchor springs (set_anchor_springs) tie chosen dofs to their
 //    displacement at that moment, with a stiffness scaled by
 //    set_anchor_spring_scale().
+//
+// Viscoelastic layers (set_viscoelastic_layers): a material with a Prony
+// series becomes the finite-strain viscoelastic law of
+// viscoelastic_material.hpp (Simo 1987 / Holzapfel 2000, Sec. 6.10) on its
+// isochoric part, the material given to the constructor being its long-term
+// law; the volumetric part stays elastic (and is condensed as above). Time
+// enters only through the history: each quadrature point of such a cell keeps
+// (Q_i, S_iso^inf) of the last committed state; solve_step() advances it by
+// set_time_step()'s dt (frozen during the Newton iterations, so the tangent
+// is exact); commit_time_step() makes the current state the committed one and
+// sets dt back to 0 (a state at the same instant: the instantaneous response).
+// Snapshots carry the history, so restoring one goes back in time as well.
+// Without viscoelastic layers nothing of this is allocated or evaluated.
 #pragma once
 
 #include <deal.II/base/point.h>
@@ -72,6 +85,7 @@
 #include <vector>
 
 #include <puncture/fem/hyperelastic_materials.hpp>
+#include <puncture/fem/viscoelastic_material.hpp>
 
 namespace puncture::fem {
 
@@ -146,8 +160,26 @@ class FiniteStrainSolver {
                      const SolverSettings& settings);
   ~FiniteStrainSolver();
 
-  /// Distributes the dofs, builds the sparsity pattern, sets u = 0.
+  /// One Prony series per material (an empty one: elastic), before setup():
+  /// material l becomes viscoelastic with the constructor's law as its
+  /// long-term (fully relaxed) law (see the file comment). Throws
+  /// std::invalid_argument for a wrong count or a bad term.
+  void set_viscoelastic_layers(const std::vector<std::vector<PronyTerm>>& prony_per_material);
+  bool has_viscoelastic_layers() const { return !viscoelastic_.empty(); }
+
+  /// Distributes the dofs, builds the sparsity pattern, sets u = 0 (and the
+  /// viscoelastic history to the undisturbed past).
   void setup();
+
+  /// Time (s) the next solve_step()s advance the viscoelastic history from its
+  /// committed state (finite, >= 0; 0 after setup() and commit_time_step()).
+  /// No effect without viscoelastic layers.
+  void set_time_step(double dt_s);
+  double time_step() const { return time_step_s_; }
+  /// The current (converged) state becomes the committed viscoelastic state at
+  /// the end of the time step; the time step is set back to 0. Call once per
+  /// accepted step.
+  void commit_time_step();
 
   MPI_Comm mpi_communicator() const;
   const dealii::DoFHandler<3>& dof_handler() const { return dof_handler_; }
@@ -186,12 +218,15 @@ class FiniteStrainSolver {
   NewtonReport solve_step(double predictor_scale = 0.0);
 
   /// The state a caller can go back to (e.g. to bisect a load step): the
-  /// displacement and the last step's increment. Removed cells, prescribed
-  /// values and springs are not part of it.
+  /// displacement, the last step's increment, the committed viscoelastic
+  /// history and the time step. Removed cells, prescribed values and springs
+  /// are not part of it.
   struct Snapshot {
     dealii::TrilinosWrappers::MPI::Vector solution, last_increment;
+    std::vector<std::vector<ViscoelasticHistory>> viscous_history;
+    double time_step_s = 0.0;
   };
-  Snapshot snapshot() const { return {solution_, last_increment_}; }
+  Snapshot snapshot() const { return {solution_, last_increment_, viscous_history_, time_step_s_}; }
   /// Restores a snapshot and re-evaluates the residual (collective).
   void restore(const Snapshot& snapshot);
 
@@ -278,6 +313,18 @@ class FiniteStrainSolver {
   std::map<dealii::types::global_dof_index, double> targets_;
   std::map<dealii::types::boundary_id, dealii::Tensor<1, 3>> tractions_;
   std::vector<char> removed_;  ///< per active cell index
+  /// Per material: its viscoelastic law, or none (elastic). Empty: no viscoelastic layers.
+  std::vector<std::optional<ViscoelasticMaterial<LayerMaterial>>> viscoelastic_;
+  /// Per active cell index: the committed history of each quadrature point
+  /// (locally owned cells of viscoelastic materials; others empty).
+  std::vector<std::vector<ViscoelasticHistory>> viscous_history_;
+  double time_step_s_ = 0.0;  ///< s, see set_time_step()
+  /// The undisturbed past at every quadrature point of a viscoelastic cell; dt = 0.
+  void allocate_viscous_history();
+  /// The viscoelastic law of a cell (nullptr: elastic or removed).
+  const ViscoelasticMaterial<LayerMaterial>* viscoelastic_of(const CellIterator& cell) const;
+  /// Its points' committed history (nullptr: elastic or removed).
+  const std::vector<ViscoelasticHistory>* viscous_history_of(const CellIterator& cell) const;
   /// locally owned dof -> (component, support point), for the AMG near null space
   std::map<dealii::types::global_dof_index, std::pair<unsigned int, dealii::Point<3>>> owned_support_;
 
