@@ -388,3 +388,32 @@ TEST(NeedleInsertion, ViscoelasticLayersGoFromTheInstantaneousToTheLongTermLawWi
   EXPECT_GT(mid, 1.05 * long_term);
   EXPECT_LT(mid, 0.95 * instantaneous);
 }
+
+TEST(NeedleInsertion, TheThreeDimensionalAndTheAxisymmetricReferenceAgreeOnABluntPunchAlongTheAxis) {
+  // Two separate programs (hexahedra in 3D, the meridian plane) on one insertion that both
+  // model: a flat punch along the axis of the layered slab (a stiff thin skin on soft fat),
+  // Prony layers at 10 mm/s, no puncture, 1 mm deep. The unrefined 3D Q1 mesh is the stiffer
+  // (results/fem_mesh_convergence.md); one uniform refinement must bring it to the
+  // axisymmetric force (refined once too). Observed: 14.3 % above, then 3.2 %.
+  Scene s = viscoelastic_slab(0.01);
+  s.needle.tip = "blunt";
+  FemRunOptions o = quiet_options("");
+  o.mesh = meshing::SlabMeshOptions{};  // the default cross-section (16 sectors), not the tests' coarse one
+  o.stop_depth_m = 1.0e-3;
+  double force_3d[2] = {0.0, 0.0};
+  for (int refinement : {0, 1}) {
+    o.refinement_override = refinement;
+    const FemRunSummary r = run_needle_insertion(s, o, MPI_COMM_WORLD);
+    ASSERT_NEAR(r.depth_m.back(), 1.0e-3, 1e-12);
+    force_3d[refinement] = r.force_N.back();
+  }
+  s.fem.geometry = "axisymmetric";
+  o.refinement_override = 1;
+  const FemRunSummary axi = run_needle_insertion(s, o, MPI_COMM_WORLD);
+  ASSERT_NEAR(axi.depth_m.back(), 1.0e-3, 1e-12);
+  const double f_axi = axi.force_N.back();
+  RecordProperty("coarse_3d_over_axisymmetric", ::testing::PrintToString(force_3d[0] / f_axi));
+  RecordProperty("refined_3d_over_axisymmetric", ::testing::PrintToString(force_3d[1] / f_axi));
+  EXPECT_LT(std::abs(force_3d[1] - f_axi), std::abs(force_3d[0] - f_axi) / 3.0);
+  EXPECT_NEAR(force_3d[1] / f_axi, 1.0, 0.04);
+}
