@@ -21,8 +21,11 @@ puncture depth and force.
 
 Usage: fem_3d_vs_axisymmetric.py OUT_DIR [--study-bin build/reference_fem/puncture_fem_study]
                                   [--depth-mm 8.2] [--refined-depth-mm 8.2] [--jobs 2]
-Writes OUT_DIR/README.md, OUT_DIR/runs.csv, OUT_DIR/comparison.csv, OUT_DIR/force_depth.png and
-OUT_DIR/runs/<case>/ (each run's fem_force_depth.csv, fem_summary.json, scene.json).
+       fem_3d_vs_axisymmetric.py OUT_DIR --report-only
+Writes OUT_DIR/README.md, OUT_DIR/runs.csv, OUT_DIR/comparison.csv, OUT_DIR/force_depth.png,
+OUT_DIR/study.json (how and when the runs were made) and OUT_DIR/runs/<case>/ (each run's
+fem_force_depth.csv, fem_summary.json, scene.json). --report-only rebuilds the comparison, plot
+and page from OUT_DIR's runs without running anything (the page keeps the runs' provenance).
 """
 import argparse
 import concurrent.futures
@@ -125,8 +128,14 @@ def compare(r3, ra):
     depth3, force3 = skin_puncture(r3["summary"])
     depth_a = crossing(ra["rows"], THRESHOLD_N)
     last = depth3 if depth3 is not None else r3["rows"][-1][0]
-    # Rows before the puncture (the row at the puncture is its peak, before the column goes).
-    pairs = [(d, f, interpolate(ra["rows"], d)) for d, f in r3["rows"] if 0.0 < d <= last + 1e-9]
+    # Rows up to the puncture: the first row at its depth is its peak, before the column goes
+    # (the rows after it, at the same depth, are the spring-back).
+    pairs = []
+    for d, f in r3["rows"]:
+        if d > 0.0:
+            pairs.append((d, f, interpolate(ra["rows"], d)))
+        if d >= last - 1e-9:
+            break
     ratios = [f / fa for d, f, fa in pairs if d >= 1.0 and fa > 0.0] or [f / fa for _, f, fa in pairs if fa > 0.0]
     rmse = math.sqrt(sum((f - fa) ** 2 for _, f, fa in pairs) / len(pairs))
     return {"depth3_mm": depth3, "force3_N": force3, "depth_axi_mm": depth_a,
@@ -193,12 +202,53 @@ def comparisons(results):
     return out
 
 
-def page(args, results, table, started):
+def reading(table):
+    """The table's findings as lines of text, from its numbers."""
+    def row(layers, sectors, refinement_3d, refinement_axi):
+        return next((c for c in table if c["layers"] == layers and c["sectors_3d"] == sectors and
+                     c["refinement_3d"] == refinement_3d and c["refinement_axisymmetric"] == refinement_axi), None)
+    out = []
+    punctured = [c for c in table if c["depth3_mm"] is not None and c["depth_axi_mm"] is not None]
+    if punctured:
+        worst_depth = max(punctured, key=lambda c: abs(c["depth_diff_pct"]))
+        worst_force = max(punctured, key=lambda c: abs(c["ratio_at_puncture"] - 1))
+        worst_rmse = max(table, key=lambda c: c["rmse_pct_of_threshold"])
+        out.append(f"- Against the issue's 5 % (puncture depth, force at the puncture, curve RMSE): the largest "
+                   f"depth difference is {worst_depth['depth_diff_pct']:+.1f} % ({worst_depth['layers']}, "
+                   f"{worst_depth['sectors_3d']} sectors, refinement {worst_depth['refinement_3d']}), the largest force "
+                   f"ratio at the 3D puncture {worst_force['ratio_at_puncture']:.3f}, the largest RMSE "
+                   f"{worst_rmse['rmse_pct_of_threshold']:.2f} % of the threshold.")
+    for layers in ("elastic", "prony"):
+        a, b = row(layers, 16, 0, 1), row(layers, 24, 0, 1)
+        if a and b:
+            out.append(f"- {layers}: 16 -> 24 sectors (against the refined axisymmetric mesh) the force ratio at "
+                       f"1 mm and deeper goes from {a['ratio_min']:.3f}-{a['ratio_max']:.3f} to "
+                       f"{b['ratio_min']:.3f}-{b['ratio_max']:.3f}, at the puncture {a['ratio_at_puncture']:.3f} -> "
+                       f"{b['ratio_at_puncture']:.3f}.")
+    c = row("elastic", 16, 1, 1)
+    if c:
+        where = (f"at its skin puncture ({c['depth3_mm']:.3f} mm against the axisymmetric crossing "
+                 f"{c['depth_axi_mm']:.3f} mm, {c['depth_diff_pct']:+.1f} %) {c['ratio_at_puncture']:.3f}"
+                 if c["depth3_mm"] is not None else f"at its deepest row {c['ratio_at_puncture']:.3f}")
+        out.append(f"- The 3D mesh refined once (16 sectors, 8 times the unknowns) against the refined axisymmetric "
+                   f"mesh: the force ratio from 1 mm is {c['ratio_min']:.3f}-{c['ratio_max']:.3f}, {where}; RMSE "
+                   f"{c['rmse_pct_of_threshold']:.2f} % of the threshold.")
+        u = row("elastic", 16, 0, 1)
+        if u and abs(c["ratio_max"] - 1) < abs(u["ratio_max"] - 1) / 2 and abs(c["ratio_min"] - 1) < 0.03:
+            out.append("- The refinement removes most of the unrefined 3D mesh's excess: it is the 3D Q1 mesh's "
+                       "discretisation (results/fem_mesh_convergence.md), not a difference of the two models.")
+        else:
+            out.append("- The refinement does not remove the unrefined 3D mesh's excess: the two models differ by "
+                       "more than the 3D mesh's discretisation; this is not explained here.")
+    return out
+
+
+def page(args, results, table, study):
     f = lambda v, p=3: "-" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.{p}f}"
     lines = ["# The two FEM references on one blunt insertion along the axis", "",
              f"The default slab (skin 0.8 mm, fat 8.4 mm, muscle 39 mm; 60 mm wide; default materials) with a flat "
              f"tip of the default needle's radius (0.635 mm), inserted along the sample axis at 10 mm/s to "
-             f"{args.depth_mm:g} mm, by the 3D reference (hexahedra, the needle column removed at puncture) and by "
+             f"{study['depth_mm']:g} mm, by the 3D reference (hexahedra, the needle column removed at puncture) and by "
              "the axisymmetric one (meridian plane). Along the axis a flat punch is axisymmetric, so the two separate "
              "programs must agree until the skin gives way. `elastic`: the default layers' laws at their "
              "instantaneous moduli, no relaxation (scripts/blunt_3d_scene.py); `prony`: the default layers' Prony "
@@ -216,10 +266,11 @@ def page(args, results, table, started):
                      f"{f(c['force3_N'], 4)} | {f(c['depth_axi_mm'])} | {c['depth_diff_pct']:+.1f} % | "
                      f"{c['ratio_min']:.3f}-{c['ratio_max']:.3f} | {c['ratio_at_puncture']:.3f} | "
                      f"{c['rmse_pct_of_threshold']:.2f} % |")
-    if args.refined_depth_mm < args.depth_mm:
-        lines += ["", f"The refined 3D run (16 sectors, refinement 1) goes to {args.refined_depth_mm:g} mm only (its cost): "
+    if study["refined_depth_mm"] < study["depth_mm"]:
+        lines += ["", f"The refined 3D run (16 sectors, refinement 1) goes to {study['refined_depth_mm']:g} mm only (its cost): "
                   "its rows compare up to there."]
-    lines += ["", "## Runs", "", "| run | unknowns | wall (s) | load steps | Newton iterations |", "|---|---|---|---|---|"]
+    lines += ["", "## What the table says", ""] + reading(table) + [
+        "", "## Runs", "", "| run | unknowns | wall (s) | load steps | Newton iterations |", "|---|---|---|---|---|"]
     for key, r in results.items():
         s = r["summary"]
         lines.append(f"| {name_of(key)} | {s.get('n_dofs', '-')} | {r['wall']:.0f} | {s.get('load_steps', '-')} | "
@@ -228,11 +279,28 @@ def page(args, results, table, started):
               "Data: `runs.csv` (one row per run), `comparison.csv` (the table); each run's force-depth CSV, summary "
               "and scene in `runs/`.", "",
               "## Provenance", "",
-              f"- Command: `python3 scripts/fem_3d_vs_axisymmetric.py {args.out} --study-bin {args.study_bin} "
-              f"--depth-mm {args.depth_mm:g} --refined-depth-mm {args.refined_depth_mm:g} --jobs {args.jobs}` (wall times with {args.jobs} run(s) side by side)",
-              f"- Machine: {provenance.machine()}", f"- Date: {started} to {provenance.utc_now()} UTC",
-              f"- Git revision: {provenance.git_revision()}", ""]
-    return "\n".join(lines)
+              f"- Command: `{study['command']}` (wall times with {study['jobs']} run(s) side by side)",
+              f"- Machine: {study['machine']}", f"- Date: {study['started_utc']} to {study['finished_utc']} UTC",
+              f"- Git revision: {study['git_revision']}"]
+    if args.report_only:
+        lines.append(f"- Page rebuilt from these runs by `python3 scripts/fem_3d_vs_axisymmetric.py {args.out} "
+                     f"--report-only` on {provenance.utc_now()} UTC, git {provenance.git_revision()}")
+    return "\n".join(lines + [""])
+
+
+def load_runs(out):
+    """The results of the runs kept in OUT (runs.csv and runs/<case>/), for --report-only."""
+    with open(os.path.join(out, "runs.csv")) as f:
+        walls = {r["run"]: float(r["wall_s"]) for r in csv.DictReader(f)}
+    results = {}
+    for key in RUNS:
+        d = os.path.join(out, "runs", name_of(key))
+        with open(os.path.join(d, "fem_summary.json")) as f:
+            summary = json.load(f)
+        rows = [(float(r["depth_mm"]), float(r["force_N"])) for r in read_rows(os.path.join(d, "fem_force_depth.csv"))
+                if r.get("phase", "insertion") in ("approach", "insertion")]
+        results[key] = {"wall": walls[name_of(key)], "summary": summary, "rows": rows}
+    return results
 
 
 def main():
@@ -242,7 +310,13 @@ def main():
     ap.add_argument("--depth-mm", type=float, default=8.2)
     ap.add_argument("--refined-depth-mm", type=float, default=8.2, help="depth of the refined 3D run")
     ap.add_argument("--jobs", type=int, default=2, help="runs side by side")
+    ap.add_argument("--report-only", action="store_true", help="rebuild the page from OUT's runs")
     args = ap.parse_args()
+    if args.report_only:
+        with open(os.path.join(args.out, "study.json")) as f:
+            study = json.load(f)
+        report(args, load_runs(args.out), study)
+        return 0
     if not os.path.exists(args.study_bin):
         sys.exit(f"fem_3d_vs_axisymmetric: {args.study_bin}: no such program (build target puncture_fem_study)")
     started = provenance.utc_now()
@@ -268,15 +342,27 @@ def main():
                 "wall_s": round(r["wall"], 1), "load_steps": r["summary"].get("load_steps"),
                 "newton_iterations": r["summary"].get("newton_iterations")} for k, r in results.items()],
               ["run", "layers", "geometry", "sectors", "refinement", "unknowns", "wall_s", "load_steps", "newton_iterations"])
+    study = {"command": f"python3 scripts/fem_3d_vs_axisymmetric.py {args.out} --study-bin {args.study_bin} "
+                        f"--depth-mm {args.depth_mm:g} --refined-depth-mm {args.refined_depth_mm:g} --jobs {args.jobs}",
+             "jobs": args.jobs, "depth_mm": args.depth_mm, "refined_depth_mm": args.refined_depth_mm, "machine": provenance.machine(), "started_utc": started,
+             "finished_utc": provenance.utc_now(), "git_revision": provenance.git_revision()}
+    with open(os.path.join(args.out, "study.json.part"), "w") as f:
+        json.dump(study, f, indent=1)
+    os.replace(os.path.join(args.out, "study.json.part"), os.path.join(args.out, "study.json"))
+    report(args, results, study)
+    return 0
+
+
+def report(args, results, study):
+    """comparison.csv, the plot and the page from the runs' RESULTS."""
     table = comparisons(results)
     write_csv(os.path.join(args.out, "comparison.csv"), table, list(table[0].keys()))
     plot(results, os.path.join(args.out, "force_depth.png"))
-    text = page(args, results, table, started)
+    text = page(args, results, table, study)
     with open(os.path.join(args.out, "README.md.part"), "w") as f:
         f.write(text)
     os.replace(os.path.join(args.out, "README.md.part"), os.path.join(args.out, "README.md"))
     print(f"wrote {args.out}/README.md")
-    return 0
 
 
 if __name__ == "__main__":
