@@ -163,7 +163,12 @@ def plot(results, out_png):
         if geometry == "3d":
             ra = results[(layers, "axisymmetric", 0, 1)]
             dp = skin_puncture(r["summary"])[0] or r["rows"][-1][0]
-            q = [(d, f / interpolate(ra["rows"], d)) for d, f in r["rows"] if 0.4 <= d <= dp + 1e-9]
+            q = []
+            for d, f in r["rows"]:  # up to the puncture's peak row (the spring-back rows follow at its depth)
+                if d >= 0.4:
+                    q.append((d, f / interpolate(ra["rows"], d)))
+                if d >= dp - 1e-9:
+                    break
             bx.plot([p[0] for p in q], [p[1] for p in q], linestyle=styles[key[1:]], color=colour,
                     label=f"{layers}, 3D {sectors} sectors refinement {refinement} / axisymmetric refinement 1")
     ax.axhline(THRESHOLD_N, color="grey", lw=0.8)
@@ -194,7 +199,7 @@ def write_csv(path, rows, fields):
 
 def comparisons(results):
     out = []
-    for key3 in (k for k in RUNS if k[1] == "3d"):
+    for key3 in (k for k in RUNS if k[1] == "3d" and k in results):
         for refinement in (0, 1):
             c = compare(results[key3], results[(key3[0], "axisymmetric", 0, refinement)])
             out.append(dict(layers=key3[0], sectors_3d=key3[2], refinement_3d=key3[3],
@@ -275,6 +280,9 @@ def page(args, results, table, study):
         s = r["summary"]
         lines.append(f"| {name_of(key)} | {s.get('n_dofs', '-')} | {r['wall']:.0f} | {s.get('load_steps', '-')} | "
                      f"{s.get('newton_iterations', '-')} |")
+    for key in RUNS:
+        if key not in results:
+            lines.append(f"| {name_of(key)} | - | {study.get('unfinished', {}).get(name_of(key), 'did not finish')} | - | - |")
     lines += ["", "![force against depth, and the ratio of the two references](force_depth.png)", "",
               "Data: `runs.csv` (one row per run), `comparison.csv` (the table); each run's force-depth CSV, summary "
               "and scene in `runs/`.", "",
@@ -295,6 +303,8 @@ def load_runs(out):
     results = {}
     for key in RUNS:
         d = os.path.join(out, "runs", name_of(key))
+        if name_of(key) not in walls:  # a run that did not finish (the page says so)
+            continue
         with open(os.path.join(d, "fem_summary.json")) as f:
             summary = json.load(f)
         rows = [(float(r["depth_mm"]), float(r["force_N"])) for r in read_rows(os.path.join(d, "fem_force_depth.csv"))
