@@ -33,14 +33,13 @@ import csv
 import json
 import math
 import os
-import shutil
-import subprocess
 import sys
 import tempfile
-import time
 
 import blunt_3d_scene
 import provenance
+import results_io
+from fem_study_run import run_fem_study
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 THRESHOLD_N = 2.0  # the skin's puncture force in blunt_3d_scene.py
@@ -78,28 +77,18 @@ def scene_for(key, depth_mm, work):
     return path
 
 
-def read_rows(path):
-    with open(path) as f:
-        return list(csv.DictReader(line for line in f if not line.startswith("#")))
-
 
 def run(binary, key, scene_path, out, keep):
-    """The FEM study driver's run; its CSV, summary and scene copied to KEEP."""
-    env = dict(os.environ)
-    if key[1] == "3d":
-        env["PUNCTURE_FEM_SECTORS"] = str(key[2])
-    refinement = str(key[3])
-    t0 = time.monotonic()
-    subprocess.run([binary, "run", scene_path, out, refinement], env=env, check=True, stdout=subprocess.DEVNULL)
-    wall = time.monotonic() - t0
-    os.makedirs(keep, exist_ok=True)
-    for name, source in (("fem_force_depth.csv", out), ("fem_summary.json", out), ("scene.json", None)):
-        shutil.copyfile(os.path.join(out, name) if source else scene_path, os.path.join(keep, name))
-    with open(os.path.join(out, "fem_summary.json")) as f:
-        summary = json.load(f)
-    rows = [(float(r["depth_mm"]), float(r["force_N"])) for r in read_rows(os.path.join(out, "fem_force_depth.csv"))
+    """The FEM study driver's run of KEY; returns (wall s, summary, [(depth mm, force N)] of the insertion)."""
+    wall, summary, rows = run_fem_study(binary, scene_path, out, keep, sectors=key[2] if key[1] == "3d" else None,
+                                        refinement=key[3])
+    return wall, summary, insertion_rows(rows)
+
+
+def insertion_rows(rows):
+    """(depth mm, force N) of a force-depth CSV's approach and insertion rows."""
+    return [(float(r["depth_mm"]), float(r["force_N"])) for r in rows
             if r.get("phase", "insertion") in ("approach", "insertion")]
-    return wall, summary, rows
 
 
 def interpolate(rows, depth):
@@ -185,16 +174,8 @@ def plot(results, out_png):
     bx.legend(fontsize=7)
     bx.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(out_png + ".part.png", dpi=120)
-    os.replace(out_png + ".part.png", out_png)
+    results_io.save_figure(fig, out_png)
 
-
-def write_csv(path, rows, fields):
-    with open(path + ".part", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields)
-        w.writeheader()
-        w.writerows(rows)
-    os.replace(path + ".part", path)
 
 
 def comparisons(results):
@@ -307,8 +288,7 @@ def load_runs(out):
             continue
         with open(os.path.join(d, "fem_summary.json")) as f:
             summary = json.load(f)
-        rows = [(float(r["depth_mm"]), float(r["force_N"])) for r in read_rows(os.path.join(d, "fem_force_depth.csv"))
-                if r.get("phase", "insertion") in ("approach", "insertion")]
+        rows = insertion_rows(results_io.read_csv_rows(os.path.join(d, "fem_force_depth.csv")))
         results[key] = {"wall": walls[name_of(key)], "summary": summary, "rows": rows}
     return results
 
@@ -347,7 +327,7 @@ def main():
                 results[key] = {"wall": wall, "summary": summary, "rows": rows}
                 print(f"[{done + 1}/{len(RUNS)}] {name_of(key)}: {wall:.0f} s", flush=True)
     results = {k: results[k] for k in RUNS}
-    write_csv(os.path.join(args.out, "runs.csv"),
+    results_io.write_csv_rows(os.path.join(args.out, "runs.csv"),
               [{"run": name_of(k), "layers": k[0], "geometry": k[1], "sectors": k[2], "refinement": k[3], "unknowns": r["summary"].get("n_dofs"),
                 "wall_s": round(r["wall"], 1), "load_steps": r["summary"].get("load_steps"),
                 "newton_iterations": r["summary"].get("newton_iterations")} for k, r in results.items()],
@@ -356,9 +336,7 @@ def main():
                         f"--depth-mm {args.depth_mm:g} --refined-depth-mm {args.refined_depth_mm:g} --jobs {args.jobs}",
              "jobs": args.jobs, "depth_mm": args.depth_mm, "refined_depth_mm": args.refined_depth_mm, "machine": provenance.machine(), "started_utc": started,
              "finished_utc": provenance.utc_now(), "git_revision": provenance.git_revision()}
-    with open(os.path.join(args.out, "study.json.part"), "w") as f:
-        json.dump(study, f, indent=1)
-    os.replace(os.path.join(args.out, "study.json.part"), os.path.join(args.out, "study.json"))
+    results_io.write_text(os.path.join(args.out, "study.json"), json.dumps(study, indent=1) + "\n")
     report(args, results, study)
     return 0
 
@@ -366,12 +344,10 @@ def main():
 def report(args, results, study):
     """comparison.csv, the plot and the page from the runs' RESULTS."""
     table = comparisons(results)
-    write_csv(os.path.join(args.out, "comparison.csv"), table, list(table[0].keys()))
+    results_io.write_csv_rows(os.path.join(args.out, "comparison.csv"), table, list(table[0].keys()))
     plot(results, os.path.join(args.out, "force_depth.png"))
     text = page(args, results, table, study)
-    with open(os.path.join(args.out, "README.md.part"), "w") as f:
-        f.write(text)
-    os.replace(os.path.join(args.out, "README.md.part"), os.path.join(args.out, "README.md"))
+    results_io.write_text(os.path.join(args.out, "README.md"), text)
     print(f"wrote {args.out}/README.md")
 
 

@@ -24,18 +24,16 @@ OUT_DIR/runs/<angle>deg_<sectors>sectors/ (each run's fem_force_depth.csv, fem_s
 """
 import argparse
 import concurrent.futures
-import csv
 import json
 import math
 import os
-import shutil
-import subprocess
 import sys
 import tempfile
-import time
 
 import blunt_3d_scene
 import provenance
+import results_io
+from fem_study_run import run_fem_study
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # (angle deg, sectors): the angles at 16 sectors, and 30 deg on the finer cross-section.
@@ -58,24 +56,6 @@ def scene_at(angle, width_mm, depth_mm, work):
         json.dump(s, f, indent=1)
     return path, s
 
-
-def read_rows(path):
-    with open(path) as f:
-        return list(csv.DictReader(line for line in f if not line.startswith("#")))
-
-
-def run(binary, scene_path, out, sectors, keep):
-    """The FEM study driver's run of SCENE_PATH in OUT with SECTORS; its CSV, summary and scene copied to KEEP."""
-    env = dict(os.environ, PUNCTURE_FEM_SECTORS=str(sectors))
-    t0 = time.monotonic()
-    subprocess.run([binary, "run", scene_path, out], env=env, check=True, stdout=subprocess.DEVNULL)
-    wall = time.monotonic() - t0
-    os.makedirs(keep, exist_ok=True)
-    for name, source in (("fem_force_depth.csv", out), ("fem_summary.json", out), ("scene.json", None)):
-        shutil.copyfile(os.path.join(out, name) if source else scene_path, os.path.join(keep, name))
-    with open(os.path.join(out, "fem_summary.json")) as f:
-        summary = json.load(f)
-    return wall, summary, read_rows(os.path.join(out, "fem_force_depth.csv"))
 
 
 def path_depth(row):
@@ -125,16 +105,8 @@ def plot(results, out_png):
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out_png + ".part.png", dpi=120)
-    os.replace(out_png + ".part.png", out_png)
+    results_io.save_figure(fig, out_png)
 
-
-def write_csv(path, rows, fields):
-    with open(path + ".part", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields)
-        w.writeheader()
-        w.writerows(rows)
-    os.replace(path + ".part", path)
 
 
 def page(args, results, started):
@@ -209,8 +181,8 @@ def main():
         def one(key):
             angle, sectors = key
             scene_path, _ = scene_at(angle, args.width_mm, args.depth_mm, os.path.join(work, f"{angle}_{sectors}_scene"))
-            return key, run(args.study_bin, scene_path, os.path.join(work, f"{angle}_{sectors}"), sectors,
-                            os.path.join(args.out, "runs", f"{angle}deg_{sectors}sectors"))
+            return key, run_fem_study(args.study_bin, scene_path, os.path.join(work, f"{angle}_{sectors}"),
+                                      os.path.join(args.out, "runs", f"{angle}deg_{sectors}sectors"), sectors=sectors)
 
         # The runs are serial programs (one rank): JOBS of them side by side.
         with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
@@ -222,21 +194,19 @@ def main():
                 print(f"[{done + 1}/{len(RUNS)}] {angle} deg, {sectors} sectors: {wall:.0f} s, {summary['n_dofs']} "
                       f"unknowns, {len(results[(angle, sectors)]['punctures'])} punctures", flush=True)
     results = {k: results[k] for k in RUNS}
-    write_csv(os.path.join(args.out, "runs.csv"),
+    results_io.write_csv_rows(os.path.join(args.out, "runs.csv"),
               [{"angle_deg": k[0], "sectors": k[1], "unknowns": r["summary"]["n_dofs"], "wall_s": round(r["wall"], 1),
                 "load_steps": r["summary"]["load_steps"], "newton_iterations": r["summary"]["newton_iterations"],
                 "first_force_path_depth_mm": r["first"][1], "closed_form_mm": -0.635 * math.tan(math.radians(k[0]))}
                for k, r in results.items()],
               ["angle_deg", "sectors", "unknowns", "wall_s", "load_steps", "newton_iterations",
                "first_force_path_depth_mm", "closed_form_mm"])
-    write_csv(os.path.join(args.out, "punctures.csv"),
+    results_io.write_csv_rows(os.path.join(args.out, "punctures.csv"),
               [dict(angle_deg=k[0], sectors=k[1], **p) for k, r in results.items() for p in r["punctures"]],
               ["angle_deg", "sectors", "layer", "depth_mm", "path_depth_mm", "force_N", "lateral_force_N"])
     plot(results, os.path.join(args.out, "force_path.png"))
     text = page(args, results, started)
-    with open(os.path.join(args.out, "README.md.part"), "w") as f:
-        f.write(text)
-    os.replace(os.path.join(args.out, "README.md.part"), os.path.join(args.out, "README.md"))
+    results_io.write_text(os.path.join(args.out, "README.md"), text)
     print(f"wrote {args.out}/README.md")
     return 0
 

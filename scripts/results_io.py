@@ -2,6 +2,7 @@
 never finds a half-written one (write to a temporary name, then rename).
 
 write_text(path, text): the text file at path.
+write_csv_rows(path, rows, fields): the dicts ROWS as a CSV with the columns FIELDS.
 save_figure(fig, path, dpi=120): a matplotlib figure as the PNG at path.
 And how it reads the project's CSV outputs:
 read_csv_rows(path): the rows (dicts by column name) of a CSV whose
@@ -21,6 +22,15 @@ def write_text(path, text):
     tmp = path + ".part"
     with open(tmp, "w") as f:
         f.write(text)
+    os.replace(tmp, path)
+
+
+def write_csv_rows(path, rows, fields):
+    tmp = path + ".part"
+    with open(tmp, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        w.writerows(rows)
     os.replace(tmp, path)
 
 
