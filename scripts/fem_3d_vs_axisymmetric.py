@@ -29,7 +29,6 @@ and page from OUT_DIR's runs without running anything (the page keeps the runs' 
 """
 import argparse
 import concurrent.futures
-import csv
 import json
 import math
 import os
@@ -91,6 +90,17 @@ def insertion_rows(rows):
             if r.get("phase", "insertion") in ("approach", "insertion")]
 
 
+def rows_to(rows, depth):
+    """The rows [(depth, force)] up to the first at DEPTH (mm): at a 3D puncture's depth that is its
+    peak, before the column goes; the rows after it, at the same depth, are the spring-back."""
+    out = []
+    for row in rows:
+        out.append(row)
+        if row[0] >= depth - 1e-9:
+            break
+    return out
+
+
 def interpolate(rows, depth):
     """Force (N) at DEPTH (mm) on the curve ROWS [(depth, force)], linear between rows."""
     for (d0, f0), (d1, f1) in zip(rows, rows[1:]):
@@ -117,14 +127,7 @@ def compare(r3, ra):
     depth3, force3 = skin_puncture(r3["summary"])
     depth_a = crossing(ra["rows"], THRESHOLD_N)
     last = depth3 if depth3 is not None else r3["rows"][-1][0]
-    # Rows up to the puncture: the first row at its depth is its peak, before the column goes
-    # (the rows after it, at the same depth, are the spring-back).
-    pairs = []
-    for d, f in r3["rows"]:
-        if d > 0.0:
-            pairs.append((d, f, interpolate(ra["rows"], d)))
-        if d >= last - 1e-9:
-            break
+    pairs = [(d, f, interpolate(ra["rows"], d)) for d, f in rows_to(r3["rows"], last) if d > 0.0]
     ratios = [f / fa for d, f, fa in pairs if d >= 1.0 and fa > 0.0] or [f / fa for _, f, fa in pairs if fa > 0.0]
     rmse = math.sqrt(sum((f - fa) ** 2 for _, f, fa in pairs) / len(pairs))
     return {"depth3_mm": depth3, "force3_N": force3, "depth_axi_mm": depth_a,
@@ -152,12 +155,7 @@ def plot(results, out_png):
         if geometry == "3d":
             ra = results[(layers, "axisymmetric", 0, 1)]
             dp = skin_puncture(r["summary"])[0] or r["rows"][-1][0]
-            q = []
-            for d, f in r["rows"]:  # up to the puncture's peak row (the spring-back rows follow at its depth)
-                if d >= 0.4:
-                    q.append((d, f / interpolate(ra["rows"], d)))
-                if d >= dp - 1e-9:
-                    break
+            q = [(d, f / interpolate(ra["rows"], d)) for d, f in rows_to(r["rows"], dp) if d >= 0.4]
             bx.plot([p[0] for p in q], [p[1] for p in q], linestyle=styles[key[1:]], color=colour,
                     label=f"{layers}, 3D {sectors} sectors refinement {refinement} / axisymmetric refinement 1")
     ax.axhline(THRESHOLD_N, color="grey", lw=0.8)
@@ -279,8 +277,7 @@ def page(args, results, table, study):
 
 def load_runs(out):
     """The results of the runs kept in OUT (runs.csv and runs/<case>/), for --report-only."""
-    with open(os.path.join(out, "runs.csv")) as f:
-        walls = {r["run"]: float(r["wall_s"]) for r in csv.DictReader(f)}
+    walls = {r["run"]: float(r["wall_s"]) for r in results_io.read_csv_rows(os.path.join(out, "runs.csv"))}
     results = {}
     for key in RUNS:
         d = os.path.join(out, "runs", name_of(key))

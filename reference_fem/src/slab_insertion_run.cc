@@ -110,11 +110,18 @@ std::unique_ptr<Tria> slab_triangulation(const Scene& scene, const FemRunOptions
 }
 
 /// Per layer its (long-term) law: a viscoelastic layer's modulus relaxed by g_inf when the
-/// scene gives the instantaneous one (insertion_common.hpp); its Prony series goes to the solver.
+/// scene gives the instantaneous one (insertion_common.hpp).
 std::vector<LayerMaterial> layer_materials(const Scene& scene) {
   std::vector<LayerMaterial> materials;
   for (const auto& layer : scene.layers) materials.push_back(insertion::long_term_material(layer.material));
   return materials;
+}
+
+/// Per layer its Prony series (empty: elastic), on the law layer_materials gives.
+std::vector<std::vector<PronyTerm>> layer_prony_terms(const Scene& scene) {
+  std::vector<std::vector<PronyTerm>> terms;
+  for (const auto& layer : scene.layers) terms.push_back(insertion::prony_terms(layer.material.viscoelastic));
+  return terms;
 }
 
 /// Solver settings from the options: formulation, Newton, linear solver
@@ -178,9 +185,7 @@ SlabInsertionRun::SlabInsertionRun(const Scene& scene, const FemRunOptions& opti
       n_steps_(std::max(1, int(std::ceil((final_depth_ + start_height_) / load_step_ - 1e-9)))),
       vtu_stride_(std::max(1, n_steps_ / std::max(1, options.max_vtu_frames))),
       depth_(-start_height_) {
-  std::vector<std::vector<PronyTerm>> prony;
-  for (const auto& layer : scene.layers) prony.push_back(insertion::prony_terms(layer.material.viscoelastic));
-  solver_.set_viscoelastic_layers(prony);
+  solver_.set_viscoelastic_layers(layer_prony_terms(scene));
   solver_.setup();
   describe_model();
   find_node_sets();

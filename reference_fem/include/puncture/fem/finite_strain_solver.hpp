@@ -175,7 +175,6 @@ class FiniteStrainSolver {
   /// committed state (finite, >= 0; 0 after setup() and commit_time_step()).
   /// No effect without viscoelastic layers.
   void set_time_step(double dt_s);
-  double time_step() const { return time_step_s_; }
   /// The current (converged) state becomes the committed viscoelastic state at
   /// the end of the time step; the time step is set back to 0. Call once per
   /// accepted step.
